@@ -1,0 +1,35 @@
+# hrg_gyro: the two set-up commands (README) and the benchmark entry point.
+#   make run    install missing Debian packages, build, run the main job, print the summary
+#   make test   install, build, run every unit test and rostest, then catkin_test_results
+#   make bench  install, build, run the benchmarks
+# Everything builds in ws/, a catkin workspace inside the checkout (ignored by git) whose
+# src/hrg_gyro links back to this directory; source ws/devel/setup.bash to use the package.
+SHELL := /bin/bash
+.SHELLFLAGS := -eo pipefail -c
+ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
+WS := $(ROOT)/ws
+# Debian's python3 has catkin_pkg; a pyenv python3 earlier on PATH does not.
+export PATH := /usr/bin:/bin:$(PATH)
+CATKIN_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release
+JOBS ?= $(shell nproc)
+
+.PHONY: deps build test run bench clean
+
+deps:
+	@$(ROOT)/scripts/install_deps.sh
+
+build: deps
+	@mkdir -p $(WS)/src
+	@ln -sfn $(ROOT) $(WS)/src/hrg_gyro
+	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS)
+
+test: build
+	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) tests
+	cd $(WS) && source devel/setup.bash && catkin_make $(CATKIN_ARGS) -j1 run_tests
+	cd $(WS) && catkin_test_results build/test_results
+
+run: build
+	cd $(WS) && source devel/setup.bash && $(ROOT)/scripts/run_main_job.sh
+
+clean:
+	rm -rf $(WS)

@@ -1,0 +1,51 @@
+// The compensation step: from two consecutive wave angles to the body-angle increment.
+//
+//   dalpha = (dtheta - D(theta_mid, f) dt) / K(theta_mid, f)      (MATH.md section 5)
+// theta_mid is the midpoint of the step, f the resonator frequency at the midpoint. dalpha is the
+// inertial increment (what a gyro measures); the increment of the Earth-fixed turntable angle is
+// dalpha - Omega_E sin(latitude) dt. The self-consistent sign has no leading minus: the paper's
+// -(...)/K belongs to its convention where K is quoted as a positive magnitude.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "hrg_gyro/core/gyro_parameters.h"
+#include "hrg_gyro/core/harmonic_basis.h"
+
+namespace hrg_gyro {
+namespace core {
+
+struct AngleIncrement {
+  double dt = 0.0;                  ///< s
+  double dtheta = 0.0;              ///< measured electrical-angle increment, rad
+  double theta_mid = 0.0;           ///< rad, where K and D were evaluated
+  double frequency = 0.0;           ///< Hz used for the models (NaN if unknown)
+  double scale_factor = 0.0;        ///< K used
+  double drift = 0.0;               ///< D used, rad/s
+  double dalpha = 0.0;              ///< inertial body-angle increment, rad
+  double dalpha_earth_fixed = 0.0;  ///< increment relative to the Earth-fixed table, rad
+};
+
+class Compensator {
+ public:
+  explicit Compensator(std::shared_ptr<const GyroParameters> parameters);
+
+  const GyroParameters& parameters() const { return *parameters_; }
+  const std::shared_ptr<const GyroParameters>& sharedParameters() const { return parameters_; }
+
+  AngleIncrement step(double theta_previous, double theta, double dt, double frequency_mid);
+
+ private:
+  void refreshCoefficients(double frequency);
+
+  std::shared_ptr<const GyroParameters> parameters_;
+  HarmonicBasis basis_;
+  std::vector<double> k_coefficients_, d_coefficients_;
+  bool frequency_dependent_ = false;
+  double cached_frequency_ = 0.0;
+  double earth_rate_ = 0.0;
+};
+
+}  // namespace core
+}  // namespace hrg_gyro

@@ -1,0 +1,87 @@
+// The eight capacitive pickoffs around the resonator rim and the channels they form.
+//
+// Sensor i nominally sits at phi_i = i pi/4. Its real defects (MATH.md section 3): an angular
+// misplacement delta_i (it reads the rim at phi_i + delta_i), a gain error g_i, the capacitive
+// nonlinearity h(r) = r / (1 - r/d0) of a gap d0 (amplitude-to-gap ratio A/d0), and additive white
+// noise. The cosine channel is c = (d0 - d2 + d4 - d6)/4, the sine channel s = (d1 - d3 + d5 - d7)/4.
+//
+// Misplacement and gain map the channels exactly linearly (c~ = a11 c + a12 s, s~ = -a21 c + a22 s);
+// linearChannelMap() gives that map on Z so tests can check that the correction matrix P inverts it.
+#pragma once
+
+#include <array>
+#include <limits>
+
+#include <Eigen/Core>
+
+#include "hrg_gyro/core/wave_parameters.h"
+
+namespace hrg_gyro {
+namespace core {
+
+constexpr int kPickoffCount = 8;
+
+struct PickoffDefects {
+  std::array<double, kPickoffCount> misplacement{};  ///< delta_i, rad (sensor i at i pi/4 + delta_i)
+  std::array<double, kPickoffCount> gain_error{};    ///< g_i: sensor output (1 + g_i) h(r)
+  /// Electrode gap d0 in amplitude units (A/d0 = amplitude / gap); infinity means a linear sensor.
+  double gap = std::numeric_limits<double>::infinity();
+  double noise = 0.0;  ///< standard deviation of the additive noise of one sensor sample, amplitude units
+};
+
+/// Half-sums and mean gains that drive the first-order defect formulas of MATH.md section 3.
+struct PickoffSignature {
+  double dc = 0.0;  ///< (delta0 + delta2 + delta4 + delta6) / 2, rad
+  double ds = 0.0;  ///< (delta1 + delta3 + delta5 + delta7) / 2, rad
+  double gc = 0.0;  ///< mean gain error of the cosine sensors (0, 2, 4, 6)
+  double gs = 0.0;  ///< mean gain error of the sine sensors (1, 3, 5, 7)
+};
+
+class PickoffArray {
+ public:
+  explicit PickoffArray(const PickoffDefects& defects);
+
+  const PickoffDefects& defects() const { return defects_; }
+  PickoffSignature signature() const;
+
+  /// Noise-free outputs d_i of the eight sensors for the wave at carrier phase (w t), rad.
+  std::array<double, kPickoffCount> sensorOutputs(const WaveParameters& wave, double carrier_phase) const;
+
+  /// Channels c, s formed from eight sensor outputs.
+  static void formChannels(const std::array<double, kPickoffCount>& d, double* c, double* s);
+
+  /// Hot path of the simulator: noise-free c, s for the pattern components
+  ///   x = A cos(wt + tau) cos(theta) - B sin(wt + tau) sin(theta),
+  ///   y = A cos(wt + tau) sin(theta) + B sin(wt + tau) cos(theta),
+  /// for which sensor i reads r_i = cos(2 psi_i) x + sin(2 psi_i) y (psi_i its true position).
+  void channels(double x, double y, double* c, double* s) const {
+    double cc = 0.0, ss = 0.0;
+    for (int i = 0; i < kPickoffCount; i += 2) {
+      const double r = cos2psi_[i] * x + sin2psi_[i] * y;
+      cc += weight_[i] * r / (1.0 - r * inv_gap_);
+    }
+    for (int i = 1; i < kPickoffCount; i += 2) {
+      const double r = cos2psi_[i] * x + sin2psi_[i] * y;
+      ss += weight_[i] * r / (1.0 - r * inv_gap_);
+    }
+    *c = cc;
+    *s = ss;
+  }
+
+  /// Standard deviation of the noise of one channel sample: four independent sensor noises of sigma,
+  /// each weighted 1/4, sum to a Gaussian of sigma / 2. The simulator draws that sum directly, which
+  /// is identical in distribution to drawing the eight sensor noises and 4x cheaper.
+  double channelNoiseSigma() const { return 0.5 * defects_.noise; }
+
+  /// Exact map of misplacement and gain errors on Z = (Ac, Bc, As, Bs): Z_measured = M Z_true
+  /// (the capacitive nonlinearity, which is not linear, is left out).
+  Eigen::Matrix4d linearChannelMap() const;
+
+ private:
+  PickoffDefects defects_;
+  std::array<double, kPickoffCount> cos2psi_{}, sin2psi_{}, weight_{};
+  double inv_gap_ = 0.0;
+};
+
+}  // namespace core
+}  // namespace hrg_gyro

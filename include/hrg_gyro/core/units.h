@@ -1,0 +1,45 @@
+// Physical constants, angle helpers and the integer-nanosecond time base of the core.
+//
+// Stamps are int64 nanoseconds so that a dt of 100 us taken between two wall-clock stamps near
+// 1.7e9 s keeps full precision (a double holds such a stamp only to ~0.2 us, a 2e-4 relative error
+// in dt and therefore in the output rate).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+namespace hrg_gyro {
+namespace core {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTwoPi = 2.0 * kPi;
+/// Sidereal rotation rate of the Earth, rad/s (WGS-84).
+constexpr double kEarthRotationRate = 7.2921150e-5;
+
+using Nanoseconds = std::int64_t;
+
+constexpr double toSeconds(Nanoseconds ns) { return static_cast<double>(ns) * 1e-9; }
+inline Nanoseconds toNanoseconds(double seconds) { return static_cast<Nanoseconds>(std::llround(seconds * 1e9)); }
+
+/// Vertical component of the Earth rate (rad/s) at a geodetic latitude (rad): what a gyro with its
+/// axis along the local up direction (REP-103 z up) sees at rest.
+inline double verticalEarthRate(double latitude) { return kEarthRotationRate * std::sin(latitude); }
+
+/// x mod period, in [0, period).
+inline double positiveModulo(double x, double period) {
+  double r = std::fmod(x, period);
+  if (r < 0.0) r += period;
+  return r >= period ? 0.0 : r;
+}
+
+/// Angle wrapped to (-pi, pi].
+inline double wrapToPi(double angle) {
+  double r = positiveModulo(angle + kPi, kTwoPi) - kPi;
+  return r == -kPi ? kPi : r;
+}
+
+/// sin(x)/x with the removable singularity handled.
+inline double sinc(double x) { return std::abs(x) < 1e-8 ? 1.0 - x * x / 6.0 : std::sin(x) / x; }
+
+}  // namespace core
+}  // namespace hrg_gyro

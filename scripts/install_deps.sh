@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Installs the Debian packages hrg_gyro needs, only those missing (idempotent; run as root or with
+# sudo available). ROS 1 comes from Debian bookworm itself, not from a ROS apt source.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake
+  ros-core-dev python3-rostest python3-roslaunch python3-rosbag rosbash rosout
+  python3-rostopic python3-rosnode python3-rosparam python3-rosmaster python3-rosservice
+  libeigen3-dev libyaml-cpp-dev libgtest-dev libbenchmark-dev
+  libnodeletlib-dev libnodeletlib-tools libnodelet-dev pluginlib-dev
+  libdiagnostic-updater-dev libstd-srvs-dev libsensor-msgs-dev
+  python3-std-srvs python3-sensor-msgs python3-diagnostic-msgs python3-yaml
+  python3-numpy python3-matplotlib
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install_deps: all ${#PACKAGES[@]} Debian packages present"
+  exit 0
+fi
+
+echo "install_deps: installing ${missing[*]}"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,333 @@
+#include "hrg_gyro/core/parameter_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+enum class ModelKind { kScaleFactor, kDrift };
+
+/// Largest plausible drift coefficient, rad/s: catches unit slips (deg/h entered as rad/s) early.
+constexpr double kMaxDriftCoefficient = 0.1;
+constexpr int kMaxHarmonicOrder = 64;
+
+std::vector<int> parseOrders(const YamlField& f) {
+  std::vector<int> orders;
+  const auto raw = f.asIntegers();
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const long k = raw[i];
+    const YamlField item = f.at(i);
+    if (k < 2 || k > kMaxHarmonicOrder) item.fail("harmonic order must be in [2, 64], got " + std::to_string(k));
+    if (k % 2 != 0) {
+      item.fail("harmonic order " + std::to_string(k) +
+                " is odd: theta is defined modulo pi, so K and D have even harmonics only");
+    }
+    if (!orders.empty() && k <= orders.back()) item.fail("orders must be strictly increasing");
+    orders.push_back(static_cast<int>(k));
+  }
+  return orders;
+}
+
+/// Per-node values of a coefficient: a number (one node) or a list with one value per node.
+std::vector<double> parseNodeValues(const YamlField& f, std::size_t nodes) {
+  if (nodes == 1) return {f.asDouble()};
+  if (!f.isSequence()) f.fail("expected a list of " + std::to_string(nodes) + " values (one per frequency node)");
+  return f.asDoubles(nodes);
+}
+
+HarmonicModel parseModel(const YamlField& f, ModelKind kind) {
+  f.requireMap();
+  f.rejectUnknownKeys({"orders", "mean", "cos", "sin", "frequency_nodes", "interpolation"});
+  const std::vector<int> orders = parseOrders(f["orders"]);
+  FrequencyInterpolator interp;
+  if (f.has("frequency_nodes")) {
+    const YamlField nf = f["frequency_nodes"];
+    const std::vector<double> nodes = nf.asDoubles();
+    if (nodes.size() < 2) nf.fail("give at least 2 frequency nodes, or omit the key for a frequency-independent model");
+    for (std::size_t j = 0; j < nodes.size(); ++j) {
+      if (!(nodes[j] > 0.0)) nf.at(j).fail("frequency must be positive (Hz)");
+      if (j > 0 && !(nodes[j] > nodes[j - 1])) nf.at(j).fail("frequency nodes must be strictly increasing");
+    }
+    Interpolation kind_of_interp = Interpolation::kNaturalCubicSpline;
+    if (f.has("interpolation") && !parseInterpolation(f["interpolation"].asString(), &kind_of_interp)) {
+      f["interpolation"].fail("expected natural_cubic_spline or piecewise_linear");
+    }
+    interp = FrequencyInterpolator(nodes, kind_of_interp);
+  } else if (f.has("interpolation")) {
+    f["interpolation"].fail("only meaningful together with frequency_nodes");
+  }
+  const std::size_t n = orders.size(), nodes = interp.size();
+  Eigen::MatrixXd values(1 + 2 * n, nodes);
+  const std::vector<double> mean = parseNodeValues(f["mean"], nodes);
+  for (std::size_t j = 0; j < nodes; ++j) values(0, j) = mean[j];
+  for (const char* part : {"cos", "sin"}) {
+    const YamlField list = f[part];
+    list.requireSequence();
+    if (list.size() != n) {
+      list.fail("expected " + std::to_string(n) + " entries (one per harmonic order), got " + std::to_string(list.size()));
+    }
+    const std::size_t row0 = std::strcmp(part, "cos") == 0 ? 1 : 1 + n;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::vector<double> v = parseNodeValues(list.at(i), nodes);
+      for (std::size_t j = 0; j < nodes; ++j) values(row0 + i, j) = v[j];
+    }
+  }
+  for (std::size_t j = 0; j < nodes; ++j) {
+    const double m0 = values(0, j);
+    double harmonics = 0.0;
+    for (std::size_t r = 1; r < 1 + 2 * n; ++r) harmonics += std::abs(values(r, j));
+    const std::string at_node = nodes > 1 ? " at frequency node " + std::to_string(j) : "";
+    if (kind == ModelKind::kScaleFactor) {
+      if (m0 == 0.0) f["mean"].fail("K0 must be non-zero" + at_node);
+      if (m0 > 0.0) {
+        f["mean"].fail("K0 must be negative (electrical wave angle lags the body rotation, K0 = -2k); got " +
+                       formatDouble(m0) + at_node);
+      }
+      if (harmonics >= 0.5 * std::abs(m0)) {
+        f.fail("harmonics too large: sum of |cos| + |sin| = " + formatDouble(harmonics) +
+               " must stay below |K0|/2 so that K(theta) keeps its sign" + at_node);
+      }
+    } else {
+      if (std::abs(m0) + harmonics > kMaxDriftCoefficient) {
+        f.fail("drift coefficients add up to " + formatDouble(std::abs(m0) + harmonics) +
+               " rad/s, above the plausible limit of 0.1 rad/s (units are rad/s of electrical angle)" + at_node);
+      }
+    }
+  }
+  if (nodes == 1) {
+    std::vector<double> c(n), s(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      c[i] = values(1 + i, 0);
+      s[i] = values(1 + n + i, 0);
+    }
+    return HarmonicModel(orders, values(0, 0), c, s);
+  }
+  return HarmonicModel(orders, interp, values);
+}
+
+void emitModel(YAML::Emitter& out, const HarmonicModel& m) {
+  const bool fdep = m.frequencyDependent();
+  const std::size_t n = m.orders().size(), nodes = m.interpolator().size();
+  const Eigen::MatrixXd& v = m.nodeValues();
+  auto nodeValues = [&](std::size_t row) {
+    if (!fdep) {
+      out << formatDouble(v(row, 0));
+      return;
+    }
+    out << YAML::Flow << YAML::BeginSeq;
+    for (std::size_t j = 0; j < nodes; ++j) out << formatDouble(v(row, j));
+    out << YAML::EndSeq;
+  };
+  out << YAML::BeginMap;
+  out << YAML::Key << "orders" << YAML::Value << YAML::Flow << m.orders()
+      << YAML::Comment("harmonic orders k (even)");
+  if (fdep) {
+    out << YAML::Key << "frequency_nodes" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (double f : m.interpolator().nodes()) out << formatDouble(f);
+    out << YAML::EndSeq << YAML::Comment("Hz, strictly increasing");
+    out << YAML::Key << "interpolation" << YAML::Value << toString(m.interpolator().kind());
+  }
+  out << YAML::Key << "mean" << YAML::Value;
+  nodeValues(0);
+  for (const char* part : {"cos", "sin"}) {
+    const std::size_t row0 = std::strcmp(part, "cos") == 0 ? 1 : 1 + n;
+    out << YAML::Key << part << YAML::Value;
+    out << (fdep ? YAML::Block : YAML::Flow) << YAML::BeginSeq;
+    for (std::size_t i = 0; i < n; ++i) nodeValues(row0 + i);
+    out << YAML::EndSeq;
+  }
+  out << YAML::EndMap;
+}
+
+[[noreturn]] void throwErrno(const std::string& what, const std::string& path) {
+  throw std::runtime_error(what + " '" + path + "': " + std::strerror(errno));
+}
+
+void fsyncDirectoryOf(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
+  if (fd < 0) throwErrno("cannot open directory", dir);
+  ::fsync(fd);
+  ::close(fd);
+}
+
+void writeAll(int fd, const std::string& text, const std::string& path) {
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throwErrno("cannot write", path);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+/// Replaces <path>.bak with the current file, atomically (a hard link where possible, else a copy).
+void keepBackup(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return;  // nothing to back up yet
+  const std::string bak = path + ".bak", bak_tmp = path + ".bak.tmp";
+  ::unlink(bak_tmp.c_str());
+  if (::link(path.c_str(), bak_tmp.c_str()) != 0) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const int fd = ::open(bak_tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0) throwErrno("cannot create backup", bak_tmp);
+    writeAll(fd, ss.str(), bak_tmp);
+    ::fsync(fd);
+    ::close(fd);
+  }
+  if (::rename(bak_tmp.c_str(), bak.c_str()) != 0) throwErrno("cannot rename backup to", bak);
+}
+
+}  // namespace
+
+GyroParameters parseParameters(const YAML::Node& root) {
+  const YamlField doc(root, "");
+  if (!root.IsMap()) throw ConfigError("", "parameter file must be a YAML map (is it empty or truncated?)");
+  doc.rejectUnknownKeys({"schema_version", "scale_factor", "drift", "correction_matrix", "earth_rate", "calibration"});
+  const long version = doc["schema_version"].asInteger();
+  if (version != kParameterSchemaVersion) {
+    doc["schema_version"].fail("unsupported schema version " + std::to_string(version) + " (this build reads " +
+                               std::to_string(kParameterSchemaVersion) + ")");
+  }
+  GyroParameters p;
+  p.scale_factor = parseModel(doc["scale_factor"], ModelKind::kScaleFactor);
+  p.drift = parseModel(doc["drift"], ModelKind::kDrift);
+
+  const YamlField cm = doc["correction_matrix"];
+  cm.requireMap();
+  cm.rejectUnknownKeys({"p"});
+  const std::vector<double> pv = cm["p"].asDoubles(4);
+  for (int i = 0; i < 4; ++i) {
+    if (std::abs(pv[i]) >= 0.5) cm["p"].at(i).fail("|p" + std::to_string(i + 1) + "| must be below 0.5 (a small correction)");
+    p.correction.p[i] = pv[i];
+  }
+
+  const YamlField er = doc["earth_rate"];
+  er.requireMap();
+  er.rejectUnknownKeys({"enabled", "latitude"});
+  p.earth_rate.enabled = er["enabled"].asBool();
+  p.earth_rate.latitude = er["latitude"].asDouble();
+  if (std::abs(p.earth_rate.latitude) > kPi / 2) er["latitude"].fail("latitude must be in [-pi/2, pi/2] rad");
+
+  if (doc.has("calibration")) {
+    const YamlField cal = doc["calibration"];
+    cal.requireMap();
+    cal.rejectUnknownKeys({"method", "time", "source", "notes"});
+    p.calibration.method = cal.getString("method", "none");
+    p.calibration.time = cal.getString("time", "");
+    p.calibration.source = cal.getString("source", "");
+    p.calibration.notes = cal.getString("notes", "");
+  }
+  return p;
+}
+
+GyroParameters parseParameterText(const std::string& text) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError("", "YAML syntax error at line " + std::to_string(e.mark.line + 1) + ", column " +
+                              std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+  return parseParameters(root);
+}
+
+GyroParameters loadParameterFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError("", "cannot read parameter file '" + path + "': " + std::strerror(errno));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw ConfigError("", "error while reading parameter file '" + path + "'");
+  try {
+    return parseParameterText(ss.str());
+  } catch (const ConfigError& e) {
+    throw ConfigError(e.key(), e.problem() + " (in '" + path + "')");
+  }
+}
+
+std::string emitParameters(const GyroParameters& p) {
+  YAML::Emitter out;
+  out << YAML::Comment(
+             "hrg_gyro parameter file (schema 1). Read by the processor, written by the calibrator.\n"
+             "Units SI. theta: electrical wave angle, rad (antinode at case angle theta/2).\n"
+             "K(theta, f) = d theta / d alpha (alpha: body angle, REP-103 sign); K0 = -2k < 0.\n"
+             "D(theta, f): drift of theta, rad/s. Compensation: dalpha = (dtheta - D dt) / K.\n"
+             "Each model: mean + sum over orders k of cos[k] cos(k theta) + sin[k] sin(k theta).")
+      << YAML::Newline;
+  out << YAML::BeginMap;
+  out << YAML::Key << "schema_version" << YAML::Value << kParameterSchemaVersion;
+  out << YAML::Key << "scale_factor" << YAML::Comment("K(theta[, f]), dimensionless") << YAML::Value;
+  emitModel(out, p.scale_factor);
+  out << YAML::Key << "drift" << YAML::Comment("D(theta[, f]), rad/s of electrical angle") << YAML::Value;
+  emitModel(out, p.drift);
+  out << YAML::Key << "correction_matrix" << YAML::Comment("(E - P) Z on Z = (Ac, Bc, As, Bs)") << YAML::Value
+      << YAML::BeginMap;
+  out << YAML::Key << "p" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (double v : p.correction.p) out << formatDouble(v);
+  out << YAML::EndSeq << YAML::Comment("p1 p2: cos/sin channel gain; p3 p4: misplacement");
+  out << YAML::EndMap;
+  out << YAML::Key << "earth_rate" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "enabled" << YAML::Value << p.earth_rate.enabled
+      << YAML::Comment("true: Earth-fixed increment = dalpha - Omega_E sin(lat) dt");
+  out << YAML::Key << "latitude" << YAML::Value << formatDouble(p.earth_rate.latitude)
+      << YAML::Comment("rad; vertical Earth rate = 7.2921150e-5 sin(latitude) rad/s");
+  out << YAML::EndMap;
+  out << YAML::Key << "calibration" << YAML::Comment("provenance") << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "method" << YAML::Value << p.calibration.method;
+  out << YAML::Key << "time" << YAML::Value << YAML::DoubleQuoted << p.calibration.time;
+  out << YAML::Key << "source" << YAML::Value << YAML::DoubleQuoted << p.calibration.source;
+  out << YAML::Key << "notes" << YAML::Value << YAML::DoubleQuoted << p.calibration.notes;
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+  if (!out.good()) throw std::runtime_error("YAML emitter error: " + out.GetLastError());
+  return std::string(out.c_str()) + "\n";
+}
+
+void saveParameterFile(const std::string& path, const GyroParameters& parameters, const SaveOptions& options) {
+  const std::string text = emitParameters(parameters);
+  try {
+    if (parseParameterText(text) != parameters) throw std::runtime_error("parameters do not survive a round trip");
+  } catch (const ConfigError& e) {
+    throw std::runtime_error(std::string("refusing to write invalid parameters: ") + e.what());
+  }
+  std::string tmp = path + ".tmp.XXXXXX";
+  std::vector<char> name(tmp.begin(), tmp.end());
+  name.push_back('\0');
+  const int fd = ::mkstemp(name.data());
+  if (fd < 0) throwErrno("cannot create temporary file next to", path);
+  tmp.assign(name.data());
+  bool fd_open = true;
+  try {
+    writeAll(fd, text, tmp);
+    if (::fchmod(fd, 0644) != 0 || ::fsync(fd) != 0) throwErrno("cannot sync", tmp);
+    fd_open = false;
+    if (::close(fd) != 0) throwErrno("cannot close", tmp);
+    if (loadParameterFile(tmp) != parameters) throw std::runtime_error("written file reads back differently: " + tmp);
+    if (options.keep_backup) keepBackup(path);
+    if (::rename(tmp.c_str(), path.c_str()) != 0) throwErrno("cannot rename over", path);
+    fsyncDirectoryOf(path);
+  } catch (...) {
+    if (fd_open) ::close(fd);
+    ::unlink(tmp.c_str());
+    throw;
+  }
+}
+
+}  // namespace core
+}  // namespace hrg_gyro

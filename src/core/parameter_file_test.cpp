@@ -1,0 +1,234 @@
+// Parameter file: round trips, key-by-key rejections with the key named, atomic save with backup.
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "hrg_gyro/core/parameter_file.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+
+class TempDir {
+ public:
+  TempDir() {
+    char tmpl[] = "/tmp/hrg_param_test_XXXXXX";
+    path_ = mkdtemp(tmpl);
+  }
+  ~TempDir() { std::system(("rm -rf '" + path_ + "'").c_str()); }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+GyroParameters sampleParameters() {
+  GyroParameters p;
+  p.scale_factor = HarmonicModel({2, 4, 6, 8}, -0.5583127, {-3.3e-4, 7.501e-4, 1.0 / 3.0 * 1e-5, -2e-7},
+                                 {2.2e-4, 1e-6, -5e-7, 0.1 / 7.0 * 1e-4});
+  p.drift = HarmonicModel({2, 4}, 1.0e-5, {2.0e-5, 3e-7}, {-1.0e-5, 0.0});
+  p.correction.p = {1.1e-3, -2.2e-3, 4.5e-4, -3.3e-4};
+  p.earth_rate.latitude = 0.9302;
+  p.calibration.method = "dual_rate";
+  p.calibration.time = "2026-11-21T10:00:00Z";
+  p.calibration.source = "live";
+  p.calibration.notes = "test: \"quoted\", colon: yes";
+  return p;
+}
+
+// A valid text to mutate key by key.
+const char* kValid = R"(schema_version: 1
+scale_factor:
+  orders: [2, 4]
+  mean: -0.56
+  cos: [1.0e-3, 2.0e-4]
+  sin: [0.0, -1.0e-4]
+drift:
+  orders: [2]
+  mean: 1.0e-5
+  cos: [2.0e-5]
+  sin: [0.0]
+correction_matrix:
+  p: [0.0, 0.0, 0.0, 0.0]
+earth_rate:
+  enabled: true
+  latitude: 0.9
+)";
+
+std::string replaced(const std::string& from, const std::string& to) {
+  std::string s = kValid;
+  const auto pos = s.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return s.replace(pos, from.size(), to);
+}
+
+// Expects a ConfigError whose key is `key` and whose message contains `fragment`.
+void expectRejected(const std::string& text, const std::string& key, const std::string& fragment) {
+  try {
+    parseParameterText(text);
+    ADD_FAILURE() << "accepted, expected rejection of " << key;
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), key) << e.what();
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
+}
+
+TEST(ParameterFile, ValidTextParses) {
+  const GyroParameters p = parseParameterText(kValid);
+  EXPECT_EQ(p.scale_factor.orders(), (std::vector<int>{2, 4}));
+  EXPECT_DOUBLE_EQ(p.scale_factor(0.0), -0.56 + 1e-3 + 2e-4);
+  EXPECT_DOUBLE_EQ(p.drift.meanAt(NAN), 1e-5);
+  EXPECT_TRUE(p.earth_rate.enabled);
+  EXPECT_EQ(p.calibration.method, "none");
+}
+
+TEST(ParameterFile, RoundTripIsExact) {
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    GyroParameters p = sampleParameters();
+    p.scale_factor = HarmonicModel({2, 4}, -0.3 - 0.3 * std::abs(u(rng)), {1e-3 * u(rng), 1e-4 * u(rng)},
+                                   {1e-3 * u(rng), std::ldexp(u(rng), -40)});
+    p.correction.p = {1e-3 * u(rng), 1e-3 * u(rng), 1e-3 * u(rng), 1e-3 * u(rng)};
+    const std::string text = emitParameters(p);
+    const GyroParameters back = parseParameterText(text);
+    EXPECT_TRUE(back == p) << text;
+    EXPECT_EQ(emitParameters(back), text);
+  }
+}
+
+TEST(ParameterFile, FrequencyDependentRoundTrip) {
+  GyroParameters p = sampleParameters();
+  Eigen::MatrixXd v(3, 3);
+  v << -0.56, -0.5601, -0.5603, 1e-3, 1.1e-3, 1.3e-3, -2e-4, -2.5e-4, -2.7e-4;
+  p.scale_factor = HarmonicModel({2}, FrequencyInterpolator({4990.0, 5000.0, 5010.5}), v);
+  const std::string text = emitParameters(p);
+  const GyroParameters back = parseParameterText(text);
+  EXPECT_TRUE(back == p) << text;
+  EXPECT_TRUE(back.scale_factor.frequencyDependent());
+}
+
+TEST(ParameterFile, EmittedFileIsCommented) {
+  const std::string text = emitParameters(sampleParameters());
+  EXPECT_NE(text.find("# hrg_gyro parameter file"), std::string::npos);
+  EXPECT_NE(text.find("rad/s of electrical angle"), std::string::npos);
+  EXPECT_NE(text.find("(E - P) Z"), std::string::npos);
+}
+
+TEST(ParameterFile, RejectsBadKeysNamingThem) {
+  expectRejected(replaced("schema_version: 1\n", ""), "schema_version", "missing");
+  expectRejected(replaced("schema_version: 1", "schema_version: 2"), "schema_version", "unsupported");
+  expectRejected(replaced("  mean: -0.56", "  mean: 0.0"), "scale_factor.mean", "non-zero");
+  expectRejected(replaced("  mean: -0.56", "  mean: 0.56"), "scale_factor.mean", "negative");
+  expectRejected(replaced("  mean: -0.56", "  mean: abc"), "scale_factor.mean", "expected a number");
+  expectRejected(replaced("  mean: -0.56", "  mean: .nan"), "scale_factor.mean", "finite");
+  expectRejected(replaced("  mean: -0.56", "  mean: .inf"), "scale_factor.mean", "finite");
+  expectRejected(replaced("  orders: [2, 4]", "  orders: [2, 3]"), "scale_factor.orders[1]", "odd");
+  expectRejected(replaced("  orders: [2, 4]", "  orders: [4, 2]"), "scale_factor.orders[1]", "increasing");
+  expectRejected(replaced("  orders: [2, 4]", "  orders: [2, 4.5]"), "scale_factor.orders[1]", "integer");
+  expectRejected(replaced("  cos: [1.0e-3, 2.0e-4]", "  cos: [1.0e-3]"), "scale_factor.cos", "expected 2 entries");
+  expectRejected(replaced("  sin: [0.0, -1.0e-4]", "  sin: 0.0"), "scale_factor.sin", "expected a list");
+  expectRejected(replaced("  cos: [1.0e-3, 2.0e-4]", "  cos: [0.2, 0.2]"), "scale_factor", "keeps its sign");
+  expectRejected(replaced("  mean: 1.0e-5", "  mean: 1.0"), "drift", "plausible");
+  expectRejected(replaced("  p: [0.0, 0.0, 0.0, 0.0]", "  p: [0.0, 0.0, 0.0]"), "correction_matrix.p", "expected 4");
+  expectRejected(replaced("  latitude: 0.9", "  latitude: 2.0"), "earth_rate.latitude", "pi/2");
+  expectRejected(replaced("  enabled: true", "  enabled: maybe"), "earth_rate.enabled", "true or false");
+  expectRejected(replaced("scale_factor:", "scale_factr:"), "scale_factr", "unknown key");
+  expectRejected(replaced("  orders: [2]", "  orders: [2]\n  extra: 1"), "drift.extra", "unknown key");
+  expectRejected(replaced("  orders: [2, 4]", "  orders: [2, 4]\n  frequency_nodes: [5000.0, 4990.0]"),
+                 "scale_factor.frequency_nodes[1]", "strictly increasing");
+  expectRejected(replaced("  orders: [2, 4]", "  orders: [2, 4]\n  frequency_nodes: [4990.0, 5000.0]"),
+                 "scale_factor.mean", "one per frequency node");
+  expectRejected("", "", "YAML map");
+  expectRejected("scale_factor: [1, 2", "", "syntax error");
+}
+
+TEST(ParameterFile, TruncatedFilesAreRejected) {
+  const std::string text = emitParameters(sampleParameters());
+  for (std::size_t cut : {std::size_t(0), text.size() / 4, text.size() / 2, text.size() * 3 / 4}) {
+    EXPECT_THROW(parseParameterText(text.substr(0, cut)), ConfigError) << cut;
+  }
+}
+
+TEST(ParameterFile, UnreadablePathIsReportedWithThePath) {
+  try {
+    loadParameterFile("/nonexistent/dir/params.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/params.yaml"), std::string::npos);
+  }
+}
+
+TEST(ParameterFile, AtomicSaveKeepsBackupAndLeavesNoTemporaries) {
+  TempDir dir;
+  const std::string path = dir.file("params.yaml");
+  GyroParameters first = sampleParameters();
+  saveParameterFile(path, first);
+  EXPECT_TRUE(loadParameterFile(path) == first);
+  GyroParameters second = first;
+  second.correction.p[0] = 5e-4;
+  saveParameterFile(path, second);
+  EXPECT_TRUE(loadParameterFile(path) == second);
+  EXPECT_TRUE(loadParameterFile(path + ".bak") == first);
+  // Only the file and its backup remain.
+  const std::string listing = [&] {
+    std::string out;
+    FILE* f = popen(("ls -A '" + dir.path() + "'").c_str(), "r");
+    char buf[256];
+    while (fgets(buf, sizeof buf, f)) out += buf;
+    pclose(f);
+    return out;
+  }();
+  EXPECT_EQ(listing, "params.yaml\nparams.yaml.bak\n");
+}
+
+TEST(ParameterFile, RefusesToWriteInvalidParametersAndKeepsTheOldFile) {
+  TempDir dir;
+  const std::string path = dir.file("params.yaml");
+  saveParameterFile(path, sampleParameters());
+  const std::string before = readText(path);
+  GyroParameters bad = sampleParameters();
+  bad.scale_factor = HarmonicModel(0.3);  // wrong sign
+  EXPECT_THROW(saveParameterFile(path, bad), std::runtime_error);
+  EXPECT_EQ(readText(path), before);
+}
+
+TEST(ParameterFile, UnwritableDirectoryFailsCleanly) {
+  if (geteuid() == 0) {
+    // root ignores directory permissions; use a path whose directory does not exist instead.
+    EXPECT_THROW(saveParameterFile("/nonexistent/dir/params.yaml", sampleParameters()), std::runtime_error);
+    return;
+  }
+  TempDir dir;
+  const std::string path = dir.file("params.yaml");
+  saveParameterFile(path, sampleParameters());
+  chmod(dir.path().c_str(), 0555);
+  EXPECT_THROW(saveParameterFile(path, sampleParameters()), std::runtime_error);
+  chmod(dir.path().c_str(), 0755);
+}
+
+TEST(ParameterFile, ShippedConfigurationFilesAreValid) {
+  const std::string root = HRG_GYRO_SOURCE_DIR;
+  for (const char* name : {"config/params_uncalibrated.yaml"}) {
+    EXPECT_NO_THROW(loadParameterFile(root + "/" + name)) << name;
+  }
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro

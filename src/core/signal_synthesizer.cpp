@@ -1,0 +1,39 @@
+#include "hrg_gyro/core/signal_synthesizer.h"
+
+#include <cmath>
+
+namespace hrg_gyro {
+namespace core {
+
+SignalSynthesizer::SignalSynthesizer(const PickoffDefects& defects, int samples_per_period, std::uint64_t seed)
+    : pickoffs_(defects), demodulator_(samples_per_period), rng_(seed) {}
+
+ChannelVector SignalSynthesizer::period(const WaveParameters& wave, double theta_end) {
+  const int n = demodulator_.samplesPerPeriod();
+  const double sigma = pickoffs_.channelNoiseSigma();
+  // Carrier: cos(2 pi j/N + tau) and sin(...) by rotating the reference table by tau.
+  const double ctau = std::cos(wave.phase), stau = std::sin(wave.phase);
+  // Wave angle: rotate (cos theta, sin theta) by a constant step per sample; exact at j = 0.
+  double ct = std::cos(wave.theta), st = std::sin(wave.theta);
+  const double step = (theta_end - wave.theta) / n;
+  const double cstep = std::cos(step), sstep = std::sin(step);
+  for (int j = 0; j < n; ++j) {
+    const double rc = demodulator_.referenceCos(j), rs = demodulator_.referenceSin(j);
+    const double u = wave.amplitude * (rc * ctau - rs * stau);   // A cos(wt + tau)
+    const double v = wave.quadrature * (rs * ctau + rc * stau);  // B sin(wt + tau)
+    double c, s;
+    pickoffs_.channels(u * ct - v * st, u * st + v * ct, &c, &s);
+    if (sigma > 0.0) {
+      c += sigma * normal_(rng_);
+      s += sigma * normal_(rng_);
+    }
+    demodulator_.push(c, s);
+    const double ct_next = ct * cstep - st * sstep;
+    st = st * cstep + ct * sstep;
+    ct = ct_next;
+  }
+  return demodulator_.result();  // the N-th push completed the period
+}
+
+}  // namespace core
+}  // namespace hrg_gyro
