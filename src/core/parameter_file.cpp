@@ -196,6 +196,9 @@ void keepBackup(const std::string& path) {
 
 }  // namespace
 
+HarmonicModel parseScaleFactorModel(const YamlField& section) { return parseModel(section, ModelKind::kScaleFactor); }
+HarmonicModel parseDriftModel(const YamlField& section) { return parseModel(section, ModelKind::kDrift); }
+
 GyroParameters parseParameters(const YAML::Node& root) {
   const YamlField doc(root, "");
   if (!root.IsMap()) throw ConfigError("", "parameter file must be a YAML map (is it empty or truncated?)");

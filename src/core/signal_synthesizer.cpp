@@ -6,16 +6,17 @@ namespace hrg_gyro {
 namespace core {
 
 SignalSynthesizer::SignalSynthesizer(const PickoffDefects& defects, int samples_per_period, std::uint64_t seed)
-    : pickoffs_(defects), demodulator_(samples_per_period), rng_(seed) {}
+    : pickoffs_(defects), demodulator_(samples_per_period), noise_(seed) {}
 
 ChannelVector SignalSynthesizer::period(const WaveParameters& wave, double theta_end) {
   const int n = demodulator_.samplesPerPeriod();
   const double sigma = pickoffs_.channelNoiseSigma();
   // Carrier: cos(2 pi j/N + tau) and sin(...) by rotating the reference table by tau.
   const double ctau = std::cos(wave.phase), stau = std::sin(wave.phase);
-  // Wave angle: rotate (cos theta, sin theta) by a constant step per sample; exact at j = 0.
-  double ct = std::cos(wave.theta), st = std::sin(wave.theta);
+  // Wave angle at the sample instants (j + 1/2) T / N: rotate (cos theta, sin theta) by a constant
+  // step per sample, starting half a step into the period.
   const double step = (theta_end - wave.theta) / n;
+  double ct = std::cos(wave.theta + 0.5 * step), st = std::sin(wave.theta + 0.5 * step);
   const double cstep = std::cos(step), sstep = std::sin(step);
   for (int j = 0; j < n; ++j) {
     const double rc = demodulator_.referenceCos(j), rs = demodulator_.referenceSin(j);
@@ -24,8 +25,8 @@ ChannelVector SignalSynthesizer::period(const WaveParameters& wave, double theta
     double c, s;
     pickoffs_.channels(u * ct - v * st, u * st + v * ct, &c, &s);
     if (sigma > 0.0) {
-      c += sigma * normal_(rng_);
-      s += sigma * normal_(rng_);
+      c += sigma * noise_.next();
+      s += sigma * noise_.next();
     }
     demodulator_.push(c, s);
     const double ct_next = ct * cstep - st * sstep;

@@ -22,7 +22,9 @@ SynchronousDemodulator::SynchronousDemodulator(int samples_per_period) : n_(samp
   }
 }
 
-double SynchronousDemodulator::carrierPhase(int j) const { return kTwoPi * j / n_; }
+// Mid-interval sampling: the N samples are centred on the period, so the amplitudes describe the
+// wave at the period's centre (a grid starting at the period start would lag it by T / 2N).
+double SynchronousDemodulator::carrierPhase(int j) const { return kTwoPi * (j + 0.5) / n_; }
 
 ChannelVector SynchronousDemodulator::demodulate(const double* c, const double* s) const {
   ChannelVector acc = ChannelVector::Zero();

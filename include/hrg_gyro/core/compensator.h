@@ -8,10 +8,9 @@
 #pragma once
 
 #include <memory>
-#include <vector>
 
 #include "hrg_gyro/core/gyro_parameters.h"
-#include "hrg_gyro/core/harmonic_basis.h"
+#include "hrg_gyro/core/model_pair_evaluator.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -34,17 +33,22 @@ class Compensator {
   const GyroParameters& parameters() const { return *parameters_; }
   const std::shared_ptr<const GyroParameters>& sharedParameters() const { return parameters_; }
 
-  AngleIncrement step(double theta_previous, double theta, double dt, double frequency_mid);
+  AngleIncrement step(double theta_previous, double theta, double dt, double frequency_mid) {
+    AngleIncrement inc;
+    inc.dt = dt;
+    inc.dtheta = theta - theta_previous;
+    inc.theta_mid = 0.5 * (theta + theta_previous);
+    inc.frequency = frequency_mid;
+    models_.evaluate(inc.theta_mid, frequency_mid, &inc.scale_factor, &inc.drift);
+    inc.dalpha = (inc.dtheta - inc.drift * dt) / inc.scale_factor;
+    inc.dalpha_earth_fixed = inc.dalpha - earth_rate_ * dt;
+    return inc;
+  }
 
  private:
-  void refreshCoefficients(double frequency);
-
   std::shared_ptr<const GyroParameters> parameters_;
-  HarmonicBasis basis_;
-  std::vector<double> k_coefficients_, d_coefficients_;
-  bool frequency_dependent_ = false;
-  double cached_frequency_ = 0.0;
-  double earth_rate_ = 0.0;
+  ModelPairEvaluator models_;
+  double earth_rate_;
 };
 
 }  // namespace core

@@ -21,6 +21,10 @@ namespace core {
 
 constexpr int kParameterSchemaVersion = 1;
 
+/// One model section (scale_factor or drift schema), shared with the simulator scenarios.
+HarmonicModel parseScaleFactorModel(const YamlField& section);
+HarmonicModel parseDriftModel(const YamlField& section);
+
 /// Validates and converts a parsed document. Throws ConfigError naming the key.
 GyroParameters parseParameters(const YAML::Node& root);
 /// Reads and validates a file. Throws ConfigError (unreadable file, YAML syntax error with its

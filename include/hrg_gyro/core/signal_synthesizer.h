@@ -2,14 +2,15 @@
 // then demodulated, exactly as the paper does it.
 //
 // Within the period the wave angle moves linearly from the value at the period start to the value
-// at its end (A, B and tau are held); sample j is taken at carrier phase 2 pi j / N. Noise is drawn
+// at its end (A, B and tau are held); sample j is taken at t0 + (j + 1/2) T / N, carrier phase
+// 2 pi (j + 1/2) / N. Noise is drawn
 // per channel sample (see PickoffArray::channelNoiseSigma) from a seeded generator, so a run is
 // reproducible bit for bit.
 #pragma once
 
 #include <cstdint>
-#include <random>
 
+#include "hrg_gyro/core/gaussian_noise.h"
 #include "hrg_gyro/core/pickoff_array.h"
 #include "hrg_gyro/core/synchronous_demodulator.h"
 #include "hrg_gyro/core/wave_parameters.h"
@@ -33,8 +34,7 @@ class SignalSynthesizer {
  private:
   PickoffArray pickoffs_;
   SynchronousDemodulator demodulator_;
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  GaussianNoise noise_;
 };
 
 }  // namespace core

@@ -1,8 +1,8 @@
 // Synchronous demodulation of the two channels over whole periods of the resonator.
 //
 // Ac = (2/T) int c cos(wt), Bc = (2/T) int c sin(wt), and likewise As, Bs from s (MATH.md section 2),
-// as sums over N samples per period taken at carrier phases 2 pi j / N (the reference is locked to
-// the resonator, so the sample grid always spans exactly one period). The sum is exact for every
+// as sums over N samples per period taken at carrier phases 2 pi (j + 1/2) / N (the reference is
+// locked to the resonator, so the sample grid always spans exactly one period, centred on it). The sum is exact for every
 // carrier harmonic m with m != +-1 mod N; the capacitive nonlinearity puts energy at the odd
 // harmonics, so N = 4 aliases the third harmonic onto the fundamental and N >= 8 is required for
 // that reason (the class itself accepts N >= 3, where the discrete orthogonality holds, so that tests

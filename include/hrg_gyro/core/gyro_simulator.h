@@ -1,0 +1,85 @@
+// The simulated gyro on its turntable: the resonator dynamics, the signal-level pickoff and
+// demodulation, and the ground truth, one output sample at a time.
+//
+// Dynamics (MATH.md section 5): d theta/dt = K(theta) (Omega_table(t) + Omega_E) + D(theta) with the
+// resonator's intrinsic K and D, integrated by RK4 over each resonator period. The table rate is
+// piecewise linear, so the RK4 stages see it exactly. Each period is then sampled N times through
+// the eight pickoffs and demodulated (SignalSynthesizer); `periods_per_output` periods are averaged
+// into one output sample stamped at the centre of its window. In generator mode the wave is set to
+// a known sweep of (theta, B, tau) instead (for the correction-matrix fit).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "hrg_gyro/core/model_pair_evaluator.h"
+#include "hrg_gyro/core/signal_synthesizer.h"
+#include "hrg_gyro/core/simulation_config.h"
+#include "hrg_gyro/core/units.h"
+
+namespace hrg_gyro {
+namespace core {
+
+struct TruthState {
+  double table_angle = 0.0;     ///< rad, Earth-fixed
+  double table_rate = 0.0;      ///< rad/s
+  double inertial_angle = 0.0;  ///< rad, table angle + vertical Earth rate x time
+  double inertial_rate = 0.0;   ///< rad/s
+  double theta = 0.0;           ///< true electrical angle, rad (continuous)
+  double amplitude = 0.0;
+  double quadrature = 0.0;
+  double phase = 0.0;
+  double frequency = 0.0;       ///< Hz
+  double temperature = NAN;     ///< degC
+  bool generator = false;
+  const std::string* segment = nullptr;  ///< profile label (owned by the simulator)
+};
+
+struct SimulationSample {
+  std::uint64_t index = 0;
+  Nanoseconds stamp = 0;          ///< centre of the demodulation window
+  ChannelVector z = ChannelVector::Zero();
+  double frequency = 0.0;         ///< Hz
+  double temperature = NAN;       ///< degC
+  std::uint32_t periods = 0;
+  TruthState truth;
+};
+
+class GyroSimulator {
+ public:
+  explicit GyroSimulator(const SimulationConfig& config);
+  // The dynamics evaluator points into config_: the simulator stays where it was built.
+  GyroSimulator(const GyroSimulator&) = delete;
+  GyroSimulator& operator=(const GyroSimulator&) = delete;
+
+  const SimulationConfig& config() const { return config_; }
+  /// Simulated duration of the whole scenario, s.
+  double duration() const;
+  /// Simulated time reached, s from the start.
+  double elapsed() const { return t_; }
+  bool done() const;
+
+  /// The next output sample; false once the scenario is complete.
+  bool next(SimulationSample* out);
+
+ private:
+  double thetaRate(double t, double theta);
+  void nextDynamic(SimulationSample* out);
+  void nextGenerator(SimulationSample* out);
+  void stamp(double t_center, SimulationSample* out) const;
+
+  SimulationConfig config_;
+  SignalSynthesizer synth_;
+  ModelPairEvaluator intrinsic_;
+  double earth_rate_;
+  double t_ = 0.0;            // s since start, Kahan-compensated
+  double t_compensation_ = 0.0;
+  double theta_;              // true electrical angle at t_
+  std::uint64_t index_ = 0;
+  std::uint64_t generator_state_ = 0;
+  std::uint64_t generator_outputs_in_state_ = 0;
+  std::string generator_label_ = "generator";
+};
+
+}  // namespace core
+}  // namespace hrg_gyro

@@ -1,0 +1,110 @@
+#include "hrg_gyro/core/calibration_session.h"
+
+#include <algorithm>
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+// Wave samples wait at most this long for the turntable stream; turntable history is kept this long.
+constexpr double kMaxWait = 2.0;  // s
+constexpr std::size_t kMaxPending = 200000;
+
+}  // namespace
+
+CalibrationSession::CalibrationSession(const CalibrationSettings& settings, const GyroParameters& prior)
+    : settings_(settings), prior_(prior), method_(makeCalibrationMethod(settings)), detector_(settings.plateau) {}
+
+void CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double rate) {
+  ++counters_.turntable;
+  if (!turntable_.empty() && stamp <= turntable_.back().stamp) {
+    ++counters_.out_of_order;
+    return;
+  }
+  turntable_.push_back({stamp, angle, rate, detector_.update(stamp, rate)});
+  drain();
+  // Keep enough history for samples still waiting, and a little more.
+  const Nanoseconds keep_from = (pending_.empty() ? stamp : std::min(stamp, pending_.front().stamp)) -
+                                toNanoseconds(kMaxWait);
+  while (turntable_.size() > 2 && turntable_[1].stamp < keep_from) turntable_.pop_front();
+}
+
+void CalibrationSession::addWave(Nanoseconds stamp, double theta, double frequency) {
+  ++counters_.wave;
+  if (stamp <= last_wave_stamp_) {
+    ++counters_.out_of_order;
+    return;
+  }
+  last_wave_stamp_ = stamp;
+  pending_.push_back({stamp, theta, frequency});
+  // A turntable stream that stopped (or never started) must not make the queue grow without bound.
+  while (!pending_.empty() && (pending_.size() > kMaxPending ||
+                               toSeconds(stamp - pending_.front().stamp) > kMaxWait * 4)) {
+    ++counters_.unsynchronized;
+    pending_.pop_front();
+  }
+  drain();
+}
+
+void CalibrationSession::addGeneratorPair(const ChannelVector& raw, const ChannelVector& reference) {
+  method_->addGeneratorPair(raw, reference);
+  ++counters_.used;
+}
+
+void CalibrationSession::drain() {
+  while (!pending_.empty() && !turntable_.empty() && pending_.front().stamp <= turntable_.back().stamp) {
+    classify(pending_.front());
+    pending_.pop_front();
+  }
+}
+
+void CalibrationSession::classify(const WaveRecord& w) {
+  // The last state at or before the sample and the first at or after it.
+  const auto after = std::lower_bound(turntable_.begin(), turntable_.end(), w.stamp,
+                                      [](const TurntableRecord& r, Nanoseconds t) { return r.stamp < t; });
+  if (after == turntable_.end() || (after == turntable_.begin() && after->stamp != w.stamp)) {
+    ++counters_.unsynchronized;
+    return;
+  }
+  const TurntableRecord& b = *after;
+  const TurntableRecord& a = after->stamp == w.stamp ? b : *(after - 1);
+  if (toSeconds(b.stamp - a.stamp) > settings_.plateau.max_gap) {
+    ++counters_.unsynchronized;
+    return;
+  }
+  if (a.plateau.id != b.plateau.id || !a.plateau.settled) {
+    ++counters_.unsettled;
+    return;
+  }
+  PlateauSample s;
+  s.stamp = w.stamp;
+  s.theta = w.theta;
+  s.frequency = w.frequency;
+  s.plateau = b.plateau;
+  const double span = toSeconds(b.stamp - a.stamp);
+  const double f = span > 0.0 ? toSeconds(w.stamp - a.stamp) / span : 0.0;
+  s.table_angle = a.angle + f * (b.angle - a.angle);
+  s.table_rate = a.rate + f * (b.rate - a.rate);
+  method_->addSample(s);
+  ++counters_.used;
+}
+
+bool CalibrationSession::shouldFinish() const {
+  if (settings_.auto_finish_idle <= 0.0 || !method_->complete()) return false;
+  if (settings_.method == "correction_matrix") return true;
+  if (turntable_.empty()) return false;
+  const TurntableRecord& last = turntable_.back();
+  return last.plateau.is_static && toSeconds(last.stamp - last.plateau.start) >= settings_.auto_finish_idle;
+}
+
+CalibrationOutcome CalibrationSession::finish() const {
+  CalibrationOutcome o = method_->finish(prior_);
+  if (counters_.unsynchronized > 0) {
+    o.notes.push_back(std::to_string(counters_.unsynchronized) +
+                      " wave samples had no turntable state around them and were not used");
+  }
+  return o;
+}
+
+}  // namespace core
+}  // namespace hrg_gyro

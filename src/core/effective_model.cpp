@@ -1,0 +1,72 @@
+#include "hrg_gyro/core/effective_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "hrg_gyro/core/dual_rate_estimator.h"
+#include "hrg_gyro/core/signal_synthesizer.h"
+#include "hrg_gyro/core/units.h"
+#include "hrg_gyro/core/wave_estimator.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+HarmonicFitResult selectOrders(const HarmonicFitResult& all, const std::vector<int>& orders) {
+  HarmonicFitResult r = all;
+  r.orders = orders;
+  r.cos.clear();
+  r.sin.clear();
+  r.cos_std.clear();
+  r.sin_std.clear();
+  for (int k : orders) {
+    const auto it = std::find(all.orders.begin(), all.orders.end(), k);
+    const bool found = it != all.orders.end();
+    const std::size_t j = static_cast<std::size_t>(it - all.orders.begin());
+    r.cos.push_back(found ? all.cos[j] : 0.0);
+    r.sin.push_back(found ? all.sin[j] : 0.0);
+    r.cos_std.push_back(0.0);
+    r.sin_std.push_back(0.0);
+  }
+  return r;
+}
+
+}  // namespace
+
+EffectiveModel computeEffectiveModel(const SimulationConfig& config, const CorrectionMatrix& correction,
+                                     const std::vector<int>& k_orders, const std::vector<int>& d_orders) {
+  PickoffDefects noiseless = config.pickoff;
+  noiseless.noise = 0.0;
+  SignalSynthesizer synth(noiseless, config.resonator.samples_per_period, 1);
+  const ResonatorConfig& rc = config.resonator;
+  const int m = 4096;
+  const double h = kPi / m;
+  // g(theta) on the grid, one extra point at each end for the central differences.
+  std::vector<double> measured(m + 2);
+  for (int j = -1; j <= m; ++j) {
+    const double theta = j * h;
+    WaveState w;
+    estimateWave(correction.apply(synth.period({rc.amplitude, rc.quadrature, theta, rc.phase}, theta)), WaveLimits{}, &w);
+    measured[j + 1] = theta + wrapToPi(2.0 * (w.theta - theta)) / 2.0;
+  }
+  std::vector<FitPoint> kp, dp;
+  for (int j = 0; j < m; ++j) {
+    const double theta = j * h;
+    const double slope = (measured[j + 2] - measured[j]) / (2.0 * h);
+    const double at = measured[j + 1];
+    kp.push_back({at, rc.scale_factor(theta, rc.frequency) * slope, 1.0, 0.0});
+    dp.push_back({at, rc.drift(theta, rc.frequency) * slope, 1.0, 0.0});
+  }
+  std::vector<int> all;
+  for (int k = 2; k <= 16; k += 2) all.push_back(k);
+  const HarmonicFitResult k_all = fitHarmonics(kp, all, {}, INFINITY);
+  const HarmonicFitResult d_all = fitHarmonics(dp, all, {}, INFINITY);
+  EffectiveModel e;
+  e.scale_factor = selectOrders(k_all, k_orders);
+  e.drift = selectOrders(d_all, d_orders);
+  e.nonlinearity_ppm = 1e6 * toModel(k_all).peakDeviation() / std::abs(k_all.mean);
+  return e;
+}
+
+}  // namespace core
+}  // namespace hrg_gyro

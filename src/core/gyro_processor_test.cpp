@@ -1,0 +1,166 @@
+// The processor's handling of bad input and time: reject, count, flag, recover, never NaN.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "hrg_gyro/core/gyro_processor.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+constexpr Nanoseconds kMs = 1000000;
+
+class ProcessorTest : public ::testing::Test {
+ protected:
+  ProcessorTest() : params_(std::make_shared<GyroParameters>()), proc_(ProcessorConfig{}, params_) {}
+
+  // A wave turning at a constant electrical rate: theta = 0.1 + rate t.
+  ChannelSample at(Nanoseconds t, double theta_rate = -0.028) const {
+    ChannelSample s;
+    s.stamp = t;
+    s.z = idealChannels({1.0, 0.02, 0.1 + theta_rate * toSeconds(t), 0.3});
+    s.frequency = 5000.0;
+    return s;
+  }
+  void expectFinite(const ProcessorResult& r) {
+    for (double v : {r.alpha, r.increment.dalpha, r.increment.dt, r.increment.scale_factor, r.wave.theta}) {
+      EXPECT_TRUE(std::isfinite(v));
+    }
+  }
+
+  std::shared_ptr<GyroParameters> params_;
+  GyroProcessor proc_;
+};
+
+TEST_F(ProcessorTest, IntegratesACleanStream) {
+  EXPECT_EQ(proc_.process(at(1000 * kMs)).verdict, SampleVerdict::kFirst);
+  ProcessorResult r;
+  for (int i = 1; i <= 1000; ++i) r = proc_.process(at((1000 + i) * kMs));
+  EXPECT_EQ(r.verdict, SampleVerdict::kAccepted);
+  EXPECT_NEAR(r.alpha, -0.028 * 1.0 / -0.56, 1e-12);  // 1 s at 0.05 rad/s
+  EXPECT_EQ(proc_.counters().outputs, 1000u);
+  EXPECT_EQ(proc_.counters().rejected(), 0u);
+}
+
+TEST_F(ProcessorTest, RejectsBadValuesCountsThemAndRecovers) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  proc_.process(at(1000 * kMs));
+  proc_.process(at(1001 * kMs));
+  ChannelSample bad = at(1002 * kMs);
+  bad.z[kAs] = nan;
+  EXPECT_EQ(proc_.process(bad).verdict, SampleVerdict::kRejectedValue);
+  bad = at(1003 * kMs);
+  bad.z.setZero();
+  EXPECT_EQ(proc_.process(bad).wave_status, WaveStatus::kNoSignal);
+  bad = at(1004 * kMs);
+  bad.z = idealChannels({1.0, 1.0, 0.3, 0.0});
+  EXPECT_EQ(proc_.process(bad).wave_status, WaveStatus::kDegenerate);
+  bad = at(1005 * kMs);
+  bad.z *= 1e300;
+  EXPECT_EQ(proc_.process(bad).wave_status, WaveStatus::kNonFinite);
+  const ProcessorResult r = proc_.process(at(1006 * kMs));
+  ASSERT_TRUE(r.has_output);
+  expectFinite(r);
+  EXPECT_EQ(r.rejected_before, 4u);
+  EXPECT_NEAR(r.increment.dt, 0.005, 1e-15);  // the increment spans the rejected samples
+  EXPECT_NEAR(r.alpha, -0.028 * 0.006 / -0.56, 1e-12);  // nothing lost
+  EXPECT_EQ(proc_.counters().non_finite, 2u);
+  EXPECT_EQ(proc_.counters().no_signal, 1u);
+  EXPECT_EQ(proc_.counters().degenerate, 1u);
+}
+
+TEST_F(ProcessorTest, DropsZeroDuplicateAndOutOfOrderStamps) {
+  proc_.process(at(1000 * kMs));
+  proc_.process(at(1001 * kMs));
+  EXPECT_EQ(proc_.process(at(0)).verdict, SampleVerdict::kRejectedStamp);
+  EXPECT_EQ(proc_.process(at(1001 * kMs)).verdict, SampleVerdict::kDuplicate);
+  EXPECT_EQ(proc_.process(at(1000 * kMs + kMs / 2)).verdict, SampleVerdict::kOutOfOrder);
+  const ProcessorResult r = proc_.process(at(1002 * kMs));
+  EXPECT_EQ(r.verdict, SampleVerdict::kAccepted);
+  EXPECT_EQ(r.rejected_before, 3u);
+  EXPECT_EQ(proc_.counters().zero_stamp, 1u);
+  EXPECT_EQ(proc_.counters().duplicate, 1u);
+  EXPECT_EQ(proc_.counters().out_of_order, 1u);
+}
+
+TEST_F(ProcessorTest, BackwardJumpResetsAndFlags) {
+  for (int i = 0; i < 100; ++i) proc_.process(at((5000 + i) * kMs));
+  EXPECT_EQ(proc_.process(at(1000 * kMs)).verdict, SampleVerdict::kFirst);  // bag looped
+  const ProcessorResult r = proc_.process(at(1001 * kMs));
+  EXPECT_TRUE(r.flags & kFlagReset);
+  EXPECT_NEAR(r.alpha, r.increment.dalpha, 1e-18);  // alpha restarted
+  EXPECT_EQ(proc_.counters().resets, 1u);
+  EXPECT_FALSE(proc_.process(at(1002 * kMs)).flags & kFlagReset);
+}
+
+TEST_F(ProcessorTest, DoesNotIntegrateAcrossAGap) {
+  proc_.process(at(1000 * kMs));
+  const double alpha_before = proc_.process(at(1001 * kMs)).alpha;
+  const ProcessorResult r = proc_.process(at(2001 * kMs));  // 1 s gap > max_gap
+  EXPECT_TRUE(r.flags & kFlagGap);
+  EXPECT_EQ(r.increment.dalpha, 0.0);
+  EXPECT_EQ(r.alpha, alpha_before);
+  EXPECT_EQ(proc_.counters().gaps, 1u);
+  EXPECT_NEAR(proc_.counters().largest_gap, 1.0, 1e-12);
+  const ProcessorResult next = proc_.process(at(2002 * kMs));
+  EXPECT_FALSE(next.flags & kFlagGap);
+  EXPECT_NEAR(next.alpha - alpha_before, -0.028 * 0.001 / -0.56, 1e-12);
+}
+
+TEST_F(ProcessorTest, RejectsAChannelSignFlipAsAGlitchThenReanchors) {
+  proc_.process(at(1000 * kMs));
+  proc_.process(at(1001 * kMs));
+  ChannelSample flip = at(1002 * kMs);
+  flip.z[kAs] = -flip.z[kAs];  // one channel inverted: theta -> -theta
+  flip.z[kBs] = -flip.z[kBs];
+  EXPECT_EQ(proc_.process(flip).verdict, SampleVerdict::kRejectedJump);
+  EXPECT_EQ(proc_.process(at(1003 * kMs)).verdict, SampleVerdict::kAccepted);
+  // A persistent jump is accepted after max_consecutive_jumps as a re-anchor.
+  ProcessorResult r;
+  for (int i = 0; i < 6; ++i) {
+    flip = at((1004 + i) * kMs);
+    flip.z[kAs] = -flip.z[kAs];
+    flip.z[kBs] = -flip.z[kBs];
+    r = proc_.process(flip);
+  }
+  EXPECT_EQ(r.verdict, SampleVerdict::kAccepted);
+  EXPECT_TRUE(r.flags & kFlagGap);
+  EXPECT_EQ(proc_.counters().jumps, 6u);
+  expectFinite(r);
+}
+
+TEST_F(ProcessorTest, ModelSwapTakesEffectOnTheNextSample) {
+  proc_.process(at(1000 * kMs));
+  const ProcessorResult a = proc_.process(at(1001 * kMs));
+  auto doubled = std::make_shared<GyroParameters>(*params_);
+  doubled->scale_factor = HarmonicModel(-1.12);
+  proc_.setParameters(doubled);
+  const ProcessorResult b = proc_.process(at(1002 * kMs));
+  EXPECT_NEAR(b.increment.dalpha, a.increment.dalpha / 2.0, 1e-15);
+  EXPECT_NEAR(b.alpha, a.alpha * 1.5, 1e-15);  // carries on, no reset
+}
+
+TEST_F(ProcessorTest, FlagsMissingOrOutOfRangeFrequency) {
+  auto p = std::make_shared<GyroParameters>();
+  Eigen::MatrixXd v(1, 2);
+  v << -0.56, -0.57;
+  p->scale_factor = HarmonicModel({}, FrequencyInterpolator({4990.0, 5010.0}), v);
+  GyroProcessor proc(ProcessorConfig{}, p);
+  ChannelSample s = at(1000 * kMs);
+  proc.process(s);
+  s = at(1001 * kMs);
+  s.frequency = NAN;
+  EXPECT_TRUE(proc.process(s).flags & kFlagFrequencyUnknown);
+  s = at(1002 * kMs);
+  s.frequency = 6000.0;
+  const ProcessorResult r = proc.process(s);
+  EXPECT_TRUE(r.flags & kFlagFrequencyUnknown);  // the previous sample had none: the midpoint is unknown
+  s = at(1003 * kMs);
+  s.frequency = 6000.0;
+  EXPECT_TRUE(proc.process(s).flags & kFlagFrequencyOutOfRange);
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro

@@ -1,0 +1,83 @@
+// Test support: a fast angle-level session (no pickoffs, no demodulation) -- the wave angle obeys
+// d theta = K(theta) (Omega_table + Omega_E) dt + D(theta) dt, sampled at `rate_hz` with white
+// noise -- fed into a calibration session together with the turntable states.
+#pragma once
+
+#include <functional>
+
+#include "hrg_gyro/core/calibration_session.h"
+#include "hrg_gyro/core/gaussian_noise.h"
+#include "hrg_gyro/core/model_pair_evaluator.h"
+#include "hrg_gyro/core/turntable_profile.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace testing {
+
+struct AngleLevelGyro {
+  HarmonicModel k{-0.56};
+  HarmonicModel d{0.0};
+  double earth_rate = 0.0;   ///< rad/s
+  double noise = 0.0;        ///< white angle noise per sample, rad
+  double rate_noise = 0.0;   ///< noise on the reported table rate, rad/s
+  double rate_hz = 1000.0;
+  double theta0 = 0.2;
+  std::uint64_t seed = 7;
+};
+
+/// Calls sink(stamp, table_angle, table_rate_reported, theta_measured) for every sample.
+inline void runAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profile,
+                          const std::function<void(Nanoseconds, double, double, double)>& sink) {
+  ModelPairEvaluator models(g.k, g.d);
+  GaussianNoise noise(g.seed);
+  const double h = 1.0 / g.rate_hz;
+  double theta = g.theta0;
+  auto f = [&](double t, double th) {
+    double angle, rate, k, d;
+    profile.evaluate(t, &angle, &rate);
+    models.evaluate(th, NAN, &k, &d);
+    return k * (rate + g.earth_rate) + d;
+  };
+  const long steps = static_cast<long>(profile.duration() * g.rate_hz);
+  for (long i = 0; i < steps; ++i) {
+    const double t = i * h;
+    double angle, rate;
+    profile.evaluate(t, &angle, &rate);
+    sink(toNanoseconds(1.0 + t), angle, rate + g.rate_noise * noise.next(), theta + g.noise * noise.next());
+    const double k1 = f(t, theta), k2 = f(t + h / 2, theta + h / 2 * k1), k3 = f(t + h / 2, theta + h / 2 * k2),
+                 k4 = f(t + h, theta + h * k3);
+    theta += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+  }
+}
+
+inline CalibrationOutcome calibrateAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profile,
+                                              const CalibrationSettings& settings, const GyroParameters& prior,
+                                              SessionCounters* counters = nullptr) {
+  CalibrationSession session(settings, prior);
+  runAngleLevel(g, profile, [&](Nanoseconds t, double angle, double rate, double theta) {
+    session.addTurntable(t, angle, rate);
+    session.addWave(t, theta, NAN);
+  });
+  if (counters) *counters = session.counters();
+  return session.finish();
+}
+
+inline TurntableProfile dualRateProfile(double w1, double w2, double duration, int repeat = 1) {
+  TurntableProfile p;
+  p.append(5.0, 0.0, 0.0, "start");
+  for (int r = 0; r < repeat; ++r) {
+    for (double w : {w1, w2}) {
+      const double from = p.finalRate();
+      p.append(std::abs(w - from) / 0.5, from, w > from ? 0.5 : -0.5, "ramp");
+      p.append(duration, w, 0.0, "plateau");
+    }
+  }
+  const double from = p.finalRate();
+  p.append(std::abs(from) / 0.5, from, from > 0 ? -0.5 : 0.5, "ramp");
+  p.append(25.0, 0.0, 0.0, "rest");
+  return p;
+}
+
+}  // namespace testing
+}  // namespace core
+}  // namespace hrg_gyro
