@@ -2,12 +2,13 @@
 #   make run    install missing Debian packages, build, run the main job, print the summary
 #   make test   install, build, run every unit test and rostest, then catkin_test_results
 #   make bench  install, build, run the benchmarks
-# Everything builds in ws/, a catkin workspace inside the checkout (ignored by git) whose
-# src/hrg_gyro links back to this directory; source ws/devel/setup.bash to use the package.
+# Everything builds in .ws/, a catkin workspace inside the checkout (ignored by git) whose
+# src/hrg_gyro links back to this directory; source .ws/devel/setup.bash to use the package.
+# (A dot directory: roslaunch/rosrun search the package tree following links and skip dot dirs.)
 SHELL := /bin/bash
 .SHELLFLAGS := -eo pipefail -c
 ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
-WS := $(ROOT)/ws
+WS := $(ROOT)/.ws
 # Debian's python3 has catkin_pkg; a pyenv python3 earlier on PATH does not.
 export PATH := /usr/bin:/bin:$(PATH)
 CATKIN_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release

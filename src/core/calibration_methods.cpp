@@ -79,9 +79,10 @@ GroupSummary summarize(const RateGroup& g, double min_bin_time) {
 
 }  // namespace
 
-std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettings& s) {
-  if (s.method == "dual_rate") return std::make_unique<DualRateMethod>(s);
-  if (s.method == "constant_rate") return std::make_unique<ConstantRateMethod>(s);
+std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettings& s, const GyroParameters& prior) {
+  const double k0 = std::abs(prior.scale_factor.meanAt(NAN));
+  if (s.method == "dual_rate") return std::make_unique<DualRateMethod>(s, k0);
+  if (s.method == "constant_rate") return std::make_unique<ConstantRateMethod>(s, k0);
   if (s.method == "step") return std::make_unique<StepMethod>(s);
   if (s.method == "correction_matrix") return std::make_unique<CorrectionMatrixMethod>(s);
   throw std::invalid_argument("unknown calibration method '" + s.method + "'");
@@ -95,8 +96,8 @@ int maxOrderOf(const CalibrationSettings& s) {
 }
 }  // namespace
 
-DualRateMethod::DualRateMethod(const CalibrationSettings& s)
-    : settings_(s), groups_(s.bins, s.window, maxOrderOf(s), s.group_tolerance, s.plateau.max_gap) {}
+DualRateMethod::DualRateMethod(const CalibrationSettings& s, double k0)
+    : settings_(s), groups_(s.bins, s.window, s.window_span, k0, maxOrderOf(s), s.group_tolerance, s.plateau.max_gap) {}
 
 void DualRateMethod::addSample(const PlateauSample& s) {
   if (s.plateau.is_static) return;
@@ -162,7 +163,7 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
   o.smoothing_factor = e.smoothing_factor;
   // Paper-style bound per bin: K changing over one window, plus the angle noise of the two window
   // means at each end of a bin (drift cancels in this method).
-  const double tau = settings_.window;
+  const double tau = std::max(g1.rates.effectiveWindow(), g2.rates.effectiveWindow());
   const double sigma = std::max(g1.rates.windowNoise(), g2.rates.windowNoise());
   o.error_bound = slopeBound(e.k) * std::abs(e.k.mean) * std::max(std::abs(w1), std::abs(w2)) * tau +
                   2.0 * std::sqrt(2.0) * sigma / (std::abs(w1 - w2) * tau);
@@ -171,8 +172,8 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
 }
 
 // ------------------------------------------------------------------------------------------------
-ConstantRateMethod::ConstantRateMethod(const CalibrationSettings& s)
-    : settings_(s), groups_(s.bins, s.window, maxOrderOf(s), s.group_tolerance, s.plateau.max_gap) {}
+ConstantRateMethod::ConstantRateMethod(const CalibrationSettings& s, double k0)
+    : settings_(s), groups_(s.bins, s.window, s.window_span, k0, maxOrderOf(s), s.group_tolerance, s.plateau.max_gap) {}
 
 void ConstantRateMethod::closeDwell() {
   if (dwell_.samples() >= 3 && dwell_.duration() > 0.0) {
@@ -281,7 +282,7 @@ CalibrationOutcome ConstantRateMethod::finish(const GyroParameters& prior) const
   d.points = 1;
   o.notes.push_back("constant_rate measures D only at the dwell angle: D(theta) harmonics are not separable from "
                     "K(theta) and leak into it by D_k / Omega; the drift model written is the constant D0");
-  const double tau = settings_.window;
+  const double tau = g.rates.effectiveWindow();
   o.error_bound = slopeBound(k) * std::abs(k.mean) * std::abs(w) * tau + std::abs(d.mean) / std::abs(w) +
                   2.0 * g.rates.windowNoise() / (std::abs(w) * tau);
   finishModel(&o, k, d, prior, q);

@@ -6,14 +6,18 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-// Wave samples wait at most this long for the turntable stream; turntable history is kept this long.
-constexpr double kMaxWait = 2.0;  // s
+// The two streams reach a live calibrator through different queues and, under accelerated sim time,
+// may be tens of seconds of data apart: wave samples wait up to kMaxWait for the turntable stream,
+// and turntable history reaches kMaxWait back from both streams' newest stamps. Both buffers are
+// bounded by count as well, so memory stays constant whatever happens.
+constexpr double kMaxWait = 60.0;  // s of stamps
 constexpr std::size_t kMaxPending = 200000;
+constexpr std::size_t kMaxHistory = 400000;
 
 }  // namespace
 
 CalibrationSession::CalibrationSession(const CalibrationSettings& settings, const GyroParameters& prior)
-    : settings_(settings), prior_(prior), method_(makeCalibrationMethod(settings)), detector_(settings.plateau) {}
+    : settings_(settings), prior_(prior), method_(makeCalibrationMethod(settings, prior)), detector_(settings.plateau) {}
 
 void CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double rate) {
   ++counters_.turntable;
@@ -23,10 +27,13 @@ void CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double ra
   }
   turntable_.push_back({stamp, angle, rate, detector_.update(stamp, rate)});
   drain();
-  // Keep enough history for samples still waiting, and a little more.
-  const Nanoseconds keep_from = (pending_.empty() ? stamp : std::min(stamp, pending_.front().stamp)) -
-                                toNanoseconds(kMaxWait);
-  while (turntable_.size() > 2 && turntable_[1].stamp < keep_from) turntable_.pop_front();
+  // Keep history for waiting samples and for wave samples that lag behind this stream.
+  Nanoseconds keep_from = std::min(stamp, last_wave_stamp_ > 0 ? last_wave_stamp_ : stamp);
+  if (!pending_.empty()) keep_from = std::min(keep_from, pending_.front().stamp);
+  keep_from -= toNanoseconds(kMaxWait);
+  while (turntable_.size() > 2 && (turntable_[1].stamp < keep_from || turntable_.size() > kMaxHistory)) {
+    turntable_.pop_front();
+  }
 }
 
 void CalibrationSession::addWave(Nanoseconds stamp, double theta, double frequency) {
@@ -39,7 +46,7 @@ void CalibrationSession::addWave(Nanoseconds stamp, double theta, double frequen
   pending_.push_back({stamp, theta, frequency});
   // A turntable stream that stopped (or never started) must not make the queue grow without bound.
   while (!pending_.empty() && (pending_.size() > kMaxPending ||
-                               toSeconds(stamp - pending_.front().stamp) > kMaxWait * 4)) {
+                               toSeconds(stamp - pending_.front().stamp) > kMaxWait)) {
     ++counters_.unsynchronized;
     pending_.pop_front();
   }

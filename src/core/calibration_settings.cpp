@@ -30,7 +30,7 @@ bool CalibrationSettings::knownMethod(const std::string& m) {
 CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
   CalibrationSettings s;
   root.requireMap();
-  std::vector<std::string> allowed = {"method", "scale_factor_orders", "drift_orders", "bins", "window",
+  std::vector<std::string> allowed = {"method", "scale_factor_orders", "drift_orders", "bins", "window", "window_span",
                                       "group_tolerance", "auto_finish_idle", "plateau", "gates"};
   allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
   root.rejectUnknownKeys(allowed);
@@ -41,6 +41,7 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   s.bins = static_cast<int>(root.getInteger("bins", s.bins));
   if (s.bins < 8 || s.bins > 4096) root["bins"].fail("must be in [8, 4096]");
   s.window = positive(root, "window", s.window);
+  s.window_span = positive(root, "window_span", s.window_span);
   s.group_tolerance = positive(root, "group_tolerance", s.group_tolerance);
   s.auto_finish_idle = root.getDouble("auto_finish_idle", s.auto_finish_idle);
   if (root.has("plateau")) {

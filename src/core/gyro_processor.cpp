@@ -15,8 +15,18 @@ GyroProcessor::GyroProcessor(const ProcessorConfig& config, std::shared_ptr<cons
     : config_(config), compensator_(std::move(parameters)), max_abs_k0_(largestMean(compensator_.parameters().scale_factor)) {}
 
 void GyroProcessor::setParameters(std::shared_ptr<const GyroParameters> parameters) {
+  const CorrectionMatrix old_p = compensator_.parameters().correction;
   compensator_ = Compensator(std::move(parameters));
   max_abs_k0_ = largestMean(compensator_.parameters().scale_factor);
+  if (has_previous_ && !(compensator_.parameters().correction == old_p)) {
+    WaveState w;
+    if (estimateWave(compensator_.parameters().correction.apply(previous_z_), config_.limits, &w) == WaveStatus::kOk) {
+      ThetaUnwrapper rebased;
+      rebased.unwrap(unwrapper_.last());
+      unwrapper_ = ThetaUnwrapper();
+      unwrapper_.unwrap(rebased.unwrap(w.theta));
+    }
+  }
 }
 
 void GyroProcessor::reset() {
@@ -81,6 +91,7 @@ ProcessorResult GyroProcessor::process(const ChannelSample& in) {
     has_previous_ = true;
     previous_stamp_ = in.stamp;
     previous_frequency_ = in.frequency;
+    previous_z_ = in.z;
     ++counters_.accepted;
     r.verdict = SampleVerdict::kFirst;
     r.has_wave = true;
@@ -141,6 +152,7 @@ ProcessorResult GyroProcessor::process(const ChannelSample& in) {
   }
   previous_stamp_ = in.stamp;
   previous_frequency_ = in.frequency;
+  previous_z_ = in.z;
   ++counters_.accepted;
   ++counters_.outputs;
   r.verdict = SampleVerdict::kAccepted;

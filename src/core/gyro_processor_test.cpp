@@ -164,3 +164,28 @@ TEST_F(ProcessorTest, FlagsMissingOrOutOfRangeFrequency) {
 }  // namespace
 }  // namespace core
 }  // namespace hrg_gyro
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+TEST(ProcessorModelSwap, ANewCorrectionMatrixDoesNotStepTheAngle) {
+  auto p = std::make_shared<GyroParameters>();
+  GyroProcessor proc(ProcessorConfig{}, p);
+  // Raw channels through a misplacement-like map: the new P rotates theta by ~1e-3 rad.
+  auto z = [](double theta) { return idealChannels({1.0, 0.0, theta, 0.2}); };
+  proc.process({toNanoseconds(1.000), z(0.300), NAN, NAN});
+  const double alpha1 = proc.process({toNanoseconds(1.001), z(0.299), NAN, NAN}).alpha;
+  auto with_p = std::make_shared<GyroParameters>(*p);
+  with_p->correction.p = {0.0, 0.0, 1e-3, -1e-3};
+  proc.setParameters(with_p);
+  const ProcessorResult r = proc.process({toNanoseconds(1.002), z(0.298), NAN, NAN});
+  // The increment is the wave's real motion (seen through the same P), not the rotation by P.
+  // (P also shears the motion slightly, by ~1e-3 relative; without the re-read the step would be 1.8e-3.)
+  EXPECT_NEAR(r.alpha - alpha1, -0.001 / -0.56, 1e-5);
+  EXPECT_FALSE(r.flags & kFlagGap);
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro

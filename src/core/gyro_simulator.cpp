@@ -14,19 +14,24 @@ GyroSimulator::GyroSimulator(const SimulationConfig& config)
       earth_rate_(verticalEarthRate(config_.latitude)),
       theta_(config_.resonator.initial_theta) {}
 
-double GyroSimulator::duration() const {
-  if (!config_.generator.enabled) return config_.profile.duration();
+std::uint64_t GyroSimulator::generatorOutputsPerState() const {
+  return static_cast<std::uint64_t>(std::max(1.0, std::round(config_.generator.dwell / config_.outputPeriod())));
+}
+
+double GyroSimulator::generatorDuration() const {
+  if (!config_.generator.enabled) return 0.0;
   const GeneratorConfig& g = config_.generator;
   const double states = static_cast<double>(g.angles) * g.quadratures.size() * g.phases.size();
-  const double per_state = std::max(1.0, std::round(g.dwell / config_.outputPeriod()));
-  return states * per_state * config_.outputPeriod();
+  return states * generatorOutputsPerState() * config_.outputPeriod();
 }
+
+double GyroSimulator::duration() const { return generatorDuration() + config_.profile.duration(); }
 
 bool GyroSimulator::done() const { return t_ >= duration() - 1e-9; }
 
 double GyroSimulator::thetaRate(double t, double theta) {
   double angle, rate, k, d;
-  config_.profile.evaluate(t, &angle, &rate);
+  config_.profile.evaluate(t - generatorDuration(), &angle, &rate);
   intrinsic_.evaluate(theta, config_.resonator.frequency, &k, &d);
   return k * (rate + earth_rate_) + d;
 }
@@ -37,7 +42,7 @@ void GyroSimulator::stamp(double t_center, SimulationSample* out) const {
 
 bool GyroSimulator::next(SimulationSample* out) {
   if (done()) return false;
-  if (config_.generator.enabled) {
+  if (config_.generator.enabled && t_ < generatorDuration() - 1e-9) {
     nextGenerator(out);
   } else {
     nextDynamic(out);
@@ -85,7 +90,7 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
   const double frac = pos - lo;
   TruthState& truth = out->truth;
   truth.theta = boundary_theta[lo] + frac * (boundary_theta[lo + 1] - boundary_theta[lo]);
-  config_.profile.evaluate(t_center, &truth.table_angle, &truth.table_rate, &truth.segment);
+  config_.profile.evaluate(t_center - generatorDuration(), &truth.table_angle, &truth.table_rate, &truth.segment);
   truth.inertial_rate = truth.table_rate + earth_rate_;
   truth.inertial_angle = truth.table_angle + earth_rate_ * t_center;
   truth.amplitude = rc.amplitude;
@@ -99,8 +104,7 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
 void GyroSimulator::nextGenerator(SimulationSample* out) {
   const GeneratorConfig& g = config_.generator;
   const ResonatorConfig& rc = config_.resonator;
-  const std::uint64_t per_state =
-      static_cast<std::uint64_t>(std::max(1.0, std::round(g.dwell / config_.outputPeriod())));
+  const std::uint64_t per_state = generatorOutputsPerState();
   // State order: phase fastest, then quadrature, then angle.
   const std::uint64_t np = g.phases.size(), nq = g.quadratures.size();
   const std::uint64_t s = generator_state_;
@@ -126,6 +130,8 @@ void GyroSimulator::nextGenerator(SimulationSample* out) {
   truth.quadrature = wave.quadrature;
   truth.phase = wave.phase;
   truth.frequency = rc.frequency;
+  truth.inertial_rate = earth_rate_;
+  truth.inertial_angle = earth_rate_ * 0.5 * (t_start + t_);
   truth.generator = true;
   truth.segment = &generator_label_;
   if (++generator_outputs_in_state_ >= per_state) {

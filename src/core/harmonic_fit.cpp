@@ -88,14 +88,14 @@ HarmonicFitResult fitHarmonics(const std::vector<FitPoint>& points, const std::v
   Eigen::MatrixXd cov = sigma2 * a_inv;
   if (value_covariance && value_covariance->rows() == static_cast<Eigen::Index>(n)) {
     Eigen::MatrixXd v = *value_covariance;
-    // Scatter beyond the model's prediction, as independent noise of variance lambda / w -- only
-    // when it exceeds the chi-square fluctuation of the scatter itself (3 sigma), so that chance
-    // does not inflate the errors of the harmonics the correlated noise barely reaches.
+    // Scatter beyond the model's prediction, as independent noise of variance lambda / w: only the
+    // part above the chance level of the scatter itself (3 sigma of its chi-square fluctuation), so
+    // that chance does not inflate the errors of the harmonics the correlated noise barely reaches.
     double predicted = 0.0;
     for (std::size_t i = 0; i < n; ++i) predicted += sw[i] * sw[i] * v(i, i);
     predicted /= static_cast<double>(n);
     const double significant = predicted * (1.0 + 3.0 * std::sqrt(2.0 / static_cast<double>(n - p)));
-    const double lambda = sigma2 > significant ? sigma2 - predicted : 0.0;
+    const double lambda = std::max(0.0, sigma2 - significant);  // continuous: no jump at the threshold
     for (std::size_t i = 0; i < n; ++i) v(i, i) += lambda / (sw[i] * sw[i]);
     const Eigen::MatrixXd xw = x.transpose() * (sw.array() * sw.array()).matrix().asDiagonal();
     cov = a_inv * (xw * v * xw.transpose()) * a_inv;

@@ -12,7 +12,8 @@ namespace core {
 OutputEvaluator::OutputEvaluator(const EvaluationSettings& settings)
     : settings_(settings),
       detector_(settings.plateau),
-      groups_(settings.bins, settings.window, settings.orders.back(), settings.group_tolerance, settings.plateau.max_gap) {}
+      groups_(settings.bins, settings.window, settings.window_span, settings.k0, settings.orders.back(),
+              settings.group_tolerance, settings.plateau.max_gap) {}
 
 void OutputEvaluator::add(Nanoseconds stamp, double theta_mid, double alpha, double table_rate, double inertial_angle,
                           double inertial_rate) {
@@ -54,7 +55,7 @@ EvaluationResult OutputEvaluator::result() const {
   const RateGroup& g1 = groups_.groups()[order[0]];
   const RateGroup& g2 = groups_.groups()[order[1]];
   const DualRateEstimate e = estimateDualRate(g1.rates, g1.meanRate(), g2.rates, g2.meanRate(), settings_.orders,
-                                              settings_.orders, 0.5 * settings_.window);
+                                              settings_.orders, 0.25 * settings_.window);
   if (!e.ok) {
     r.reason = e.reason;
     return r;

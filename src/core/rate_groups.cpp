@@ -16,7 +16,7 @@ void RateGroups::add(Nanoseconds stamp, double theta, double y, std::uint64_t pl
     }
   }
   if (!group) {
-    groups_.emplace_back(bins_, window_, max_order_);
+    groups_.emplace_back(bins_, windowFor(plateau_rate), max_order_);
     group = &groups_.back();
   }
   if (group->last_plateau != plateau_id || (group->last_stamp != 0 && toSeconds(stamp - group->last_stamp) > max_gap_)) {

@@ -86,6 +86,9 @@ void printSessionSummary(std::ostream& out, const SessionSummary& s) {
   both("angle error at end", s.before.angle_error_final * 1e6, s.after.angle_error_final * 1e6, "urad");
   out << line("  over %.1f s of verification profile, %.0f samples\n", s.after.duration,
               static_cast<double>(s.after.samples), 0, 0);
+  for (const std::string& w : s.warnings) out << "WARNING: " << w << "\n";
+  if (!s.before.ok) out << "WARNING: before: " << s.before.reason << "\n";
+  if (!s.after.ok) out << "WARNING: after: " << s.after.reason << "\n";
   out << line("nonlinearity_ppm before=%.3f after=%.3f\n", s.before.nonlinearity_ppm, s.after.nonlinearity_ppm, 0, 0);
   out.flush();
 }

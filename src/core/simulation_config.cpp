@@ -8,8 +8,9 @@ namespace hrg_gyro {
 namespace core {
 
 const std::vector<std::string>& nodeOnlyScenarioKeys() {
-  static const std::vector<std::string> keys = {"time_scale", "clock_period", "frame_id", "publish_clock",
-                                                "wait_for_subscribers", "shutdown_when_done", "queue_size"};
+  static const std::vector<std::string> keys = {"time_scale",         "clock_period", "frame_id",
+                                                "publish_clock",      "wait_for_subscribers",
+                                                "wait_timeout",       "shutdown_when_done", "queue_size"};
   return keys;
 }
 

@@ -30,14 +30,22 @@ void ThetaBinnedRates::add(Nanoseconds stamp, double theta, double y) {
     origin_ = stamp;
   }
   ++samples_;
-  // Noise of y from second differences: var(y_i - 2 y_{i-1} + y_{i-2}) = 6 sigma^2 for white noise.
+  // Noise of y: the deviation of each sample from the straight line through its two neighbours,
+  // r = y1 - (w0 y0 + w2 y2), has variance sigma^2 (1 + w0^2 + w2^2) for white noise and any
+  // spacing, so a missing sample (uneven dt) does not pass the signal's slope off as noise.
   if (history_ >= 2) {
-    const double d2 = y - 2.0 * y1_ + y2_;
-    d2_sum_ += d2 * d2;
-    ++d2_n_;
+    const double span = toSeconds(stamp - t2_);
+    if (span > 0.0) {
+      const double w0 = toSeconds(stamp - t1_) / span, w2 = toSeconds(t1_ - t2_) / span;
+      const double r = y1_ - (w0 * y2_ + w2 * y);
+      d2_sum_ += r * r / (1.0 + w0 * w0 + w2 * w2);
+      ++d2_n_;
+    }
   }
   y2_ = y1_;
   y1_ = y;
+  t2_ = t1_;
+  t1_ = stamp;
   if (history_ < 2) ++history_;
 
   if (block_.n == 0) block_.start = stamp;
@@ -83,6 +91,7 @@ void ThetaBinnedRates::closeBlock() {
       }
       total_time_ += dt;
       theta_swept_ += std::abs(theta - previous_theta_);
+      sweep(std::min(theta, previous_theta_), std::max(theta, previous_theta_), dt);
       ++increments_;
     }
   }
@@ -92,9 +101,30 @@ void ThetaBinnedRates::closeBlock() {
   previous_y_ = y;
 }
 
+void ThetaBinnedRates::sweep(double lo, double hi, double dt) {
+  const double w = binWidth();
+  const double span = hi - lo;
+  if (span <= 0.0 || span >= kPi) {
+    // At rest in angle, or a full half-turn in one increment: time goes to the bin(s) evenly.
+    if (span <= 0.0) {
+      bins_[std::min(binCount() - 1, static_cast<int>(positiveModulo(lo, kPi) / w))].swept += dt;
+    } else {
+      for (Bin& b : bins_) b.swept += dt / binCount();
+    }
+    return;
+  }
+  // Whole bins by index (the angle is continuous; bin i covers [i w, (i + 1) w) modulo pi).
+  const long first = static_cast<long>(std::floor(lo / w)), last = static_cast<long>(std::floor(hi / w));
+  const long n = binCount();
+  for (long i = first; i <= last; ++i) {
+    const double overlap = std::min(hi, (i + 1) * w) - std::max(lo, i * w);
+    if (overlap > 0.0) bins_[((i % n) + n) % n].swept += dt * overlap / span;
+  }
+}
+
 double ThetaBinnedRates::coverage(double min_time) const {
   int covered = 0;
-  for (const Bin& b : bins_) covered += b.dt >= min_time && b.dt > 0.0 ? 1 : 0;
+  for (const Bin& b : bins_) covered += b.swept >= min_time && b.swept > 0.0 ? 1 : 0;
   return static_cast<double>(covered) / binCount();
 }
 
@@ -126,7 +156,7 @@ Eigen::MatrixXd ThetaBinnedRates::rateCovariance(const std::vector<int>& bins) c
   return cov;
 }
 
-double ThetaBinnedRates::sampleNoise() const { return d2_n_ > 0 ? std::sqrt(d2_sum_ / (6.0 * d2_n_)) : 0.0; }
+double ThetaBinnedRates::sampleNoise() const { return d2_n_ > 0 ? std::sqrt(d2_sum_ / d2_n_) : 0.0; }
 
 double ThetaBinnedRates::windowNoise() const {
   if (increments_ == 0) return sampleNoise();

@@ -20,7 +20,8 @@ namespace {
 void usage(std::ostream& out) {
   out << "usage: hrg_session --calibration SCENARIO.yaml --verification SCENARIO.yaml --params PARAMS.yaml\n"
          "                   [--out NEW_PARAMS.yaml] [--method dual_rate|constant_rate|step]\n"
-         "                   [--orders 2,4,6,8] [--drift-orders 2,4]\n"
+         "                   [--orders 2,4,6,8] [--drift-orders 2,4] [--evaluation-orders 2,4,...,12]\n"
+         "                   [--window SECONDS] [--bins N]\n"
          "Calibrates a simulated gyro without ROS and verifies the result against the ground truth.\n";
 }
 
@@ -29,6 +30,7 @@ void usage(std::ostream& out) {
 int main(int argc, char** argv) {
   std::string calibration, verification, params, out, method = "dual_rate";
   CalibrationSettings settings;
+  EvaluationSettings evaluation;
   auto parseOrders = [](const std::string& text) {
     std::vector<int> orders;
     std::size_t pos = 0;
@@ -55,6 +57,9 @@ int main(int argc, char** argv) {
     else if (a == "--method") method = value();
     else if (a == "--orders") settings.scale_factor_orders = parseOrders(value());
     else if (a == "--drift-orders") settings.drift_orders = parseOrders(value());
+    else if (a == "--evaluation-orders") evaluation.orders = parseOrders(value());
+    else if (a == "--window") settings.window = std::stod(value());
+    else if (a == "--bins") settings.bins = std::stoi(value());
     else if (a == "-h" || a == "--help") {
       usage(std::cout);
       return 0;
@@ -88,7 +93,7 @@ int main(int argc, char** argv) {
       }
     }
     std::cerr << "hrg_session: verifying on " << verification << " ...\n";
-    const auto results = verifyOnSimulation(ver_scenario, {uncalibrated, calibrated});
+    const auto results = verifyOnSimulation(ver_scenario, {uncalibrated, calibrated}, evaluation);
     summary.before = results[0];
     summary.after = results[1];
     printSessionSummary(std::cout, summary);

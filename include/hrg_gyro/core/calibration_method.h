@@ -44,8 +44,10 @@ class CalibrationMethod {
   virtual CalibrationOutcome finish(const GyroParameters& prior) const = 0;
 };
 
-/// The method named in the settings (throws std::invalid_argument for an unknown name).
-std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettings& settings);
+/// The method named in the settings (throws std::invalid_argument for an unknown name); `prior`
+/// is the parameter set the data are measured with.
+std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettings& settings,
+                                                         const GyroParameters& prior);
 
 }  // namespace core
 }  // namespace hrg_gyro

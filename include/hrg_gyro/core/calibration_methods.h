@@ -18,7 +18,8 @@ namespace core {
 
 class DualRateMethod : public CalibrationMethod {
  public:
-  explicit DualRateMethod(const CalibrationSettings& settings);
+  /// k0: the prior's mean scale factor (the angle rate per table rate, for the window length).
+  DualRateMethod(const CalibrationSettings& settings, double k0);
   std::string name() const override { return "dual_rate"; }
   void addSample(const PlateauSample& s) override;
   bool complete() const override;
@@ -26,7 +27,7 @@ class DualRateMethod : public CalibrationMethod {
   CalibrationOutcome finish(const GyroParameters& prior) const override;
 
  private:
-  double minBinTime() const { return 0.5 * settings_.window; }
+  double minBinTime() const { return 0.25 * settings_.window; }
   CalibrationSettings settings_;
   RateGroups groups_;
   std::uint64_t samples_ = 0;
@@ -34,7 +35,7 @@ class DualRateMethod : public CalibrationMethod {
 
 class ConstantRateMethod : public CalibrationMethod {
  public:
-  explicit ConstantRateMethod(const CalibrationSettings& settings);
+  ConstantRateMethod(const CalibrationSettings& settings, double k0);
   std::string name() const override { return "constant_rate"; }
   void addSample(const PlateauSample& s) override;
   bool complete() const override;
@@ -42,7 +43,7 @@ class ConstantRateMethod : public CalibrationMethod {
   CalibrationOutcome finish(const GyroParameters& prior) const override;
 
  private:
-  double minBinTime() const { return 0.5 * settings_.window; }
+  double minBinTime() const { return 0.25 * settings_.window; }
   double dwellTime() const;
   CalibrationSettings settings_;
   RateGroups groups_;

@@ -33,7 +33,8 @@ struct CalibrationSettings {
   std::vector<int> scale_factor_orders{2, 4, 6, 8};
   std::vector<int> drift_orders{2, 4};
   int bins = 128;            ///< theta bins over [0, pi)
-  double window = 0.5;       ///< s, averaging window tau
+  double window = 2.0;       ///< s, longest averaging window tau
+  double window_span = 0.06; ///< rad, most wave angle a window may sweep (shortens tau at high rates)
   double group_tolerance = 1e-3;  ///< rad/s: plateaus closer than this in rate form one group
   double auto_finish_idle = 20.0; ///< s at rest after the data are complete -> finish (<= 0: never)
   PlateauSettings plateau;

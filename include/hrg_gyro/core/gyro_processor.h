@@ -86,7 +86,9 @@ class GyroProcessor {
  public:
   GyroProcessor(const ProcessorConfig& config, std::shared_ptr<const GyroParameters> parameters);
 
-  /// Takes effect from the next sample; the angle, its unwrapping and alpha carry on.
+  /// Takes effect from the next sample; the angle, its unwrapping and alpha carry on. When the
+  /// correction matrix changes, the previous sample is re-read through the new P, so the increment
+  /// across the swap compares two angles measured the same way (no spurious step).
   void setParameters(std::shared_ptr<const GyroParameters> parameters);
   const GyroParameters& parameters() const { return compensator_.parameters(); }
   const std::shared_ptr<const GyroParameters>& sharedParameters() const { return compensator_.sharedParameters(); }
@@ -109,6 +111,7 @@ class GyroProcessor {
   bool has_previous_ = false;
   Nanoseconds previous_stamp_ = 0;
   double previous_frequency_ = NAN;
+  ChannelVector previous_z_ = ChannelVector::Zero();  // raw, for re-reading under a new P
   double alpha_ = 0.0;
   std::uint8_t pending_flags_ = 0;
   std::uint32_t rejected_since_output_ = 0;

@@ -5,8 +5,9 @@
 // resonator's intrinsic K and D, integrated by RK4 over each resonator period. The table rate is
 // piecewise linear, so the RK4 stages see it exactly. Each period is then sampled N times through
 // the eight pickoffs and demodulated (SignalSynthesizer); `periods_per_output` periods are averaged
-// into one output sample stamped at the centre of its window. In generator mode the wave is set to
-// a known sweep of (theta, B, tau) instead (for the correction-matrix fit).
+// into one output sample stamped at the centre of its window. With the generator enabled the
+// session starts with a known sweep of (theta, B, tau) at rest (for the correction-matrix fit), and
+// the turntable profile, if any, follows it.
 #pragma once
 
 #include <cstdint>
@@ -66,6 +67,8 @@ class GyroSimulator {
   double thetaRate(double t, double theta);
   void nextDynamic(SimulationSample* out);
   void nextGenerator(SimulationSample* out);
+  double generatorDuration() const;
+  std::uint64_t generatorOutputsPerState() const;
   void stamp(double t_center, SimulationSample* out) const;
 
   SimulationConfig config_;

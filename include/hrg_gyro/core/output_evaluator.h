@@ -23,7 +23,9 @@ namespace core {
 
 struct EvaluationSettings {
   int bins = 128;
-  double window = 0.5;  ///< s
+  double window = 2.0;        ///< s, longest averaging window
+  double window_span = 0.06;  ///< rad of wave angle per window at most (as the calibrator)
+  double k0 = 0.56;           ///< |K0|, wave angle per body angle, for the window length
   std::vector<int> orders{2, 4, 6, 8, 10, 12};
   PlateauSettings plateau{2e-4, 2e-3, 1.0, 2e-4, 0.5};
   double group_tolerance = 1e-3;

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <ostream>
+#include <string>
+#include <vector>
 
 #include "hrg_gyro/core/calibration_outcome.h"
 #include "hrg_gyro/core/effective_model.h"
@@ -17,6 +19,7 @@ struct SessionSummary {
   EffectiveModel injected;          ///< what a perfect calibration would find
   CalibrationOutcome calibration;
   EvaluationResult before, after;   ///< measured on the verification profile
+  std::vector<std::string> warnings;  ///< printed before the machine-readable last line
 };
 
 void printSessionSummary(std::ostream& out, const SessionSummary& s);

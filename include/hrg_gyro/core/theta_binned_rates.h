@@ -50,7 +50,9 @@ class ThetaBinnedRates {
   double basisMean(int b, int k, bool sine) const {
     return bins_[b].dt > 0.0 ? basis_[b * 2 * (max_order_ / 2) + 2 * (k / 2 - 1) + (sine ? 1 : 0)] / bins_[b].dt : 0.0;
   }
-  /// Fraction of bins holding at least min_time seconds of increments.
+  /// Fraction of bins whose angle the increments swept for at least min_time seconds (an increment
+  /// spreads its time over the bins its angle span overlaps; with long windows one increment spans
+  /// several bins, so counting midpoints would understate the coverage).
   double coverage(double min_time) const;
 
   std::uint64_t samples() const { return samples_; }
@@ -63,7 +65,8 @@ class ThetaBinnedRates {
   double effectiveWindow() const { return increments_ > 0 ? total_time_ / increments_ : 0.0; }
   /// Angle swept in one effective window, rad: the window smoothing acts as sinc^2(k span / 2).
   double windowSpan() const { return meanThetaRate() * effectiveWindow(); }
-  /// Noise of y per input sample, from second differences (white-noise estimate).
+  /// Noise of y per input sample (white-noise estimate from each sample's deviation from the line
+  /// through its neighbours; valid for uneven spacing).
   double sampleNoise() const;
   /// Noise of one window mean of y.
   double windowNoise() const;
@@ -79,6 +82,7 @@ class ThetaBinnedRates {
     double dt = 0.0;
     std::uint32_t runs = 0;         // maximal runs of consecutive increments in this bin
     std::uint32_t shared_next = 0;  // window means shared with bin (b + 1) mod n
+    double swept = 0.0;             // s of increments whose angle span overlaps the bin
   };
   struct Block {
     Nanoseconds start = 0;
@@ -87,6 +91,7 @@ class ThetaBinnedRates {
   };
 
   void closeBlock();
+  void sweep(double lo, double hi, double dt);
 
   std::vector<Bin> bins_;
   int max_order_;
@@ -101,9 +106,10 @@ class ThetaBinnedRates {
   std::map<std::pair<int, int>, std::uint32_t> shared_far_;  // rare: boundaries between non-adjacent bins
   std::uint64_t samples_ = 0, increments_ = 0, window_samples_ = 0;
   double total_time_ = 0.0, theta_swept_ = 0.0;
-  // Second differences of y for the noise estimate.
+  // The last two samples, for the noise estimate.
   int history_ = 0;
   double y1_ = 0.0, y2_ = 0.0;
+  Nanoseconds t1_ = 0, t2_ = 0;
   double d2_sum_ = 0.0;
   std::uint64_t d2_n_ = 0;
   HarmonicBasis basis_eval_;

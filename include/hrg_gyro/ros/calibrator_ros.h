@@ -1,0 +1,88 @@
+// ROS wrapper of the calibration (node calibrator, nodelet hrg_gyro/Calibrator).
+//
+// Listens to `turntable/state` and `wave` (and, for the correction matrix, to the raw `channels`
+// and the generator reference on `truth`) and feeds a core::CalibrationSession. A run starts at
+// start-up (`~autostart`) or on `~start`; it finishes on `~finish` or by itself once its data are
+// complete and the table has rested for `~auto_finish_idle` s. The outcome is published latched on
+// `~result`; when every quality gate passes, the parameter file is rewritten atomically (previous
+// kept as .bak), a report is written next to it and the processor's `~reload` is called. `~stages`
+// runs several methods in a row: [correction_matrix, dual_rate] is the paper's two-stage
+// refinement (P first, then the residual K and D measured through the new P).
+#pragma once
+
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+#include <std_srvs/Trigger.h>
+
+#include "hrg_gyro/ChannelAmplitudes.h"
+#include "hrg_gyro/GroundTruth.h"
+#include "hrg_gyro/StartCalibration.h"
+#include "hrg_gyro/TurntableState.h"
+#include "hrg_gyro/WaveState.h"
+#include "hrg_gyro/core/calibration_session.h"
+
+namespace hrg_gyro {
+
+class CalibratorRos {
+ public:
+  /// Throws std::exception for invalid settings or an unreadable prior parameter file.
+  CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~CalibratorRos();
+
+ private:
+  void onTurntable(const TurntableState::ConstPtr& msg);
+  void onWave(const WaveState::ConstPtr& msg);
+  void onChannels(const ChannelAmplitudes::ConstPtr& msg);
+  void onTruth(const GroundTruth::ConstPtr& msg);
+  bool onStart(StartCalibration::Request& req, StartCalibration::Response& res);
+  bool onFinish(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool onAbort(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  /// Starts a run of `method` with the current parameter file as prior; false + reason on failure.
+  bool startRun(const std::string& method, std::string* reason);
+  /// Fits, gates, writes, publishes, reloads; returns the outcome. Caller holds the mutex.
+  core::CalibrationOutcome finishRun(bool* written, std::string* message);
+  void pairGenerator();
+  /// The reload worker: calls the processor's ~reload off the callback threads, then starts the
+  /// next stage if there is one (it must see the wave through the new model).
+  void reloadLoop();
+
+  ros::NodeHandle nh_, pnh_;
+  std::mutex mutex_;  // session and state; never held while calling a service
+  core::CalibrationSettings base_settings_;
+  std::unique_ptr<core::CalibrationSession> session_;
+  std::vector<std::string> stages_;
+  std::size_t next_stage_ = 0;
+  std::string parameter_file_, report_file_, output_directory_, reload_service_;
+  bool write_ = true;
+  std::uint64_t runs_ = 0;
+  std::string last_result_;
+  bool last_accepted_ = false;
+
+  // Generator pairs: raw channels and the reference wave, matched by stamp.
+  std::map<core::Nanoseconds, core::ChannelVector> raw_, reference_;
+
+  ros::Subscriber turntable_sub_, wave_sub_, channels_sub_, truth_sub_;
+  ros::Publisher result_pub_;
+  ros::ServiceServer start_srv_, finish_srv_, abort_srv_;
+  diagnostic_updater::Updater updater_;
+  ros::Timer diagnostics_timer_;
+
+  std::mutex reload_mutex_;
+  std::condition_variable reload_cv_;
+  std::deque<bool> reload_requests_;  // each: start the next stage after reloading
+  bool stopping_ = false;
+  std::thread reload_worker_;
+};
+
+}  // namespace hrg_gyro

@@ -1,0 +1,48 @@
+// ROS wrapper of the simulated gyro on its turntable (node driver_sim, nodelet hrg_gyro/DriverSim).
+//
+// Reads the scenario from the private parameters (the keys of config/scenarios/*.yaml, loaded with
+// `rosparam load` into ~), runs core::GyroSimulator in a worker thread and publishes, per output
+// sample: `channels` (ChannelAmplitudes), `turntable/state` (TurntableState) and `truth`
+// (GroundTruth). With /use_sim_time it also drives /clock, `~time_scale` times faster than real
+// time; without it, stamps follow the wall clock from the start. `~done` (std_msgs/Bool, latched)
+// turns true when the scenario is over.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <ros/ros.h>
+
+#include "hrg_gyro/core/gyro_simulator.h"
+
+namespace hrg_gyro {
+
+class DriverSimRos {
+ public:
+  /// Throws std::exception (with the offending key named) when the parameters are invalid.
+  DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_process);
+  ~DriverSimRos();
+
+ private:
+  void run();
+  bool waitForSubscribers();
+
+  ros::NodeHandle nh_, pnh_;
+  bool owns_process_;  // a node may shut itself down when done; a nodelet must not
+  std::unique_ptr<core::SimulationConfig> config_;
+  ros::Publisher channels_pub_, turntable_pub_, truth_pub_, clock_pub_, done_pub_;
+  double time_scale_ = 1.0;
+  double clock_period_ = 0.05;  // every subscriber of /clock (every node under sim time) pays for it
+  std::string frame_id_ = "gyro_link";
+  bool use_sim_time_ = false;
+  bool publish_clock_ = true;
+  bool shutdown_when_done_ = false;
+  int wait_channels_ = 0, wait_turntable_ = 0, wait_truth_ = 0;
+  double wait_timeout_ = 10.0;
+  std::atomic<bool> stop_{false};
+  std::thread worker_;
+};
+
+}  // namespace hrg_gyro

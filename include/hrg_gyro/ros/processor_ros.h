@@ -1,0 +1,77 @@
+// ROS wrapper of the measurement pipeline (node processor, nodelet hrg_gyro/Processor).
+//
+// Subscribes `channels`, runs core::GyroProcessor (the same object `hrg_bag process` runs, hence
+// identical numbers) and publishes `wave` (WaveState), `output` (GyroOutput) and `imu/data_raw`
+// (sensor_msgs/Imu, REP-145). `~reload` (std_srvs/Trigger) re-reads and validates
+// `~parameter_file` and swaps the model between two samples; a bad file is refused with the reason
+// and the old model stays. Health goes to /diagnostics through diagnostic_updater.
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+#include <ros/ros.h>
+#include <std_srvs/Trigger.h>
+
+#include "hrg_gyro/ChannelAmplitudes.h"
+#include "hrg_gyro/core/gyro_processor.h"
+
+namespace hrg_gyro {
+
+class ProcessorRos {
+ public:
+  /// Throws std::exception when ~parameter_file is missing or invalid at start-up.
+  ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh);
+
+ private:
+  void onChannels(const ChannelAmplitudes::ConstPtr& msg);
+  bool onReload(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  void diagnoseInput(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  void diagnoseWave(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  void diagnoseModel(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  double angularVelocityVariance() const;
+  /// Publishes ~model for the model now in force; `since` is the last stamp of the previous one.
+  void publishModel(const ros::Time& since);
+
+  ros::NodeHandle nh_, pnh_;
+  std::mutex mutex_;  // the model swap and the samples (nodelets may run callbacks concurrently)
+  std::unique_ptr<core::GyroProcessor> processor_;
+  std::string parameter_file_;
+  std::string frame_id_;
+  bool publish_imu_ = true;
+  double configured_rate_variance_ = -1.0;
+  double stall_timeout_ = 0.5;
+  double quadrature_warn_ = 0.1;
+
+  ros::Subscriber channels_sub_;
+  ros::Publisher wave_pub_, output_pub_, imu_pub_, model_pub_;
+  ros::Time last_stamp_;
+  ros::ServiceServer reload_srv_;
+
+  diagnostic_updater::Updater updater_;
+  ros::Timer diagnostics_timer_;
+  double expected_rate_ = 200.0;
+  double min_rate_ = 0.0, max_rate_ = 0.0;
+  std::unique_ptr<diagnostic_updater::FrequencyStatus> frequency_;
+  std::unique_ptr<diagnostic_updater::TimeStampStatus> stamps_;
+
+  // Health since the last diagnostics report.
+  ros::Time last_input_;
+  bool seen_input_ = false;
+  std::uint32_t last_seq_ = 0;
+  std::uint64_t dropped_ = 0;
+  core::ProcessorCounters reported_;
+  std::uint64_t reloads_ = 0, failed_reloads_ = 0;
+  std::string last_reload_error_;
+  core::WaveState last_wave_;
+  bool has_wave_ = false;
+  std::uint8_t last_flags_ = 0;
+  // Angle-noise estimate from second differences of alpha, for the IMU covariance.
+  double alpha1_ = 0.0, alpha2_ = 0.0, dt_last_ = 0.0, d2_variance_ = 0.0;
+  int history_ = 0;
+};
+
+}  // namespace hrg_gyro

@@ -1,0 +1,17 @@
+// The calibrator node: a thin main around hrg_gyro::CalibratorRos (also available as a nodelet).
+#include <ros/ros.h>
+
+#include "hrg_gyro/ros/calibrator_ros.h"
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "calibrator");
+  ros::NodeHandle nh, pnh("~");
+  try {
+    hrg_gyro::CalibratorRos node(nh, pnh);
+    ros::spin();
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s", e.what());
+    return 1;
+  }
+  return 0;
+}

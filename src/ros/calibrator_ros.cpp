@@ -1,0 +1,324 @@
+#include "hrg_gyro/ros/calibrator_ros.h"
+
+#include <climits>
+#include <cstdlib>
+#include <fstream>
+#include <thread>
+
+#include "hrg_gyro/CalibrationResult.h"
+#include "hrg_gyro/core/parameter_file.h"
+#include "hrg_gyro/ros/conversions.h"
+#include "hrg_gyro/ros/param_tree.h"
+
+namespace hrg_gyro {
+namespace {
+
+using diagnostic_msgs::DiagnosticStatus;
+
+const std::vector<std::string>& nodeOnlyKeys() {
+  static const std::vector<std::string> keys = {"parameter_file", "report_file", "output_directory", "reload_service",
+                                                "write", "autostart", "stages", "queue_size", "diagnostic_period"};
+  return keys;
+}
+
+std::string directoryOf(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+}
+
+std::string canonical(const std::string& path) {
+  char buf[PATH_MAX];
+  return ::realpath(path.c_str(), buf) ? std::string(buf) : std::string();
+}
+
+/// True when `path` (its directory must exist) lies inside `directory`.
+bool inside(const std::string& path, const std::string& directory) {
+  const std::string dir = canonical(directory), parent = canonical(directoryOf(path));
+  return !dir.empty() && !parent.empty() && (parent == dir || parent.rfind(dir + "/", 0) == 0);
+}
+
+}  // namespace
+
+CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh), pnh_(pnh), updater_(nh, pnh, pnh.getNamespace()) {
+  base_settings_ = core::CalibrationSettings::parse(core::YamlField(privateParameters(pnh_), ""), nodeOnlyKeys());
+  if (!pnh_.getParam("parameter_file", parameter_file_) || parameter_file_.empty()) {
+    throw std::invalid_argument("calibrator: ~parameter_file is required (the file to refresh)");
+  }
+  report_file_ = parameter_file_;
+  if (report_file_.size() > 5 && report_file_.substr(report_file_.size() - 5) == ".yaml") {
+    report_file_.resize(report_file_.size() - 5);
+  }
+  report_file_ += ".report.yaml";
+  pnh_.param("report_file", report_file_, report_file_);
+  pnh_.param<std::string>("output_directory", output_directory_, "");
+  pnh_.param<std::string>("reload_service", reload_service_, "processor/reload");
+  pnh_.param("write", write_, write_);
+  if (!output_directory_.empty()) {
+    for (const std::string& f : {parameter_file_, report_file_}) {
+      if (!inside(f, output_directory_)) {
+        throw std::invalid_argument("calibrator: '" + f + "' is outside ~output_directory '" + output_directory_ + "'");
+      }
+    }
+  }
+  core::loadParameterFile(parameter_file_);  // fail early on a bad prior
+  std::vector<std::string> stages;
+  if (!pnh_.getParam("stages", stages) || stages.empty()) stages = {base_settings_.method};
+  for (const std::string& m : stages) {
+    if (!core::CalibrationSettings::knownMethod(m)) throw std::invalid_argument("calibrator: unknown method in ~stages: " + m);
+  }
+  stages_ = stages;
+  int queue_size = 10000;
+  pnh_.param("queue_size", queue_size, queue_size);
+
+  result_pub_ = pnh_.advertise<CalibrationResult>("result", 1, true);
+  turntable_sub_ = nh_.subscribe("turntable/state", queue_size, &CalibratorRos::onTurntable, this,
+                                 ros::TransportHints().tcpNoDelay());
+  wave_sub_ = nh_.subscribe("wave", queue_size, &CalibratorRos::onWave, this, ros::TransportHints().tcpNoDelay());
+  if (std::find(stages_.begin(), stages_.end(), "correction_matrix") != stages_.end()) {
+    channels_sub_ = nh_.subscribe("channels", queue_size, &CalibratorRos::onChannels, this,
+                                  ros::TransportHints().tcpNoDelay());
+    truth_sub_ = nh_.subscribe("truth", queue_size, &CalibratorRos::onTruth, this, ros::TransportHints().tcpNoDelay());
+  }
+  start_srv_ = pnh_.advertiseService("start", &CalibratorRos::onStart, this);
+  finish_srv_ = pnh_.advertiseService("finish", &CalibratorRos::onFinish, this);
+  abort_srv_ = pnh_.advertiseService("abort", &CalibratorRos::onAbort, this);
+  updater_.setHardwareID("hrg_gyro");
+  updater_.add("calibration", this, &CalibratorRos::diagnose);
+  diagnostics_timer_ = nh_.createTimer(ros::Duration(0.1), [this](const ros::TimerEvent&) { updater_.update(); });
+
+  reload_worker_ = std::thread(&CalibratorRos::reloadLoop, this);
+  bool autostart = true;
+  pnh_.param("autostart", autostart, autostart);
+  if (autostart) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::string reason;
+    if (!startRun(stages_[next_stage_++], &reason)) throw std::runtime_error("calibrator: " + reason);
+  }
+}
+
+CalibratorRos::~CalibratorRos() {
+  {
+    std::lock_guard<std::mutex> lock(reload_mutex_);
+    stopping_ = true;
+  }
+  reload_cv_.notify_all();
+  if (reload_worker_.joinable()) reload_worker_.join();
+}
+
+void CalibratorRos::reloadLoop() {
+  for (;;) {
+    bool start_next = false;
+    {
+      std::unique_lock<std::mutex> lock(reload_mutex_);
+      reload_cv_.wait(lock, [this] { return stopping_ || !reload_requests_.empty(); });
+      if (stopping_) return;
+      start_next = reload_requests_.front();
+      reload_requests_.pop_front();
+    }
+    bool reloaded = reload_service_.empty();
+    if (!reloaded) {
+      const std::string service = nh_.resolveName(reload_service_);
+      std_srvs::Trigger call;
+      if (ros::service::waitForService(service, ros::Duration(5.0)) && ros::service::call(service, call)) {
+        reloaded = call.response.success;
+        if (reloaded) {
+          ROS_INFO("calibrator: processor reloaded: %s", call.response.message.c_str());
+        } else {
+          ROS_ERROR("calibrator: processor refused the new file: %s", call.response.message.c_str());
+        }
+      } else {
+        ROS_ERROR("calibrator: could not call %s", service.c_str());
+      }
+    }
+    if (start_next && reloaded) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      std::string reason;
+      if (next_stage_ < stages_.size()) startRun(stages_[next_stage_++], &reason);
+    }
+  }
+}
+
+bool CalibratorRos::startRun(const std::string& method, std::string* reason) {
+  try {
+    core::CalibrationSettings settings = base_settings_;
+    settings.method = method;
+    session_ = std::make_unique<core::CalibrationSession>(settings, core::loadParameterFile(parameter_file_));
+    raw_.clear();
+    reference_.clear();
+    ROS_INFO("calibrator: %s run started (prior %s)", method.c_str(), parameter_file_.c_str());
+    return true;
+  } catch (const std::exception& e) {
+    *reason = std::string("cannot start ") + method + ": " + e.what();
+    ROS_ERROR("calibrator: %s", reason->c_str());
+    session_.reset();
+    return false;
+  }
+}
+
+void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!session_) return;
+  session_->addTurntable(toNanoseconds(msg->header.stamp), msg->angle, msg->rate);
+  if (session_->shouldFinish()) {
+    bool written = false;
+    std::string message;
+    finishRun(&written, &message);
+  }
+}
+
+void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (session_) session_->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency);
+}
+
+void CalibratorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!session_ || session_->settings().method != "correction_matrix") return;
+  raw_[toNanoseconds(msg->header.stamp)] = core::ChannelVector(msg->c_in, msg->c_quad, msg->s_in, msg->s_quad);
+  pairGenerator();
+}
+
+void CalibratorRos::onTruth(const GroundTruth::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!session_ || session_->settings().method != "correction_matrix" || !msg->generator) return;
+  reference_[toNanoseconds(msg->header.stamp)] =
+      core::idealChannels({msg->amplitude, msg->quadrature, msg->theta, msg->phase});
+  pairGenerator();
+  if (session_->shouldFinish()) {
+    bool written = false;
+    std::string message;
+    finishRun(&written, &message);
+  }
+}
+
+void CalibratorRos::pairGenerator() {
+  // Both streams carry the driver's stamps: pair exactly, forget what can no longer pair.
+  while (!raw_.empty() && !reference_.empty()) {
+    const core::Nanoseconds a = raw_.begin()->first, b = reference_.begin()->first;
+    if (a == b) {
+      session_->addGeneratorPair(raw_.begin()->second, reference_.begin()->second);
+      raw_.erase(raw_.begin());
+      reference_.erase(reference_.begin());
+    } else if (a < b) {
+      raw_.erase(raw_.begin());
+    } else {
+      reference_.erase(reference_.begin());
+    }
+  }
+  while (raw_.size() > 10000) raw_.erase(raw_.begin());
+}
+
+core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* message) {
+  core::CalibrationOutcome o = session_->finish();
+  *written = false;
+  if (o.accepted && write_) {
+    try {
+      o.parameters.calibration.source = "live";
+      core::saveParameterFile(parameter_file_, o.parameters);
+      *written = true;
+      *message = "accepted and written to " + parameter_file_;
+    } catch (const std::exception& e) {
+      *message = std::string("accepted but not written: ") + e.what();
+      o.reason = *message;
+    }
+  } else {
+    *message = o.accepted ? "accepted, not written (~write is false)" : "refused: " + o.reason;
+  }
+  {
+    std::ofstream report(report_file_);
+    report << core::emitCalibrationReport(o);
+    if (!report) ROS_WARN("calibrator: cannot write the report %s", report_file_.c_str());
+  }
+  result_pub_.publish(toMessage(o, *written, parameter_file_, ros::Time::now()));
+  ++runs_;
+  last_accepted_ = o.accepted && *written;
+  last_result_ = *message;
+  if (*written) {
+    ROS_INFO("calibrator: %s %s (peak nonlinearity of the new K: %.1f ppm, coverage %.1f %%)", o.method.c_str(),
+             message->c_str(), o.nonlinearity_ppm, 100 * o.coverage);
+  } else {
+    ROS_WARN("calibrator: %s %s", o.method.c_str(), message->c_str());
+  }
+  session_.reset();
+  const bool more = *written && next_stage_ < stages_.size();
+  if (*written) {
+    {
+      std::lock_guard<std::mutex> lock(reload_mutex_);
+      reload_requests_.push_back(more);
+    }
+    reload_cv_.notify_one();
+  }
+  return o;
+}
+
+bool CalibratorRos::onStart(StartCalibration::Request& req, StartCalibration::Response& res) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (req.method.empty()) {
+    next_stage_ = 0;
+  } else {
+    if (!core::CalibrationSettings::knownMethod(req.method)) {
+      res.success = false;
+      res.message = "unknown method '" + req.method + "' (dual_rate, constant_rate, step, correction_matrix)";
+      return true;
+    }
+    stages_ = {req.method};
+    next_stage_ = 0;
+  }
+  std::string reason;
+  res.success = startRun(stages_[next_stage_++], &reason);
+  res.message = res.success ? "started " + session_->settings().method : reason;
+  return true;
+}
+
+bool CalibratorRos::onFinish(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!session_) {
+    res.success = false;
+    res.message = "no calibration run in progress";
+    return true;
+  }
+  bool written = false;
+  std::string message;
+  finishRun(&written, &message);
+  res.success = written;
+  res.message = message;
+  return true;
+}
+
+bool CalibratorRos::onAbort(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  res.success = session_ != nullptr;
+  res.message = session_ ? "aborted " + session_->settings().method + ": nothing written" : "no run in progress";
+  session_.reset();
+  next_stage_ = stages_.size();
+  return true;
+}
+
+void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (session_) {
+    const core::CalibrationProgress p = session_->progress();
+    const core::SessionCounters& c = session_->counters();
+    if (c.turntable == 0 && c.wave > 100) {
+      stat.summary(DiagnosticStatus::WARN, "wave samples but no turntable state: check turntable/state");
+    } else {
+      stat.summaryf(DiagnosticStatus::OK, "%s %.0f %%", p.summary.c_str(), 100 * p.fraction);
+    }
+    stat.add("method", session_->settings().method);
+    stat.add("progress", p.fraction);
+    stat.add("turntable states", c.turntable);
+    stat.add("wave samples", c.wave);
+    stat.add("used", c.used);
+    stat.add("not on a settled plateau", c.unsettled);
+    stat.add("without turntable state", c.unsynchronized);
+  } else if (runs_ > 0 && !last_accepted_) {
+    stat.summary(DiagnosticStatus::WARN, "idle; last run " + last_result_);
+  } else {
+    stat.summary(DiagnosticStatus::OK, runs_ > 0 ? "idle; last run " + last_result_ : "idle");
+  }
+  stat.add("runs", runs_);
+  stat.add("parameter file", parameter_file_);
+}
+
+}  // namespace hrg_gyro

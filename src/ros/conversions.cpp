@@ -1,0 +1,108 @@
+#include "hrg_gyro/ros/conversions.h"
+
+#include <cmath>
+
+namespace hrg_gyro {
+
+HarmonicEstimate toMessage(const core::HarmonicFitResult& fit, double frequency) {
+  HarmonicEstimate m;
+  m.orders.assign(fit.orders.begin(), fit.orders.end());
+  m.frequency = frequency;
+  m.mean = fit.mean;
+  m.mean_std = fit.mean_std;
+  m.cos = fit.cos;
+  m.cos_std = fit.cos_std;
+  m.sin = fit.sin;
+  m.sin_std = fit.sin_std;
+  m.residual_rms = fit.residual_rms;
+  m.points = static_cast<std::uint32_t>(fit.points);
+  return m;
+}
+
+core::HarmonicFitResult fromMessage(const HarmonicEstimate& m) {
+  core::HarmonicFitResult f;
+  f.ok = true;
+  f.orders.assign(m.orders.begin(), m.orders.end());
+  f.mean = m.mean;
+  f.mean_std = m.mean_std;
+  f.cos = m.cos;
+  f.cos_std = m.cos_std;
+  f.sin = m.sin;
+  f.sin_std = m.sin_std;
+  f.residual_rms = m.residual_rms;
+  f.points = m.points;
+  return f;
+}
+
+CalibrationResult toMessage(const core::CalibrationOutcome& o, bool written, const std::string& file,
+                            const ros::Time& stamp) {
+  CalibrationResult m;
+  m.header.stamp = stamp;
+  m.method = o.method;
+  m.accepted = o.accepted;
+  m.written = written;
+  m.reason = o.reason;
+  m.parameter_file = file;
+  for (std::size_t i = 0; i < o.scale_factor.size(); ++i) {
+    m.scale_factor.push_back(toMessage(o.scale_factor[i], i < o.frequency_nodes.size() ? o.frequency_nodes[i] : NAN));
+  }
+  for (std::size_t i = 0; i < o.drift.size(); ++i) {
+    m.drift.push_back(toMessage(o.drift[i], i < o.frequency_nodes.size() ? o.frequency_nodes[i] : NAN));
+  }
+  for (int i = 0; i < 4; ++i) {
+    m.correction[i] = o.parameters.correction.p[i];
+    m.correction_std[i] = o.has_correction ? o.correction.standard_error[i] : 0.0;
+  }
+  m.coverage = o.coverage;
+  m.smoothing_factor = o.smoothing_factor;
+  m.error_bound = o.error_bound;
+  m.nonlinearity_ppm = o.nonlinearity_ppm;
+  m.duration = o.duration;
+  m.samples = o.samples;
+  for (const core::GroupSummary& g : o.plateaus) {
+    PlateauSummary p;
+    p.rate = g.rate;
+    p.rate_std = g.rate_std;
+    p.duration = g.duration;
+    p.samples = g.samples;
+    p.coverage = g.coverage;
+    p.turns = g.turns;
+    m.plateaus.push_back(p);
+  }
+  for (const core::GateResult& g : o.gates) {
+    QualityGate q;
+    q.name = g.name;
+    q.passed = g.passed;
+    q.value = g.value;
+    q.limit = g.limit;
+    q.message = g.message;
+    m.gates.push_back(q);
+  }
+  return m;
+}
+
+core::CalibrationOutcome fromMessage(const CalibrationResult& m) {
+  core::CalibrationOutcome o;
+  o.method = m.method;
+  o.accepted = m.accepted;
+  o.reason = m.reason;
+  for (const HarmonicEstimate& h : m.scale_factor) {
+    o.scale_factor.push_back(fromMessage(h));
+    if (!std::isnan(h.frequency)) o.frequency_nodes.push_back(h.frequency);
+  }
+  for (const HarmonicEstimate& h : m.drift) o.drift.push_back(fromMessage(h));
+  for (int i = 0; i < 4; ++i) o.parameters.correction.p[i] = m.correction[i];
+  o.coverage = m.coverage;
+  o.smoothing_factor = m.smoothing_factor;
+  o.error_bound = m.error_bound;
+  o.nonlinearity_ppm = m.nonlinearity_ppm;
+  o.duration = m.duration;
+  o.samples = m.samples;
+  for (const PlateauSummary& p : m.plateaus) {
+    o.plateaus.push_back({p.rate, p.rate_std, p.duration, p.samples, p.coverage, p.turns});
+  }
+  for (const QualityGate& q : m.gates) o.gates.push_back({q.name, q.passed, q.value, q.limit, q.message});
+  return o;
+}
+
+}  // namespace hrg_gyro

@@ -1,0 +1,155 @@
+#include "hrg_gyro/ros/driver_sim_ros.h"
+
+#include <rosgraph_msgs/Clock.h>
+#include <std_msgs/Bool.h>
+
+#include "hrg_gyro/ChannelAmplitudes.h"
+#include "hrg_gyro/GroundTruth.h"
+#include "hrg_gyro/TurntableState.h"
+#include "hrg_gyro/ros/conversions.h"
+#include "hrg_gyro/ros/param_tree.h"
+
+namespace hrg_gyro {
+
+DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_process)
+    : nh_(nh), pnh_(pnh), owns_process_(owns_process) {
+  const YAML::Node params = privateParameters(pnh_);
+  config_ = std::make_unique<core::SimulationConfig>(
+      core::SimulationConfig::parse(core::YamlField(params, ""), core::nodeOnlyScenarioKeys()));
+  pnh_.param("time_scale", time_scale_, time_scale_);
+  pnh_.param("clock_period", clock_period_, clock_period_);
+  pnh_.param("frame_id", frame_id_, frame_id_);
+  ros::param::param("/use_sim_time", use_sim_time_, false);
+  pnh_.param("publish_clock", publish_clock_, use_sim_time_);
+  pnh_.param("shutdown_when_done", shutdown_when_done_, shutdown_when_done_);
+  pnh_.param("wait_for_subscribers/channels", wait_channels_, 0);
+  pnh_.param("wait_for_subscribers/turntable", wait_turntable_, 0);
+  pnh_.param("wait_for_subscribers/truth", wait_truth_, 0);
+  pnh_.param("wait_timeout", wait_timeout_, wait_timeout_);
+  int queue_size = 20000;
+  pnh_.param("queue_size", queue_size, queue_size);
+  if (!(clock_period_ > 0.0)) throw std::invalid_argument("~clock_period must be positive (s)");
+  if (!use_sim_time_ && time_scale_ != 1.0) {
+    ROS_WARN("driver_sim: ~time_scale = %g without /use_sim_time: stamps will run ahead of the wall clock",
+             time_scale_);
+  }
+  channels_pub_ = nh_.advertise<ChannelAmplitudes>("channels", queue_size);
+  turntable_pub_ = nh_.advertise<TurntableState>("turntable/state", queue_size);
+  truth_pub_ = nh_.advertise<GroundTruth>("truth", queue_size);
+  done_pub_ = pnh_.advertise<std_msgs::Bool>("done", 1, true);
+  if (use_sim_time_ && publish_clock_) clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 100);
+  std_msgs::Bool done;
+  done.data = false;
+  done_pub_.publish(done);
+  core::GyroSimulator probe(*config_);
+  ROS_INFO("driver_sim: %.1f s scenario at %.0f Hz output (%s), time scale %s", probe.duration(),
+           1.0 / config_->outputPeriod(), config_->generator.enabled ? "generator sweep first" : "turntable profile",
+           time_scale_ > 0.0 ? std::to_string(time_scale_).c_str() : "as fast as possible");
+  worker_ = std::thread(&DriverSimRos::run, this);
+}
+
+DriverSimRos::~DriverSimRos() {
+  stop_ = true;
+  if (worker_.joinable()) worker_.join();
+}
+
+bool DriverSimRos::waitForSubscribers() {
+  const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(wait_timeout_);
+  while (!stop_ && ros::ok()) {
+    if (static_cast<int>(channels_pub_.getNumSubscribers()) >= wait_channels_ &&
+        static_cast<int>(turntable_pub_.getNumSubscribers()) >= wait_turntable_ &&
+        static_cast<int>(truth_pub_.getNumSubscribers()) >= wait_truth_) {
+      return true;
+    }
+    if (ros::WallTime::now() > until) {
+      ROS_WARN("driver_sim: starting after %.1f s without all expected subscribers (channels %u/%d, "
+               "turntable %u/%d, truth %u/%d)",
+               wait_timeout_, channels_pub_.getNumSubscribers(), wait_channels_, turntable_pub_.getNumSubscribers(),
+               wait_turntable_, truth_pub_.getNumSubscribers(), wait_truth_);
+      return true;
+    }
+    ros::WallDuration(0.01).sleep();
+  }
+  return false;
+}
+
+void DriverSimRos::run() {
+  core::GyroSimulator sim(*config_);
+  const core::Nanoseconds origin =
+      use_sim_time_ ? 0 : toNanoseconds(ros::Time::now()) - core::toNanoseconds(config_->start_time);
+  // Under sim time the clock must run before anyone waits for subscribers' time to pass.
+  if (!clock_pub_.getTopic().empty()) {
+    rosgraph_msgs::Clock c;
+    c.clock = toRosTime(core::toNanoseconds(config_->start_time));
+    clock_pub_.publish(c);
+  }
+  if (!waitForSubscribers()) return;
+  const ros::WallTime wall_start = ros::WallTime::now();
+  core::SimulationSample s;
+  double next_clock = 0.0;
+  std::uint32_t seq = 0;
+  while (!stop_ && ros::ok() && sim.next(&s)) {
+    const ros::Time stamp = toRosTime(origin + s.stamp);
+    if (time_scale_ > 0.0) {
+      const ros::WallTime due = wall_start + ros::WallDuration(sim.elapsed() / time_scale_);
+      const ros::WallTime now = ros::WallTime::now();
+      if (due > now) (due - now).sleep();
+    }
+    if (!clock_pub_.getTopic().empty() && sim.elapsed() >= next_clock) {
+      rosgraph_msgs::Clock c;
+      c.clock = stamp;
+      clock_pub_.publish(c);
+      next_clock = sim.elapsed() + clock_period_;
+    }
+    auto channels = boost::make_shared<ChannelAmplitudes>();
+    channels->header.seq = seq;
+    channels->header.stamp = stamp;
+    channels->header.frame_id = frame_id_;
+    channels->c_in = s.z[core::kAc];
+    channels->c_quad = s.z[core::kBc];
+    channels->s_in = s.z[core::kAs];
+    channels->s_quad = s.z[core::kBs];
+    channels->frequency = s.frequency;
+    channels->temperature = s.temperature;
+    channels->periods = s.periods;
+    channels_pub_.publish(channels);
+
+    auto table = boost::make_shared<TurntableState>();
+    table->header = channels->header;
+    table->angle = s.truth.table_angle;
+    table->rate = s.truth.table_rate;
+    turntable_pub_.publish(table);
+
+    if (truth_pub_.getNumSubscribers() > 0) {
+      auto truth = boost::make_shared<GroundTruth>();
+      truth->header = channels->header;
+      truth->table_angle = s.truth.table_angle;
+      truth->table_rate = s.truth.table_rate;
+      truth->inertial_angle = s.truth.inertial_angle;
+      truth->inertial_rate = s.truth.inertial_rate;
+      truth->theta = s.truth.theta;
+      truth->amplitude = s.truth.amplitude;
+      truth->quadrature = s.truth.quadrature;
+      truth->phase = s.truth.phase;
+      truth->frequency = s.truth.frequency;
+      truth->temperature = s.truth.temperature;
+      truth->generator = s.truth.generator;
+      truth->segment = s.truth.segment ? *s.truth.segment : std::string();
+      truth_pub_.publish(truth);
+    }
+    ++seq;
+  }
+  if (stop_ || !ros::ok()) return;
+  const double wall = (ros::WallTime::now() - wall_start).toSec();
+  ROS_INFO("driver_sim: scenario complete: %u samples, %.1f s simulated in %.1f s of wall time (%.1fx)", seq,
+           sim.elapsed(), wall, wall > 0 ? sim.elapsed() / wall : 0.0);
+  std_msgs::Bool done;
+  done.data = true;
+  done_pub_.publish(done);
+  if (shutdown_when_done_ && owns_process_) {
+    ros::WallDuration(0.5).sleep();  // let the last messages and the latched flag go out
+    ros::requestShutdown();
+  }
+}
+
+}  // namespace hrg_gyro
