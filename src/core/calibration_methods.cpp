@@ -296,14 +296,18 @@ StepMethod::StepMethod(const CalibrationSettings& s)
 void StepMethod::pair(const DwellFit& before, const DwellFit& after) {
   const double dalpha = after.meanTableAngle() - before.meanTableAngle();
   if (std::abs(dalpha) < 1e-3) return;  // a pause, not a step
-  const double theta1 = before.valueAt(before.end()), theta2 = after.valueAt(after.start());
-  const double tau = toSeconds(after.start() - before.end());
+  // Bridge the motion only: from the last sample at rest before it to the instant the table
+  // stopped, each end taken from its dwell's line (the next dwell's slope covers its own settling,
+  // so the mean rest rate is applied only while the angle actually moves).
+  const double theta1 = before.valueAt(before.end()), theta2 = after.valueAt(after.restSince());
+  const double tau = toSeconds(after.restSince() - before.end());
   const double rest = 0.5 * (before.slope() + after.slope());
   const double k = (theta2 - theta1 - rest * tau) / dalpha;
   const double mid = positiveModulo(0.5 * (theta1 + theta2), kPi), span = std::abs(theta2 - theta1);
   int b = static_cast<int>(mid / kPi * steps_.size());
   b = std::min(b, static_cast<int>(steps_.size()) - 1);
   steps_[b].k_sum += k;
+  steps_[b].theta_sum += mid;
   steps_[b].span_sum += span;
   steps_[b].count += 1.0;
   ++step_count_;
@@ -328,6 +332,7 @@ void StepMethod::closeDwell() {
   const int b = std::min(static_cast<int>(dwells_.size()) - 1,
                          static_cast<int>(positiveModulo(current_.meanTheta(), kPi) / kPi * dwells_.size()));
   dwells_[b].rate_sum += current_.slope();
+  dwells_[b].theta_sum += positiveModulo(current_.meanTheta(), kPi);
   dwells_[b].count += 1.0;
   dwell_time_ += current_.duration();
   previous_ = current_;
@@ -341,6 +346,7 @@ void StepMethod::addSample(const PlateauSample& s) {
   if (s.plateau.id != current_plateau_) {
     closeDwell();
     current_plateau_ = s.plateau.id;
+    current_.setRestSince(s.plateau.start);
   }
   current_.add(s.stamp, s.theta, s.table_angle);
 }
@@ -379,7 +385,7 @@ CalibrationOutcome StepMethod::finish(const GyroParameters& prior) const {
   for (std::size_t b = 0; b < m.steps_.size(); ++b) {
     const StepBin& s = m.steps_[b];
     if (s.count <= 0.0) continue;
-    kp.push_back({(b + 0.5) * kPi / m.steps_.size(), s.k_sum / s.count, s.count, s.span_sum / s.count});
+    kp.push_back({s.theta_sum / s.count, s.k_sum / s.count, s.count, s.span_sum / s.count, {}});
     o.binned.push_back({kp.back().theta, kp.back().value, 0.0, s.count});
   }
   HarmonicFitResult k = fitHarmonics(kp, settings_.scale_factor_orders, {}, INFINITY);
@@ -396,8 +402,8 @@ CalibrationOutcome StepMethod::finish(const GyroParameters& prior) const {
   for (std::size_t b = 0; b < m.dwells_.size(); ++b) {
     const DwellBin& d = m.dwells_[b];
     if (d.count <= 0.0) continue;
-    const double th = (b + 0.5) * kPi / m.dwells_.size();
-    dp.push_back({th, d.rate_sum / d.count - k_model(th) * earth, d.count, kPi / m.dwells_.size()});
+    const double th = d.theta_sum / d.count;
+    dp.push_back({th, d.rate_sum / d.count - k_model(th) * earth, d.count, 0.0, {}});
   }
   HarmonicFitResult d = fitHarmonics(dp, settings_.drift_orders, {}, INFINITY);
   if (!d.ok) {

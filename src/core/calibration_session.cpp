@@ -53,7 +53,10 @@ void CalibrationSession::addWave(Nanoseconds stamp, double theta, double frequen
   drain();
 }
 
-void CalibrationSession::addGeneratorPair(const ChannelVector& raw, const ChannelVector& reference) {
+void CalibrationSession::generatorSweepEnded() { generator_ended_ = last_generator_stamp_ > 0; }
+
+void CalibrationSession::addGeneratorPair(Nanoseconds stamp, const ChannelVector& raw, const ChannelVector& reference) {
+  last_generator_stamp_ = std::max(last_generator_stamp_, stamp);
   method_->addGeneratorPair(raw, reference);
   ++counters_.used;
 }
@@ -98,7 +101,7 @@ void CalibrationSession::classify(const WaveRecord& w) {
 
 bool CalibrationSession::shouldFinish() const {
   if (settings_.auto_finish_idle <= 0.0 || !method_->complete()) return false;
-  if (settings_.method == "correction_matrix") return true;
+  if (settings_.method == "correction_matrix") return generator_ended_;
   if (turntable_.empty()) return false;
   const TurntableRecord& last = turntable_.back();
   return last.plateau.is_static && toSeconds(last.stamp - last.plateau.start) >= settings_.auto_finish_idle;

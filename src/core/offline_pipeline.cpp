@@ -12,7 +12,8 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
   SimulationSample s;
   while (sim.next(&s)) {
     if (s.truth.generator) {
-      session.addGeneratorPair(s.z, idealChannels({s.truth.amplitude, s.truth.quadrature, s.truth.theta, s.truth.phase}));
+      session.addGeneratorPair(s.stamp, s.z,
+                               idealChannels({s.truth.amplitude, s.truth.quadrature, s.truth.theta, s.truth.phase}));
       continue;
     }
     session.addTurntable(s.stamp, s.truth.table_angle, s.truth.table_rate);

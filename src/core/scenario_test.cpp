@@ -88,7 +88,8 @@ TEST(Scenarios, ShippedScenariosParseAndDescribeTheSameGyro) {
   const std::string dir = std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/";
   std::string reference_gyro;
   for (const char* name :
-       {"dual_rate.yaml", "constant_rate.yaml", "steps.yaml", "verification.yaml", "generator.yaml", "demo.yaml"}) {
+       {"dual_rate.yaml", "constant_rate.yaml", "steps.yaml", "verification.yaml", "generator.yaml", "demo.yaml",
+        "two_stage.yaml"}) {
     SCOPED_TRACE(name);
     const SimulationConfig c = SimulationConfig::load(dir + name, nodeOnlyScenarioKeys());
     EXPECT_EQ(c.resonator.samples_per_period, 32);

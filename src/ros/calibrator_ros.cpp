@@ -49,8 +49,7 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   if (report_file_.size() > 5 && report_file_.substr(report_file_.size() - 5) == ".yaml") {
     report_file_.resize(report_file_.size() - 5);
   }
-  report_file_ += ".report.yaml";
-  pnh_.param("report_file", report_file_, report_file_);
+  pnh_.param("report_file", report_file_, report_file_ + ".report.yaml");
   pnh_.param<std::string>("output_directory", output_directory_, "");
   pnh_.param<std::string>("reload_service", reload_service_, "processor/reload");
   pnh_.param("write", write_, write_);
@@ -181,15 +180,23 @@ void CalibratorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
 
 void CalibratorRos::onTruth(const GroundTruth::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!session_ || session_->settings().method != "correction_matrix" || !msg->generator) return;
+  if (!session_ || session_->settings().method != "correction_matrix") return;
+  if (!msg->generator) {
+    // The truth stream has left the sweep: every generator reference has arrived. The raw channels
+    // that pair with them may still be queued, so pair what is there, then finish.
+    if (!reference_.empty() || session_->counters().used > 0) {
+      session_->generatorSweepEnded();
+      if (session_->shouldFinish()) {
+        bool written = false;
+        std::string message;
+        finishRun(&written, &message);
+      }
+    }
+    return;
+  }
   reference_[toNanoseconds(msg->header.stamp)] =
       core::idealChannels({msg->amplitude, msg->quadrature, msg->theta, msg->phase});
   pairGenerator();
-  if (session_->shouldFinish()) {
-    bool written = false;
-    std::string message;
-    finishRun(&written, &message);
-  }
 }
 
 void CalibratorRos::pairGenerator() {
@@ -197,7 +204,7 @@ void CalibratorRos::pairGenerator() {
   while (!raw_.empty() && !reference_.empty()) {
     const core::Nanoseconds a = raw_.begin()->first, b = reference_.begin()->first;
     if (a == b) {
-      session_->addGeneratorPair(raw_.begin()->second, reference_.begin()->second);
+      session_->addGeneratorPair(a, raw_.begin()->second, reference_.begin()->second);
       raw_.erase(raw_.begin());
       reference_.erase(reference_.begin());
     } else if (a < b) {
@@ -226,9 +233,13 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
     *message = o.accepted ? "accepted, not written (~write is false)" : "refused: " + o.reason;
   }
   {
-    std::ofstream report(report_file_);
+    // One report per method, so a two-stage session keeps both.
+    std::string path = report_file_;
+    const std::size_t dot = path.rfind(".report.yaml");
+    if (dot != std::string::npos) path.insert(dot, "." + o.method);
+    std::ofstream report(path);
     report << core::emitCalibrationReport(o);
-    if (!report) ROS_WARN("calibrator: cannot write the report %s", report_file_.c_str());
+    if (!report) ROS_WARN("calibrator: cannot write the report %s", path.c_str());
   }
   result_pub_.publish(toMessage(o, *written, parameter_file_, ros::Time::now()));
   ++runs_;

@@ -65,11 +65,11 @@ class StepMethod : public CalibrationMethod {
   CalibrationOutcome finish(const GyroParameters& prior) const override;
 
  private:
-  struct StepBin {  // step results binned by mid angle (weights: steps)
-    double k_sum = 0.0, span_sum = 0.0, count = 0.0;
+  struct StepBin {  // step results binned by mid angle; the fit uses their mean angle, not the bin centre
+    double k_sum = 0.0, theta_sum = 0.0, span_sum = 0.0, count = 0.0;
   };
   struct DwellBin {
-    double rate_sum = 0.0, count = 0.0;
+    double rate_sum = 0.0, theta_sum = 0.0, count = 0.0;
   };
   /// Bins the step between two consecutive dwells and the first dwell's rest rate.
   void pair(const DwellFit& before, const DwellFit& after);

@@ -32,14 +32,18 @@ class CalibrationSession {
 
   void addTurntable(Nanoseconds stamp, double angle, double rate);
   void addWave(Nanoseconds stamp, double theta, double frequency);
-  void addGeneratorPair(const ChannelVector& raw, const ChannelVector& reference);
+  void addGeneratorPair(Nanoseconds stamp, const ChannelVector& raw, const ChannelVector& reference);
+  /// The generator stream has moved past its sweep (told by that same stream, so it cannot be
+  /// confused by another stream's lag): the correction-matrix run may finish.
+  void generatorSweepEnded();
 
   const CalibrationSettings& settings() const { return settings_; }
   const GyroParameters& prior() const { return prior_; }
   const SessionCounters& counters() const { return counters_; }
   CalibrationProgress progress() const { return method_->progress(); }
   bool complete() const { return method_->complete(); }
-  /// Auto-finish rule: the data are complete and the table has rested for auto_finish_idle s.
+  /// Auto-finish rule: the data are complete and the table has rested for auto_finish_idle s (for
+  /// the correction matrix: the generator sweep has ended).
   bool shouldFinish() const;
   /// Fits, applies the gates and builds the new parameters (does not write anything).
   CalibrationOutcome finish() const;
@@ -65,6 +69,8 @@ class CalibrationSession {
   std::deque<WaveRecord> pending_;
   SessionCounters counters_;
   Nanoseconds last_wave_stamp_ = 0;
+  Nanoseconds last_generator_stamp_ = 0;
+  bool generator_ended_ = false;
 };
 
 }  // namespace core

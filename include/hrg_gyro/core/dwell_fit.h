@@ -14,6 +14,10 @@ class DwellFit {
  public:
   void add(Nanoseconds stamp, double theta, double table_angle);
 
+  /// When the table came to rest (the plateau's first state); the settled samples start later.
+  void setRestSince(Nanoseconds t) { rest_since_ = t; }
+  Nanoseconds restSince() const { return rest_since_ != 0 ? rest_since_ : start_; }
+
   std::uint64_t samples() const { return n_; }
   Nanoseconds start() const { return start_; }
   Nanoseconds end() const { return end_; }
@@ -26,7 +30,7 @@ class DwellFit {
   double residualStd() const;           ///< rad
 
  private:
-  Nanoseconds start_ = 0, end_ = 0;
+  Nanoseconds start_ = 0, end_ = 0, rest_since_ = 0;
   double theta0_ = 0.0;  // first theta: keeps the sums small when theta is ~1e3 rad
   double t_ = 0.0, th_ = 0.0, tt_ = 0.0, tth_ = 0.0, thth_ = 0.0, angle_ = 0.0;
   std::uint64_t n_ = 0;

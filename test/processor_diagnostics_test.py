@@ -1,0 +1,96 @@
+#!/usr/bin/env python3
+"""Diagnostics of the processor: OK on good input, ERROR naming the cause when every sample is bad
+(NaN, degenerate wave), WARN when some are, ERROR when the input stalls, OK again on recovery;
+and the output never carries a NaN."""
+import math
+import os
+import sys
+import time
+import unittest
+
+import rospy
+import rostest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+
+from hrg_gyro.msg import ChannelAmplitudes, GyroOutput
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import hrg_test_util as util  # noqa: E402
+from processor_reload_test import channels  # noqa: E402
+
+
+class Diagnostics(unittest.TestCase):
+    def setUp(self):
+        self.statuses = {}
+        self.nan_outputs = 0
+        rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diag)
+        rospy.Subscriber("/output", GyroOutput, self.on_output)
+        self.pub = rospy.Publisher("/channels", ChannelAmplitudes, queue_size=100)
+        util.wait_for(lambda: self.pub.get_num_connections() > 0, 30, "the processor to subscribe")
+        self.seq = 0
+        self.t = time.time()
+
+    def on_diag(self, msg):
+        for s in msg.status:
+            self.statuses[s.name.split(": ")[-1]] = (s.level, s.message, rospy.get_time())
+
+    def on_output(self, msg):
+        if any(math.isnan(v) for v in (msg.dalpha, msg.alpha, msg.rate, msg.scale_factor)):
+            self.nan_outputs += 1
+
+    def feed(self, seconds, mutate=None):
+        end = time.time() + seconds
+        while time.time() < end:
+            self.seq += 1
+            self.t += 0.005
+            m = channels(self.seq, self.t, 0.2 - 0.028 * (self.t % 100))
+            if mutate:
+                mutate(m)
+            self.pub.publish(m)
+            time.sleep(0.005)
+
+    def status_after(self, name, since):
+        def fresh():
+            s = self.statuses.get(name)
+            return s if s and s[2] > since else None
+        return util.wait_for(fresh, 10, "a diagnostic '%s'" % name)
+
+    def test_good_bad_stalled_recovered(self):
+        self.feed(2.5)
+        level, message, _ = self.status_after("wave", rospy.get_time())
+        self.assertEqual(level, DiagnosticStatus.OK, message)
+
+        def nan(m):
+            m.s_in = float("nan")
+        start = rospy.get_time()
+        self.feed(2.5, nan)
+        level, message, _ = self.status_after("wave", start + 1.2)
+        self.assertEqual(level, DiagnosticStatus.ERROR, message)
+        self.assertIn("non-finite", message)
+
+        def degenerate(m):  # a travelling wave: A = B
+            m.c_in, m.c_quad, m.s_in, m.s_quad = 1.0, 0.0, 0.0, 1.0
+        start = rospy.get_time()
+        self.feed(2.5, degenerate)
+        level, message, _ = self.status_after("wave", start + 1.2)
+        self.assertEqual(level, DiagnosticStatus.ERROR, message)
+        self.assertIn("degenerate", message)
+
+        start = rospy.get_time()
+        time.sleep(2.5)  # nothing arrives
+        level, message, _ = self.status_after("input", start + 1.0)
+        self.assertEqual(level, DiagnosticStatus.ERROR, message)
+        self.assertIn("stalled", message)
+
+        start = rospy.get_time()
+        self.feed(3.0)
+        level, message, _ = self.status_after("wave", start + 1.5)
+        self.assertEqual(level, DiagnosticStatus.OK, message)
+        level, message, _ = self.status_after("input", start + 1.5)
+        self.assertNotEqual(level, DiagnosticStatus.ERROR, message)
+        self.assertEqual(self.nan_outputs, 0)
+
+
+if __name__ == "__main__":
+    rospy.init_node("processor_diagnostics_test")
+    rostest.rosrun("hrg_gyro", "processor_diagnostics", Diagnostics)
