@@ -23,6 +23,10 @@ build: deps
 	@mkdir -p $(WS)/src
 	@ln -sfn $(ROOT) $(WS)/src/hrg_gyro
 	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS)
+	@# catkin caches the environment at the first configure, before the generated Python messages
+	@# exist; reconfigure once so tests and tools run with them on PYTHONPATH.
+	@grep -q "dist-packages" $(WS)/build/catkin_generated/setup_cached.sh || \
+	  (cd $(WS) && catkin_make $(CATKIN_ARGS) --force-cmake -j$(JOBS) > /dev/null)
 
 test: build
 	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) tests

@@ -10,6 +10,7 @@ namespace core {
 GyroSimulator::GyroSimulator(const SimulationConfig& config)
     : config_(config),
       synth_(config_.pickoff, config_.resonator.samples_per_period, config_.seed),
+      rate_noise_(config_.seed ^ 0x5deece66dULL),
       intrinsic_(config_.resonator.scale_factor, config_.resonator.drift),
       earth_rate_(verticalEarthRate(config_.latitude)),
       theta_(config_.resonator.initial_theta) {}
@@ -67,7 +68,13 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
     const double k2 = thetaRate(t + h / 2, theta_ + h / 2 * k1);
     const double k3 = thetaRate(t + h / 2, theta_ + h / 2 * k2);
     const double k4 = thetaRate(t + h, theta_ + h * k3);
-    const double theta_end = theta_ + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    double theta_end = theta_ + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    if (rc.rate_noise > 0.0) {
+      // A white body-rate noise, seen through the scale factor like any rotation.
+      double k, d;
+      intrinsic_.evaluate(theta_, rc.frequency, &k, &d);
+      theta_end += k * rc.rate_noise * std::sqrt(h) * rate_noise_.next();
+    }
     wave.theta = theta_;
     sum += synth_.period(wave, theta_end);
     theta_ = theta_end;

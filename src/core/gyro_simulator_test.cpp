@@ -50,7 +50,9 @@ TEST(GyroSimulator, IdealPickoffMeasuresTheTrueAngleUpToTheRotationTerm) {
     EXPECT_NEAR(w.amplitude, std::sqrt(1.0 + 0.02 * 0.02 - quadrature * quadrature), 0.05 * tolerance + 1e-12) << n;
     previous_rate = s.truth.table_rate;
     worst = std::max(worst, std::abs(dtheta));
-    if (n > 0) EXPECT_NEAR(toSeconds(s.stamp) - previous_stamp, 1e-3, 1e-9);
+    if (n > 0) {
+      EXPECT_NEAR(toSeconds(s.stamp) - previous_stamp, 1e-3, 1e-9);
+    }
     previous_stamp = toSeconds(s.stamp);
     previous_theta = s.truth.theta;
     ++n;

@@ -29,7 +29,7 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
   if (root.has("resonator")) {
     const YamlField r = root["resonator"];
     r.rejectUnknownKeys({"frequency", "samples_per_period", "periods_per_output", "amplitude", "quadrature", "phase",
-                         "initial_theta", "scale_factor", "drift"});
+                         "initial_theta", "scale_factor", "drift", "rate_noise"});
     ResonatorConfig& rc = c.resonator;
     rc.frequency = r.getDouble("frequency", rc.frequency);
     if (!(rc.frequency > 0.0)) r["frequency"].fail("must be positive (Hz)");
@@ -47,6 +47,8 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
     rc.initial_theta = r.getDouble("initial_theta", rc.initial_theta);
     if (r.has("scale_factor")) rc.scale_factor = parseScaleFactorModel(r["scale_factor"]);
     if (r.has("drift")) rc.drift = parseDriftModel(r["drift"]);
+    rc.rate_noise = r.getDouble("rate_noise", 0.0);
+    if (rc.rate_noise < 0.0) r["rate_noise"].fail("must be >= 0 (rad/sqrt(s))");
   }
 
   if (root.has("pickoff")) {

@@ -4,6 +4,92 @@
 
 namespace hrg_gyro {
 
+core::ChannelSample fromMessage(const ChannelAmplitudes& msg) {
+  core::ChannelSample in;
+  in.stamp = toNanoseconds(msg.header.stamp);
+  in.z << msg.c_in, msg.c_quad, msg.s_in, msg.s_quad;
+  in.frequency = msg.frequency;
+  in.temperature = msg.temperature;
+  return in;
+}
+
+WaveState toWaveMessage(const ChannelAmplitudes& input, const core::WaveState& w, const std::string& frame_id) {
+  WaveState m;
+  m.header = input.header;
+  m.header.frame_id = frame_id;
+  m.theta = w.theta;
+  m.amplitude = w.amplitude;
+  m.quadrature = w.quadrature;
+  m.phase = w.phase;
+  m.energy = w.energy;
+  m.quadrature_product = w.quadrature_product;
+  m.phase_error = w.phase_error;
+  m.frequency = input.frequency;
+  m.temperature = input.temperature;
+  return m;
+}
+
+GyroOutput toOutputMessage(const std_msgs::Header& header, const core::ProcessorResult& r) {
+  const core::AngleIncrement& inc = r.increment;
+  GyroOutput out;
+  out.header = header;
+  out.dt = inc.dt;
+  out.dtheta = inc.dtheta;
+  out.dalpha = inc.dalpha;
+  out.dalpha_earth_fixed = inc.dalpha_earth_fixed;
+  out.alpha = r.alpha;
+  out.rate = inc.dt > 0.0 ? inc.dalpha / inc.dt : 0.0;
+  out.theta_mid = inc.theta_mid;
+  out.frequency = inc.frequency;
+  out.scale_factor = inc.scale_factor;
+  out.drift = inc.drift;
+  out.rejected_before = r.rejected_before;
+  out.flags = r.flags;
+  return out;
+}
+
+ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::Time& stamp, std::uint32_t seq,
+                                    const std::string& frame_id) {
+  ChannelAmplitudes m;
+  m.header.seq = seq;
+  m.header.stamp = stamp;
+  m.header.frame_id = frame_id;
+  m.c_in = s.z[core::kAc];
+  m.c_quad = s.z[core::kBc];
+  m.s_in = s.z[core::kAs];
+  m.s_quad = s.z[core::kBs];
+  m.frequency = s.frequency;
+  m.temperature = s.temperature;
+  m.periods = s.periods;
+  return m;
+}
+
+TurntableState toTurntableMessage(const core::SimulationSample& s, const std_msgs::Header& header) {
+  TurntableState m;
+  m.header = header;
+  m.angle = s.truth.table_angle;
+  m.rate = s.truth.table_rate;
+  return m;
+}
+
+GroundTruth toTruthMessage(const core::SimulationSample& s, const std_msgs::Header& header) {
+  GroundTruth t;
+  t.header = header;
+  t.table_angle = s.truth.table_angle;
+  t.table_rate = s.truth.table_rate;
+  t.inertial_angle = s.truth.inertial_angle;
+  t.inertial_rate = s.truth.inertial_rate;
+  t.theta = s.truth.theta;
+  t.amplitude = s.truth.amplitude;
+  t.quadrature = s.truth.quadrature;
+  t.phase = s.truth.phase;
+  t.frequency = s.truth.frequency;
+  t.temperature = s.truth.temperature;
+  t.generator = s.truth.generator;
+  t.segment = s.truth.segment ? *s.truth.segment : std::string();
+  return t;
+}
+
 HarmonicEstimate toMessage(const core::HarmonicFitResult& fit, double frequency) {
   HarmonicEstimate m;
   m.orders.assign(fit.orders.begin(), fit.orders.end());

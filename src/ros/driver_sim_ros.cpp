@@ -101,41 +101,11 @@ void DriverSimRos::run() {
       clock_pub_.publish(c);
       next_clock = sim.elapsed() + clock_period_;
     }
-    auto channels = boost::make_shared<ChannelAmplitudes>();
-    channels->header.seq = seq;
-    channels->header.stamp = stamp;
-    channels->header.frame_id = frame_id_;
-    channels->c_in = s.z[core::kAc];
-    channels->c_quad = s.z[core::kBc];
-    channels->s_in = s.z[core::kAs];
-    channels->s_quad = s.z[core::kBs];
-    channels->frequency = s.frequency;
-    channels->temperature = s.temperature;
-    channels->periods = s.periods;
+    auto channels = boost::make_shared<ChannelAmplitudes>(toChannelsMessage(s, stamp, seq, frame_id_));
     channels_pub_.publish(channels);
-
-    auto table = boost::make_shared<TurntableState>();
-    table->header = channels->header;
-    table->angle = s.truth.table_angle;
-    table->rate = s.truth.table_rate;
-    turntable_pub_.publish(table);
-
+    turntable_pub_.publish(boost::make_shared<TurntableState>(toTurntableMessage(s, channels->header)));
     if (truth_pub_.getNumSubscribers() > 0) {
-      auto truth = boost::make_shared<GroundTruth>();
-      truth->header = channels->header;
-      truth->table_angle = s.truth.table_angle;
-      truth->table_rate = s.truth.table_rate;
-      truth->inertial_angle = s.truth.inertial_angle;
-      truth->inertial_rate = s.truth.inertial_rate;
-      truth->theta = s.truth.theta;
-      truth->amplitude = s.truth.amplitude;
-      truth->quadrature = s.truth.quadrature;
-      truth->phase = s.truth.phase;
-      truth->frequency = s.truth.frequency;
-      truth->temperature = s.truth.temperature;
-      truth->generator = s.truth.generator;
-      truth->segment = s.truth.segment ? *s.truth.segment : std::string();
-      truth_pub_.publish(truth);
+      truth_pub_.publish(boost::make_shared<GroundTruth>(toTruthMessage(s, channels->header)));
     }
     ++seq;
   }

@@ -122,11 +122,7 @@ void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   last_input_ = ros::Time::now();
   last_stamp_ = msg->header.stamp;
 
-  core::ChannelSample in;
-  in.stamp = toNanoseconds(msg->header.stamp);
-  in.z << msg->c_in, msg->c_quad, msg->s_in, msg->s_quad;
-  in.frequency = msg->frequency;
-  in.temperature = msg->temperature;
+  const core::ChannelSample in = fromMessage(*msg);
   const core::ProcessorResult r = processor_->process(in);
   if (r.verdict == core::SampleVerdict::kRejectedStamp || r.verdict == core::SampleVerdict::kDuplicate ||
       r.verdict == core::SampleVerdict::kOutOfOrder) {
@@ -147,37 +143,13 @@ void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   last_wave_ = r.wave;
   has_wave_ = true;
 
-  auto wave = boost::make_shared<WaveState>();
-  wave->header = msg->header;
-  wave->header.frame_id = frame_id_;
-  wave->theta = r.wave.theta;
-  wave->amplitude = r.wave.amplitude;
-  wave->quadrature = r.wave.quadrature;
-  wave->phase = r.wave.phase;
-  wave->energy = r.wave.energy;
-  wave->quadrature_product = r.wave.quadrature_product;
-  wave->phase_error = r.wave.phase_error;
-  wave->frequency = msg->frequency;
-  wave->temperature = msg->temperature;
+  auto wave = boost::make_shared<WaveState>(toWaveMessage(*msg, r.wave, frame_id_));
   wave_pub_.publish(wave);
   if (!r.has_output) return;
   last_flags_ = r.flags;
 
   const core::AngleIncrement& inc = r.increment;
-  auto out = boost::make_shared<GyroOutput>();
-  out->header = wave->header;
-  out->dt = inc.dt;
-  out->dtheta = inc.dtheta;
-  out->dalpha = inc.dalpha;
-  out->dalpha_earth_fixed = inc.dalpha_earth_fixed;
-  out->alpha = r.alpha;
-  out->rate = inc.dt > 0.0 ? inc.dalpha / inc.dt : 0.0;
-  out->theta_mid = inc.theta_mid;
-  out->frequency = inc.frequency;
-  out->scale_factor = inc.scale_factor;
-  out->drift = inc.drift;
-  out->rejected_before = r.rejected_before;
-  out->flags = r.flags;
+  auto out = boost::make_shared<GyroOutput>(toOutputMessage(wave->header, r));
   output_pub_.publish(out);
 
   const bool continuous = !(r.flags & (core::kFlagGap | core::kFlagReset));

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <string>
 
+#include "hrg_gyro/core/gaussian_noise.h"
 #include "hrg_gyro/core/model_pair_evaluator.h"
 #include "hrg_gyro/core/signal_synthesizer.h"
 #include "hrg_gyro/core/simulation_config.h"
@@ -73,6 +74,7 @@ class GyroSimulator {
 
   SimulationConfig config_;
   SignalSynthesizer synth_;
+  GaussianNoise rate_noise_;  // separate stream: switching it on leaves the pickoff noise unchanged
   ModelPairEvaluator intrinsic_;
   double earth_rate_;
   double t_ = 0.0;            // s since start, Kahan-compensated

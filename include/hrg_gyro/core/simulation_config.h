@@ -25,6 +25,9 @@ struct ResonatorConfig {
   double initial_theta = 0.0;      ///< electrical rad
   HarmonicModel scale_factor{-0.56};  ///< intrinsic K(theta) of the resonator (Bryan factor and its anisotropy)
   HarmonicModel drift{0.0};           ///< intrinsic D(theta), rad/s
+  /// White noise of the body rate the resonator senses (angle random walk), rad/sqrt(s); the
+  /// pickoff noise gives white *angle* noise instead. 0: none.
+  double rate_noise = 0.0;
 };
 
 struct GeneratorConfig {

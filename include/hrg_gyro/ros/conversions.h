@@ -6,7 +6,14 @@
 #include <ros/time.h>
 
 #include "hrg_gyro/CalibrationResult.h"
+#include "hrg_gyro/ChannelAmplitudes.h"
+#include "hrg_gyro/GroundTruth.h"
+#include "hrg_gyro/GyroOutput.h"
+#include "hrg_gyro/TurntableState.h"
+#include "hrg_gyro/WaveState.h"
 #include "hrg_gyro/core/calibration_outcome.h"
+#include "hrg_gyro/core/gyro_processor.h"
+#include "hrg_gyro/core/gyro_simulator.h"
 #include "hrg_gyro/core/units.h"
 
 namespace hrg_gyro {
@@ -20,6 +27,18 @@ inline ros::Time toRosTime(core::Nanoseconds ns) {
   t.fromNSec(static_cast<std::uint64_t>(ns < 0 ? 0 : ns));
   return t;
 }
+
+// The messages of one processed sample. The processor node and `hrg_bag process` both build their
+// output with these, so the offline tool gives the node's numbers bit for bit.
+core::ChannelSample fromMessage(const ChannelAmplitudes& msg);
+WaveState toWaveMessage(const ChannelAmplitudes& input, const core::WaveState& wave, const std::string& frame_id);
+GyroOutput toOutputMessage(const std_msgs::Header& header, const core::ProcessorResult& result);
+
+// The messages of one simulated sample (driver_sim and `hrg_bag simulate`).
+ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::Time& stamp, std::uint32_t seq,
+                                    const std::string& frame_id);
+TurntableState toTurntableMessage(const core::SimulationSample& s, const std_msgs::Header& header);
+GroundTruth toTruthMessage(const core::SimulationSample& s, const std_msgs::Header& header);
 
 HarmonicEstimate toMessage(const core::HarmonicFitResult& fit, double frequency);
 core::HarmonicFitResult fromMessage(const HarmonicEstimate& msg);

@@ -1,0 +1,142 @@
+// hrg_bag info: is this a usable gyro bag? Topics and types, counts, rates and the dt histogram,
+// gaps, stamp order, lost sequence numbers, header vs record time. Non-zero exit on errors.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <vector>
+
+#include "bag_tools.h"
+#include "hrg_gyro/GroundTruth.h"
+#include "hrg_gyro/TurntableState.h"
+
+namespace hrg_gyro {
+namespace {
+
+struct StampStats {
+  std::uint64_t count = 0, zero = 0, duplicate = 0, backwards = 0, seq_lost = 0;
+  double first = 0.0, last = 0.0, max_record_lag = 0.0;
+  std::vector<double> dts;
+  bool has_prev = false;
+  double prev = 0.0;
+  std::uint32_t prev_seq = 0;
+
+  void add(const std_msgs::Header& h, const ros::Time& record) {
+    ++count;
+    const double t = h.stamp.toSec();
+    if (h.stamp.isZero()) {
+      ++zero;
+      return;
+    }
+    max_record_lag = std::max(max_record_lag, std::abs(record.toSec() - t));
+    if (has_prev) {
+      if (t == prev) ++duplicate;
+      else if (t < prev) ++backwards;
+      else dts.push_back(t - prev);
+      if (h.seq > prev_seq + 1) seq_lost += h.seq - prev_seq - 1;
+    } else {
+      first = t;
+    }
+    has_prev = true;
+    prev = std::max(prev, t);
+    last = prev;
+    prev_seq = h.seq;
+  }
+};
+
+template <typename M>
+StampStats scan(const rosbag::Bag& bag, const std::string& topic) {
+  StampStats s;
+  rosbag::View view(bag, rosbag::TopicQuery(topic));
+  for (const rosbag::MessageInstance& m : view) {
+    const typename M::ConstPtr msg = m.instantiate<M>();
+    if (msg) s.add(msg->header, m.getTime());
+  }
+  return s;
+}
+
+}  // namespace
+
+int infoCommand(int argc, char** argv) {
+  using namespace bag_tools;
+  const Args args(argc, argv, {"channels-topic", "turntable-topic", "truth-topic", "gap"}, {});
+  if (args.help() || args.positional().size() != 1) {
+    std::cout << "usage: hrg_bag info BAG [--channels-topic T] [--turntable-topic T] [--truth-topic T] [--gap FACTOR]\n"
+                 "Validates a gyro bag: topics and types, counts, rates and dt histogram, gaps (dt above FACTOR x\n"
+                 "the median, default 3), stamp order, lost sequence numbers, header vs record time.\n"
+                 "Exit 1 when the bag cannot be processed as it is (no channels, bad stamps), 0 otherwise.\n";
+    return args.help() ? 0 : 2;
+  }
+  const std::unique_ptr<rosbag::Bag> bag = openBag(args.positional()[0]);
+  rosbag::View all(*bag);
+  std::map<std::string, std::pair<std::string, std::uint64_t>> topics;
+  for (const rosbag::ConnectionInfo* c : all.getConnections()) topics[c->topic].first = c->datatype;
+  for (const auto& kv : topics) topics[kv.first].second = rosbag::View(*bag, rosbag::TopicQuery(kv.first)).size();
+  std::printf("bag %s: %.3f s, %u messages\n", args.positional()[0].c_str(),
+              (all.getEndTime() - all.getBeginTime()).toSec(), all.size());
+  for (const auto& kv : topics) std::printf("  %-28s %-34s %10lu\n", kv.first.c_str(), kv.second.first.c_str(),
+                                            static_cast<unsigned long>(kv.second.second));
+  int errors = 0, warnings = 0;
+  GyroTopics t;
+  try {
+    t = findTopics(*bag, args, true, false);
+  } catch (const UsageError& e) {
+    std::printf("ERROR: %s\n", e.what());
+    return 1;
+  }
+  const double gap_factor = args.getDouble("gap", 3.0);
+  auto report = [&](const std::string& name, const StampStats& s, bool required) {
+    std::printf("%s (%s): %lu messages\n", name.c_str(), name.c_str(), static_cast<unsigned long>(s.count));
+    if (s.dts.empty()) {
+      if (required) {
+        std::printf("  ERROR: fewer than two valid stamps\n");
+        ++errors;
+      }
+      return;
+    }
+    std::vector<double> sorted = s.dts;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    std::printf("  span %.3f s, median dt %.6f s (%.2f Hz), mean rate %.2f Hz\n", s.last - s.first, median,
+                1.0 / median, (s.count - 1) / std::max(1e-12, s.last - s.first));
+    const double edges[] = {0.0, 0.5, 0.9, 1.1, 2.0, 10.0, INFINITY};
+    std::uint64_t counts[6] = {0, 0, 0, 0, 0, 0};
+    std::uint64_t gaps = 0;
+    double largest = 0.0;
+    for (double dt : s.dts) {
+      const double r = dt / median;
+      for (int b = 0; b < 6; ++b) {
+        if (r >= edges[b] && r < edges[b + 1]) ++counts[b];
+      }
+      if (r > gap_factor) ++gaps;
+      largest = std::max(largest, dt);
+    }
+    std::printf("  dt / median: <0.5 %lu | 0.5-0.9 %lu | 0.9-1.1 %lu | 1.1-2 %lu | 2-10 %lu | >10 %lu\n",
+                static_cast<unsigned long>(counts[0]), static_cast<unsigned long>(counts[1]),
+                static_cast<unsigned long>(counts[2]), static_cast<unsigned long>(counts[3]),
+                static_cast<unsigned long>(counts[4]), static_cast<unsigned long>(counts[5]));
+    std::printf("  gaps above %.1f x median: %lu (largest %.6f s); lost sequence numbers: %lu\n", gap_factor,
+                static_cast<unsigned long>(gaps), largest, static_cast<unsigned long>(s.seq_lost));
+    std::printf("  header vs record time: largest difference %.6f s\n", s.max_record_lag);
+    if (gaps || s.seq_lost) ++warnings;
+    if (s.zero || s.duplicate || s.backwards) {
+      std::printf("  ERROR: %lu zero, %lu duplicate, %lu backward stamps\n", static_cast<unsigned long>(s.zero),
+                  static_cast<unsigned long>(s.duplicate), static_cast<unsigned long>(s.backwards));
+      if (required) ++errors;
+      else ++warnings;
+    }
+  };
+  report(t.channels, scan<ChannelAmplitudes>(*bag, t.channels), true);
+  if (!t.turntable.empty()) {
+    report(t.turntable, scan<TurntableState>(*bag, t.turntable), false);
+  } else {
+    std::printf("WARNING: no TurntableState topic: the bag can be processed but not calibrated\n");
+    ++warnings;
+  }
+  if (!t.truth.empty()) report(t.truth, scan<GroundTruth>(*bag, t.truth), false);
+  std::printf("%s: %d error(s), %d warning(s)\n", errors ? "INVALID" : "OK", errors, warnings);
+  return errors ? 1 : 0;
+}
+
+}  // namespace hrg_gyro
