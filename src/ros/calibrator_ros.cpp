@@ -8,6 +8,7 @@
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/core/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "hrg_gyro/ros/diagnostics_timer.h"
 #include "hrg_gyro/ros/param_tree.h"
 
 namespace hrg_gyro {
@@ -17,7 +18,8 @@ using diagnostic_msgs::DiagnosticStatus;
 
 const std::vector<std::string>& nodeOnlyKeys() {
   static const std::vector<std::string> keys = {"parameter_file", "report_file", "output_directory", "reload_service",
-                                                "write", "autostart", "stages", "queue_size", "diagnostic_period"};
+                                                "write", "autostart", "stages", "queue_size", "diagnostic_period",
+                                                "backward_reset"};
   return keys;
 }
 
@@ -53,6 +55,8 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   pnh_.param<std::string>("output_directory", output_directory_, "");
   pnh_.param<std::string>("reload_service", reload_service_, "processor/reload");
   pnh_.param("write", write_, write_);
+  pnh_.param("backward_reset", backward_reset_, backward_reset_);
+  if (!(backward_reset_ > 0.0)) throw std::invalid_argument("calibrator: ~backward_reset must be positive (s)");
   if (!output_directory_.empty()) {
     for (const std::string& f : {parameter_file_, report_file_}) {
       if (!inside(f, output_directory_)) {
@@ -84,7 +88,7 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   abort_srv_ = pnh_.advertiseService("abort", &CalibratorRos::onAbort, this);
   updater_.setHardwareID("hrg_gyro");
   updater_.add("calibration", this, &CalibratorRos::diagnose);
-  diagnostics_timer_ = nh_.createTimer(ros::Duration(0.1), [this](const ros::TimerEvent&) { updater_.update(); });
+  diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
 
   reload_worker_ = std::thread(&CalibratorRos::reloadLoop, this);
   bool autostart = true;
@@ -155,8 +159,25 @@ bool CalibratorRos::startRun(const std::string& method, std::string* reason) {
   }
 }
 
+bool CalibratorRos::restartIfTimeWentBack(const ros::Time& stamp, ros::Time* last) {
+  const bool back = !last->isZero() && (*last - stamp).toSec() > backward_reset_;
+  *last = stamp;
+  if (!back || !session_) return false;
+  // A looping bag (or a restarted driver): the bins hold the previous pass, and the new data would
+  // all be dropped as out of order. Start the same method again from the prior.
+  const std::string method = session_->settings().method;
+  ++resets_;
+  ROS_WARN("calibrator: time went backwards by more than %.1f s (bag loop?): %s run restarted", backward_reset_,
+           method.c_str());
+  std::string reason;
+  startRun(method, &reason);
+  last_turntable_stamp_ = last_wave_stamp_ = stamp;
+  return true;
+}
+
 void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  restartIfTimeWentBack(msg->header.stamp, &last_turntable_stamp_);
   if (!session_) return;
   session_->addTurntable(toNanoseconds(msg->header.stamp), msg->angle, msg->rate);
   if (session_->shouldFinish()) {
@@ -168,6 +189,7 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
 
 void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  restartIfTimeWentBack(msg->header.stamp, &last_wave_stamp_);
   if (session_) session_->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency);
 }
 
@@ -313,6 +335,9 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
     const core::SessionCounters& c = session_->counters();
     if (c.turntable == 0 && c.wave > 100) {
       stat.summary(DiagnosticStatus::WARN, "wave samples but no turntable state: check turntable/state");
+    } else if (resets_ > reported_resets_) {
+      stat.summaryf(DiagnosticStatus::WARN, "time went backwards: run restarted; %s %.0f %%", p.summary.c_str(),
+                    100 * p.fraction);
     } else {
       stat.summaryf(DiagnosticStatus::OK, "%s %.0f %%", p.summary.c_str(), 100 * p.fraction);
     }
@@ -323,13 +348,16 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
     stat.add("used", c.used);
     stat.add("not on a settled plateau", c.unsettled);
     stat.add("without turntable state", c.unsynchronized);
+    stat.add("dropped (out-of-order stamps)", c.out_of_order);
   } else if (runs_ > 0 && !last_accepted_) {
     stat.summary(DiagnosticStatus::WARN, "idle; last run " + last_result_);
   } else {
     stat.summary(DiagnosticStatus::OK, runs_ > 0 ? "idle; last run " + last_result_ : "idle");
   }
   stat.add("runs", runs_);
+  stat.add("restarts (time went backwards)", resets_);
   stat.add("parameter file", parameter_file_);
+  reported_resets_ = resets_;
 }
 
 }  // namespace hrg_gyro

@@ -9,6 +9,7 @@
 #include "hrg_gyro/WaveState.h"
 #include "hrg_gyro/core/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "hrg_gyro/ros/diagnostics_timer.h"
 
 namespace hrg_gyro {
 namespace {
@@ -84,8 +85,7 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   updater_.add("model", this, &ProcessorRos::diagnoseModel);
   channels_sub_ = nh_.subscribe("channels", queue_size, &ProcessorRos::onChannels, this,
                                 ros::TransportHints().tcpNoDelay());
-  // The updater publishes at its own ~diagnostic_period (1 s); this only gives it the chance.
-  diagnostics_timer_ = nh_.createTimer(ros::Duration(0.1), [this](const ros::TimerEvent&) { updater_.update(); });
+  diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
   ROS_INFO("processor: %s (K0 %.6f, %zu K harmonics, calibration %s)", parameter_file_.c_str(),
            params->scale_factor.meanAt(NAN), params->scale_factor.orders().size(), params->calibration.method.c_str());
 }
@@ -135,7 +135,10 @@ void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   } else if (r.verdict == core::SampleVerdict::kRejectedJump) {
     ROS_WARN_THROTTLE(5.0, "processor: rejected a wave-angle jump above ~max_rate (glitch or sign flip)");
   }
-  if (r.flags & core::kFlagReset) ROS_WARN("processor: time went backwards (bag loop?): state reset, alpha restarts");
+  if (r.flags & core::kFlagReset) {
+    ROS_WARN("processor: time went backwards (bag loop?): state reset, alpha restarts");
+    frequency_->clear();  // its window of past ticks is in the future now
+  }
   if (r.flags & core::kFlagGap) {
     ROS_WARN_THROTTLE(5.0, "processor: %.3f s gap in the input: not integrated across", r.increment.dt);
   }

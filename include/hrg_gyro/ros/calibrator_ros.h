@@ -49,6 +49,8 @@ class CalibratorRos {
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   /// Starts a run of `method` with the current parameter file as prior; false + reason on failure.
+  /// Restarts the current run when `stamp` is more than ~backward_reset s before `*last`; updates `*last`.
+  bool restartIfTimeWentBack(const ros::Time& stamp, ros::Time* last);
   bool startRun(const std::string& method, std::string* reason);
   /// Fits, gates, writes, publishes, reloads; returns the outcome. Caller holds the mutex.
   core::CalibrationOutcome finishRun(bool* written, std::string* message);
@@ -67,6 +69,10 @@ class CalibratorRos {
   bool write_ = true;
   std::uint64_t runs_ = 0;
   std::string last_result_;
+  // Bag loops: a stream going back by more than backward_reset_ s restarts the run.
+  double backward_reset_ = 1.0;
+  ros::Time last_turntable_stamp_, last_wave_stamp_;
+  std::uint64_t resets_ = 0, reported_resets_ = 0;
   bool last_accepted_ = false;
 
   // Generator pairs: raw channels and the reference wave, matched by stamp.

@@ -79,6 +79,10 @@ std::unique_ptr<rosbag::Bag> openBag(const std::string& path) {
     throw UsageError("bag '" + path + "' is unindexed (recording interrupted?): run `rosbag reindex` on a copy");
   } catch (const rosbag::BagFormatException& e) {
     throw UsageError("bag '" + path + "' is truncated or corrupt: " + e.what());
+  } catch (const rosbag::BagIOException& e) {
+    // The header points at an index past the end of the file: cut short after it was closed.
+    throw UsageError("bag '" + path + "' is truncated or unindexed (copy cut short?): run `rosbag reindex` on a copy (" +
+                     e.what() + ")");
   } catch (const rosbag::BagException& e) {
     throw UsageError("cannot open bag '" + path + "': " + e.what());
   }
@@ -169,7 +173,8 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
       const ChannelAmplitudes::ConstPtr msg = m.instantiate<ChannelAmplitudes>();
       if (!msg) continue;
       sink(*msg, processor.process(fromMessage(*msg)));
-      progress.update(++n, n);
+      ++n;
+      progress.update(n, n);
     }
   } catch (const rosbag::BagException& e) {
     throw UsageError(std::string("bag read error after ") + std::to_string(n) + " samples (truncated?): " + e.what());

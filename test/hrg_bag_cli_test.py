@@ -1,0 +1,211 @@
+#!/usr/bin/env python3
+"""The hrg_bag command line, as a lab user runs it: every subcommand on small generated bags, the
+documented chain simulate -> info -> calibrate -> process on config/scenarios/dual_rate.yaml, and
+bad bags (missing, truncated/unindexed, wrong types, no channels topic) answered by a clear error
+and a non-zero exit, never a crash. Needs no master; run as a rostest for the package environment."""
+import csv
+import filecmp
+import math
+import os
+import shutil
+import subprocess
+import unittest
+
+import rosbag
+import rospy
+import rostest
+import yaml
+from hrg_gyro.msg import TurntableState
+from std_msgs.msg import String
+
+
+HRG_BAG = subprocess.check_output(["catkin_find", "--first-only", "--libexec", "hrg_gyro", "hrg_bag"],
+                                  universal_newlines=True).strip()
+
+
+def hrg_bag(*args, timeout=600):
+    p = subprocess.run([HRG_BAG] + list(args), stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, universal_newlines=True, timeout=timeout)
+    return p.returncode, p.stdout, p.stderr
+
+
+class HrgBagCli(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.work = os.path.join(rospy.get_param("~work_dir"), "hrg_bag_cli")
+        shutil.rmtree(cls.work, ignore_errors=True)
+        os.makedirs(cls.work)
+        cls.pkg = rospy.get_param("~package_dir")
+        cls.params = os.path.join(cls.pkg, "config", "params_uncalibrated.yaml")
+        cls.short = os.path.join(cls.work, "short.bag")
+        code, out, err = hrg_bag("simulate", "--scenario", os.path.join(cls.pkg, "test/scenarios/short_session.yaml"),
+                                 "--out", cls.short)
+        assert code == 0, err
+
+    def path(self, name):
+        return os.path.join(self.work, name)
+
+    def assertFails(self, result, code, *fragments):
+        self.assertEqual(result[0], code, result)
+        for f in fragments:
+            self.assertIn(f, result[2])
+        self.assertNotIn("terminate called", result[2])
+
+    def test_help_for_the_tool_and_every_subcommand(self):
+        code, out, _ = hrg_bag("--help")
+        self.assertEqual(code, 0)
+        for sub in ("simulate", "info", "process", "calibrate", "allan"):
+            self.assertIn(sub, out)
+            code, out_sub, _ = hrg_bag(sub, "--help")
+            self.assertEqual(code, 0, sub)
+            self.assertIn("usage: hrg_bag " + sub, out_sub)
+        self.assertFails(hrg_bag("frobnicate"), 2, "frobnicate")
+        self.assertFails(hrg_bag("process", self.short, "--params", self.params, "--out", self.path("x.bag"),
+                                 "--bogus", "1"), 2, "--bogus")
+
+    def test_simulate_writes_the_three_streams_deterministically(self):
+        with rosbag.Bag(self.short) as bag:
+            info = bag.get_type_and_topic_info().topics
+        self.assertEqual(info["/channels"].msg_type, "hrg_gyro/ChannelAmplitudes")
+        self.assertEqual(info["/turntable/state"].msg_type, "hrg_gyro/TurntableState")
+        self.assertEqual(info["/truth"].msg_type, "hrg_gyro/GroundTruth")
+        n = info["/channels"].message_count
+        self.assertEqual(info["/turntable/state"].message_count, n)
+        self.assertEqual(info["/truth"].message_count, n)
+        self.assertGreater(n, 6000)
+        scenario = os.path.join(self.pkg, "test/scenarios/short_session.yaml")
+        self.assertEqual(hrg_bag("simulate", "--scenario", scenario, "--out", self.path("again.bag"))[0], 0)
+        self.assertTrue(filecmp.cmp(self.short, self.path("again.bag"), shallow=False), "same seed, same bag")
+        self.assertEqual(hrg_bag("simulate", "--scenario", scenario, "--out", self.path("seed7.bag"),
+                                 "--seed", "7")[0], 0)
+        self.assertFalse(filecmp.cmp(self.short, self.path("seed7.bag"), shallow=False), "--seed changes the noise")
+        self.assertFails(hrg_bag("simulate", "--scenario", self.path("nope.yaml"), "--out", self.path("n.bag")), 2,
+                         "nope.yaml")
+
+    def test_info_reports_rates_and_validates(self):
+        code, out, err = hrg_bag("info", self.short)
+        self.assertEqual(code, 0, err)
+        self.assertIn("200.00 Hz", out)
+        self.assertIn("OK", out)
+
+    def test_bad_bags_get_clear_errors(self):
+        self.assertFails(hrg_bag("info", self.path("missing.bag")), 2, "missing")
+        truncated = self.path("truncated.bag")
+        with open(self.short, "rb") as f:
+            data = f.read()
+        with open(truncated, "wb") as f:
+            f.write(data[: len(data) // 2])
+        for sub in (["info", truncated], ["process", truncated, "--params", self.params, "--csv", self.path("t.csv")],
+                    ["calibrate", truncated, "--method", "dual_rate", "--out", self.path("t.yaml")],
+                    ["allan", truncated]):
+            self.assertFails(hrg_bag(*sub), 2, "unindexed")
+        wrong = self.path("wrong_types.bag")
+        with rosbag.Bag(wrong, "w") as bag:
+            for i in range(10):
+                bag.write("/channels", String(data="not a gyro"), rospy.Time(1 + i))
+        code, out, err = hrg_bag("info", wrong)
+        self.assertNotEqual(code, 0)
+        self.assertIn("no hrg_gyro/ChannelAmplitudes topic", out + err)
+        self.assertFails(hrg_bag("process", wrong, "--params", self.params, "--csv", self.path("w.csv"),
+                                 "--channels-topic", "/channels"), 2, "type std_msgs/String")
+        no_channels = self.path("no_channels.bag")
+        with rosbag.Bag(no_channels, "w") as bag:
+            for i in range(10):
+                msg = TurntableState()
+                msg.header.stamp = rospy.Time(1 + i)
+                bag.write("/turntable/state", msg, msg.header.stamp)
+        self.assertFails(hrg_bag("process", no_channels, "--params", self.params, "--csv", self.path("n.csv")), 2,
+                         "no hrg_gyro/ChannelAmplitudes topic", "/turntable/state")
+        self.assertFails(hrg_bag("calibrate", no_channels, "--method", "dual_rate", "--out", self.path("n.yaml")), 2,
+                         "no hrg_gyro/ChannelAmplitudes topic")
+        self.assertFalse(os.path.exists(self.path("n.yaml")))
+
+    def test_process_csv_has_a_header_and_one_row_per_sample(self):
+        out_csv = self.path("short.csv")
+        code, out, err = hrg_bag("process", self.short, "--params", self.params, "--csv", out_csv,
+                                 "--out", self.path("short_out.bag"))
+        self.assertEqual(code, 0, err)
+        with open(out_csv) as f:
+            rows = list(csv.DictReader(f))
+        with rosbag.Bag(self.short) as bag:
+            n = bag.get_message_count(topic_filters=["/channels"])
+        self.assertEqual(len(rows), n)
+        self.assertEqual(rows[0]["status"], "first")
+        self.assertTrue(all(r["status"] == "accepted" for r in rows[1:]))
+        for r in rows[1:]:
+            self.assertTrue(math.isfinite(float(r["dalpha"])) and math.isfinite(float(r["alpha"])))
+        with rosbag.Bag(self.path("short_out.bag")) as bag:
+            self.assertEqual(bag.get_message_count(topic_filters=["/output"]), n - 1)
+            outputs = [m for _, m, _ in bag.read_messages(topics=["/output"])]
+        # the CSV and the bag are the same numbers (%.17g round-trips a double)
+        for r, o in zip(rows[1:], outputs):
+            self.assertEqual(float(r["dalpha"]), o.dalpha)
+            self.assertEqual(float(r["alpha"]), o.alpha)
+
+    def test_calibrate_refuses_what_the_gates_refuse(self):
+        out, report = self.path("refused.yaml"), self.path("refused.report.yaml")
+        code, stdout, err = hrg_bag("calibrate", self.short, "--method", "dual_rate", "--params", self.params,
+                                    "--out", out, "--report", report)
+        self.assertEqual(code, 1, stdout + err)
+        self.assertFalse(os.path.exists(out), "a refused calibration writes no parameter file")
+        with open(report) as f:
+            r = yaml.safe_load(f)
+        self.assertFalse(r["accepted"])
+        self.assertTrue(r["reason"])
+
+    def test_calibrate_step_method(self):
+        bag, out = self.path("steps.bag"), self.path("steps.yaml")
+        self.assertEqual(hrg_bag("simulate", "--scenario", os.path.join(self.pkg, "config/scenarios/steps.yaml"),
+                                 "--out", bag)[0], 0)
+        code, stdout, err = hrg_bag("calibrate", bag, "--method", "step", "--params", self.params, "--out", out)
+        self.assertEqual(code, 0, stdout + err)
+        with open(out) as f:
+            p = yaml.safe_load(f)
+        self.assertEqual(p["calibration"]["method"], "step")
+        self.assertAlmostEqual(p["scale_factor"]["mean"], -0.56, delta=0.56 * 1e-3)
+
+    def test_allan_reads_the_angle_random_walk(self):
+        bag, out_csv = self.path("static.bag"), self.path("allan.csv")
+        self.assertEqual(hrg_bag("simulate", "--scenario", os.path.join(self.pkg, "test/scenarios/static_noise.yaml"),
+                                 "--out", bag)[0], 0)
+        code, stdout, err = hrg_bag("allan", bag, "--params", self.params, "--csv", out_csv)
+        self.assertEqual(code, 0, err)
+        self.assertIn("angle random walk", stdout)
+        line = [l for l in stdout.splitlines() if "angle random walk" in l][0]
+        self.assertNotIn("not identified", line)
+        with open(out_csv) as f:
+            rows = list(csv.DictReader(f))
+        self.assertGreater(len(rows), 10)
+        # sigma(1 s) of a 1e-4 rad/sqrt(s) random walk is 1e-4 rad/s
+        near = min(rows, key=lambda r: abs(math.log(float(r["tau"]))))
+        self.assertAlmostEqual(float(near["tau"]), 1.0, delta=0.2)
+        self.assertAlmostEqual(float(near["deviation"]), 1e-4, delta=0.15e-4)
+
+    def test_the_documented_chain_on_the_dual_rate_scenario(self):
+        bag, out, report = self.path("dual_rate.bag"), self.path("calibrated.yaml"), self.path("report.yaml")
+        code, _, err = hrg_bag("simulate", "--scenario", os.path.join(self.pkg, "config/scenarios/dual_rate.yaml"),
+                               "--out", bag)
+        self.assertEqual(code, 0, err)
+        code, out_info, err = hrg_bag("info", bag)
+        self.assertEqual(code, 0, out_info + err)
+        code, stdout, err = hrg_bag("calibrate", bag, "--method", "dual_rate", "--params", self.params, "--out", out,
+                                    "--report", report)
+        self.assertEqual(code, 0, stdout + err)
+        with open(out) as f:
+            p = yaml.safe_load(f)
+        self.assertEqual(p["calibration"]["method"], "dual_rate")
+        with open(report) as f:
+            r = yaml.safe_load(f)
+        self.assertTrue(r["accepted"])
+        out_csv = self.path("dual_rate.csv")
+        code, _, err = hrg_bag("process", bag, "--params", out, "--csv", out_csv)
+        self.assertEqual(code, 0, err)
+        with open(out_csv) as f:
+            rows = sum(1 for _ in f) - 1
+        with rosbag.Bag(bag) as b:
+            self.assertEqual(rows, b.get_message_count(topic_filters=["/channels"]))
+
+
+if __name__ == "__main__":
+    rospy.init_node("hrg_bag_cli_test")
+    rostest.rosrun("hrg_gyro", "hrg_bag_cli", HrgBagCli)
