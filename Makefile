@@ -36,5 +36,11 @@ test: build
 run: build
 	cd $(WS) && source devel/setup.bash && $(ROOT)/scripts/run_main_job.sh
 
+# Benchmarks: Google Benchmark core suites, calibration, offline and live pipelines (about 12 min);
+# figures in bench_output/results.md. BENCH_ONLY=core,... selects parts (see bench/run_benchmarks.py).
+bench: build
+	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) hrg_gyro_benchmarks
+	cd $(WS) && source devel/setup.bash && /usr/bin/python3 $(ROOT)/bench/run_benchmarks.py
+
 clean:
 	rm -rf $(WS)

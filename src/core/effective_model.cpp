@@ -54,8 +54,12 @@ EffectiveModel computeEffectiveModel(const SimulationConfig& config, const Corre
     const double theta = j * h;
     const double slope = (measured[j + 2] - measured[j]) / (2.0 * h);
     const double at = measured[j + 1];
-    kp.push_back({at, rc.scale_factor(theta, rc.frequency) * slope, 1.0, 0.0});
-    dp.push_back({at, rc.drift(theta, rc.frequency) * slope, 1.0, 0.0});
+    FitPoint k_point, d_point;
+    k_point.theta = d_point.theta = at;
+    k_point.value = rc.scale_factor(theta, rc.frequency) * slope;
+    d_point.value = rc.drift(theta, rc.frequency) * slope;
+    kp.push_back(k_point);
+    dp.push_back(d_point);
   }
   std::vector<int> all;
   for (int k = 2; k <= 16; k += 2) all.push_back(k);

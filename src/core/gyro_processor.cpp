@@ -23,8 +23,12 @@ void GyroProcessor::setParameters(std::shared_ptr<const GyroParameters> paramete
     if (estimateWave(compensator_.parameters().correction.apply(previous_z_), config_.limits, &w) == WaveStatus::kOk) {
       ThetaUnwrapper rebased;
       rebased.unwrap(unwrapper_.last());
+      const double theta = rebased.unwrap(w.theta);
+      w.rebase(theta);
       unwrapper_ = ThetaUnwrapper();
-      unwrapper_.unwrap(rebased.unwrap(w.theta));
+      unwrapper_.unwrap(theta);
+      previous_cos_ = w.cos_theta;
+      previous_sin_ = w.sin_theta;
     }
   }
 }
@@ -92,6 +96,8 @@ ProcessorResult GyroProcessor::process(const ChannelSample& in) {
     previous_stamp_ = in.stamp;
     previous_frequency_ = in.frequency;
     previous_z_ = in.z;
+    previous_cos_ = wave.cos_theta;
+    previous_sin_ = wave.sin_theta;
     ++counters_.accepted;
     r.verdict = SampleVerdict::kFirst;
     r.has_wave = true;
@@ -139,20 +145,24 @@ ProcessorResult GyroProcessor::process(const ChannelSample& in) {
     }
   }
   if (integrate) {
-    r.increment = compensator_.step(previous_theta, theta, dt, f_mid);
+    r.increment = compensator_.step(previous_theta, theta, dt, f_mid, previous_cos_, previous_sin_, wave.cos_theta,
+                                    wave.sin_theta);
     alpha_ += r.increment.dalpha;
   } else {
     r.increment = AngleIncrement();
     r.increment.dt = dt;
     r.increment.theta_mid = theta;
     r.increment.frequency = f_mid;
-    const AngleIncrement at = compensator_.step(theta, theta, 0.0, f_mid);
+    const AngleIncrement at =
+        compensator_.step(theta, theta, 0.0, f_mid, wave.cos_theta, wave.sin_theta, wave.cos_theta, wave.sin_theta);
     r.increment.scale_factor = at.scale_factor;
     r.increment.drift = at.drift;
   }
   previous_stamp_ = in.stamp;
   previous_frequency_ = in.frequency;
   previous_z_ = in.z;
+  previous_cos_ = wave.cos_theta;
+  previous_sin_ = wave.sin_theta;
   ++counters_.accepted;
   ++counters_.outputs;
   r.verdict = SampleVerdict::kAccepted;

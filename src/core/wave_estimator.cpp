@@ -20,8 +20,12 @@ const char* toString(WaveStatus status) {
 }
 
 void WaveState::rebase(double continuous_theta) {
-  const double half_turns = std::round((continuous_theta - theta) / kPi);
-  if (std::fmod(std::abs(half_turns), 2.0) == 1.0) phase = wrapToPi(phase + kPi);
+  const long long half_turns = std::llround((continuous_theta - theta) / kPi);
+  if (half_turns & 1) {
+    phase = wrapToPi(phase + kPi);
+    cos_theta = -cos_theta;
+    sin_theta = -sin_theta;
+  }
   theta = continuous_theta;
 }
 
@@ -32,7 +36,9 @@ WaveStatus estimateWave(const ChannelVector& z, const WaveLimits& limits, WaveSt
   if (e <= limits.min_energy) return WaveStatus::kNoSignal;
   const double r = ac * ac + bc * bc - as * as - bs * bs;
   const double s = 2.0 * (ac * as + bc * bs);
-  const double h = std::hypot(r, s);  // A^2 - B^2
+  // A^2 - B^2. r^2 + s^2 <= e^2 cannot overflow for the amplitudes a pickoff can report; hypot
+  // (several times slower) only guards the absurd range.
+  const double h = e < 1e150 ? std::sqrt(r * r + s * s) : std::hypot(r, s);
   if (!(h > limits.min_anisotropy * e)) return WaveStatus::kDegenerate;
   const double a = std::sqrt(0.5 * (e + h));
   if (a < limits.min_amplitude || a > limits.max_amplitude) return WaveStatus::kAmplitudeOutOfRange;
@@ -49,8 +55,20 @@ WaveStatus estimateWave(const ChannelVector& z, const WaveLimits& limits, WaveSt
   w.phase_error = 2.0 * (ac * bc + as * bs);
   // Rotate the channels onto the antinode: Ac cos th + As sin th = A cos tau and
   // Bc cos th + Bs sin th = -A sin tau (MATH.md section 2 with the quadrature terms cancelling).
-  const double ct = std::cos(w.theta), st = std::sin(w.theta);
+  // (cos th, sin th) up to a positive factor, which atan2 ignores, from the half-angle identities
+  // tan th = s / (h + r) = (h - r) / s, taking the better-conditioned one: no trigonometry.
+  double ct, st;
+  if (r >= 0.0) {
+    ct = h + r;
+    st = s;
+  } else {
+    ct = std::abs(s);
+    st = std::copysign(h - r, s);
+  }
   w.phase = std::atan2(-(bc * ct + bs * st), ac * ct + as * st);
+  const double norm = 1.0 / std::sqrt(ct * ct + st * st);
+  w.cos_theta = ct * norm;
+  w.sin_theta = st * norm;
   *state = w;
   return WaveStatus::kOk;
 }

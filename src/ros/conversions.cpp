@@ -187,7 +187,7 @@ core::CalibrationOutcome fromMessage(const CalibrationResult& m) {
   for (const PlateauSummary& p : m.plateaus) {
     o.plateaus.push_back({p.rate, p.rate_std, p.duration, p.samples, p.coverage, p.turns});
   }
-  for (const QualityGate& q : m.gates) o.gates.push_back({q.name, q.passed, q.value, q.limit, q.message});
+  for (const QualityGate& q : m.gates) o.gates.push_back({q.name, q.passed != 0, q.value, q.limit, q.message});
   return o;
 }
 

@@ -44,6 +44,22 @@ class Compensator {
     inc.dalpha_earth_fixed = inc.dalpha - earth_rate_ * dt;
     return inc;
   }
+  /// The same with the unit vectors (cos, sin) of both angles supplied: cos and sin of
+  /// 2 theta_mid = theta_previous + theta are their complex product, so no sincos per sample.
+  AngleIncrement step(double theta_previous, double theta, double dt, double frequency_mid, double cos_previous,
+                      double sin_previous, double cos_theta, double sin_theta) {
+    AngleIncrement inc;
+    inc.dt = dt;
+    inc.dtheta = theta - theta_previous;
+    inc.theta_mid = 0.5 * (theta + theta_previous);
+    inc.frequency = frequency_mid;
+    const double c2 = cos_previous * cos_theta - sin_previous * sin_theta;
+    const double s2 = sin_previous * cos_theta + cos_previous * sin_theta;
+    models_.evaluate(inc.theta_mid, c2, s2, frequency_mid, &inc.scale_factor, &inc.drift);
+    inc.dalpha = (inc.dtheta - inc.drift * dt) / inc.scale_factor;
+    inc.dalpha_earth_fixed = inc.dalpha - earth_rate_ * dt;
+    return inc;
+  }
 
  private:
   std::shared_ptr<const GyroParameters> parameters_;

@@ -112,6 +112,7 @@ class GyroProcessor {
   Nanoseconds previous_stamp_ = 0;
   double previous_frequency_ = NAN;
   ChannelVector previous_z_ = ChannelVector::Zero();  // raw, for re-reading under a new P
+  double previous_cos_ = 1.0, previous_sin_ = 0.0;  // of the previous (unwrapped) theta
   double alpha_ = 0.0;
   std::uint8_t pending_flags_ = 0;
   std::uint32_t rejected_since_output_ = 0;

@@ -17,6 +17,9 @@ class HarmonicBasis {
   HarmonicBasis(int step, int max_order);
 
   void evaluate(double theta);
+  /// The same from c2 = cos 2 theta, s2 = sin 2 theta (exact; no trigonometry) when every order is
+  /// even; otherwise falls back to evaluate(theta).
+  void evaluate(double theta, double c2, double s2);
 
   int step() const { return step_; }
   int maxOrder() const { return max_order_; }

@@ -27,6 +27,14 @@ class ModelPairEvaluator {
     *k = k_->evaluate(basis_, k_coefficients_.data());
     *d = d_->evaluate(basis_, d_coefficients_.data());
   }
+  /// The same with c2 = cos 2 theta and s2 = sin 2 theta supplied (the per-sample path).
+  void evaluate(double theta, double c2, double s2, double frequency, double* k, double* d) {
+    const bool same = frequency == cached_frequency_ || (std::isnan(frequency) && cached_is_nan_);
+    if (frequency_dependent_ && !same) refresh(frequency);
+    basis_.evaluate(theta, c2, s2);
+    *k = k_->evaluate(basis_, k_coefficients_.data());
+    *d = d_->evaluate(basis_, d_coefficients_.data());
+  }
 
  private:
   void refresh(double frequency);

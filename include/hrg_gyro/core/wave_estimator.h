@@ -41,6 +41,9 @@ struct WaveState {
   double cos_component = 0.0;       ///< R
   double sin_component = 0.0;       ///< S
   double phase_error = 0.0;         ///< L
+  /// cos and sin of theta (follow rebase): the compensator builds its harmonics from them with
+  /// products instead of a sincos per sample.
+  double cos_theta = 1.0, sin_theta = 0.0;
 
   /// Moves theta to theta + n pi (as the unwrapper decides) and keeps the phase consistent with it:
   /// (A, theta + pi, tau + pi) is the same wave as (A, theta, tau).

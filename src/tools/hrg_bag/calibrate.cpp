@@ -61,7 +61,8 @@ int calibrateCommand(int argc, char** argv) {
   std::uint64_t n = 0;
   try {
     for (const rosbag::MessageInstance& m : view) {
-      progress.update(++n, n);
+      ++n;
+      progress.update(n, n);
       if (m.getTopic() == topics.channels) {
         const ChannelAmplitudes::ConstPtr c = m.instantiate<ChannelAmplitudes>();
         if (!c) continue;

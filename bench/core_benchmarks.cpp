@@ -1,0 +1,211 @@
+// Google Benchmark suites of the ROS-free core: the per-sample pipeline and its parts, the fits,
+// and the simulator's real-time factor. `make bench` runs them (Release build) and writes JSON.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hrg_gyro/core/compensator.h"
+#include "hrg_gyro/core/correction_matrix.h"
+#include "hrg_gyro/core/gaussian_noise.h"
+#include "hrg_gyro/core/gyro_processor.h"
+#include "hrg_gyro/core/gyro_simulator.h"
+#include "hrg_gyro/core/harmonic_fit.h"
+#include "hrg_gyro/core/simulation_config.h"
+#include "hrg_gyro/core/synchronous_demodulator.h"
+#include "hrg_gyro/core/wave_estimator.h"
+#include "hrg_gyro/core/wave_parameters.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+// A model of `orders` K harmonics (2, 4, ...) and two D harmonics; frequency dependent over three
+// nodes when asked (the paper's K(theta, f)).
+std::shared_ptr<const GyroParameters> parametersWith(int harmonics, bool frequency_dependent) {
+  auto p = std::make_shared<GyroParameters>();
+  std::vector<int> orders;
+  std::vector<double> cos, sin;
+  for (int k = 1; k <= harmonics; ++k) {
+    orders.push_back(2 * k);
+    cos.push_back(1e-4 / k);
+    sin.push_back(-0.5e-4 / k);
+  }
+  if (frequency_dependent) {
+    Eigen::MatrixXd nodes(1 + 2 * orders.size(), 3);
+    for (int j = 0; j < 3; ++j) {
+      nodes(0, j) = -0.56 * (1.0 + 1e-4 * j);
+      for (std::size_t i = 0; i < orders.size(); ++i) {
+        nodes(1 + i, j) = cos[i] * (1.0 + 0.1 * j);
+        nodes(1 + orders.size() + i, j) = sin[i] * (1.0 - 0.1 * j);
+      }
+    }
+    p->scale_factor = HarmonicModel(orders, FrequencyInterpolator({4990.0, 5000.0, 5010.0}), nodes);
+  } else {
+    p->scale_factor = HarmonicModel(orders, -0.56, cos, sin);
+  }
+  p->drift = HarmonicModel({2, 4}, 1e-5, {2e-5, 1e-6}, {-1e-5, 0.0});
+  return p;
+}
+
+// Channel amplitudes of a wave turning at 0.5 rad/s electrical, 1 kHz, 4096 samples (cycled).
+std::vector<ChannelSample> channelStream(std::size_t n = 4096) {
+  std::vector<ChannelSample> s(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    s[i].stamp = static_cast<Nanoseconds>(i + 1) * 1000000;
+    s[i].z = idealChannels({1.0, 0.02, 0.5e-3 * static_cast<double>(i), 0.3});
+    s[i].frequency = 5000.0;
+  }
+  return s;
+}
+
+void BM_Demodulation(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  SynchronousDemodulator d(n);
+  std::vector<double> c(n), s(n);
+  GaussianNoise g(1);
+  for (int j = 0; j < n; ++j) {
+    c[j] = g.next();
+    s[j] = g.next();
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(d.demodulate(c.data(), s.data()));
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel("per period of " + std::to_string(n) + " samples");
+}
+BENCHMARK(BM_Demodulation)->Arg(8)->Arg(32)->Arg(128);
+
+void BM_WaveState(benchmark::State& state) {
+  const std::vector<ChannelSample> in = channelStream();
+  WaveLimits limits;
+  WaveState w;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(estimateWave(in[i].z, limits, &w));
+    i = (i + 1) & 4095;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_WaveState);
+
+// The per-sample form: cos/sin of both angles come with the wave state, no trigonometry here.
+void BM_CompensationStep(benchmark::State& state) {
+  Compensator c(parametersWith(static_cast<int>(state.range(0)), state.range(1) != 0));
+  std::vector<double> cs(8192);
+  for (std::size_t i = 0; i < 4096; ++i) {
+    cs[2 * i] = std::cos(0.1 + 5e-4 * i);
+    cs[2 * i + 1] = std::sin(0.1 + 5e-4 * i);
+  }
+  double sum = 0.0;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const double theta = 0.1 + 5e-4 * i;
+    const AngleIncrement inc =
+        c.step(theta, theta + 5e-4, 1e-3, 5000.0 + theta, cs[2 * i], cs[2 * i + 1], cs[2 * i + 2], cs[2 * i + 3]);
+    if (++i == 4095) i = 0;
+    sum += inc.dalpha;
+  }
+  benchmark::DoNotOptimize(sum);
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(std::to_string(state.range(0)) + " K harmonics" + (state.range(1) ? ", K(theta, f)" : ""));
+}
+BENCHMARK(BM_CompensationStep)->Args({0, 0})->Args({4, 0})->Args({8, 0})->Args({4, 1})->Args({8, 1});
+
+// The angle-only form (one sincos of theta_mid per call): tools and tests use it.
+void BM_CompensationStepFromAngle(benchmark::State& state) {
+  Compensator c(parametersWith(static_cast<int>(state.range(0)), false));
+  double theta = 0.1, sum = 0.0;
+  for (auto _ : state) {
+    sum += c.step(theta, theta + 5e-4, 1e-3, 5000.0).dalpha;
+    theta += 5e-4;
+  }
+  benchmark::DoNotOptimize(sum);
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(std::to_string(state.range(0)) + " K harmonics");
+}
+BENCHMARK(BM_CompensationStepFromAngle)->Arg(4);
+
+// The target figure: Z -> (E - P)Z -> theta -> K, D -> dalpha, everything the processor does per sample.
+void BM_ProcessSample(benchmark::State& state) {
+  GyroProcessor p(ProcessorConfig(), parametersWith(static_cast<int>(state.range(0)), state.range(1) != 0));
+  std::vector<ChannelSample> in = channelStream();
+  const Nanoseconds period = static_cast<Nanoseconds>(in.size()) * 1000000;
+  std::size_t i = 0;
+  Nanoseconds offset = 0;
+  double sum = 0.0;
+  for (auto _ : state) {
+    ChannelSample s = in[i];
+    s.stamp += offset;
+    sum += p.process(s).increment.dalpha;
+    if (++i == in.size()) {
+      i = 0;
+      offset += period;  // keep time moving forward; the wave angle jumps back to the start once
+    }
+  }
+  benchmark::DoNotOptimize(sum);
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(std::to_string(state.range(0)) + " K harmonics" + (state.range(1) ? ", K(theta, f)" : ""));
+}
+BENCHMARK(BM_ProcessSample)->Args({0, 0})->Args({4, 0})->Args({8, 0})->Args({4, 1});
+
+void BM_HarmonicFit(benchmark::State& state) {
+  const int bins = static_cast<int>(state.range(0));
+  std::vector<FitPoint> points(bins);
+  GaussianNoise g(2);
+  for (int b = 0; b < bins; ++b) {
+    points[b].theta = M_PI * (b + 0.5) / bins;
+    points[b].value = -0.56 + 1e-4 * std::cos(2 * points[b].theta) + 1e-6 * g.next();
+    points[b].span = M_PI / bins;
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(fitHarmonics(points, {2, 4, 6, 8}));
+  state.SetLabel(std::to_string(bins) + " bins, orders 2,4,6,8");
+}
+BENCHMARK(BM_HarmonicFit)->Arg(128)->Arg(1024);
+
+void BM_CorrectionMatrixFit(benchmark::State& state) {
+  const int pairs = static_cast<int>(state.range(0));
+  std::vector<ChannelVector> measured, reference;
+  for (int i = 0; i < pairs; ++i) {
+    const ChannelVector z = idealChannels({1.0, 0.02 * (i % 3), 0.1 * i, 0.3});
+    reference.push_back(z);
+    measured.push_back(z + 1e-3 * ChannelVector(z[1], -z[0], z[3], z[2]));
+  }
+  for (auto _ : state) {
+    CorrectionMatrixEstimator e;
+    for (int i = 0; i < pairs; ++i) e.add(measured[i], reference[i]);
+    benchmark::DoNotOptimize(e.solve());
+  }
+  state.SetLabel(std::to_string(pairs) + " generator pairs");
+}
+BENCHMARK(BM_CorrectionMatrixFit)->Arg(24)->Arg(1000);
+
+// Real-time factor of the signal-level simulator: simulated seconds per wall second (counter rtf).
+void BM_SimulatorRealTimeFactor(benchmark::State& state) {
+  SimulationConfig config = SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/dual_rate.yaml",
+                                                   nodeOnlyScenarioKeys());
+  config.resonator.frequency = 5000.0;
+  config.resonator.samples_per_period = 32;
+  config.resonator.periods_per_output = static_cast<int>(state.range(0));  // 5: 1 kHz output
+  GyroSimulator sim(config);
+  SimulationSample s;
+  double simulated = 0.0;
+  for (auto _ : state) {
+    const double before = sim.elapsed();
+    for (int k = 0; k < 200; ++k) {
+      if (!sim.next(&s)) state.SkipWithError("scenario ended");
+    }
+    simulated += sim.elapsed() - before;
+  }
+  state.counters["rtf"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);
+  state.SetItemsProcessed(200 * state.iterations());
+  state.SetLabel("5 kHz, 32 samples/period, 8 defective sensors, " +
+                 std::to_string(5000 / state.range(0)) + " Hz output");
+}
+BENCHMARK(BM_SimulatorRealTimeFactor)->Arg(5)->Arg(25)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro
+
+BENCHMARK_MAIN();

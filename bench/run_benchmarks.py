@@ -1,0 +1,243 @@
+#!/usr/bin/env python3
+"""`make bench`: runs every benchmark of hrg_gyro and writes bench_output/results.{json,md}.
+
+  1. core suites (Google Benchmark, 5 repetitions, medians): demodulation, wave state, compensation
+     with 0/4/8 harmonics and K(theta, f), the whole per-sample processor, fits, simulator RTF;
+  2. calibration: 24 h of 1 kHz streams through the dual-rate session (time, peak RSS);
+  3. offline: `hrg_bag process` on a 1 M-sample bag vs `rosbag play --immediate` of the same bag
+     into the processor node (processed and dropped counted from the node's diagnostics);
+  4. live: driver_sim -> processor at 1, 5 and 10 kHz, separate processes vs nodelets: drops,
+     latency p50/p99/max, CPU per process (from /proc).
+Environment: BENCH_LIVE_SECONDS (default 60), BENCH_CAL_HOURS (default 24), BENCH_ONLY (comma list
+of core,calibration,offline,live)."""
+import json
+import os
+import random
+import re
+import signal
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+WS = os.path.join(ROOT, ".ws")
+BIN = os.path.join(WS, "devel", "lib", "hrg_gyro")
+OUT = os.path.join(ROOT, "bench_output")
+CLK = os.sysconf("SC_CLK_TCK")
+
+
+def log(msg):
+    print("bench: " + msg, file=sys.stderr, flush=True)
+
+
+def machine():
+    cpu = "unknown"
+    with open("/proc/cpuinfo") as f:
+        for line in f:
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    with open("/proc/meminfo") as f:
+        mem = int(f.readline().split()[1]) / 1024 / 1024
+    return "%s, %d cores, %.0f GiB RAM, %s" % (cpu, os.cpu_count(), mem, os.uname().release)
+
+
+def core_suites(results):
+    log("core suites (Google Benchmark, 5 repetitions)")
+    path = os.path.join(OUT, "core.json")
+    subprocess.run([os.path.join(BIN, "hrg_gyro_core_bench"), "--benchmark_repetitions=5",
+                    "--benchmark_report_aggregates_only=true", "--benchmark_out=" + path,
+                    "--benchmark_out_format=json"], check=True, stdout=sys.stderr)
+    with open(path) as f:
+        data = json.load(f)
+    rows = []
+    for b in data["benchmarks"]:
+        if b.get("aggregate_name") != "median":
+            continue
+        row = {"name": b["run_name"], "label": b.get("label", ""), "time": b["real_time"], "unit": b["time_unit"]}
+        if "items_per_second" in b:
+            row["ns_per_item"] = 1e9 / b["items_per_second"]
+        if "rtf" in b:
+            row["rtf"] = b["rtf"]
+        rows.append(row)
+    results["core"] = rows
+
+
+def calibration(results):
+    hours = os.environ.get("BENCH_CAL_HOURS", "24")
+    log("calibration: %s h of 1 kHz streams" % hours)
+    t = time.time()
+    p = subprocess.run([os.path.join(BIN, "hrg_gyro_calibration_bench"), hours, "1000"], stdout=subprocess.PIPE,
+                       universal_newlines=True)
+    print(p.stdout, file=sys.stderr)
+    results["calibration"] = {"hours": float(hours), "wall_s": time.time() - t, "output": p.stdout,
+                              "exit": p.returncode}
+
+
+class Master(object):
+    """A private master port for each launch (a roscore of the user's is left alone)."""
+
+    def __init__(self):
+        self.port = random.randint(20000, 40000)
+        self.env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % self.port)
+
+
+def process_cpu(patterns):
+    """utime+stime ticks of the processes whose command line matches each pattern."""
+    ticks = {}
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            with open("/proc/%s/cmdline" % pid, "rb") as f:
+                cmd = f.read().replace(b"\0", b" ").decode(errors="replace")
+            with open("/proc/%s/stat" % pid) as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except (IOError, OSError):
+            continue
+        for name, pattern in patterns.items():
+            if pattern in cmd:
+                ticks[name] = ticks.get(name, 0) + int(fields[11]) + int(fields[12])
+    return ticks
+
+
+def offline(results):
+    bag = os.path.join(OUT, "offline_1M.bag")
+    params = os.path.join(ROOT, "config", "params_uncalibrated.yaml")
+    log("offline: simulating a 1 M-sample bag")
+    subprocess.run([os.path.join(BIN, "hrg_bag"), "simulate", "--scenario", os.path.join(ROOT, "bench",
+                    "offline_scenario.yaml"), "--out", bag], check=True, stderr=subprocess.PIPE)
+    out = {}
+    for variant, args in (("bag", ["--out", os.path.join(OUT, "offline_out.bag")]),
+                          ("csv", ["--csv", os.path.join(OUT, "offline_out.csv")]),
+                          ("bag+csv", ["--out", os.path.join(OUT, "offline_out.bag"), "--csv",
+                                       os.path.join(OUT, "offline_out.csv")])):
+        t = time.time()
+        p = subprocess.run([os.path.join(BIN, "hrg_bag"), "process", bag, "--params", params] + args,
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True, check=True)
+        wall = time.time() - t
+        m = re.search(r"done, (\d+) samples in ([0-9.]+) s", p.stderr)
+        out["process_" + variant] = {"samples": int(m.group(1)), "loop_s": float(m.group(2)), "wall_s": wall,
+                                     "samples_per_s": int(m.group(1)) / wall}
+        log("  hrg_bag process (%s): %.0f samples/s" % (variant, int(m.group(1)) / wall))
+    # The playback path: rosbag play --immediate into the processor node.
+    log("offline: rosbag play --immediate into the processor node")
+    master = Master()
+    launch = subprocess.Popen(["roslaunch", "-p", str(master.port), "hrg_gyro", "processor.launch",
+                               "parameter_file:=" + params, "expected_rate:=1000"], env=master.env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, preexec_fn=os.setsid)
+    received = []
+    try:
+        time.sleep(6)
+        reader = subprocess.Popen(["rostopic", "echo", "-p", "/diagnostics/status[0]/values"], env=master.env,
+                                  stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, universal_newlines=True)
+        time.sleep(3)
+        t = time.time()
+        subprocess.run(["rosbag", "play", "--immediate", "-q", bag, "--topics", "/channels"], env=master.env,
+                       check=True, stdout=subprocess.DEVNULL)
+        play_wall = time.time() - t
+        time.sleep(4)  # let the node drain its queue and report
+        reader.send_signal(signal.SIGINT)
+        text = reader.communicate(timeout=10)[0]
+        received = [int(v) for v in re.findall(r"key='received', value='(\d+)'", text.replace('"', "'"))]
+        if not received:
+            received = [int(v) for v in re.findall(r"received[^0-9]+(\d+)", text)]
+    finally:
+        os.killpg(launch.pid, signal.SIGINT)
+        launch.wait(timeout=30)
+    processed = max(received) if received else 0
+    total = out["process_bag"]["samples"]
+    out["playback"] = {"published": total, "processed": processed, "dropped": total - processed,
+                       "play_wall_s": play_wall, "processed_per_s": processed / play_wall}
+    log("  playback: %d of %d processed in %.1f s" % (processed, total, play_wall))
+    results["offline"] = out
+
+
+def live(results):
+    seconds = float(os.environ.get("BENCH_LIVE_SECONDS", "60"))
+    rows = []
+    for rate, frequency, ppo in ((1000, 5000.0, 5), (5000, 5000.0, 1), (10000, 10000.0, 1)):
+        for nodelets in (False, True):
+            mode = "nodelets" if nodelets else "processes"
+            log("live: %d Hz, %s, %.0f s" % (rate, mode, seconds))
+            master = Master()
+            result = os.path.join(OUT, "live_%d_%s.yaml" % (rate, mode))
+            if os.path.exists(result):
+                os.remove(result)
+            launch = subprocess.Popen(["roslaunch", "-p", str(master.port), "hrg_gyro", "live_pipeline.launch",
+                                       "frequency:=%s" % frequency, "periods_per_output:=%d" % ppo,
+                                       "use_nodelets:=%s" % str(nodelets).lower(), "duration:=%s" % seconds,
+                                       "result_file:=" + result], env=master.env, stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.DEVNULL, preexec_fn=os.setsid)
+            patterns = ({"manager": "__name:=gyro_manager"} if nodelets else
+                        {"driver_sim": "__name:=driver_sim", "processor": "__name:=processor"})
+            patterns["latency_probe"] = "__name:=latency_probe"
+            time.sleep(8)
+            first, t_first = process_cpu(patterns), time.time()
+            last, t_last = first, t_first
+            while launch.poll() is None:
+                time.sleep(1)
+                sample = process_cpu(patterns)
+                if sample:
+                    last, t_last = sample, time.time()
+            cpu = {k: 100.0 * (last.get(k, 0) - first.get(k, 0)) / CLK / max(t_last - t_first, 1e-9) for k in patterns}
+            row = {"rate": rate, "mode": mode, "cpu_percent": cpu}
+            if os.path.exists(result):
+                with open(result) as f:
+                    for line in f:
+                        k, v = line.split(":", 1)
+                        row[k.strip()] = v.strip()
+            rows.append(row)
+            log("  %s" % row)
+    results["live"] = rows
+
+
+def markdown(results):
+    lines = ["# hrg_gyro benchmark results", "", "Machine: " + results["machine"], "Date: " + results["date"], ""]
+    if "core" in results:
+        lines += ["## Core (median of 5 repetitions)", "", "| benchmark | case | median | per item | RTF |",
+                  "| --- | --- | --- | --- | --- |"]
+        for r in results["core"]:
+            lines.append("| %s | %s | %.4g %s | %s | %s |" % (
+                r["name"], r["label"], r["time"], r["unit"],
+                "%.1f ns" % r["ns_per_item"] if "ns_per_item" in r else "",
+                "%.0fx" % r["rtf"] if "rtf" in r else ""))
+    if "calibration" in results:
+        lines += ["", "## Calibration", "", "```", results["calibration"]["output"].rstrip(), "```"]
+    if "offline" in results:
+        o = results["offline"]
+        lines += ["", "## Offline: 1 M samples", "", "| path | samples/s | notes |", "| --- | --- | --- |"]
+        for k in ("process_bag", "process_csv", "process_bag+csv"):
+            lines.append("| hrg_bag %s | %.0f | %d samples in %.2f s wall |" % (
+                k.replace("process_", "process --"), o[k]["samples_per_s"], o[k]["samples"], o[k]["wall_s"]))
+        p = o["playback"]
+        lines.append("| rosbag play --immediate -> processor node | %.0f | %d processed, %d dropped of %d, %.1f s |" % (
+            p["processed_per_s"], p["processed"], p["dropped"], p["published"], p["play_wall_s"]))
+    if "live" in results:
+        lines += ["", "## Live pipeline", "", "| rate | mode | outputs | missing | input lost | p50 ms | p99 ms | max ms | CPU % |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+        for r in results["live"]:
+            lines.append("| %d Hz | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                r["rate"], r["mode"], r.get("outputs", "-"), r.get("outputs_missing", "-"),
+                r.get("processor_input_lost", "-"), r.get("latency_p50_ms", "-"), r.get("latency_p99_ms", "-"),
+                r.get("latency_max_ms", "-"), ", ".join("%s %.1f" % kv for kv in sorted(r["cpu_percent"].items()))))
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    os.makedirs(OUT, exist_ok=True)
+    only = os.environ.get("BENCH_ONLY", "core,calibration,offline,live").split(",")
+    results = {"machine": machine(), "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}
+    for name, fn in (("core", core_suites), ("calibration", calibration), ("offline", offline), ("live", live)):
+        if name in only:
+            fn(results)
+    with open(os.path.join(OUT, "results.json"), "w") as f:
+        json.dump(results, f, indent=1)
+    md = markdown(results)
+    with open(os.path.join(OUT, "results.md"), "w") as f:
+        f.write(md)
+    print(md)
+
+
+if __name__ == "__main__":
+    main()
