@@ -108,10 +108,11 @@ def offline(results):
     subprocess.run([os.path.join(BIN, "hrg_bag"), "simulate", "--scenario", os.path.join(ROOT, "bench",
                     "offline_scenario.yaml"), "--out", bag], check=True, stderr=subprocess.PIPE)
     out = {}
-    for variant, args in (("bag", ["--out", os.path.join(OUT, "offline_out.bag")]),
+    for variant, args in (("dry", []),
                           ("csv", ["--csv", os.path.join(OUT, "offline_out.csv")]),
-                          ("bag+csv", ["--out", os.path.join(OUT, "offline_out.bag"), "--csv",
-                                       os.path.join(OUT, "offline_out.csv")])):
+                          ("bag", ["--out", os.path.join(OUT, "offline_out.bag")]),
+                          ("bag_uncompressed", ["--out", os.path.join(OUT, "offline_out.bag"), "--compression",
+                                                "none"])):
         t = time.time()
         p = subprocess.run([os.path.join(BIN, "hrg_bag"), "process", bag, "--params", params] + args,
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True, check=True)
@@ -126,27 +127,37 @@ def offline(results):
     launch = subprocess.Popen(["roslaunch", "-p", str(master.port), "hrg_gyro", "processor.launch",
                                "parameter_file:=" + params, "expected_rate:=1000"], env=master.env,
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, preexec_fn=os.setsid)
-    received = []
+    seen = {"received": 0, "lost": 0, "updated": time.time()}
     try:
-        time.sleep(6)
-        reader = subprocess.Popen(["rostopic", "echo", "-p", "/diagnostics/status[0]/values"], env=master.env,
-                                  stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, universal_newlines=True)
-        time.sleep(3)
+        # This process listens to the processor's diagnostics on the private master.
+        os.environ["ROS_MASTER_URI"] = master.env["ROS_MASTER_URI"]
+        import rospy
+        from diagnostic_msgs.msg import DiagnosticArray
+
+        def on_diagnostics(msg):
+            for status in msg.status:
+                for kv in status.values:
+                    if kv.key == "received" and int(kv.value) != seen["received"]:
+                        seen["received"], seen["updated"] = int(kv.value), time.time()
+                    elif kv.key == "lost (sequence gaps)":
+                        seen["lost"] = int(kv.value)
+
+        time.sleep(5)
+        rospy.init_node("bench_offline", anonymous=True, disable_signals=True)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics, queue_size=100)
+        time.sleep(2)
         t = time.time()
         subprocess.run(["rosbag", "play", "--immediate", "-q", bag, "--topics", "/channels"], env=master.env,
                        check=True, stdout=subprocess.DEVNULL)
         play_wall = time.time() - t
-        time.sleep(4)  # let the node drain its queue and report
-        reader.send_signal(signal.SIGINT)
-        text = reader.communicate(timeout=10)[0]
-        received = [int(v) for v in re.findall(r"key='received', value='(\d+)'", text.replace('"', "'"))]
-        if not received:
-            received = [int(v) for v in re.findall(r"received[^0-9]+(\d+)", text)]
+        while time.time() - seen["updated"] < 3.0:  # until the count has settled
+            time.sleep(0.5)
+        rospy.signal_shutdown("done")
     finally:
         os.killpg(launch.pid, signal.SIGINT)
         launch.wait(timeout=30)
-    processed = max(received) if received else 0
-    total = out["process_bag"]["samples"]
+    processed = seen["received"]
+    total = out["process_dry"]["samples"]
     out["playback"] = {"published": total, "processed": processed, "dropped": total - processed,
                        "play_wall_s": play_wall, "processed_per_s": processed / play_wall}
     log("  playback: %d of %d processed in %.1f s" % (processed, total, play_wall))
@@ -174,19 +185,20 @@ def live(results):
             patterns["latency_probe"] = "__name:=latency_probe"
             time.sleep(8)
             first, t_first = process_cpu(patterns), time.time()
-            last, t_last = first, t_first
+            last = {k: (v, t_first) for k, v in first.items()}
             while launch.poll() is None:
                 time.sleep(1)
-                sample = process_cpu(patterns)
-                if sample:
-                    last, t_last = sample, time.time()
-            cpu = {k: 100.0 * (last.get(k, 0) - first.get(k, 0)) / CLK / max(t_last - t_first, 1e-9) for k in patterns}
+                now = time.time()
+                for k, v in process_cpu(patterns).items():
+                    last[k] = (v, now)
+            cpu = {k: 100.0 * (last[k][0] - first[k]) / CLK / max(last[k][1] - t_first, 1e-9)
+                   for k in first if k in last}
             row = {"rate": rate, "mode": mode, "cpu_percent": cpu}
             if os.path.exists(result):
                 with open(result) as f:
                     for line in f:
                         k, v = line.split(":", 1)
-                        row[k.strip()] = v.strip()
+                        row.setdefault(k.strip(), v.strip())
             rows.append(row)
             log("  %s" % row)
     results["live"] = rows
@@ -207,9 +219,12 @@ def markdown(results):
     if "offline" in results:
         o = results["offline"]
         lines += ["", "## Offline: 1 M samples", "", "| path | samples/s | notes |", "| --- | --- | --- |"]
-        for k in ("process_bag", "process_csv", "process_bag+csv"):
-            lines.append("| hrg_bag %s | %.0f | %d samples in %.2f s wall |" % (
-                k.replace("process_", "process --"), o[k]["samples_per_s"], o[k]["samples"], o[k]["wall_s"]))
+        names = {"process_dry": "hrg_bag process (no output files)", "process_csv": "hrg_bag process --csv",
+                 "process_bag": "hrg_bag process --out (LZ4)",
+                 "process_bag_uncompressed": "hrg_bag process --out --compression none"}
+        for k, name in names.items():
+            lines.append("| %s | %.0f | %d samples in %.2f s wall |" % (
+                name, o[k]["samples_per_s"], o[k]["samples"], o[k]["wall_s"]))
         p = o["playback"]
         lines.append("| rosbag play --immediate -> processor node | %.0f | %d processed, %d dropped of %d, %.1f s |" % (
             p["processed_per_s"], p["processed"], p["dropped"], p["published"], p["play_wall_s"]))

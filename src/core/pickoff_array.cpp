@@ -17,6 +17,12 @@ PickoffArray::PickoffArray(const PickoffDefects& defects) : defects_(defects) {
     weight_[i] = sign * (1.0 + defects.gain_error[i]) / 4.0;
   }
   inv_gap_ = std::isfinite(defects.gap) ? 1.0 / defects.gap : 0.0;
+  for (int i = 0; i < kPickoffCount; ++i) {
+    const int slot = 4 * (i % 2) + i / 2;
+    channel_cos_[slot] = cos2psi_[i];
+    channel_sin_[slot] = sin2psi_[i];
+    channel_weight_[slot] = weight_[i];
+  }
 }
 
 PickoffSignature PickoffArray::signature() const {

@@ -84,6 +84,23 @@ TEST(ThetaUnwrapper, FollowsSeveralRevolutionsBothWays) {
   EXPECT_FALSE(unwrapper.initialized());
 }
 
+TEST(WaveEstimator, CarriesTheUnitVectorOfThetaThroughRebase) {
+  // cos/sin of theta come from half-angle identities (no trigonometry) and follow the unwrapping.
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> angle(-kPi, kPi), turns(-40.0, 40.0);
+  for (int i = 0; i < 500; ++i) {
+    const double theta = angle(rng);
+    WaveState w;
+    ASSERT_EQ(estimateWave(idealChannels({1.0, 0.02, theta, 0.3}), WaveLimits(), &w), WaveStatus::kOk);
+    EXPECT_NEAR(w.cos_theta, std::cos(w.theta), 1e-14);
+    EXPECT_NEAR(w.sin_theta, std::sin(w.theta), 1e-14);
+    const double continuous = w.theta + kPi * std::round(turns(rng));
+    w.rebase(continuous);
+    EXPECT_NEAR(w.cos_theta, std::cos(continuous), 1e-12);
+    EXPECT_NEAR(w.sin_theta, std::sin(continuous), 1e-12);
+  }
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace hrg_gyro

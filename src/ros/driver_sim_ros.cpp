@@ -75,8 +75,6 @@ bool DriverSimRos::waitForSubscribers() {
 
 void DriverSimRos::run() {
   core::GyroSimulator sim(*config_);
-  const core::Nanoseconds origin =
-      use_sim_time_ ? 0 : toNanoseconds(ros::Time::now()) - core::toNanoseconds(config_->start_time);
   // Under sim time the clock must run before anyone waits for subscribers' time to pass.
   if (!clock_pub_.getTopic().empty()) {
     rosgraph_msgs::Clock c;
@@ -84,6 +82,9 @@ void DriverSimRos::run() {
     clock_pub_.publish(c);
   }
   if (!waitForSubscribers()) return;
+  // In wall time the stamps start now, after the wait, so they say when each sample was taken.
+  const core::Nanoseconds origin =
+      use_sim_time_ ? 0 : toNanoseconds(ros::Time::now()) - core::toNanoseconds(config_->start_time);
   const ros::WallTime wall_start = ros::WallTime::now();
   core::SimulationSample s;
   double next_clock = 0.0;

@@ -9,6 +9,10 @@
 // linearChannelMap() gives that map on Z so tests can check that the correction matrix P inverts it.
 #pragma once
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <array>
 #include <limits>
 
@@ -55,17 +59,26 @@ class PickoffArray {
   ///   y = A cos(wt + tau) sin(theta) + B sin(wt + tau) cos(theta),
   /// for which sensor i reads r_i = cos(2 psi_i) x + sin(2 psi_i) y (psi_i its true position).
   void channels(double x, double y, double* c, double* s) const {
-    double cc = 0.0, ss = 0.0;
-    for (int i = 0; i < kPickoffCount; i += 2) {
-      const double r = cos2psi_[i] * x + sin2psi_[i] * y;
-      cc += weight_[i] * r / (1.0 - r * inv_gap_);
+    // Channel-major copies of the sensor constants (c sensors 0, 2, 4, 6, then s sensors 1, 3, 5,
+    // 7): the eight independent divisions go two per SSE2 instruction, with the same IEEE results.
+    alignas(16) double t[8];
+#if defined(__SSE2__)
+    const __m128d xv = _mm_set1_pd(x), yv = _mm_set1_pd(y), one = _mm_set1_pd(1.0), g = _mm_set1_pd(inv_gap_);
+    for (int q = 0; q < 8; q += 2) {
+      const __m128d r =
+          _mm_add_pd(_mm_mul_pd(_mm_load_pd(channel_cos_ + q), xv), _mm_mul_pd(_mm_load_pd(channel_sin_ + q), yv));
+      _mm_store_pd(t + q, _mm_div_pd(_mm_mul_pd(_mm_load_pd(channel_weight_ + q), r),
+                                     _mm_sub_pd(one, _mm_mul_pd(r, g))));
     }
-    for (int i = 1; i < kPickoffCount; i += 2) {
-      const double r = cos2psi_[i] * x + sin2psi_[i] * y;
-      ss += weight_[i] * r / (1.0 - r * inv_gap_);
+#else
+    for (int q = 0; q < 8; ++q) {
+      const double r = channel_cos_[q] * x + channel_sin_[q] * y;
+      t[q] = channel_weight_[q] * r / (1.0 - r * inv_gap_);
     }
-    *c = cc;
-    *s = ss;
+#endif
+    // Summed in sensor order, as the definition reads.
+    *c = ((t[0] + t[1]) + t[2]) + t[3];
+    *s = ((t[4] + t[5]) + t[6]) + t[7];
   }
 
   /// Standard deviation of the noise of one channel sample: four independent sensor noises of sigma,
@@ -80,6 +93,9 @@ class PickoffArray {
  private:
   PickoffDefects defects_;
   std::array<double, kPickoffCount> cos2psi_{}, sin2psi_{}, weight_{};
+  alignas(16) double channel_cos_[8] = {};
+  alignas(16) double channel_sin_[8] = {};
+  alignas(16) double channel_weight_[8] = {};
   double inv_gap_ = 0.0;
 };
 

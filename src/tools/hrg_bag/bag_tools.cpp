@@ -69,6 +69,28 @@ double Args::getDouble(const std::string& key, double fallback) const {
   }
 }
 
+std::unique_ptr<rosbag::Bag> createBag(const std::string& path, const Args& args) {
+  const std::string name = args.get("compression", "lz4");
+  rosbag::compression::CompressionType type;
+  if (name == "none") {
+    type = rosbag::compression::Uncompressed;
+  } else if (name == "lz4") {
+    type = rosbag::compression::LZ4;
+  } else if (name == "bz2") {
+    type = rosbag::compression::BZ2;
+  } else {
+    throw UsageError("--compression must be none, lz4 or bz2, got '" + name + "'");
+  }
+  auto bag = std::make_unique<rosbag::Bag>();
+  try {
+    bag->open(path, rosbag::bagmode::Write);
+  } catch (const rosbag::BagException& e) {
+    throw UsageError("cannot write " + path + ": " + e.what());
+  }
+  bag->setCompression(type);
+  return bag;
+}
+
 std::unique_ptr<rosbag::Bag> openBag(const std::string& path) {
   std::ifstream probe(path, std::ios::binary);
   if (!probe) throw UsageError("cannot read bag '" + path + "' (missing or unreadable)");

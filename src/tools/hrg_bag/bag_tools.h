@@ -75,6 +75,10 @@ class Progress {
 core::ProcessorConfig processorConfig(const Args& args);
 extern const std::vector<std::string> kProcessorOptions;
 
+/// Opens `path` for writing with the chunk compression named by --compression (none, lz4, bz2;
+/// default lz4: readers then decompress whole chunks instead of seeking for every message).
+std::unique_ptr<rosbag::Bag> createBag(const std::string& path, const Args& args);
+
 /// Replays the channels topic of `bag` in record order through `processor`, calling `sink` with
 /// every input message and its result.
 std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, core::GyroProcessor& processor,

@@ -9,11 +9,13 @@ namespace hrg_gyro {
 
 int simulateCommand(int argc, char** argv) {
   using namespace bag_tools;
-  const Args args(argc, argv, {"scenario", "out", "seed", "frame-id"}, {"no-truth"});
+  const Args args(argc, argv, {"scenario", "out", "seed", "frame-id", "compression"}, {"no-truth"});
   if (args.help()) {
     std::cout << "usage: hrg_bag simulate --scenario FILE.yaml --out OUT.bag [--seed N] [--frame-id ID] [--no-truth]\n"
+                 "       [--compression lz4|bz2|none]\n"
                  "Runs the simulated gyro of a scenario (the driver_sim parameters) and writes /channels,\n"
-                 "/turntable/state and /truth (unless --no-truth), stamped and recorded at simulated time.\n";
+                 "/turntable/state and /truth (unless --no-truth), stamped and recorded at simulated time. Chunks are LZ4-compressed\n"
+                 "by default (several times faster to read back; every rosbag reader handles it).\n";
     return 0;
   }
   core::SimulationConfig config =
@@ -25,12 +27,8 @@ int simulateCommand(int argc, char** argv) {
   }
   const std::string frame = args.get("frame-id", "gyro_link");
   const bool truth = !args.flag("no-truth");
-  rosbag::Bag bag;
-  try {
-    bag.open(args.require("out"), rosbag::bagmode::Write);
-  } catch (const rosbag::BagException& e) {
-    throw UsageError(std::string("cannot write ") + args.get("out") + ": " + e.what());
-  }
+  const std::unique_ptr<rosbag::Bag> out = createBag(args.require("out"), args);
+  rosbag::Bag& bag = *out;
   core::GyroSimulator sim(config);
   Progress progress("simulate", sim.duration());
   core::SimulationSample s;
