@@ -2,6 +2,8 @@
 #   make run    install missing Debian packages, build, run the main job, print the summary
 #   make test   install, build, run every unit test and rostest, then catkin_test_results
 #   make bench  install, build, run the benchmarks
+#   make soak   1 h at 10 kHz through the nodes, memory and drops watched
+#   make fuzz   libFuzzer + ASan/UBSan on the parameter loader and the sample path (FUZZ_SECONDS each)
 # Everything builds in .ws/, a catkin workspace inside the checkout (ignored by git) whose
 # src/hrg_gyro links back to this directory; source .ws/devel/setup.bash to use the package.
 # (A dot directory: roslaunch/rosrun search the package tree following links and skip dot dirs.)
@@ -14,7 +16,7 @@ export PATH := /usr/bin:/bin:$(PATH)
 CATKIN_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build test run bench clean
+.PHONY: deps build test run bench fuzz soak clean
 
 deps:
 	@$(ROOT)/scripts/install_deps.sh
@@ -41,6 +43,17 @@ run: build
 bench: build
 	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) hrg_gyro_benchmarks
 	cd $(WS) && source devel/setup.bash && /usr/bin/python3 $(ROOT)/bench/run_benchmarks.py
+
+# Soak: SOAK_SECONDS (default 3600) of 10 kHz through driver_sim, processor and calibrator with RSS
+# sampled; report in bench_output/soak (see bench/soak.py).
+soak: build
+	cd $(WS) && source devel/setup.bash && /usr/bin/python3 $(ROOT)/bench/soak.py
+
+# Fuzzing (clang from Debian): FUZZ_SECONDS per target (default 120), FUZZ_MERGE=1 to grow the
+# checked-in corpus. `make test` replays the corpus without sanitizers (hrg_gyro_fuzz_corpus_test).
+fuzz:
+	@$(ROOT)/scripts/install_deps.sh clang-14 libclang-rt-14-dev
+	$(ROOT)/scripts/run_fuzzers.sh
 
 clean:
 	rm -rf $(WS)

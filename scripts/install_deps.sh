@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian packages hrg_gyro needs, only those missing (idempotent; run as root or with
-# sudo available). ROS 1 comes from Debian bookworm itself, not from a ROS apt source.
+# sudo available). Arguments name extra packages. ROS 1 comes from Debian bookworm itself, not from a ROS apt source.
 set -euo pipefail
 
 PACKAGES=(
@@ -13,6 +13,8 @@ PACKAGES=(
   python3-std-srvs python3-sensor-msgs python3-diagnostic-msgs python3-yaml
   python3-numpy python3-matplotlib
 )
+# Extra packages for one target, e.g. `install_deps.sh clang-14 libclang-rt-14-dev` for `make fuzz`.
+PACKAGES+=("$@")
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -83,25 +83,42 @@ HarmonicModel parseModel(const YamlField& f, ModelKind kind) {
       for (std::size_t j = 0; j < nodes; ++j) values(row0 + i, j) = v[j];
     }
   }
-  for (std::size_t j = 0; j < nodes; ++j) {
-    const double m0 = values(0, j);
+  // The same limits hold at every node and, for a spline (which can overshoot its nodes), on a
+  // grid between them: K must keep its sign and D stay plausible at every temperature.
+  auto checkCoefficients = [&](const Eigen::VectorXd& v, const std::string& where) {
+    const double m0 = v(0);
     double harmonics = 0.0;
-    for (std::size_t r = 1; r < 1 + 2 * n; ++r) harmonics += std::abs(values(r, j));
-    const std::string at_node = nodes > 1 ? " at frequency node " + std::to_string(j) : "";
+    for (std::size_t r = 1; r < 1 + 2 * n; ++r) harmonics += std::abs(v(r));
+    if (!std::isfinite(m0) || !std::isfinite(harmonics)) f.fail("coefficients overflow" + where);
     if (kind == ModelKind::kScaleFactor) {
-      if (m0 == 0.0) f["mean"].fail("K0 must be non-zero" + at_node);
+      if (m0 == 0.0) f["mean"].fail("K0 must be non-zero" + where);
       if (m0 > 0.0) {
         f["mean"].fail("K0 must be negative (electrical wave angle lags the body rotation, K0 = -2k); got " +
-                       formatDouble(m0) + at_node);
+                       formatDouble(m0) + where);
       }
       if (harmonics >= 0.5 * std::abs(m0)) {
         f.fail("harmonics too large: sum of |cos| + |sin| = " + formatDouble(harmonics) +
-               " must stay below |K0|/2 so that K(theta) keeps its sign" + at_node);
+               " must stay below |K0|/2 so that K(theta) keeps its sign" + where);
       }
-    } else {
-      if (std::abs(m0) + harmonics > kMaxDriftCoefficient) {
-        f.fail("drift coefficients add up to " + formatDouble(std::abs(m0) + harmonics) +
-               " rad/s, above the plausible limit of 0.1 rad/s (units are rad/s of electrical angle)" + at_node);
+    } else if (std::abs(m0) + harmonics > kMaxDriftCoefficient) {
+      f.fail("drift coefficients add up to " + formatDouble(std::abs(m0) + harmonics) +
+             " rad/s, above the plausible limit of 0.1 rad/s (units are rad/s of electrical angle)" + where);
+    }
+  };
+  for (std::size_t j = 0; j < nodes; ++j) {
+    checkCoefficients(values.col(j), nodes > 1 ? " at frequency node " + std::to_string(j) : "");
+  }
+  if (nodes > 1 && interp.kind() == Interpolation::kNaturalCubicSpline) {
+    constexpr int kPointsPerInterval = 16;
+    const std::vector<double>& fn = interp.nodes();
+    Eigen::VectorXd w(nodes);
+    for (std::size_t j = 0; j + 1 < nodes; ++j) {
+      for (int i = 1; i < kPointsPerInterval; ++i) {
+        const double fi = fn[j] + (fn[j + 1] - fn[j]) * i / kPointsPerInterval;
+        interp.weights(fi, w.data());
+        checkCoefficients(values * w, " between frequency nodes " + std::to_string(j) + " and " +
+                                          std::to_string(j + 1) + " (the spline at " + formatDouble(fi) +
+                                          " Hz overshoots; add nodes or use piecewise_linear)");
       }
     }
   }

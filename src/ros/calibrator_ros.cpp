@@ -1,11 +1,11 @@
 #include "hrg_gyro/ros/calibrator_ros.h"
 
-#include <climits>
 #include <cstdlib>
 #include <fstream>
 #include <thread>
 
 #include "hrg_gyro/CalibrationResult.h"
+#include "hrg_gyro/core/output_directory.h"
 #include "hrg_gyro/core/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/diagnostics_timer.h"
@@ -23,21 +23,6 @@ const std::vector<std::string>& nodeOnlyKeys() {
   return keys;
 }
 
-std::string directoryOf(const std::string& path) {
-  const std::size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-}
-
-std::string canonical(const std::string& path) {
-  char buf[PATH_MAX];
-  return ::realpath(path.c_str(), buf) ? std::string(buf) : std::string();
-}
-
-/// True when `path` (its directory must exist) lies inside `directory`.
-bool inside(const std::string& path, const std::string& directory) {
-  const std::string dir = canonical(directory), parent = canonical(directoryOf(path));
-  return !dir.empty() && !parent.empty() && (parent == dir || parent.rfind(dir + "/", 0) == 0);
-}
 
 }  // namespace
 
@@ -52,16 +37,16 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     report_file_.resize(report_file_.size() - 5);
   }
   pnh_.param("report_file", report_file_, report_file_ + ".report.yaml");
-  pnh_.param<std::string>("output_directory", output_directory_, "");
+  // Every file the calibrator writes stays in one directory (by default that of the parameter file).
+  pnh_.param<std::string>("output_directory", output_directory_, core::directoryOf(parameter_file_));
   pnh_.param<std::string>("reload_service", reload_service_, "processor/reload");
   pnh_.param("write", write_, write_);
   pnh_.param("backward_reset", backward_reset_, backward_reset_);
   if (!(backward_reset_ > 0.0)) throw std::invalid_argument("calibrator: ~backward_reset must be positive (s)");
-  if (!output_directory_.empty()) {
-    for (const std::string& f : {parameter_file_, report_file_}) {
-      if (!inside(f, output_directory_)) {
-        throw std::invalid_argument("calibrator: '" + f + "' is outside ~output_directory '" + output_directory_ + "'");
-      }
+  for (const std::string& f : {parameter_file_, report_file_}) {
+    if (!core::isInsideDirectory(f, output_directory_)) {
+      throw std::invalid_argument("calibrator: '" + f + "' is outside ~output_directory '" + output_directory_ +
+                                  "' (or its directory does not exist)");
     }
   }
   core::loadParameterFile(parameter_file_);  // fail early on a bad prior
@@ -190,7 +175,10 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
 void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   restartIfTimeWentBack(msg->header.stamp, &last_wave_stamp_);
-  if (session_) session_->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency);
+  if (session_) {
+    session_->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency,
+                      msg->amplitude > 0.0 ? msg->quadrature / msg->amplitude : NAN);
+  }
 }
 
 void CalibratorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {

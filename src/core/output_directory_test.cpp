@@ -1,0 +1,54 @@
+#include "hrg_gyro/core/output_directory.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+namespace fs = std::filesystem;
+
+class OutputDirectory : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() / ("hrg_gyro_outdir_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+    fs::remove_all(root_);
+    fs::create_directories(root_ / "out" / "sub");
+    fs::create_directories(root_ / "outside");
+    fs::create_directories(root_ / "outer");
+    fs::create_directory_symlink(root_ / "outside", root_ / "out" / "link");
+  }
+  void TearDown() override { fs::remove_all(root_); }
+  std::string at(const std::string& relative) const { return (root_ / relative).string(); }
+  fs::path root_;
+};
+
+TEST_F(OutputDirectory, AcceptsFilesInsideAndInSubdirectories) {
+  EXPECT_TRUE(isInsideDirectory(at("out/params.yaml"), at("out")));
+  EXPECT_TRUE(isInsideDirectory(at("out/sub/params.report.yaml"), at("out")));
+  EXPECT_TRUE(isInsideDirectory(at("out/./params.yaml"), at("out/")));
+}
+
+TEST_F(OutputDirectory, RefusesEscapesByDotDotLinksAndPrefixes) {
+  EXPECT_FALSE(isInsideDirectory(at("out/../outside/params.yaml"), at("out")));
+  EXPECT_FALSE(isInsideDirectory(at("out/link/params.yaml"), at("out")));  // a link leading out
+  EXPECT_FALSE(isInsideDirectory(at("outer/params.yaml"), at("out")));     // a name prefix is not a parent
+  EXPECT_FALSE(isInsideDirectory("/etc/passwd", at("out")));
+}
+
+TEST_F(OutputDirectory, RefusesWhatDoesNotExist) {
+  EXPECT_FALSE(isInsideDirectory(at("out/missing/params.yaml"), at("out")));
+  EXPECT_FALSE(isInsideDirectory(at("out/params.yaml"), at("nowhere")));
+}
+
+TEST(DirectoryOf, SplitsAtTheLastSlash) {
+  EXPECT_EQ(directoryOf("/a/b/c.yaml"), "/a/b");
+  EXPECT_EQ(directoryOf("/c.yaml"), "/");
+  EXPECT_EQ(directoryOf("c.yaml"), ".");
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro
