@@ -1,5 +1,7 @@
 #include "hrg_gyro/core/calibration_outcome.h"
 
+#include <cmath>
+
 #include <yaml-cpp/yaml.h>
 
 #include "hrg_gyro/core/parameter_file.h"
@@ -49,6 +51,16 @@ void emitFit(YAML::Emitter& out, const HarmonicFitResult& f, double frequency) {
 
 }  // namespace
 
+void diagnose(CalibrationOutcome* o, const CorrectionMatrix& correction_in_force) {
+  o->diagnosis.clear();
+  for (std::size_t i = 0; i < o->scale_factor.size(); ++i) {
+    const HarmonicFitResult& k = o->scale_factor[i];
+    if (!k.ok) continue;
+    const double f = i < o->frequency_nodes.size() ? o->frequency_nodes[i] : NAN;
+    o->diagnosis.push_back(diagnoseDefects(k, o->quadrature_ratio, correction_in_force, f));
+  }
+}
+
 std::string emitCalibrationReport(const CalibrationOutcome& o) {
   YAML::Emitter out;
   out << YAML::Comment("hrg_gyro calibration report. K dimensionless, D in rad/s, angles in rad.");
@@ -85,6 +97,32 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
     out << YAML::Key << "pairs" << YAML::Value << o.correction.pairs;
     out << YAML::EndMap;
   }
+  out << YAML::Key << "quadrature_ratio" << YAML::Value << formatDouble(o.quadrature_ratio);
+  // Root causes read from the K harmonics (first order, MATH.md section 3); see defect_diagnosis.h.
+  out << YAML::Key << "diagnosis" << YAML::Value << YAML::BeginSeq;
+  for (const DefectDiagnosis& d : o.diagnosis) {
+    out << YAML::BeginMap;
+    if (std::isfinite(d.frequency)) out << YAML::Key << "frequency" << YAML::Value << formatDouble(d.frequency);
+    out << YAML::Key << "valid" << YAML::Value << d.valid;
+    out << YAML::Key << "note" << YAML::Value << YAML::DoubleQuoted << d.note;
+    out << YAML::Key << "gain_mismatch" << YAML::Value << formatDouble(d.gain_mismatch)
+        << YAML::Comment("gc - gs, relative");
+    out << YAML::Key << "gain_mismatch_std" << YAML::Value << formatDouble(d.gain_mismatch_std);
+    out << YAML::Key << "misplacement_difference" << YAML::Value << formatDouble(d.misplacement_difference)
+        << YAML::Comment("dc - ds, rad");
+    out << YAML::Key << "misplacement_difference_std" << YAML::Value << formatDouble(d.misplacement_difference_std);
+    out << YAML::Key << "pickoff_ratio" << YAML::Value << formatDouble(d.pickoff_ratio) << YAML::Comment("A/d0");
+    out << YAML::Key << "pickoff_ratio_std" << YAML::Value << formatDouble(d.pickoff_ratio_std);
+    out << YAML::Key << "quadrature_factor" << YAML::Value << formatDouble(d.quadrature_factor);
+    out << YAML::Key << "current_p" << YAML::Value;
+    emitNumbers(out, {d.current_correction.p.begin(), d.current_correction.p.end()});
+    out << YAML::Key << "recommended_p" << YAML::Value;
+    emitNumbers(out, {d.recommended_correction.p.begin(), d.recommended_correction.p.end()});
+    out << YAML::Key << "recommended_p_std" << YAML::Value;
+    emitNumbers(out, {d.recommended_correction_std.begin(), d.recommended_correction_std.end()});
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
   out << YAML::Key << "plateaus" << YAML::Value << YAML::BeginSeq;
   for (const GroupSummary& g : o.plateaus) {
     out << YAML::Flow << YAML::BeginMap;

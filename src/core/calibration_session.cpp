@@ -36,8 +36,12 @@ void CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double ra
   }
 }
 
-void CalibrationSession::addWave(Nanoseconds stamp, double theta, double frequency) {
+void CalibrationSession::addWave(Nanoseconds stamp, double theta, double frequency, double quadrature_ratio) {
   ++counters_.wave;
+  if (std::isfinite(quadrature_ratio)) {
+    quadrature_sum_ += std::abs(quadrature_ratio);
+    ++quadrature_count_;
+  }
   if (stamp <= last_wave_stamp_) {
     ++counters_.out_of_order;
     return;
@@ -109,6 +113,8 @@ bool CalibrationSession::shouldFinish() const {
 
 CalibrationOutcome CalibrationSession::finish() const {
   CalibrationOutcome o = method_->finish(prior_);
+  o.quadrature_ratio = quadrature_count_ > 0 ? quadrature_sum_ / quadrature_count_ : 0.0;
+  diagnose(&o, prior_.correction);
   if (counters_.unsynchronized > 0) {
     o.notes.push_back(std::to_string(counters_.unsynchronized) +
                       " wave samples had no turntable state around them and were not used");

@@ -18,7 +18,7 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
     }
     session.addTurntable(s.stamp, s.truth.table_angle, s.truth.table_rate);
     const ProcessorResult r = proc.process({s.stamp, s.z, s.frequency, s.temperature});
-    if (r.has_wave) session.addWave(s.stamp, r.wave.theta, s.frequency);
+    if (r.has_wave) session.addWave(s.stamp, r.wave.theta, s.frequency, r.wave.quadrature / r.wave.amplitude);
   }
   OfflineCalibration out;
   out.outcome = session.finish();

@@ -164,6 +164,26 @@ CalibrationResult toMessage(const core::CalibrationOutcome& o, bool written, con
     q.message = g.message;
     m.gates.push_back(q);
   }
+  for (const core::DefectDiagnosis& d : o.diagnosis) {
+    DefectDiagnosis x;
+    x.frequency = d.frequency;
+    x.valid = d.valid;
+    x.note = d.note;
+    x.gain_mismatch = d.gain_mismatch;
+    x.gain_mismatch_std = d.gain_mismatch_std;
+    x.misplacement_difference = d.misplacement_difference;
+    x.misplacement_difference_std = d.misplacement_difference_std;
+    x.pickoff_ratio = d.pickoff_ratio;
+    x.pickoff_ratio_std = d.pickoff_ratio_std;
+    x.quadrature_factor = d.quadrature_factor;
+    for (int i = 0; i < 4; ++i) {
+      x.current_p[i] = d.current_correction.p[i];
+      x.recommended_p[i] = d.recommended_correction.p[i];
+      x.recommended_p_std[i] = d.recommended_correction_std[i];
+    }
+    m.diagnosis.push_back(x);
+  }
+  m.quadrature_ratio = o.quadrature_ratio;
   return m;
 }
 

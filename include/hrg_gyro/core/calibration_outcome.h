@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "hrg_gyro/core/correction_matrix.h"
+#include "hrg_gyro/core/defect_diagnosis.h"
 #include "hrg_gyro/core/dual_rate_estimator.h"
 #include "hrg_gyro/core/gyro_parameters.h"
 #include "hrg_gyro/core/harmonic_fit.h"
@@ -52,12 +53,17 @@ struct CalibrationOutcome {
   std::vector<GateResult> gates;
   std::vector<BinnedCurvePoint> binned;  ///< binned K and D (dual-rate) or step points
   std::vector<std::string> notes;
+  double quadrature_ratio = 0.0;          ///< mean |B/A| of the wave samples (F of the diagnosis)
+  std::vector<DefectDiagnosis> diagnosis;  ///< one per scale_factor fit with 2 and 4 theta terms
 
   /// Appends a gate; the first failing one becomes the reason.
   void gate(const std::string& name, bool passed, double value, double limit, const std::string& message);
   /// accepted = every gate passed (and at least one exists).
   void decide();
 };
+
+/// Fills outcome->diagnosis from its scale-factor fits, read against the P in force during the run.
+void diagnose(CalibrationOutcome* outcome, const CorrectionMatrix& correction_in_force);
 
 /// Human- and machine-readable YAML of the outcome (report files, plots).
 std::string emitCalibrationReport(const CalibrationOutcome& outcome);

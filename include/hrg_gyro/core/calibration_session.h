@@ -7,6 +7,7 @@
 // the wave queue and the turntable history are trimmed by age, the methods keep bins.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -31,7 +32,8 @@ class CalibrationSession {
   CalibrationSession(const CalibrationSettings& settings, const GyroParameters& prior);
 
   void addTurntable(Nanoseconds stamp, double angle, double rate);
-  void addWave(Nanoseconds stamp, double theta, double frequency);
+  /// quadrature_ratio: B/A of the wave (NaN if unknown), averaged for the defect diagnosis.
+  void addWave(Nanoseconds stamp, double theta, double frequency, double quadrature_ratio = NAN);
   void addGeneratorPair(Nanoseconds stamp, const ChannelVector& raw, const ChannelVector& reference);
   /// The generator stream has moved past its sweep (told by that same stream, so it cannot be
   /// confused by another stream's lag): the correction-matrix run may finish.
@@ -71,6 +73,8 @@ class CalibrationSession {
   Nanoseconds last_wave_stamp_ = 0;
   Nanoseconds last_generator_stamp_ = 0;
   bool generator_ended_ = false;
+  double quadrature_sum_ = 0.0;  // of |B/A|, for the diagnosis's F factor
+  std::uint64_t quadrature_count_ = 0;
 };
 
 }  // namespace core

@@ -72,7 +72,7 @@ int calibrateCommand(int argc, char** argv) {
           continue;
         }
         const core::ProcessorResult r = processor.process(in);
-        if (r.has_wave) session.addWave(in.stamp, r.wave.theta, in.frequency);
+        if (r.has_wave) session.addWave(in.stamp, r.wave.theta, in.frequency, r.wave.quadrature / r.wave.amplitude);
       } else if (m.getTopic() == topics.turntable) {
         const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
         if (t) session.addTurntable(toNanoseconds(t->header.stamp), t->angle, t->rate);
