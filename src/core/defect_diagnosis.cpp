@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace hrg_gyro {
 namespace core {
@@ -74,6 +75,26 @@ DefectDiagnosis diagnoseDefects(const HarmonicFitResult& k, double quadrature_ra
   else if (d.pickoff_ratio_squared < 0.0)
     d.note = "negative cos 4theta reading: not a capacitive pickoff nonlinearity (A/d0 set to 0)";
   return d;
+}
+
+std::string describe(const DefectDiagnosis& d) {
+  char buf[512];
+  std::string out;
+  if (std::isfinite(d.frequency)) {
+    std::snprintf(buf, sizeof buf, "at %.3f Hz:\n", d.frequency);
+    out += buf;
+  }
+  if (!d.note.empty()) out += "  note: " + d.note + "\n";
+  std::snprintf(buf, sizeof buf,
+                "  gain mismatch gc - gs           = %+.3e +- %.1e\n"
+                "  misplacement difference dc - ds = %+.3e +- %.1e rad\n"
+                "  pickoff ratio A/d0              = %.4f +- %.4f\n"
+                "  recommended P = [%+.3e, %+.3e, %+.3e, %+.3e] (now [%+.3e, %+.3e, %+.3e, %+.3e])\n",
+                d.gain_mismatch, d.gain_mismatch_std, d.misplacement_difference, d.misplacement_difference_std,
+                d.pickoff_ratio, d.pickoff_ratio_std, d.recommended_correction.p[0], d.recommended_correction.p[1],
+                d.recommended_correction.p[2], d.recommended_correction.p[3], d.current_correction.p[0],
+                d.current_correction.p[1], d.current_correction.p[2], d.current_correction.p[3]);
+  return out + buf;
 }
 
 }  // namespace core

@@ -14,10 +14,11 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
+// The README's worked example: dual_rate.yaml with an isotropic resonator, pickoff defects only.
 SimulationConfig pickoffOnlyScenario() {
-  SimulationConfig c = SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/dual_rate.yaml",
+  SimulationConfig c = SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/diagnosis.yaml",
                                               nodeOnlyScenarioKeys());
-  c.resonator.scale_factor = HarmonicModel(c.resonator.scale_factor.meanAt(NAN));  // no intrinsic anisotropy
+  EXPECT_TRUE(c.resonator.scale_factor.orders().empty());
   return c;
 }
 
@@ -88,6 +89,21 @@ TEST(DefectDiagnosis, IncompleteFitsAreReportedNotGuessed) {
   d = diagnoseDefects(k, 0.0, CorrectionMatrix());
   EXPECT_FALSE(d.valid);
   EXPECT_EQ(d.recommended_correction, CorrectionMatrix());
+}
+
+TEST(DefectDiagnosis, DescriptionCarriesEveryQuantity) {
+  DefectDiagnosis d;
+  d.gain_mismatch = 3.5e-4;
+  d.gain_mismatch_std = 3.6e-6;
+  d.misplacement_difference = 1.1e-3;
+  d.pickoff_ratio = 0.05;
+  d.recommended_correction.p = {1.75e-4, -1.75e-4, 5.5e-4, -5.5e-4};
+  d.frequency = NAN;
+  const std::string text = describe(d);
+  for (const char* part : {"gc - gs", "+3.500e-04 +- 3.6e-06", "dc - ds", "+1.100e-03", "A/d0", "0.0500",
+                           "recommended P = [+1.750e-04, -1.750e-04, +5.500e-04, -5.500e-04]"}) {
+    EXPECT_NE(text.find(part), std::string::npos) << part << "\n" << text;
+  }
 }
 
 TEST(DefectDiagnosis, QuadratureFactor) {

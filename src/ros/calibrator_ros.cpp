@@ -261,6 +261,10 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
   } else {
     ROS_WARN("calibrator: %s %s", o.method.c_str(), message->c_str());
   }
+  for (const core::DefectDiagnosis& d : o.diagnosis) {
+    ROS_INFO("calibrator: root-cause diagnosis (first order, read against the P in force) %s",
+             core::describe(d).c_str());
+  }
   session_.reset();
   const bool more = *written && next_stage_ < stages_.size();
   if (*written) {

@@ -53,5 +53,9 @@ double quadratureFactor(double quadrature_ratio);
 DefectDiagnosis diagnoseDefects(const HarmonicFitResult& scale_factor, double quadrature_ratio,
                                 const CorrectionMatrix& current, double frequency = NAN);
 
+/// One line per quantity for logs and the command line, e.g.
+/// "gain mismatch gc - gs = 3.51e-04 +- 3.6e-06".
+std::string describe(const DefectDiagnosis& diagnosis);
+
 }  // namespace core
 }  // namespace hrg_gyro

@@ -104,6 +104,9 @@ int calibrateCommand(int argc, char** argv) {
     std::cout << "  " << (g.passed ? "pass" : "FAIL") << "  " << g.name << ": " << g.message << "\n";
   }
   for (const std::string& note : o.notes) std::cout << "  note: " << note << "\n";
+  for (const core::DefectDiagnosis& d : o.diagnosis) {
+    std::cout << "calibrate: root-cause diagnosis (first order, read against the P in force) " << core::describe(d);
+  }
   if (o.accepted) {
     core::saveParameterFile(out_path, o.parameters);
     std::cout << "calibrate: wrote " << out_path << " (peak nonlinearity of the new K: " << o.nonlinearity_ppm
