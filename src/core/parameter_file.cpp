@@ -265,7 +265,13 @@ GyroParameters parseParameterText(const std::string& text) {
     throw ConfigError("", "YAML syntax error at line " + std::to_string(e.mark.line + 1) + ", column " +
                               std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
-  return parseParameters(root);
+  try {
+    return parseParameters(root);
+  } catch (const YAML::Exception& e) {
+    // Every key is checked before it is converted; this is the backstop that keeps the promise
+    // "ConfigError or a valid model" for whatever yaml-cpp may still throw.
+    throw ConfigError("", std::string("unreadable YAML structure: ") + e.what());
+  }
 }
 
 GyroParameters loadParameterFile(const std::string& path) {

@@ -157,6 +157,13 @@ TEST(ParameterFile, RejectsBadKeysNamingThem) {
   expectRejected(replaced("  orders: [2, 4]", "  orders: [2, 4]\n  frequency_nodes: [4990.0, 5000.0]"),
                  "scale_factor.mean", "one per frequency node");
   expectRejected("", "", "YAML map");
+  // Found by the fuzzer: text that is not UTF-8 would not read back as written.
+  expectRejected(std::string(kValid) + "calibration:\n  notes: \"a\xff\"\n", "calibration.notes", "UTF-8");
+  expectRejected(std::string(kValid) + "calibration:\n  time: \"\xc0\xaf\"\n", "calibration.time", "UTF-8");
+  EXPECT_NO_THROW(parseParameterText(std::string(kValid) + "calibration:\n  notes: \"d\xc3\xa9j\xc3\xa0 vu \xe2\x9c\x93\"\n"));
+  // Found by the fuzzer: a map or a list used as a key escaped as a yaml-cpp conversion error.
+  expectRejected(replaced("earth_rate:", "{e: 0}: 1\nearth_rate:"), "", "plain names");
+  expectRejected(replaced("  enabled: true", "  [a, b]: 1\n  enabled: true"), "earth_rate", "plain names");
   expectRejected("scale_factor: [1, 2", "", "syntax error");
 }
 

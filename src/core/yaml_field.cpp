@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <set>
 
 namespace hrg_gyro {
@@ -49,6 +50,12 @@ void YamlField::rejectUnknownKeys(const std::vector<std::string>& allowed) const
   requireMap();
   const std::set<std::string> ok(allowed.begin(), allowed.end());
   for (const auto& kv : node_) {
+    // A key that is itself a list or a map ({a: 1}: 2) has no name to check: refuse it here rather
+    // than let yaml-cpp's conversion error escape as something other than a ConfigError.
+    if (!kv.first.IsScalar()) {
+      fail(std::string("keys must be plain names, got ") +
+           (kv.first.IsMap() ? "a map" : kv.first.IsSequence() ? "a list" : "an empty key"));
+    }
     const std::string key = kv.first.as<std::string>();
     if (!ok.count(key)) {
       std::string list;
@@ -88,8 +95,38 @@ bool YamlField::asBool() const {
   }
 }
 
+namespace {
+
+// Strict UTF-8 (no overlong forms, no surrogates, at most U+10FFFF). The emitter escapes what it
+// cannot write as UTF-8, so a file with other bytes would not read back to the same text.
+bool isValidUtf8(const std::string& s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    std::size_t n = 0;
+    std::uint32_t cp = 0, min = 0;
+    if (c < 0x80) { ++i; continue; }
+    if ((c & 0xE0) == 0xC0) { n = 1; cp = c & 0x1F; min = 0x80; }
+    else if ((c & 0xF0) == 0xE0) { n = 2; cp = c & 0x0F; min = 0x800; }
+    else if ((c & 0xF8) == 0xF0) { n = 3; cp = c & 0x07; min = 0x10000; }
+    else return false;
+    for (std::size_t k = 1; k <= n; ++k) {
+      if (i + k >= s.size()) return false;
+      const unsigned char cc = static_cast<unsigned char>(s[i + k]);
+      if ((cc & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (cc & 0x3F);
+    }
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+    i += n + 1;
+  }
+  return true;
+}
+
+}  // namespace
+
 std::string YamlField::asString() const {
   if (!node_.IsScalar()) fail("expected a string, got " + describe());
+  if (!isValidUtf8(node_.Scalar())) fail("text must be valid UTF-8");
   return node_.Scalar();
 }
 

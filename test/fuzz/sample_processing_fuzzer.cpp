@@ -54,6 +54,12 @@ std::shared_ptr<const core::GyroParameters> model(std::size_t index) {
   return models[index % kModelCount];
 }
 
+// Stamp arithmetic of the harness wraps like the unsigned it is made of (the processor must cope
+// with any int64 stamp, but the harness itself must not overflow a signed integer).
+std::int64_t shifted(std::int64_t stamp, std::int64_t delta) {
+  return static_cast<std::int64_t>(static_cast<std::uint64_t>(stamp) + static_cast<std::uint64_t>(delta));
+}
+
 class Reader {
  public:
   Reader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
@@ -121,7 +127,7 @@ int sampleProcessingTarget(const std::uint8_t* data, std::size_t size) {
         wave.quadrature = wave.amplitude * (in.take<std::int8_t>() / 128.0);
         wave.phase = in.take<std::int8_t>() * 0.025;
         sample.z = core::idealChannels(wave);
-        sample.stamp += static_cast<std::int64_t>(in.take<std::uint16_t>()) * 1000;
+        sample.stamp = shifted(sample.stamp, static_cast<std::int64_t>(in.take<std::uint16_t>()) * 1000);
         sample.frequency = 4980.0 + in.take<std::uint8_t>() * 0.2;
         break;
       }
@@ -132,8 +138,8 @@ int sampleProcessingTarget(const std::uint8_t* data, std::size_t size) {
           case 0: sample.z[channel] = -sample.z[channel]; break;
           case 1: sample.z[channel] = 0.0; break;
           case 2: sample.z *= in.take<double>(); break;
-          case 3: sample.stamp -= static_cast<std::int64_t>(in.take<std::uint32_t>()); break;
-          case 4: sample.stamp += static_cast<std::int64_t>(in.take<std::uint32_t>()) * 1000; break;
+          case 3: sample.stamp = shifted(sample.stamp, -static_cast<std::int64_t>(in.take<std::uint32_t>())); break;
+          case 4: sample.stamp = shifted(sample.stamp, static_cast<std::int64_t>(in.take<std::uint32_t>()) * 1000); break;
           default: sample.frequency = in.take<double>(); break;
         }
         break;
