@@ -5,7 +5,8 @@
       binned K(theta) and D(theta) with the fitted models, the residual of K after compensation
       (binned data minus the model, in ppm of K0), and the theta coverage of each plateau group.
       A frequency-dependent (thermal) result is drawn at the middle frequency of its nodes, where
-      the calibrator moved its binned data, with the model at each node as dashed lines.
+      the calibrator moved its binned data; the residual panel adds the model at each node minus
+      the model there (the temperature dependence, on the residual's scale).
   plot_calibration.py allan ALLAN.csv OUT.png
       the Allan deviation of the compensated rate (hrg_bag allan --csv), with its 1-sigma band.
 
@@ -111,8 +112,6 @@ def plot_calibration(report_path, out_path):
     ax = axes[0][0]
     ax.plot(theta, [1e6 * (k / k0 - 1.0) for k in binned.get("k", [])], ".", ms=3, label="binned data")
     ax.plot(grid, [1e6 * (model(k_est, t) / k0 - 1.0) for t in grid], "-", label="fitted model" + where)
-    for f, fit in node_models:
-        ax.plot(grid, [1e6 * (model(fit, t) / k0 - 1.0) for t in grid], "--", lw=0.8, label="model at %.3f Hz" % f)
     ax.set_xlabel("theta (electrical rad)")
     ax.set_ylabel("K / K0 - 1 (ppm)")
     ax.set_title("scale factor%s, K0 = %.9f, peak %.1f ppm" % (where, k0, r.get("nonlinearity_ppm", 0.0)))
@@ -134,6 +133,11 @@ def plot_calibration(report_path, out_path):
         ax.plot(theta, residual, ".", ms=3)
         rms = math.sqrt(sum(x * x for x in residual) / len(residual))
         ax.set_title("residual of binned K after compensation (rms %.2f ppm; bins are noisier than the fit)" % rms)
+    for f, fit in node_models:
+        ax.plot(grid, [1e6 * (model(fit, t) - model(k_est, t)) / abs(k0) for t in grid], "--", lw=0.8,
+                label="K(%.3f Hz) - K%s" % (f, where))
+    if node_models:
+        ax.legend(fontsize=8)
     ax.axhline(0.0, color="k", lw=0.5)
     ax.set_xlabel("theta (electrical rad)")
     ax.set_ylabel("(K_binned - K_model) / |K0| (ppm)")
