@@ -4,6 +4,9 @@
   plot_calibration.py calibration REPORT.yaml OUT.png
       binned K(theta) and D(theta) with the fitted models, the residual of K after compensation
       (binned data minus the model, in ppm of K0), and the theta coverage of each plateau group.
+      A frequency-dependent (thermal) result is drawn at the middle frequency of its nodes, where
+      the calibrator moved its binned data; the residual panel adds the model at each node minus
+      the model there (the temperature dependence, on the residual's scale).
   plot_calibration.py allan ALLAN.csv OUT.png
       the Allan deviation of the compensated rate (hrg_bag allan --csv), with its 1-sigma band.
 
@@ -25,6 +28,61 @@ def model(estimate, theta):
     return value
 
 
+def spline_weights(nodes, f, natural):
+    """Weights w_j with value(f) = sum_j w_j y_j: natural cubic spline or piecewise linear, end values
+    held outside the nodes (as FrequencyInterpolator does)."""
+    n = len(nodes)
+    w = [0.0] * n
+    if f <= nodes[0] or f >= nodes[-1]:
+        w[0 if f <= nodes[0] else n - 1] = 1.0
+        return w
+    i = max(j for j in range(n - 1) if nodes[j] <= f)
+    h = nodes[i + 1] - nodes[i]
+    t = (f - nodes[i]) / h
+    w[i], w[i + 1] = 1.0 - t, t
+    if not natural or n < 3:
+        return w
+    # Second derivatives m = C y with m_0 = m_{n-1} = 0 from the interior equations T m = D y.
+    m = n - 2
+    T = [[0.0] * m for _ in range(m)]
+    D = [[0.0] * n for _ in range(m)]
+    for r in range(m):
+        h0, h1 = nodes[r + 1] - nodes[r], nodes[r + 2] - nodes[r + 1]
+        if r > 0:
+            T[r][r - 1] = h0
+        T[r][r] = 2.0 * (h0 + h1)
+        if r < m - 1:
+            T[r][r + 1] = h1
+        D[r][r], D[r][r + 1], D[r][r + 2] = 6.0 / h0, -6.0 / h0 - 6.0 / h1, 6.0 / h1
+    # Solve T C = D by Gaussian elimination (T is small and diagonally dominant).
+    for c in range(m):
+        for r in range(c + 1, m):
+            factor = T[r][c] / T[c][c]
+            T[r] = [a - factor * b for a, b in zip(T[r], T[c])]
+            D[r] = [a - factor * b for a, b in zip(D[r], D[c])]
+    C = [[0.0] * n for _ in range(m)]
+    for r in reversed(range(m)):
+        row = D[r][:]
+        for c in range(r + 1, m):
+            row = [a - T[r][c] * b for a, b in zip(row, C[c])]
+        C[r] = [a / T[r][r] for a in row]
+    curvature = [[0.0] * n] + C + [[0.0] * n]
+    ci = h * h / 6.0 * ((1.0 - t) ** 3 - (1.0 - t))
+    cj = h * h / 6.0 * (t ** 3 - t)
+    return [w[k] + ci * curvature[i][k] + cj * curvature[i + 1][k] for k in range(n)]
+
+
+def at_frequency(fits, nodes, f, natural):
+    """The fitted coefficients of a frequency-dependent result interpolated at f."""
+    w = spline_weights(nodes, f, natural)
+    out = dict(fits[0])
+    for key in ("mean",):
+        out[key] = sum(wj * fit[key] for wj, fit in zip(w, fits))
+    for key in ("cos", "sin"):
+        out[key] = [sum(wj * fit[key][q] for wj, fit in zip(w, fits)) for q in range(len(fits[0][key]))]
+    return out
+
+
 def plot_calibration(report_path, out_path):
     with open(report_path) as f:
         r = yaml.safe_load(f)
@@ -34,6 +92,17 @@ def plot_calibration(report_path, out_path):
         raise SystemExit("the report has no K(theta) estimate (method %s, %s)" % (r.get("method"), r.get("reason")))
     k_est = r["scale_factor"][0]
     d_est = r["drift"][0] if r.get("drift") else None
+    nodes = r.get("frequency_nodes") or []
+    node_models, where = [], ""
+    if len(nodes) > 1 and len(r["scale_factor"]) == len(nodes):
+        written = yaml.safe_load(r["parameters"]) if r.get("accepted") else None
+        natural = not written or written["scale_factor"].get("interpolation") != "piecewise_linear"
+        f_mid = 0.5 * (nodes[0] + nodes[-1])
+        node_models = list(zip(nodes, r["scale_factor"]))
+        k_est = at_frequency(r["scale_factor"], nodes, f_mid, natural)
+        if r.get("drift"):
+            d_est = at_frequency(r["drift"], nodes, f_mid, natural)
+        where = " at %.3f Hz" % f_mid
     k0 = k_est["mean"]
     grid = [math.pi * i / 720 for i in range(721)]
     fig, axes = plt.subplots(2, 2, figsize=(12, 8))
@@ -42,10 +111,10 @@ def plot_calibration(report_path, out_path):
 
     ax = axes[0][0]
     ax.plot(theta, [1e6 * (k / k0 - 1.0) for k in binned.get("k", [])], ".", ms=3, label="binned data")
-    ax.plot(grid, [1e6 * (model(k_est, t) / k0 - 1.0) for t in grid], "-", label="fitted model")
+    ax.plot(grid, [1e6 * (model(k_est, t) / k0 - 1.0) for t in grid], "-", label="fitted model" + where)
     ax.set_xlabel("theta (electrical rad)")
     ax.set_ylabel("K / K0 - 1 (ppm)")
-    ax.set_title("scale factor, K0 = %.9f, peak %.1f ppm" % (k0, r.get("nonlinearity_ppm", 0.0)))
+    ax.set_title("scale factor%s, K0 = %.9f, peak %.1f ppm" % (where, k0, r.get("nonlinearity_ppm", 0.0)))
     ax.legend()
 
     ax = axes[0][1]
@@ -64,6 +133,11 @@ def plot_calibration(report_path, out_path):
         ax.plot(theta, residual, ".", ms=3)
         rms = math.sqrt(sum(x * x for x in residual) / len(residual))
         ax.set_title("residual of binned K after compensation (rms %.2f ppm; bins are noisier than the fit)" % rms)
+    for f, fit in node_models:
+        ax.plot(grid, [1e6 * (model(fit, t) - model(k_est, t)) / abs(k0) for t in grid], "--", lw=0.8,
+                label="K(%.3f Hz) - K%s" % (f, where))
+    if node_models:
+        ax.legend(fontsize=8)
     ax.axhline(0.0, color="k", lw=0.5)
     ax.set_xlabel("theta (electrical rad)")
     ax.set_ylabel("(K_binned - K_model) / |K0| (ppm)")

@@ -5,6 +5,7 @@
 #include <ctime>
 #include <sstream>
 
+#include "hrg_gyro/core/thermal_method.h"
 #include "hrg_gyro/core/units.h"
 
 namespace hrg_gyro {
@@ -85,6 +86,7 @@ std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettin
   if (s.method == "constant_rate") return std::make_unique<ConstantRateMethod>(s, k0);
   if (s.method == "step") return std::make_unique<StepMethod>(s);
   if (s.method == "correction_matrix") return std::make_unique<CorrectionMatrixMethod>(s);
+  if (s.method == "thermal") return std::make_unique<ThermalMethod>(s, k0);
   throw std::invalid_argument("unknown calibration method '" + s.method + "'");
 }
 

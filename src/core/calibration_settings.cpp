@@ -24,18 +24,18 @@ double positive(const YamlField& parent, const char* key, double fallback) {
 }  // namespace
 
 bool CalibrationSettings::knownMethod(const std::string& m) {
-  return m == "dual_rate" || m == "constant_rate" || m == "step" || m == "correction_matrix";
+  return m == "dual_rate" || m == "constant_rate" || m == "step" || m == "correction_matrix" || m == "thermal";
 }
 
 CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
   CalibrationSettings s;
   root.requireMap();
   std::vector<std::string> allowed = {"method", "scale_factor_orders", "drift_orders", "bins", "window", "window_span",
-                                      "group_tolerance", "auto_finish_idle", "plateau", "gates"};
+                                      "group_tolerance", "auto_finish_idle", "plateau", "gates", "thermal"};
   allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
   root.rejectUnknownKeys(allowed);
   s.method = root.getString("method", s.method);
-  if (!knownMethod(s.method)) root["method"].fail("unknown method '" + s.method + "' (dual_rate, constant_rate, step, correction_matrix)");
+  if (!knownMethod(s.method)) root["method"].fail("unknown method '" + s.method + "' (dual_rate, constant_rate, step, correction_matrix, thermal)");
   if (root.has("scale_factor_orders")) s.scale_factor_orders = parseEvenOrders(root["scale_factor_orders"]);
   if (root.has("drift_orders")) s.drift_orders = parseEvenOrders(root["drift_orders"]);
   s.bins = static_cast<int>(root.getInteger("bins", s.bins));
@@ -79,6 +79,28 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
     if (min_pairs < 2) g["min_pairs"].fail("must be >= 2");
     q.min_pairs = static_cast<std::uint64_t>(min_pairs);
     q.max_p_condition = positive(g, "max_p_condition", q.max_p_condition);
+  }
+  if (root.has("thermal")) {
+    const YamlField t = root["thermal"];
+    t.rejectUnknownKeys({"frequency_nodes", "node_count", "interpolation", "slice_width", "max_slices"});
+    ThermalSettings& ts = s.thermal;
+    if (t.has("frequency_nodes")) {
+      const YamlField nf = t["frequency_nodes"];
+      ts.frequency_nodes = nf.asDoubles();
+      if (ts.frequency_nodes.size() == 1) nf.fail("give at least 2 nodes, or none for automatic nodes (node_count)");
+      for (std::size_t j = 0; j < ts.frequency_nodes.size(); ++j) {
+        if (!(ts.frequency_nodes[j] > 0.0)) nf.at(j).fail("frequency must be positive (Hz)");
+        if (j > 0 && !(ts.frequency_nodes[j] > ts.frequency_nodes[j - 1])) nf.at(j).fail("nodes must be strictly increasing");
+      }
+    }
+    ts.node_count = static_cast<int>(t.getInteger("node_count", ts.node_count));
+    if (ts.node_count < 2 || ts.node_count > 32) t["node_count"].fail("must be in [2, 32]");
+    if (t.has("interpolation") && !parseInterpolation(t["interpolation"].asString(), &ts.interpolation)) {
+      t["interpolation"].fail("expected natural_cubic_spline or piecewise_linear");
+    }
+    ts.slice_width = positive(t, "slice_width", ts.slice_width);
+    ts.max_slices = static_cast<int>(t.getInteger("max_slices", ts.max_slices));
+    if (ts.max_slices < 1 || ts.max_slices > 100000) t["max_slices"].fail("must be in [1, 100000]");
   }
   return s;
 }

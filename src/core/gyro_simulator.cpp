@@ -12,8 +12,27 @@ GyroSimulator::GyroSimulator(const SimulationConfig& config)
       synth_(config_.pickoff, config_.resonator.samples_per_period, config_.seed),
       rate_noise_(config_.seed ^ 0x5deece66dULL),
       intrinsic_(config_.resonator.scale_factor, config_.resonator.drift),
+      frequency_(config_.resonator.frequency),
+      amplitude_(config_.resonator.amplitude),
       earth_rate_(verticalEarthRate(config_.latitude)),
-      theta_(config_.resonator.initial_theta) {}
+      theta_(config_.resonator.initial_theta) {
+  if (config_.thermal.enabled) updateTemperature(0.0);
+}
+
+void GyroSimulator::updateTemperature(double t) {
+  const double temperature = config_.thermal.profile.evaluate(t);
+  if (temperature == temperature_) return;  // a hold: nothing to rebuild
+  const ResonatorConfig& rc = config_.resonator;
+  GyroAtTemperature g = gyroAtTemperature(config_.thermal, temperature, rc.frequency, rc.amplitude, config_.pickoff,
+                                          rc.scale_factor, rc.drift);
+  temperature_ = temperature;
+  frequency_ = g.frequency;
+  amplitude_ = g.amplitude;
+  synth_.setDefects(g.pickoff);
+  thermal_k_ = std::move(g.scale_factor);
+  thermal_d_ = std::move(g.drift);
+  intrinsic_ = ModelPairEvaluator(thermal_k_, thermal_d_);
+}
 
 std::uint64_t GyroSimulator::generatorOutputsPerState() const {
   return static_cast<std::uint64_t>(std::max(1.0, std::round(config_.generator.dwell / config_.outputPeriod())));
@@ -59,8 +78,9 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
   std::vector<double> boundary_theta(m + 1);
   boundary_theta[0] = theta_;
   const double t_start = t_;
+  if (config_.thermal.enabled) updateTemperature(t_start + 0.5 * m * period);
   ChannelVector sum = ChannelVector::Zero();
-  WaveParameters wave{rc.amplitude, rc.quadrature, theta_, rc.phase};
+  WaveParameters wave{amplitude_, rc.quadrature, theta_, rc.phase};
   for (int p = 0; p < m; ++p) {
     // RK4 over one period: the rate changes by < 1e-5 relative within it.
     const double h = period, t = t_;
@@ -86,8 +106,8 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
     t_ = sum_t;
   }
   out->z = sum / m;
-  out->frequency = rc.frequency;
-  out->temperature = NAN;
+  out->frequency = frequency_;
+  out->temperature = temperature_;
   out->periods = static_cast<std::uint32_t>(m);
   const double t_center = 0.5 * (t_start + t_);
   stamp(t_center, out);
@@ -100,11 +120,11 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
   config_.profile.evaluate(t_center - generatorDuration(), &truth.table_angle, &truth.table_rate, &truth.segment);
   truth.inertial_rate = truth.table_rate + earth_rate_;
   truth.inertial_angle = truth.table_angle + earth_rate_ * t_center;
-  truth.amplitude = rc.amplitude;
+  truth.amplitude = amplitude_;
   truth.quadrature = rc.quadrature;
   truth.phase = rc.phase;
-  truth.frequency = rc.frequency;
-  truth.temperature = NAN;
+  truth.frequency = frequency_;
+  truth.temperature = temperature_;
   truth.generator = false;
 }
 
@@ -115,8 +135,9 @@ void GyroSimulator::nextGenerator(SimulationSample* out) {
   // State order: phase fastest, then quadrature, then angle.
   const std::uint64_t np = g.phases.size(), nq = g.quadratures.size();
   const std::uint64_t s = generator_state_;
+  if (config_.thermal.enabled) updateTemperature((index_ + 0.5) * config_.outputPeriod());
   WaveParameters wave;
-  wave.amplitude = rc.amplitude;
+  wave.amplitude = amplitude_;
   wave.phase = g.phases[s % np];
   wave.quadrature = g.quadratures[(s / np) % nq];
   wave.theta = kPi * static_cast<double>(s / (np * nq)) / g.angles;
@@ -126,8 +147,8 @@ void GyroSimulator::nextGenerator(SimulationSample* out) {
   const double t_start = t_;
   t_ = (index_ + 1) * config_.outputPeriod();
   out->z = sum / m;
-  out->frequency = rc.frequency;
-  out->temperature = NAN;
+  out->frequency = frequency_;
+  out->temperature = temperature_;
   out->periods = static_cast<std::uint32_t>(m);
   stamp(0.5 * (t_start + t_), out);
   TruthState& truth = out->truth;
@@ -136,7 +157,8 @@ void GyroSimulator::nextGenerator(SimulationSample* out) {
   truth.amplitude = wave.amplitude;
   truth.quadrature = wave.quadrature;
   truth.phase = wave.phase;
-  truth.frequency = rc.frequency;
+  truth.frequency = frequency_;
+  truth.temperature = temperature_;
   truth.inertial_rate = earth_rate_;
   truth.inertial_angle = earth_rate_ * 0.5 * (t_start + t_);
   truth.generator = true;

@@ -89,7 +89,7 @@ TEST(Scenarios, ShippedScenariosParseAndDescribeTheSameGyro) {
   std::string reference_gyro;
   for (const char* name :
        {"dual_rate.yaml", "constant_rate.yaml", "steps.yaml", "verification.yaml", "generator.yaml", "demo.yaml",
-        "two_stage.yaml"}) {
+        "two_stage.yaml", "thermal_ramp.yaml"}) {
     SCOPED_TRACE(name);
     const SimulationConfig c = SimulationConfig::load(dir + name, nodeOnlyScenarioKeys());
     EXPECT_EQ(c.resonator.samples_per_period, 32);

@@ -14,9 +14,66 @@ const std::vector<std::string>& nodeOnlyScenarioKeys() {
   return keys;
 }
 
+namespace {
+
+/// The limits the resonator and pickoff sections enforce must hold at every temperature of the
+/// profile; the defects are linear in T, so checking both extremes suffices.
+void checkThermalLimits(const SimulationConfig& c, const YamlField& section) {
+  const ThermalConfig& t = c.thermal;
+  const ResonatorConfig& rc = c.resonator;
+  // The coefficient keys may be absent (0): name them by path rather than through the node.
+  const std::string coefficients = section.path() + ".coefficients";
+  for (const double temperature : {t.profile.minimum(), t.profile.maximum()}) {
+    const std::string at = " at " + formatDouble(temperature) + " degC of the profile";
+    if (!(t.frequencyAt(temperature, rc.frequency) > 0.0)) {
+      throw ConfigError(section.path() + ".frequency_coefficient", "the resonance frequency becomes non-positive" + at);
+    }
+    const GyroAtTemperature g =
+        gyroAtTemperature(t, temperature, rc.frequency, rc.amplitude, c.pickoff, rc.scale_factor, rc.drift);
+    if (!(g.amplitude > 0.0) || !(std::abs(rc.quadrature) < 0.5 * g.amplitude) ||
+        !(g.amplitude / c.pickoff.gap < 0.5)) {
+      throw ConfigError(coefficients + ".amplitude", "the amplitude A = " + formatDouble(g.amplitude) +
+                                                         " leaves the valid range (A > 2|B|, A/d0 < 0.5)" + at);
+    }
+    for (int i = 0; i < kPickoffCount; ++i) {
+      const std::string index = "[" + std::to_string(i) + "]";
+      if (std::abs(g.pickoff.misplacement[i]) > 0.1) {
+        throw ConfigError(coefficients + ".misplacement" + index, "misplacement exceeds 0.1 rad" + at);
+      }
+      if (std::abs(g.pickoff.gain_error[i]) >= 0.5) {
+        throw ConfigError(coefficients + ".gain_error" + index, "gain error reaches 0.5" + at);
+      }
+    }
+    double harmonics = 0.0;
+    const HarmonicModel& k = g.scale_factor;
+    for (Eigen::Index r = 1; r < k.nodeValues().rows(); ++r) harmonics += std::abs(k.nodeValues()(r, 0));
+    const double k0 = k.meanAt(NAN);
+    if (!(k0 < 0.0) || harmonics >= 0.5 * std::abs(k0)) {
+      throw ConfigError(coefficients + ".scale_factor", "K0 must stay negative and its harmonics below |K0|/2" + at);
+    }
+  }
+}
+
+}  // namespace
+
+SimulationConfig atTemperature(const SimulationConfig& config, double temperature) {
+  if (!config.thermal.enabled) return config;
+  SimulationConfig c = config;
+  const ResonatorConfig& rc = config.resonator;
+  GyroAtTemperature g = gyroAtTemperature(config.thermal, temperature, rc.frequency, rc.amplitude, config.pickoff,
+                                          rc.scale_factor, rc.drift);
+  c.resonator.amplitude = g.amplitude;
+  c.resonator.scale_factor = std::move(g.scale_factor);
+  c.resonator.drift = std::move(g.drift);
+  c.pickoff = g.pickoff;
+  c.thermal = ThermalConfig();
+  return c;
+}
+
 SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
   root.requireMap();
-  std::vector<std::string> allowed = {"seed", "start_time", "resonator", "pickoff", "turntable", "generator"};
+  std::vector<std::string> allowed = {"seed",      "start_time", "resonator", "pickoff",
+                                      "turntable", "generator",  "thermal"};
   allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
   root.rejectUnknownKeys(allowed);
   SimulationConfig c;
@@ -98,6 +155,10 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
     c.acceleration = t.getDouble("acceleration", c.acceleration);
     if (!(c.acceleration > 0.0)) t["acceleration"].fail("must be positive (rad/s^2)");
     if (t.has("profile")) c.profile = TurntableProfile::parse(t["profile"], c.acceleration);
+  }
+  if (root.has("thermal")) {
+    c.thermal = ThermalConfig::parse(root["thermal"]);
+    checkThermalLimits(c, root["thermal"]);
   }
   if (!c.generator.enabled && c.profile.pieces().empty()) {
     throw ConfigError("turntable.profile", "missing: give a turntable profile (or enable the generator)");

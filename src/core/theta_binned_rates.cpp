@@ -24,7 +24,7 @@ void ThetaBinnedRates::breakChain() {
   history_ = 0;
 }
 
-void ThetaBinnedRates::add(Nanoseconds stamp, double theta, double y) {
+void ThetaBinnedRates::add(Nanoseconds stamp, double theta, double y, double tag) {
   if (!has_origin_) {
     has_origin_ = true;
     origin_ = stamp;
@@ -52,13 +52,14 @@ void ThetaBinnedRates::add(Nanoseconds stamp, double theta, double y) {
   block_.t_sum += toSeconds(stamp - origin_);
   block_.theta_sum += theta;
   block_.y_sum += y;
+  block_.tag_sum += tag;
   ++block_.n;
   if (stamp - block_.start >= window_ns_) closeBlock();
 }
 
 void ThetaBinnedRates::closeBlock() {
   const double n = static_cast<double>(block_.n);
-  const double t = block_.t_sum / n, theta = block_.theta_sum / n, y = block_.y_sum / n;
+  const double t = block_.t_sum / n, theta = block_.theta_sum / n, y = block_.y_sum / n, tag = block_.tag_sum / n;
   window_samples_ += block_.n;
   block_ = Block();
   if (has_previous_mean_) {
@@ -69,6 +70,7 @@ void ThetaBinnedRates::closeBlock() {
       if (b >= binCount()) b = binCount() - 1;
       bins_[b].dy += y - previous_y_;
       bins_[b].dt += dt;
+      bins_[b].tag += dt * 0.5 * (tag + previous_tag_);
       if (b != previous_bin_) {
         ++bins_[b].runs;
         if (previous_bin_ >= 0) {
@@ -99,6 +101,7 @@ void ThetaBinnedRates::closeBlock() {
   previous_t_ = t;
   previous_theta_ = theta;
   previous_y_ = y;
+  previous_tag_ = tag;
 }
 
 void ThetaBinnedRates::sweep(double lo, double hi, double dt) {

@@ -284,7 +284,7 @@ bool CalibratorRos::onStart(StartCalibration::Request& req, StartCalibration::Re
   } else {
     if (!core::CalibrationSettings::knownMethod(req.method)) {
       res.success = false;
-      res.message = "unknown method '" + req.method + "' (dual_rate, constant_rate, step, correction_matrix)";
+      res.message = "unknown method '" + req.method + "' (dual_rate, constant_rate, step, correction_matrix, thermal)";
       return true;
     }
     stages_ = {req.method};

@@ -3,6 +3,7 @@
 //   ConstantRateMethod     one table rate and a dwell for the rest rate; drift leaks into K (method 2)
 //   StepMethod             steps of the table angle between dwells; the dwells give D (method 1)
 //   CorrectionMatrixMethod P from generator pairs (the paper's first refinement stage)
+// (and, in thermal_method.h, ThermalMethod: the dual-rate method across temperature)
 // Each keeps memory bounded by its bins, whatever the session length.
 #pragma once
 

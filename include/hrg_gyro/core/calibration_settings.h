@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "hrg_gyro/core/frequency_interpolator.h"
 #include "hrg_gyro/core/plateau_detector.h"
 #include "hrg_gyro/core/yaml_field.h"
 
@@ -28,8 +29,19 @@ struct QualityLimits {
   double max_p_condition = 1e3;        ///< correction-matrix method
 };
 
+/// The thermal method (K and D as splines over the resonator frequency, thermal_method.h).
+struct ThermalSettings {
+  /// Hz, strictly increasing; empty: node_count nodes spread evenly over the frequencies seen.
+  std::vector<double> frequency_nodes;
+  int node_count = 3;
+  Interpolation interpolation = Interpolation::kNaturalCubicSpline;
+  double slice_width = 0.5;  ///< Hz: the data are theta-binned separately per frequency slice
+  int max_slices = 512;      ///< bound on the slices kept (memory): data in further slices are dropped
+  std::size_t nodeCount() const { return frequency_nodes.empty() ? node_count : frequency_nodes.size(); }
+};
+
 struct CalibrationSettings {
-  std::string method = "dual_rate";  ///< dual_rate | constant_rate | step | correction_matrix
+  std::string method = "dual_rate";  ///< dual_rate | constant_rate | step | correction_matrix | thermal
   std::vector<int> scale_factor_orders{2, 4, 6, 8};
   std::vector<int> drift_orders{2, 4};
   int bins = 128;            ///< theta bins over [0, pi)
@@ -39,6 +51,7 @@ struct CalibrationSettings {
   double auto_finish_idle = 20.0; ///< s at rest after the data are complete -> finish (<= 0: never)
   PlateauSettings plateau;
   QualityLimits gates;
+  ThermalSettings thermal;
 
   /// Parses the calibrator settings map. Throws ConfigError naming the key.
   static CalibrationSettings parse(const YamlField& root, const std::vector<std::string>& extra_keys = {});

@@ -8,6 +8,11 @@
 // into one output sample stamped at the centre of its window. With the generator enabled the
 // session starts with a known sweep of (theta, B, tau) at rest (for the correction-matrix fit), and
 // the turntable profile, if any, follows it.
+//
+// With a thermal section (thermal_model.h) the temperature is evaluated at the centre of each
+// output window and held over it: the pickoff defects, the amplitude and the intrinsic K and D are
+// those of that temperature, and the sample reports T and f(T). Without one every sample reports
+// the nominal frequency and an unknown (NaN) temperature, exactly as before thermal support existed.
 #pragma once
 
 #include <cstdint>
@@ -71,11 +76,18 @@ class GyroSimulator {
   double generatorDuration() const;
   std::uint64_t generatorOutputsPerState() const;
   void stamp(double t_center, SimulationSample* out) const;
+  /// Thermal scenarios: moves the gyro to the temperature at time t (s from the start).
+  void updateTemperature(double t);
 
   SimulationConfig config_;
   SignalSynthesizer synth_;
   GaussianNoise rate_noise_;  // separate stream: switching it on leaves the pickoff noise unchanged
+  // Intrinsic K and D: the resonator's own models, or (thermal) those of the current temperature.
+  HarmonicModel thermal_k_{0.0}, thermal_d_{0.0};
   ModelPairEvaluator intrinsic_;
+  double temperature_ = NAN;  // degC; NaN without a thermal section
+  double frequency_;          // reported resonance frequency, Hz
+  double amplitude_;          // wave amplitude A at the current temperature
   double earth_rate_;
   double t_ = 0.0;            // s since start, Kahan-compensated
   double t_compensation_ = 0.0;

@@ -1,5 +1,5 @@
-// A simulation scenario: the gyro (resonator, pickoffs), the turntable profile and the generator
-// sweep. The keys are those of the driver_sim node's private parameters, so one YAML file serves
+// A simulation scenario: the gyro (resonator, pickoffs), the turntable profile, the generator
+// sweep and, optionally, the temperature (thermal_model.h). The keys are those of the driver_sim node's private parameters, so one YAML file serves
 // `roslaunch` (rosparam load into ~) and `hrg_bag simulate` alike. Defaults follow MATH.md section 7.
 #pragma once
 
@@ -9,6 +9,7 @@
 
 #include "hrg_gyro/core/harmonic_model.h"
 #include "hrg_gyro/core/pickoff_array.h"
+#include "hrg_gyro/core/thermal_model.h"
 #include "hrg_gyro/core/turntable_profile.h"
 #include "hrg_gyro/core/yaml_field.h"
 
@@ -47,6 +48,7 @@ struct SimulationConfig {
   double acceleration = 0.5;  ///< rad/s^2 of the turntable
   TurntableProfile profile;
   GeneratorConfig generator;
+  ThermalConfig thermal;      ///< disabled unless the scenario has a thermal section
 
   double outputPeriod() const { return resonator.periods_per_output / resonator.frequency; }
 
@@ -55,6 +57,12 @@ struct SimulationConfig {
   static SimulationConfig parse(const YamlField& root, const std::vector<std::string>& extra_keys = {});
   static SimulationConfig load(const std::string& path, const std::vector<std::string>& extra_keys = {});
 };
+
+/// The scenario with its gyro frozen at one temperature: amplitude, pickoff defects and intrinsic K
+/// and D taken at `temperature`, thermal section disabled (the sampling frequency stays f0). The
+/// exact injected model at that temperature is computeEffectiveModel() of the result. Without a
+/// thermal section the scenario is returned unchanged.
+SimulationConfig atTemperature(const SimulationConfig& config, double temperature);
 
 /// Parameters of driver_sim that only the ROS node reads; scenario files may carry them.
 const std::vector<std::string>& nodeOnlyScenarioKeys();

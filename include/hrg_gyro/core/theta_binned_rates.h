@@ -14,6 +14,10 @@
 // max_order); a fit on those means is exactly the fit on every increment, with no bin-width or
 // jitter error. The window-to-window difference still averages harmonic k by sinc^2(k L / 2), L the
 // angle swept in one window (windowSpan()); the fit corrects that factor.
+//
+// A sample may carry a tag (the resonator frequency, for the thermal calibration): each bin keeps
+// the dt-weighted mean tag of its increments, so a model that depends on the tag can be evaluated
+// where the bin's data really were.
 #pragma once
 
 #include <cstdint>
@@ -34,8 +38,8 @@ class ThetaBinnedRates {
   /// max_order: highest (even) harmonic order whose basis means are kept.
   ThetaBinnedRates(int bins, double window_seconds, int max_order);
 
-  /// Adds one sample of the plateau (stamps increasing within a chain).
-  void add(Nanoseconds stamp, double theta, double y);
+  /// Adds one sample of the plateau (stamps increasing within a chain); `tag` is averaged per bin.
+  void add(Nanoseconds stamp, double theta, double y, double tag = 0.0);
   /// The next sample starts a new chain: no increment spans a plateau change or a gap.
   void breakChain();
 
@@ -45,6 +49,10 @@ class ThetaBinnedRates {
   double binTime(int b) const { return bins_[b].dt; }
   /// sum dy / sum dt of the bin (0 when the bin is empty; check binTime()).
   double binRate(int b) const { return bins_[b].dt > 0.0 ? bins_[b].dy / bins_[b].dt : 0.0; }
+  /// dt-weighted mean tag of the bin's increments (0 when the bin is empty).
+  double binTag(int b) const { return bins_[b].dt > 0.0 ? bins_[b].tag / bins_[b].dt : 0.0; }
+  /// s of increments whose angle span overlapped the bin (what coverage() counts).
+  double binSwept(int b) const { return bins_[b].swept; }
   int maxOrder() const { return max_order_; }
   /// dt-weighted mean of cos(k theta) (or sin) over the bin's increment midpoints; k even <= maxOrder().
   double basisMean(int b, int k, bool sine) const {
@@ -83,10 +91,11 @@ class ThetaBinnedRates {
     std::uint32_t runs = 0;         // maximal runs of consecutive increments in this bin
     std::uint32_t shared_next = 0;  // window means shared with bin (b + 1) mod n
     double swept = 0.0;             // s of increments whose angle span overlaps the bin
+    double tag = 0.0;               // sum dt tag
   };
   struct Block {
     Nanoseconds start = 0;
-    double t_sum = 0.0, theta_sum = 0.0, y_sum = 0.0;
+    double t_sum = 0.0, theta_sum = 0.0, y_sum = 0.0, tag_sum = 0.0;
     std::uint64_t n = 0;
   };
 
@@ -101,7 +110,7 @@ class ThetaBinnedRates {
   Nanoseconds origin_ = 0;
   Block block_;
   bool has_previous_mean_ = false;
-  double previous_t_ = 0.0, previous_theta_ = 0.0, previous_y_ = 0.0;
+  double previous_t_ = 0.0, previous_theta_ = 0.0, previous_y_ = 0.0, previous_tag_ = 0.0;
   int previous_bin_ = -1;  // bin of the last increment of the chain
   std::map<std::pair<int, int>, std::uint32_t> shared_far_;  // rare: boundaries between non-adjacent bins
   std::uint64_t samples_ = 0, increments_ = 0, window_samples_ = 0;

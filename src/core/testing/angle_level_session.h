@@ -1,6 +1,7 @@
 // Test support: a fast angle-level session (no pickoffs, no demodulation) -- the wave angle obeys
 // d theta = K(theta) (Omega_table + Omega_E) dt + D(theta) dt, sampled at `rate_hz` with white
-// noise -- fed into a calibration session together with the turntable states.
+// noise -- fed into a calibration session together with the turntable states. K and D may depend
+// on the resonator frequency, given as a function of time (a temperature ramp at angle level).
 #pragma once
 
 #include <functional>
@@ -23,19 +24,23 @@ struct AngleLevelGyro {
   double rate_hz = 1000.0;
   double theta0 = 0.2;
   std::uint64_t seed = 7;
+  /// Resonator frequency (Hz) at t s from the start, where K and D are evaluated and which the
+  /// samples report; empty: unknown (NaN).
+  std::function<double(double)> frequency;
 };
 
-/// Calls sink(stamp, table_angle, table_rate_reported, theta_measured) for every sample.
+/// Calls sink(stamp, table_angle, table_rate_reported, theta_measured, frequency) for every sample.
 inline void runAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profile,
-                          const std::function<void(Nanoseconds, double, double, double)>& sink) {
+                          const std::function<void(Nanoseconds, double, double, double, double)>& sink) {
   ModelPairEvaluator models(g.k, g.d);
   GaussianNoise noise(g.seed);
   const double h = 1.0 / g.rate_hz;
   double theta = g.theta0;
+  auto frequency = [&](double t) { return g.frequency ? g.frequency(t) : NAN; };
   auto f = [&](double t, double th) {
     double angle, rate, k, d;
     profile.evaluate(t, &angle, &rate);
-    models.evaluate(th, NAN, &k, &d);
+    models.evaluate(th, frequency(t), &k, &d);
     return k * (rate + g.earth_rate) + d;
   };
   const long steps = static_cast<long>(profile.duration() * g.rate_hz);
@@ -43,20 +48,29 @@ inline void runAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profi
     const double t = i * h;
     double angle, rate;
     profile.evaluate(t, &angle, &rate);
-    sink(toNanoseconds(1.0 + t), angle, rate + g.rate_noise * noise.next(), theta + g.noise * noise.next());
+    sink(toNanoseconds(1.0 + t), angle, rate + g.rate_noise * noise.next(), theta + g.noise * noise.next(),
+         frequency(t));
     const double k1 = f(t, theta), k2 = f(t + h / 2, theta + h / 2 * k1), k3 = f(t + h / 2, theta + h / 2 * k2),
                  k4 = f(t + h, theta + h * k3);
     theta += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
   }
 }
 
+/// The same without the frequency: sink(stamp, table_angle, table_rate_reported, theta_measured).
+inline void runAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profile,
+                          const std::function<void(Nanoseconds, double, double, double)>& sink) {
+  runAngleLevel(g, profile, [&](Nanoseconds t, double angle, double rate, double theta, double) {
+    sink(t, angle, rate, theta);
+  });
+}
+
 inline CalibrationOutcome calibrateAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profile,
                                               const CalibrationSettings& settings, const GyroParameters& prior,
                                               SessionCounters* counters = nullptr) {
   CalibrationSession session(settings, prior);
-  runAngleLevel(g, profile, [&](Nanoseconds t, double angle, double rate, double theta) {
+  runAngleLevel(g, profile, [&](Nanoseconds t, double angle, double rate, double theta, double frequency) {
     session.addTurntable(t, angle, rate);
-    session.addWave(t, theta, NAN);
+    session.addWave(t, theta, frequency);
   });
   if (counters) *counters = session.counters();
   return session.finish();

@@ -21,12 +21,13 @@ int calibrateCommand(int argc, char** argv) {
   valued.insert(valued.end(), kProcessorOptions.begin(), kProcessorOptions.end());
   const Args args(argc, argv, valued, {});
   if (args.help() || args.positional().size() != 1) {
-    std::cout << "usage: hrg_bag calibrate BAG --method dual_rate|constant_rate|step|correction_matrix --out OUT.yaml\n"
+    std::cout << "usage: hrg_bag calibrate BAG --method dual_rate|constant_rate|step|correction_matrix|thermal --out OUT.yaml\n"
                  "       [--params IN.yaml] [--config SETTINGS.yaml] [--report REPORT.yaml] [--plot OUT.png]\n"
                  "Processes the bag's channels with IN.yaml (default: the nominal model at latitude 0) and runs\n"
                  "the calibrator's method with its quality gates on the turntable plateaus. SETTINGS.yaml holds\n"
-                 "calibrator parameters (bins, window, gates/..., as the node's). OUT.yaml is written atomically\n"
-                 "only when every gate passes. Exit 0 accepted, 1 refused, 2 bad input.\n";
+                 "calibrator parameters (bins, window, gates/..., thermal/..., as the node's). OUT.yaml is written\n"
+                 "atomically only when every gate passes; thermal writes K and D as splines over the resonator\n"
+                 "frequency (the bag's channels must carry it). Exit 0 accepted, 1 refused, 2 bad input.\n";
     return args.help() ? 0 : 2;
   }
   core::CalibrationSettings settings;
