@@ -55,12 +55,14 @@ def scenario(seconds, rate):
     frequency = 10000.0 if rate > 5000 else 5000.0
     s["resonator"]["frequency"] = frequency
     s["resonator"]["periods_per_output"] = max(1, int(round(frequency / rate)))
-    repeat = max(1, int((seconds - 40.0) // 226.0))
+    # One repeat is a pair of 226 s plateaus (452 s); end with a rest long enough for the calibrator
+    # to finish (auto_finish_idle 20 s) inside the soak.
+    repeat = max(1, int((seconds - 10.0 - 60.0) // 452.0))
     s["turntable"]["profile"] = [
         {"type": "dwell", "duration": 10.0, "label": "start"},
         {"type": "dual_rate", "rates": [0.05, -0.05], "duration": 226.0, "settle": 3.0, "repeat": repeat,
          "label": "calibration"},
-        {"type": "dwell", "duration": max(30.0, seconds - 10.0 - 226.0 * repeat), "label": "rest"},
+        {"type": "dwell", "duration": max(60.0, seconds - 10.0 - 452.0 * repeat), "label": "rest"},
     ]
     return s, frequency / s["resonator"]["periods_per_output"]
 
