@@ -12,20 +12,6 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-std::string utcNow() {
-  char buf[32];
-  const std::time_t now = std::time(nullptr);
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  return buf;
-}
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(4);
-  s << v;
-  return s.str();
-}
-
 /// Upper bound of |dK/dtheta| for a fitted model: sum_k k sqrt(a_k^2 + b_k^2).
 double slopeBound(const HarmonicFitResult& f) {
   double s = 0.0;
@@ -46,17 +32,17 @@ void finishModel(CalibrationOutcome* o, const HarmonicFitResult& k, const Harmon
   o->drift = {d};
   const double k0 = k.mean, k0_prior = prior.scale_factor.meanAt(NAN);
   o->gate("fit_condition", k.condition_number <= q.max_condition, k.condition_number, q.max_condition,
-          "harmonic fit condition number " + fmt(k.condition_number));
-  o->gate("k0_sign", k0 < 0.0, k0, 0.0, "estimated K0 = " + fmt(k0) + " must be negative");
+          "harmonic fit condition number " + formatShort(k.condition_number));
+  o->gate("k0_sign", k0 < 0.0, k0, 0.0, "estimated K0 = " + formatShort(k0) + " must be negative");
   const double change = std::abs(k0 - k0_prior) / std::abs(k0_prior);
   o->gate("k0_change", change <= q.max_k0_change, change, q.max_k0_change,
-          "K0 moved by " + fmt(100 * change) + " % from the prior " + fmt(k0_prior));
+          "K0 moved by " + formatShort(100 * change) + " % from the prior " + formatShort(k0_prior));
   const double residual = k.residual_rms / std::abs(k0);
   o->gate("residual", residual <= q.max_relative_residual, residual, q.max_relative_residual,
-          "rms of the binned K about the fit is " + fmt(residual) + " of |K0|");
+          "rms of the binned K about the fit is " + formatShort(residual) + " of |K0|");
   const double hstd = maxHarmonicStd(k) / std::abs(k0);
   o->gate("harmonic_std", hstd <= q.max_harmonic_std, hstd, q.max_harmonic_std,
-          "largest K harmonic standard error is " + fmt(hstd * 1e6) + " ppm of |K0|");
+          "largest K harmonic standard error is " + formatShort(hstd * 1e6) + " ppm of |K0|");
   const HarmonicModel k_model = toModel(k);
   o->nonlinearity_ppm = 1e6 * k_model.peakDeviation() / std::abs(k0);
   o->parameters = prior;
@@ -92,14 +78,10 @@ std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettin
 
 // ------------------------------------------------------------------------------------------------
 namespace {
-int maxOrderOf(const CalibrationSettings& s) {
-  const std::vector<int> all = mergeOrders(s.scale_factor_orders, s.drift_orders);
-  return all.empty() ? 2 : all.back();
-}
 }  // namespace
 
 DualRateMethod::DualRateMethod(const CalibrationSettings& s, double k0)
-    : settings_(s), groups_(s.bins, s.window, s.window_span, k0, maxOrderOf(s), s.group_tolerance, s.plateau.max_gap) {}
+    : settings_(s), groups_(s.bins, s.window, s.window_span, k0, maxFittedOrder(s.scale_factor_orders, s.drift_orders), s.group_tolerance, s.plateau.max_gap) {}
 
 void DualRateMethod::addSample(const PlateauSample& s) {
   if (s.plateau.is_static) return;
@@ -119,7 +101,7 @@ CalibrationProgress DualRateMethod::progress() const {
     const RateGroup& g = groups_.groups()[order[i]];
     const double cov = g.rates.coverage(minBinTime());
     worst = std::min(worst, cov);
-    s << ", " << fmt(g.meanRate()) << " rad/s: coverage " << fmt(100 * cov) << " %";
+    s << ", " << formatShort(g.meanRate()) << " rad/s: coverage " << formatShort(100 * cov) << " %";
   }
   p.fraction = order.size() >= 2 ? std::min(1.0, worst / settings_.gates.min_coverage) : 0.0;
   p.summary = s.str();
@@ -147,12 +129,12 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
   o.duration = g1.rates.totalTime() + g2.rates.totalTime();
   o.coverage = std::min(g1.rates.coverage(minBinTime()), g2.rates.coverage(minBinTime()));
   o.gate("coverage", o.coverage >= q.min_coverage, o.coverage, q.min_coverage,
-         "theta bins covered by both plateaus: " + fmt(100 * o.coverage) + " %");
+         "theta bins covered by both plateaus: " + formatShort(100 * o.coverage) + " %");
   o.gate("rate_separation", std::abs(w1 - w2) >= q.min_rate_separation, std::abs(w1 - w2), q.min_rate_separation,
-         "plateau rates " + fmt(w1) + " and " + fmt(w2) + " rad/s");
+         "plateau rates " + formatShort(w1) + " and " + formatShort(w2) + " rad/s");
   const double noise = std::max(g1.rateStd() / std::abs(w1), g2.rateStd() / std::abs(w2));
   o.gate("rate_noise", noise <= q.max_rate_noise, noise, q.max_rate_noise,
-         "reported table rate scatters by " + fmt(100 * noise) + " % within a plateau");
+         "reported table rate scatters by " + formatShort(100 * noise) + " % within a plateau");
   const double earth = prior.earth_rate.verticalRate();
   const DualRateEstimate e = estimateDualRate(g1.rates, w1 + earth, g2.rates, w2 + earth,
                                               settings_.scale_factor_orders, settings_.drift_orders, minBinTime());
@@ -175,7 +157,7 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
 
 // ------------------------------------------------------------------------------------------------
 ConstantRateMethod::ConstantRateMethod(const CalibrationSettings& s, double k0)
-    : settings_(s), groups_(s.bins, s.window, s.window_span, k0, maxOrderOf(s), s.group_tolerance, s.plateau.max_gap) {}
+    : settings_(s), groups_(s.bins, s.window, s.window_span, k0, maxFittedOrder(s.scale_factor_orders, s.drift_orders), s.group_tolerance, s.plateau.max_gap) {}
 
 void ConstantRateMethod::closeDwell() {
   if (dwell_.samples() >= 3 && dwell_.duration() > 0.0) {
@@ -212,7 +194,7 @@ CalibrationProgress ConstantRateMethod::progress() const {
   const double dwell = dwellTime();
   p.fraction = std::min(std::min(1.0, cov / settings_.gates.min_coverage),
                         settings_.gates.min_dwell_time > 0 ? std::min(1.0, dwell / settings_.gates.min_dwell_time) : 1.0);
-  p.summary = "constant_rate: coverage " + fmt(100 * cov) + " %, rest data " + fmt(dwell) + " s";
+  p.summary = "constant_rate: coverage " + formatShort(100 * cov) + " %, rest data " + formatShort(dwell) + " s";
   return p;
 }
 
@@ -231,7 +213,7 @@ CalibrationOutcome ConstantRateMethod::finish(const GyroParameters& prior) const
   }
   const double dwell = dwellTime();
   o.gate("dwell_time", dwell >= q.min_dwell_time, dwell, q.min_dwell_time,
-         fmt(dwell) + " s at rest to measure the rest rate K Omega_E + D");
+         formatShort(dwell) + " s at rest to measure the rest rate K Omega_E + D");
   const auto order = groups_.byDuration();
   if (order.empty() || wsum <= 0.0) {
     o.gate("data", false, 0.0, 1.0, order.empty() ? "no constant-rate plateau" : "no dwell at rest");
@@ -244,12 +226,12 @@ CalibrationOutcome ConstantRateMethod::finish(const GyroParameters& prior) const
   o.duration = g.rates.totalTime() + dwell;
   o.coverage = g.rates.coverage(minBinTime());
   o.gate("coverage", o.coverage >= q.min_coverage, o.coverage, q.min_coverage,
-         "theta bins covered: " + fmt(100 * o.coverage) + " %");
+         "theta bins covered: " + formatShort(100 * o.coverage) + " %");
   o.gate("rate", std::abs(w) >= q.min_rate_separation, std::abs(w), q.min_rate_separation,
-         "plateau rate " + fmt(w) + " rad/s");
+         "plateau rate " + formatShort(w) + " rad/s");
   const double noise = g.rateStd() / std::abs(w);
   o.gate("rate_noise", noise <= q.max_rate_noise, noise, q.max_rate_noise,
-         "reported table rate scatters by " + fmt(100 * noise) + " %");
+         "reported table rate scatters by " + formatShort(100 * noise) + " %");
   HarmonicFitResult fit = fitBinnedRates(g.rates, settings_.scale_factor_orders, minBinTime());
   if (!fit.ok) {
     o.gate("fit", false, 0.0, 0.0, fit.reason);
@@ -363,7 +345,7 @@ CalibrationProgress StepMethod::progress() const {
   CalibrationProgress p;
   p.fraction = std::min(std::min(1.0, static_cast<double>(step_count_) / settings_.gates.min_steps),
                         std::min(1.0, coverage() / settings_.gates.min_coverage));
-  p.summary = "step: " + std::to_string(step_count_) + " steps, theta coverage " + fmt(100 * coverage()) + " %";
+  p.summary = "step: " + std::to_string(step_count_) + " steps, theta coverage " + formatShort(100 * coverage()) + " %";
   return p;
 }
 
@@ -380,7 +362,7 @@ CalibrationOutcome StepMethod::finish(const GyroParameters& prior) const {
   o.gate("steps", m.step_count_ >= q.min_steps, m.step_count_, q.min_steps,
          std::to_string(m.step_count_) + " steps between dwells");
   o.gate("coverage", o.coverage >= q.min_coverage, o.coverage, q.min_coverage,
-         "theta swept by the steps: " + fmt(100 * o.coverage) + " %");
+         "theta swept by the steps: " + formatShort(100 * o.coverage) + " %");
   o.gate("samples", m.samples_ >= q.min_samples, static_cast<double>(m.samples_), static_cast<double>(q.min_samples),
          std::to_string(m.samples_) + " wave samples at rest");
   std::vector<FitPoint> kp;
@@ -461,16 +443,16 @@ CalibrationOutcome CorrectionMatrixMethod::finish(const GyroParameters& prior) c
   o.gate("pairs", estimator_.pairs() >= q.min_pairs, static_cast<double>(estimator_.pairs()),
          static_cast<double>(q.min_pairs), std::to_string(estimator_.pairs()) + " generator samples");
   o.gate("condition", o.correction.condition_number <= q.max_p_condition, o.correction.condition_number,
-         q.max_p_condition, "generator sweep condition number " + fmt(o.correction.condition_number) +
+         q.max_p_condition, "generator sweep condition number " + formatShort(o.correction.condition_number) +
                                 (o.correction.ok ? "" : " (" + o.correction.reason + ")"));
   const double rms_amplitude =
       estimator_.pairs() ? std::sqrt(reference_energy_ / (4.0 * estimator_.pairs())) : 1.0;
   const double relative = o.correction.residual_rms / rms_amplitude;
   o.gate("residual", o.correction.ok && relative <= 1e-2, relative, 1e-2,
-         "channel residual after correction is " + fmt(relative) + " of the amplitude");
+         "channel residual after correction is " + formatShort(relative) + " of the amplitude");
   double pmax = 0.0;
   for (double p : o.correction.correction.p) pmax = std::max(pmax, std::abs(p));
-  o.gate("plausible", pmax < 0.05, pmax, 0.05, "largest |p| = " + fmt(pmax));
+  o.gate("plausible", pmax < 0.05, pmax, 0.05, "largest |p| = " + formatShort(pmax));
   o.parameters = prior;
   o.parameters.correction = o.correction.correction;
   // K and D were measured through the old P: keep their means, drop their harmonics until the

@@ -1,6 +1,8 @@
 #include "hrg_gyro/core/calibration_outcome.h"
 
 #include <cmath>
+#include <ctime>
+#include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
@@ -50,6 +52,25 @@ void emitFit(YAML::Emitter& out, const HarmonicFitResult& f, double frequency) {
 }
 
 }  // namespace
+
+std::string utcNow() {
+  char buf[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  return buf;
+}
+
+std::string formatShort(double value, int precision) {
+  std::ostringstream s;
+  s.precision(precision);
+  s << value;
+  return s.str();
+}
+
+int maxFittedOrder(const std::vector<int>& scale_factor_orders, const std::vector<int>& drift_orders) {
+  const std::vector<int> all = mergeOrders(scale_factor_orders, drift_orders);
+  return all.empty() ? 2 : all.back();
+}
 
 void diagnose(CalibrationOutcome* o, const CorrectionMatrix& correction_in_force) {
   o->diagnosis.clear();

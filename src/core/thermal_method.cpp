@@ -12,25 +12,6 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-std::string utcNow() {
-  char buf[32];
-  const std::time_t now = std::time(nullptr);
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  return buf;
-}
-
-std::string fmt(double v, int precision = 4) {
-  std::ostringstream s;
-  s.precision(precision);
-  s << v;
-  return s.str();
-}
-
-int maxOrderOf(const CalibrationSettings& s) {
-  const std::vector<int> all = mergeOrders(s.scale_factor_orders, s.drift_orders);
-  return all.empty() ? 2 : all.back();
-}
-
 /// Fraction of bins with at least min_time s of swept data in the per-bin sums.
 double coverageOf(const std::vector<double>& swept, double min_time) {
   if (swept.empty()) return 0.0;
@@ -42,7 +23,7 @@ double coverageOf(const std::vector<double>& swept, double min_time) {
 
 ThermalMethod::ThermalMethod(const CalibrationSettings& s, double k0)
     : settings_(s),
-      rates_(s.bins, s.window, s.window_span, k0, maxOrderOf(s), s.group_tolerance, s.plateau.max_gap,
+      rates_(s.bins, s.window, s.window_span, k0, maxFittedOrder(s.scale_factor_orders, s.drift_orders), s.group_tolerance, s.plateau.max_gap,
              s.thermal.slice_width, s.thermal.max_slices) {}
 
 void ThermalMethod::addSample(const PlateauSample& s) {
@@ -115,9 +96,9 @@ CalibrationProgress ThermalMethod::progress() const {
   const auto order = rates_.byDuration();
   std::ostringstream s;
   s << "thermal: " << order.size() << " rate group(s), " << rates_.sliceCount() << " frequency slice(s)";
-  if (samples_ > 0) s << ", " << fmt(f_min_, 8) << ".." << fmt(f_max_, 8) << " Hz";
+  if (samples_ > 0) s << ", " << formatShort(f_min_, 8) << ".." << formatShort(f_max_, 8) << " Hz";
   const double cov = worstCoverage(n, nullptr);
-  if (order.size() >= 2 && n.size() >= 2) s << ", worst node-interval coverage " << fmt(100 * cov) << " %";
+  if (order.size() >= 2 && n.size() >= 2) s << ", worst node-interval coverage " << formatShort(100 * cov) << " %";
   p.fraction = std::min(1.0, cov / settings_.gates.min_coverage);
   p.summary = s.str();
   return p;
@@ -150,7 +131,7 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   }
   if (out_of_range_ > 0) {
     o.notes.push_back(std::to_string(out_of_range_) + " samples lay outside the frequency nodes [" +
-                      fmt(ts.frequency_nodes.front(), 8) + ", " + fmt(ts.frequency_nodes.back(), 8) + "] Hz");
+                      formatShort(ts.frequency_nodes.front(), 8) + ", " + formatShort(ts.frequency_nodes.back(), 8) + "] Hz");
   }
   if (slice_limit_ > 0) {
     o.notes.push_back(std::to_string(slice_limit_) + " samples fell beyond thermal/max_slices (" +
@@ -167,7 +148,7 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   const std::vector<double> n = nodes();
   if (n.size() < 2) {
     o.gate("frequency_nodes", false, 0.0, static_cast<double>(ts.nodeCount()),
-           "the data span no frequency range (" + (samples_ ? fmt(f_min_, 8) + " Hz only" : std::string("none")) +
+           "the data span no frequency range (" + (samples_ ? formatShort(f_min_, 8) + " Hz only" : std::string("none")) +
                "): a frequency-dependent model cannot be fitted; use dual_rate");
     o.decide();
     return o;
@@ -176,7 +157,7 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   for (std::size_t j = 1; j < n.size(); ++j) narrowest = std::min(narrowest, n[j] - n[j - 1]);
   o.frequency_nodes = n;
   o.gate("node_spacing", narrowest >= ts.slice_width, narrowest, ts.slice_width,
-         "narrowest node interval " + fmt(narrowest) + " Hz against frequency slices of " + fmt(ts.slice_width) +
+         "narrowest node interval " + formatShort(narrowest) + " Hz against frequency slices of " + formatShort(ts.slice_width) +
              " Hz (use fewer nodes, a finer thermal/slice_width, or the dual_rate method)");
   const SlicedRateGroup& g1 = rates_.groups()[order[0]];
   const SlicedRateGroup& g2 = rates_.groups()[order[1]];
@@ -185,13 +166,13 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   std::size_t worst = 0;
   o.coverage = worstCoverage(n, &worst);
   o.gate("coverage", o.coverage >= q.min_coverage, o.coverage, q.min_coverage,
-         "theta bins covered at both rates in every node interval: worst " + fmt(100 * o.coverage) + " % in [" +
-             fmt(n[worst], 8) + ", " + fmt(n[worst + 1], 8) + "] Hz");
+         "theta bins covered at both rates in every node interval: worst " + formatShort(100 * o.coverage) + " % in [" +
+             formatShort(n[worst], 8) + ", " + formatShort(n[worst + 1], 8) + "] Hz");
   o.gate("rate_separation", std::abs(w1 - w2) >= q.min_rate_separation, std::abs(w1 - w2), q.min_rate_separation,
-         "plateau rates " + fmt(w1) + " and " + fmt(w2) + " rad/s");
+         "plateau rates " + formatShort(w1) + " and " + formatShort(w2) + " rad/s");
   const double noise = std::max(g1.rateStd() / std::abs(w1), g2.rateStd() / std::abs(w2));
   o.gate("rate_noise", noise <= q.max_rate_noise, noise, q.max_rate_noise,
-         "reported table rate scatters by " + fmt(100 * noise) + " % within a plateau");
+         "reported table rate scatters by " + formatShort(100 * noise) + " % within a plateau");
 
   const double earth = prior.earth_rate.verticalRate();
   const FrequencyInterpolator interpolator(n, ts.interpolation);
@@ -208,7 +189,7 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   o.binned = e.binned;
   o.smoothing_factor = e.smoothing_factor;
   o.gate("fit_condition", e.condition_number <= q.max_condition, e.condition_number, q.max_condition,
-         "frequency-dependent fit condition number " + fmt(e.condition_number));
+         "frequency-dependent fit condition number " + formatShort(e.condition_number));
 
   // Per node: K0 sign and change from the prior, largest K-harmonic standard error, peak
   // nonlinearity; the paper-style error bound with the steepest node's model.
@@ -227,14 +208,14 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
     k0_abs_mean += std::abs(k.mean) / static_cast<double>(n.size());
     o.nonlinearity_ppm = std::max(o.nonlinearity_ppm, 1e6 * e.k_model.peakDeviation(n[j]) / std::abs(k.mean));
   }
-  o.gate("k0_sign", k0_max < 0.0, k0_max, 0.0, "largest K0 over the nodes = " + fmt(k0_max) + " must be negative");
+  o.gate("k0_sign", k0_max < 0.0, k0_max, 0.0, "largest K0 over the nodes = " + formatShort(k0_max) + " must be negative");
   o.gate("k0_change", change <= q.max_k0_change, change, q.max_k0_change,
-         "K0 moved by up to " + fmt(100 * change) + " % from the prior");
+         "K0 moved by up to " + formatShort(100 * change) + " % from the prior");
   const double residual = e.k_residual_rms / k0_abs_mean;
   o.gate("residual", residual <= q.max_relative_residual, residual, q.max_relative_residual,
-         "rms of the binned K (moved to the middle frequency) about the fit is " + fmt(residual) + " of |K0|");
+         "rms of the binned K (moved to the middle frequency) about the fit is " + formatShort(residual) + " of |K0|");
   o.gate("harmonic_std", hstd <= q.max_harmonic_std, hstd, q.max_harmonic_std,
-         "largest K harmonic standard error at any node is " + fmt(hstd * 1e6) + " ppm of |K0|");
+         "largest K harmonic standard error at any node is " + formatShort(hstd * 1e6) + " ppm of |K0|");
   double sigma = 0.0;
   for (const SlicedRateGroup* g : {&g1, &g2}) {
     double noise_time = 0.0, time = 0.0;
@@ -253,7 +234,7 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   o.parameters.calibration.method = o.method;
   o.parameters.calibration.time = utcNow();
   o.notes.push_back("K and D are splines (" + std::string(toString(ts.interpolation)) + ") over " +
-                    std::to_string(n.size()) + " frequency nodes " + fmt(n.front(), 8) + ".." + fmt(n.back(), 8) +
+                    std::to_string(n.size()) + " frequency nodes " + formatShort(n.front(), 8) + ".." + formatShort(n.back(), 8) +
                     " Hz; outside them the processor holds the end values and flags the samples");
   o.decide();
   return o;

@@ -62,6 +62,13 @@ struct CalibrationOutcome {
   void decide();
 };
 
+/// ISO 8601 UTC time of now, for CalibrationProvenance::time.
+std::string utcNow();
+/// A number with `precision` significant digits, for gate messages.
+std::string formatShort(double value, int precision = 4);
+/// Highest harmonic order fitted for K or D (2 if none): what the window smoothing is sized for.
+int maxFittedOrder(const std::vector<int>& scale_factor_orders, const std::vector<int>& drift_orders);
+
 /// Fills outcome->diagnosis from its scale-factor fits, read against the P in force during the run.
 void diagnose(CalibrationOutcome* outcome, const CorrectionMatrix& correction_in_force);
 
