@@ -94,7 +94,7 @@ def main():
     patterns = ({"manager": "__name:=gyro_manager"} if mode == "nodelets" else
                 {"driver_sim": "__name:=driver_sim", "processor": "__name:=processor",
                  "calibrator": "__name:=calibrator"})
-    state = {"errors": [], "levels": {}, "processor": {}, "results": []}
+    state = {"errors": [], "levels": {}, "processor": {}, "results": [], "delays": [], "heap": []}
     try:
         time.sleep(5)
         import rospy
@@ -110,6 +110,26 @@ def main():
                     state["errors"].append((round(time.time() - state["t0"], 1), s.name, s.message))
                 if s.name.endswith("processor: input") or s.name.endswith("processor: wave"):
                     state["processor"].update((kv.key, kv.value) for kv in s.values)
+                if s.name.endswith("processor: memory"):
+                    v = dict((kv.key, kv.value) for kv in s.values)
+                    try:
+                        state["heap"].append((time.time() - state.get("t0", time.time()),
+                                              float(v["process heap in use (MiB)"])))
+                    except (KeyError, ValueError):
+                        pass
+                if s.name.endswith("processor: channels stamps"):
+                    # Latest delay of the window: how far behind its samples' stamps the processor ran.
+                    # (diagnostic_updater versions name the values differently)
+                    v = dict((kv.key.rstrip(":"), kv.value) for kv in s.values)
+                    try:
+                        if "Timestamp delay - Earliest | Latest | Acceptable" in v:
+                            early, late = v["Timestamp delay - Earliest | Latest | Acceptable"].split("|")[:2]
+                        else:
+                            early, late = v["Earliest timestamp delay"], v["Latest timestamp delay"]
+                        state["delays"].append((round(time.time() - state.get("t0", time.time()), 1),
+                                                float(early), float(late)))
+                    except (KeyError, ValueError):
+                        pass
 
         def on_result(msg):
             state["results"].append({"accepted": msg.accepted, "written": msg.written, "reason": msg.reason,
@@ -171,6 +191,26 @@ def main():
     report["processor"] = {k: p.get(k) for k in ("received", "lost (sequence gaps)", "outputs", "rejected non-finite",
                                                  "rejected degenerate", "rejected jumps", "gaps not integrated")}
     report["expected_samples"] = int(round(output_rate * (samples[-1][0] if samples else 0)))
+    with open(os.path.join(out, "heap.csv"), "w") as f:
+        f.write("t_s,heap_in_use_mib\n")
+        f.writelines("%.1f,%.3f\n" % h for h in state["heap"])
+    heap_warm = [h for t, h in state["heap"] if t >= 0.1 * seconds]
+    if heap_warm:
+        # Live malloc bytes of the process holding the processor (the whole manager for nodelets):
+        # what a leak would raise, whatever the allocator keeps resident.
+        report["heap_in_use_mib"] = {"after_warmup": round(heap_warm[0], 2), "end": round(heap_warm[-1], 2),
+                                     "max": round(max(heap_warm), 2),
+                                     "growth_after_warmup": round(heap_warm[-1] - heap_warm[0], 2)}
+    lags = sorted(max(abs(e), abs(l)) for _, e, l in state["delays"])
+    if lags:
+        report["stamp_delay_s"] = {"windows": len(lags), "median": round(lags[len(lags) // 2], 4),
+                                   "p99": round(lags[min(len(lags) - 1, int(0.99 * len(lags)))], 4),
+                                   "max": round(lags[-1], 4),
+                                   "windows_over_0.1_s": sum(1 for x in lags if x > 0.1),
+                                   "windows_over_0.5_s": sum(1 for x in lags if x > 0.5)}
+        with open(os.path.join(out, "stamp_delay.csv"), "w") as f:
+            f.write("t_s,earliest_delay_s,latest_delay_s\n")
+            f.writelines("%.1f,%.6f,%.6f\n" % d for d in state["delays"])
     report["error_diagnostics"] = state["errors"][:20]
     report["error_diagnostic_count"] = len(state["errors"])
     report["worst_level"] = state["levels"]

@@ -9,6 +9,7 @@
 #include "hrg_gyro/core/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/diagnostics_timer.h"
+#include "hrg_gyro/ros/process_heap.h"
 #include "hrg_gyro/ros/param_tree.h"
 
 namespace hrg_gyro {
@@ -19,7 +20,7 @@ using diagnostic_msgs::DiagnosticStatus;
 const std::vector<std::string>& nodeOnlyKeys() {
   static const std::vector<std::string> keys = {"parameter_file", "report_file", "output_directory", "reload_service",
                                                 "write", "autostart", "stages", "queue_size", "diagnostic_period",
-                                                "backward_reset"};
+                                                "backward_reset", "heap_trim_period"};
   return keys;
 }
 
@@ -56,26 +57,31 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     if (!core::CalibrationSettings::knownMethod(m)) throw std::invalid_argument("calibrator: unknown method in ~stages: " + m);
   }
   stages_ = stages;
-  int queue_size = 10000;
+  int queue_size = 50000;  // as the processor's: seconds of backlog at 10 kHz, lost by none
   pnh_.param("queue_size", queue_size, queue_size);
+  pnh_.param("heap_trim_period", heap_trim_period_, heap_trim_period_);
 
   result_pub_ = pnh_.advertise<CalibrationResult>("result", 1, true);
-  turntable_sub_ = nh_.subscribe("turntable/state", queue_size, &CalibratorRos::onTurntable, this,
-                                 ros::TransportHints().tcpNoDelay());
-  wave_sub_ = nh_.subscribe("wave", queue_size, &CalibratorRos::onWave, this, ros::TransportHints().tcpNoDelay());
+  ros::NodeHandle in = input_.handle(nh_);
+  turntable_sub_ = in.subscribe("turntable/state", queue_size, &CalibratorRos::onTurntable, this,
+                                ros::TransportHints().tcpNoDelay());
+  wave_sub_ = in.subscribe("wave", queue_size, &CalibratorRos::onWave, this, ros::TransportHints().tcpNoDelay());
   if (std::find(stages_.begin(), stages_.end(), "correction_matrix") != stages_.end()) {
-    channels_sub_ = nh_.subscribe("channels", queue_size, &CalibratorRos::onChannels, this,
-                                  ros::TransportHints().tcpNoDelay());
-    truth_sub_ = nh_.subscribe("truth", queue_size, &CalibratorRos::onTruth, this, ros::TransportHints().tcpNoDelay());
+    channels_sub_ = in.subscribe("channels", queue_size, &CalibratorRos::onChannels, this,
+                                 ros::TransportHints().tcpNoDelay());
+    truth_sub_ = in.subscribe("truth", queue_size, &CalibratorRos::onTruth, this, ros::TransportHints().tcpNoDelay());
   }
   start_srv_ = pnh_.advertiseService("start", &CalibratorRos::onStart, this);
   finish_srv_ = pnh_.advertiseService("finish", &CalibratorRos::onFinish, this);
   abort_srv_ = pnh_.advertiseService("abort", &CalibratorRos::onAbort, this);
   updater_.setHardwareID("hrg_gyro");
   updater_.add("calibration", this, &CalibratorRos::diagnose);
+  updater_.add("memory", [this](diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "process heap");
+    reportProcessHeap(stat, heap_trim_period_);
+  });
   diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
 
-  reload_worker_ = std::thread(&CalibratorRos::reloadLoop, this);
   bool autostart = true;
   pnh_.param("autostart", autostart, autostart);
   if (autostart) {
@@ -83,9 +89,17 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     std::string reason;
     if (!startRun(stages_[next_stage_++], &reason)) throw std::runtime_error("calibrator: " + reason);
   }
+  // Threads last: a constructor that throws must not leave a joinable thread behind.
+  reload_worker_ = std::thread(&CalibratorRos::reloadLoop, this);
+  input_.start();
 }
 
 CalibratorRos::~CalibratorRos() {
+  turntable_sub_.shutdown();
+  wave_sub_.shutdown();
+  channels_sub_.shutdown();
+  truth_sub_.shutdown();
+  input_.stop();
   {
     std::lock_guard<std::mutex> lock(reload_mutex_);
     stopping_ = true;

@@ -1,5 +1,8 @@
 #include "hrg_gyro/ros/driver_sim_ros.h"
 
+#include <algorithm>
+#include <string>
+
 #include <rosgraph_msgs/Clock.h>
 #include <std_msgs/Bool.h>
 
@@ -89,12 +92,24 @@ void DriverSimRos::run() {
   core::SimulationSample s;
   double next_clock = 0.0;
   std::uint32_t seq = 0;
+  double max_behind = 0.0;
   while (!stop_ && ros::ok() && sim.next(&s)) {
     const ros::Time stamp = toRosTime(origin + s.stamp);
     if (time_scale_ > 0.0) {
       const ros::WallTime due = wall_start + ros::WallDuration(sim.elapsed() / time_scale_);
       const ros::WallTime now = ros::WallTime::now();
-      if (due > now) (due - now).sleep();
+      if (due > now) {
+        (due - now).sleep();
+      } else {
+        // Behind schedule: the stamps still say when each sample was due (as a hardware clock
+        // would), so consumers see the delay; this says where it came from.
+        const double behind = (now - due).toSec();
+        max_behind = std::max(max_behind, behind);
+        if (behind > 0.1 && !use_sim_time_) {  // under sim time it only slows the clock
+          ROS_WARN_THROTTLE(10.0, "driver_sim: %.3f s behind schedule (this thread was not run in time); "
+                                  "catching up", behind);
+        }
+      }
     }
     if (!clock_pub_.getTopic().empty() && sim.elapsed() >= next_clock) {
       rosgraph_msgs::Clock c;
@@ -112,8 +127,9 @@ void DriverSimRos::run() {
   }
   if (stop_ || !ros::ok()) return;
   const double wall = (ros::WallTime::now() - wall_start).toSec();
-  ROS_INFO("driver_sim: scenario complete: %u samples, %.1f s simulated in %.1f s of wall time (%.1fx)", seq,
-           sim.elapsed(), wall, wall > 0 ? sim.elapsed() / wall : 0.0);
+  ROS_INFO("driver_sim: scenario complete: %u samples, %.1f s simulated in %.1f s of wall time (%.1fx)%s", seq,
+           sim.elapsed(), wall, wall > 0 ? sim.elapsed() / wall : 0.0,
+           time_scale_ > 0.0 && !use_sim_time_ ? (", at most " + std::to_string(max_behind) + " s behind schedule").c_str() : "");
   std_msgs::Bool done;
   done.data = true;
   done_pub_.publish(done);

@@ -10,6 +10,7 @@
 #include "hrg_gyro/core/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/diagnostics_timer.h"
+#include "hrg_gyro/ros/process_heap.h"
 
 namespace hrg_gyro {
 namespace {
@@ -59,8 +60,11 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   pnh_.param("rate_tolerance", tolerance, tolerance);
   min_rate_ = expected_rate_ * (1.0 - tolerance);
   max_rate_ = expected_rate_ * (1.0 + tolerance);
-  int queue_size = 10000;
+  // 5 s of 10 kHz: a host that deschedules the pipeline for a few seconds delays samples but
+  // loses none (a queued message costs a few hundred bytes only while it waits).
+  int queue_size = 50000;
   pnh_.param("queue_size", queue_size, queue_size);
+  pnh_.param("heap_trim_period", heap_trim_period_, heap_trim_period_);
 
   wave_pub_ = nh_.advertise<WaveState>("wave", queue_size);
   output_pub_ = nh_.advertise<GyroOutput>("output", queue_size);
@@ -83,11 +87,21 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   updater_.add("input", this, &ProcessorRos::diagnoseInput);
   updater_.add("wave", this, &ProcessorRos::diagnoseWave);
   updater_.add("model", this, &ProcessorRos::diagnoseModel);
-  channels_sub_ = nh_.subscribe("channels", queue_size, &ProcessorRos::onChannels, this,
-                                ros::TransportHints().tcpNoDelay());
+  updater_.add("memory", [this](diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    stat.summary(DiagnosticStatus::OK, "process heap");
+    reportProcessHeap(stat, heap_trim_period_);
+  });
+  channels_sub_ = input_.handle(nh_).subscribe("channels", queue_size, &ProcessorRos::onChannels, this,
+                                               ros::TransportHints().tcpNoDelay());
+  input_.start();
   diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
   ROS_INFO("processor: %s (K0 %.6f, %zu K harmonics, calibration %s)", parameter_file_.c_str(),
            params->scale_factor.meanAt(NAN), params->scale_factor.orders().size(), params->calibration.method.c_str());
+}
+
+ProcessorRos::~ProcessorRos() {
+  channels_sub_.shutdown();
+  input_.stop();
 }
 
 void ProcessorRos::publishModel(const ros::Time& since) {

@@ -29,6 +29,7 @@
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
 #include "hrg_gyro/core/calibration_session.h"
+#include "hrg_gyro/ros/input_thread.h"
 
 namespace hrg_gyro {
 
@@ -71,6 +72,7 @@ class CalibratorRos {
   std::string last_result_;
   // Bag loops: a stream going back by more than backward_reset_ s restarts the run.
   double backward_reset_ = 1.0;
+  double heap_trim_period_ = 10.0;  // s of wall time between malloc_trim calls; <= 0: never
   ros::Time last_turntable_stamp_, last_wave_stamp_;
   std::uint64_t resets_ = 0, reported_resets_ = 0;
   bool last_accepted_ = false;
@@ -78,6 +80,7 @@ class CalibratorRos {
   // Generator pairs: raw channels and the reference wave, matched by stamp.
   std::map<core::Nanoseconds, core::ChannelVector> raw_, reference_;
 
+  InputThread input_;  // serves the four subscriptions below
   ros::Subscriber turntable_sub_, wave_sub_, channels_sub_, truth_sub_;
   ros::Publisher result_pub_;
   ros::ServiceServer start_srv_, finish_srv_, abort_srv_;

@@ -18,6 +18,7 @@
 
 #include "hrg_gyro/ChannelAmplitudes.h"
 #include "hrg_gyro/core/gyro_processor.h"
+#include "hrg_gyro/ros/input_thread.h"
 
 namespace hrg_gyro {
 
@@ -25,6 +26,7 @@ class ProcessorRos {
  public:
   /// Throws std::exception when ~parameter_file is missing or invalid at start-up.
   ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~ProcessorRos();
 
  private:
   void onChannels(const ChannelAmplitudes::ConstPtr& msg);
@@ -45,7 +47,9 @@ class ProcessorRos {
   double configured_rate_variance_ = -1.0;
   double stall_timeout_ = 0.5;
   double quadrature_warn_ = 0.1;
+  double heap_trim_period_ = 10.0;  // s of wall time between malloc_trim calls; <= 0: never
 
+  InputThread input_;  // serves channels_sub_
   ros::Subscriber channels_sub_;
   ros::Publisher wave_pub_, output_pub_, imu_pub_, model_pub_;
   ros::Time last_stamp_;

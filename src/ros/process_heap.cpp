@@ -1,0 +1,44 @@
+#include "hrg_gyro/ros/process_heap.h"
+
+#include <malloc.h>
+
+#include <atomic>
+#include <chrono>
+
+namespace hrg_gyro {
+namespace {
+
+std::atomic<std::int64_t> last_trim_ns{0};
+std::atomic<std::uint64_t> trims{0};
+
+std::int64_t steadyNowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+double processHeapInUseMiB() {
+  const struct mallinfo2 m = mallinfo2();
+  return static_cast<double>(m.uordblks + m.hblkhd) / (1024.0 * 1024.0);
+}
+
+bool trimProcessHeap(double period) {
+  if (!(period > 0.0)) return false;
+  const std::int64_t now = steadyNowNs();
+  std::int64_t last = last_trim_ns.load();
+  if (last != 0 && now - last < static_cast<std::int64_t>(period * 1e9)) return false;
+  // One caller wins the period; the others see the new stamp and return.
+  if (!last_trim_ns.compare_exchange_strong(last, now)) return false;
+  malloc_trim(0);
+  ++trims;
+  return true;
+}
+
+void reportProcessHeap(diagnostic_updater::DiagnosticStatusWrapper& stat, double trim_period) {
+  trimProcessHeap(trim_period);
+  stat.addf("process heap in use (MiB)", "%.2f", processHeapInUseMiB());
+  stat.add("heap trims", trims.load());
+}
+
+}  // namespace hrg_gyro
