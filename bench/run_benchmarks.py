@@ -19,6 +19,8 @@ import subprocess
 import sys
 import time
 
+import proc_stats
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WS = os.path.join(ROOT, ".ws")
 BIN = os.path.join(WS, "devel", "lib", "hrg_gyro")
@@ -84,21 +86,7 @@ class Master(object):
 
 def process_cpu(patterns):
     """utime+stime ticks of the processes whose command line matches each pattern."""
-    ticks = {}
-    for pid in os.listdir("/proc"):
-        if not pid.isdigit():
-            continue
-        try:
-            with open("/proc/%s/cmdline" % pid, "rb") as f:
-                cmd = f.read().replace(b"\0", b" ").decode(errors="replace")
-            with open("/proc/%s/stat" % pid) as f:
-                fields = f.read().rsplit(")", 1)[1].split()
-        except (IOError, OSError):
-            continue
-        for name, pattern in patterns.items():
-            if pattern in cmd:
-                ticks[name] = ticks.get(name, 0) + int(fields[11]) + int(fields[12])
-    return ticks
+    return {name: ticks for name, (_, ticks) in proc_stats.scan(patterns).items()}
 
 
 def offline(results):

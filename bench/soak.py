@@ -18,34 +18,13 @@ import time
 
 import yaml
 
+import proc_stats
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-CLK = os.sysconf("SC_CLK_TCK")
 
 
 def log(msg):
     print("soak: " + msg, file=sys.stderr, flush=True)
-
-
-def rss_and_cpu(patterns):
-    """(VmRSS in MiB, utime+stime ticks) per name, for processes whose command line matches."""
-    found = {}
-    for pid in os.listdir("/proc"):
-        if not pid.isdigit():
-            continue
-        try:
-            with open("/proc/%s/cmdline" % pid, "rb") as f:
-                cmd = f.read().replace(b"\0", b" ").decode(errors="replace")
-            name = next((n for n, p in patterns.items() if p in cmd), None)
-            if name is None or "roslaunch" in cmd:
-                continue
-            with open("/proc/%s/status" % pid) as f:
-                rss = next(int(line.split()[1]) for line in f if line.startswith("VmRSS:")) / 1024.0
-            with open("/proc/%s/stat" % pid) as f:
-                fields = f.read().rsplit(")", 1)[1].split()
-            found[name] = (rss, int(fields[11]) + int(fields[12]))
-        except (IOError, OSError, StopIteration):
-            continue
-    return found
 
 
 def scenario(seconds, rate):
@@ -145,7 +124,7 @@ def main():
         next_report = t0 + 60
         while time.time() - t0 < seconds and launch.poll() is None:
             time.sleep(10)
-            now = rss_and_cpu(patterns)
+            now = proc_stats.scan(patterns)
             samples.append((time.time() - t0, now))
             if time.time() > next_report:
                 next_report += 300
@@ -177,7 +156,7 @@ def main():
             report["nodes"][name] = "never seen"
             continue
         after_warmup = [v for t, v in series if t >= 0.1 * seconds] or [series[-1][1]]
-        cpu = 100.0 * (series[-1][1][1] - series[0][1][1]) / CLK / max(series[-1][0] - series[0][0], 1e-9)
+        cpu = 100.0 * (series[-1][1][1] - series[0][1][1]) / proc_stats.CLK_TCK / max(series[-1][0] - series[0][0], 1e-9)
         node = {"rss_start_mib": round(series[0][1][0], 2), "rss_after_warmup_mib": round(after_warmup[0][0], 2),
                 "rss_end_mib": round(series[-1][1][0], 2), "rss_max_mib": round(max(v[0] for _, v in series), 2),
                 "growth_after_warmup_mib": round(series[-1][1][0] - after_warmup[0][0], 2),

@@ -32,7 +32,8 @@ class Diagnostics(unittest.TestCase):
 
     def on_diag(self, msg):
         for s in msg.status:
-            self.statuses[s.name.split(": ")[-1]] = (s.level, s.message, rospy.get_time())
+            self.statuses[s.name.split(": ")[-1]] = (s.level, s.message, rospy.get_time(),
+                                                     dict((kv.key, kv.value) for kv in s.values))
 
     def on_output(self, msg):
         if any(math.isnan(v) for v in (msg.dalpha, msg.alpha, msg.rate, msg.scale_factor)):
@@ -57,14 +58,14 @@ class Diagnostics(unittest.TestCase):
 
     def test_good_bad_stalled_recovered(self):
         self.feed(2.5)
-        level, message, _ = self.status_after("wave", rospy.get_time())
+        level, message = self.status_after("wave", rospy.get_time())[:2]
         self.assertEqual(level, DiagnosticStatus.OK, message)
 
         def nan(m):
             m.s_in = float("nan")
         start = rospy.get_time()
         self.feed(2.5, nan)
-        level, message, _ = self.status_after("wave", start + 1.2)
+        level, message = self.status_after("wave", start + 1.2)[:2]
         self.assertEqual(level, DiagnosticStatus.ERROR, message)
         self.assertIn("non-finite", message)
 
@@ -72,23 +73,34 @@ class Diagnostics(unittest.TestCase):
             m.c_in, m.c_quad, m.s_in, m.s_quad = 1.0, 0.0, 0.0, 1.0
         start = rospy.get_time()
         self.feed(2.5, degenerate)
-        level, message, _ = self.status_after("wave", start + 1.2)
+        level, message = self.status_after("wave", start + 1.2)[:2]
         self.assertEqual(level, DiagnosticStatus.ERROR, message)
         self.assertIn("degenerate", message)
 
         start = rospy.get_time()
         time.sleep(2.5)  # nothing arrives
-        level, message, _ = self.status_after("input", start + 1.0)
+        level, message = self.status_after("input", start + 1.0)[:2]
         self.assertEqual(level, DiagnosticStatus.ERROR, message)
         self.assertIn("stalled", message)
 
         start = rospy.get_time()
         self.feed(3.0)
-        level, message, _ = self.status_after("wave", start + 1.5)
+        level, message = self.status_after("wave", start + 1.5)[:2]
         self.assertEqual(level, DiagnosticStatus.OK, message)
-        level, message, _ = self.status_after("input", start + 1.5)
+        level, message = self.status_after("input", start + 1.5)[:2]
         self.assertNotEqual(level, DiagnosticStatus.ERROR, message)
         self.assertEqual(self.nan_outputs, 0)
+
+    def test_memory_status(self):
+        # The live heap is reported, and trimmed every ~heap_trim_period (1 s in this launch).
+        self.feed(1.0)
+        start = rospy.get_time()
+        time.sleep(3.0)
+        level, message, _, values = self.status_after("memory", start + 2.0)
+        self.assertEqual(level, DiagnosticStatus.OK, message)
+        heap = float(values["process heap in use (MiB)"])
+        self.assertTrue(0.1 < heap < 1000.0, heap)
+        self.assertGreaterEqual(int(values["heap trims"]), 2)
 
 
 if __name__ == "__main__":

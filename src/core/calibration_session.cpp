@@ -17,7 +17,12 @@ constexpr std::size_t kMaxHistory = 400000;
 }  // namespace
 
 CalibrationSession::CalibrationSession(const CalibrationSettings& settings, const GyroParameters& prior)
-    : settings_(settings), prior_(prior), method_(makeCalibrationMethod(settings, prior)), detector_(settings.plateau) {}
+    : settings_(settings),
+      prior_(prior),
+      method_(makeCalibrationMethod(settings, prior)),
+      detector_(settings.plateau),
+      turntable_(kMaxHistory + 1),
+      pending_(kMaxPending + 1) {}
 
 void CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double rate) {
   ++counters_.turntable;
@@ -74,14 +79,14 @@ void CalibrationSession::drain() {
 
 void CalibrationSession::classify(const WaveRecord& w) {
   // The last state at or before the sample and the first at or after it.
-  const auto after = std::lower_bound(turntable_.begin(), turntable_.end(), w.stamp,
-                                      [](const TurntableRecord& r, Nanoseconds t) { return r.stamp < t; });
-  if (after == turntable_.end() || (after == turntable_.begin() && after->stamp != w.stamp)) {
+  const std::size_t after =
+      turntable_.lowerBound(w.stamp, [](const TurntableRecord& r, Nanoseconds t) { return r.stamp < t; });
+  if (after == turntable_.size() || (after == 0 && turntable_[0].stamp != w.stamp)) {
     ++counters_.unsynchronized;
     return;
   }
-  const TurntableRecord& b = *after;
-  const TurntableRecord& a = after->stamp == w.stamp ? b : *(after - 1);
+  const TurntableRecord& b = turntable_[after];
+  const TurntableRecord& a = b.stamp == w.stamp ? b : turntable_[after - 1];
   if (toSeconds(b.stamp - a.stamp) > settings_.plateau.max_gap) {
     ++counters_.unsynchronized;
     return;

@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "hrg_gyro/CalibrationResult.h"
+#include "hrg_gyro/ModelInfo.h"
 #include "hrg_gyro/core/output_directory.h"
 #include "hrg_gyro/core/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
@@ -71,6 +72,20 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
                                  ros::TransportHints().tcpNoDelay());
     truth_sub_ = in.subscribe("truth", queue_size, &CalibratorRos::onTruth, this, ros::TransportHints().tcpNoDelay());
   }
+  if (!reload_service_.empty()) {
+    // The processor's model topic sits beside its reload service (processor/reload -> processor/model).
+    std::string model_topic = reload_service_;
+    const std::size_t slash = model_topic.rfind('/');
+    model_topic = (slash == std::string::npos ? std::string() : model_topic.substr(0, slash + 1)) + "model";
+    model_sub_ = nh_.subscribe<ModelInfo>(model_topic, 10, [this](const ModelInfo::ConstPtr& m) {
+      {
+        std::lock_guard<std::mutex> lock(reload_mutex_);
+        model_calibration_ = m->calibration_method + " " + m->calibration_time;
+        model_since_ = m->header.stamp;
+      }
+      model_cv_.notify_all();
+    });
+  }
   start_srv_ = pnh_.advertiseService("start", &CalibratorRos::onStart, this);
   finish_srv_ = pnh_.advertiseService("finish", &CalibratorRos::onFinish, this);
   abort_srv_ = pnh_.advertiseService("abort", &CalibratorRos::onAbort, this);
@@ -105,19 +120,21 @@ CalibratorRos::~CalibratorRos() {
     stopping_ = true;
   }
   reload_cv_.notify_all();
+  model_cv_.notify_all();
   if (reload_worker_.joinable()) reload_worker_.join();
 }
 
 void CalibratorRos::reloadLoop() {
   for (;;) {
-    bool start_next = false;
+    ReloadRequest request;
     {
       std::unique_lock<std::mutex> lock(reload_mutex_);
       reload_cv_.wait(lock, [this] { return stopping_ || !reload_requests_.empty(); });
       if (stopping_) return;
-      start_next = reload_requests_.front();
+      request = reload_requests_.front();
       reload_requests_.pop_front();
     }
+    const bool start_next = request.start_next;
     bool reloaded = reload_service_.empty();
     if (!reloaded) {
       const std::string service = nh_.resolveName(reload_service_);
@@ -134,9 +151,26 @@ void CalibratorRos::reloadLoop() {
       }
     }
     if (start_next && reloaded) {
+      // Waves already queued (here or in transit) went through the previous model: the next stage
+      // must not see them. The processor's ModelInfo for this file says up to which stamp.
+      ros::Time since;
+      bool known = false;
+      if (model_sub_) {
+        std::unique_lock<std::mutex> lock(reload_mutex_);
+        known = model_cv_.wait_for(lock, std::chrono::seconds(5), [&] {
+          return stopping_ || model_calibration_ == request.calibration;
+        }) && !stopping_;
+        since = model_since_;
+      }
+      if (!known) {
+        ROS_WARN("calibrator: no ModelInfo from the processor for the new file: the next stage may see waves "
+                 "still queued from the previous model");
+      }
       std::lock_guard<std::mutex> lock(mutex_);
       std::string reason;
-      if (next_stage_ < stages_.size()) startRun(stages_[next_stage_++], &reason);
+      if (next_stage_ < stages_.size() && startRun(stages_[next_stage_++], &reason) && known) {
+        skip_waves_until_ = since;
+      }
     }
   }
 }
@@ -146,6 +180,7 @@ bool CalibratorRos::startRun(const std::string& method, std::string* reason) {
     core::CalibrationSettings settings = base_settings_;
     settings.method = method;
     session_ = std::make_unique<core::CalibrationSession>(settings, core::loadParameterFile(parameter_file_));
+    skip_waves_until_ = ros::Time();
     raw_.clear();
     reference_.clear();
     ROS_INFO("calibrator: %s run started (prior %s)", method.c_str(), parameter_file_.c_str());
@@ -189,6 +224,10 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
 void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   restartIfTimeWentBack(msg->header.stamp, &last_wave_stamp_);
+  if (session_ && !skip_waves_until_.isZero() && msg->header.stamp <= skip_waves_until_) {
+    ++skipped_old_model_;
+    return;
+  }
   if (session_) {
     session_->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency,
                       msg->amplitude > 0.0 ? msg->quadrature / msg->amplitude : NAN);
@@ -284,7 +323,7 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
   if (*written) {
     {
       std::lock_guard<std::mutex> lock(reload_mutex_);
-      reload_requests_.push_back(more);
+      reload_requests_.push_back({more, o.parameters.calibration.method + " " + o.parameters.calibration.time});
     }
     reload_cv_.notify_one();
   }
@@ -362,6 +401,7 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
   }
   stat.add("runs", runs_);
   stat.add("restarts (time went backwards)", resets_);
+  stat.add("waves skipped (through the previous model)", skipped_old_model_);
   stat.add("parameter file", parameter_file_);
   reported_resets_ = resets_;
 }

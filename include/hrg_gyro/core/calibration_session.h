@@ -9,11 +9,11 @@
 
 #include <cmath>
 #include <cstdint>
-#include <deque>
 #include <memory>
 
 #include "hrg_gyro/core/calibration_method.h"
 #include "hrg_gyro/core/gyro_parameters.h"
+#include "hrg_gyro/core/ring_buffer.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -67,8 +67,8 @@ class CalibrationSession {
   GyroParameters prior_;
   std::unique_ptr<CalibrationMethod> method_;
   PlateauDetector detector_;
-  std::deque<TurntableRecord> turntable_;
-  std::deque<WaveRecord> pending_;
+  RingBuffer<TurntableRecord> turntable_;
+  RingBuffer<WaveRecord> pending_;
   SessionCounters counters_;
   Nanoseconds last_wave_stamp_ = 0;
   Nanoseconds last_generator_stamp_ = 0;

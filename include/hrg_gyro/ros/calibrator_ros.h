@@ -89,7 +89,19 @@ class CalibratorRos {
 
   std::mutex reload_mutex_;
   std::condition_variable reload_cv_;
-  std::deque<bool> reload_requests_;  // each: start the next stage after reloading
+  struct ReloadRequest {
+    bool start_next;          // start the next stage once the processor runs the new file
+    std::string calibration;  // the file's calibration method and time, to recognise its ModelInfo
+  };
+  std::deque<ReloadRequest> reload_requests_;
+  // The processor's ModelInfo (latched): header.stamp is the last input stamp processed under the
+  // previous model, so a stage that must see the wave through the new model skips waves up to it.
+  ros::Subscriber model_sub_;
+  std::string model_calibration_;  // method + time of the latest ModelInfo (under reload_mutex_)
+  ros::Time model_since_;
+  std::condition_variable model_cv_;
+  ros::Time skip_waves_until_;  // under mutex_
+  std::uint64_t skipped_old_model_ = 0;
   bool stopping_ = false;
   std::thread reload_worker_;
 };
