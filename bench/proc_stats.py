@@ -27,3 +27,11 @@ def scan(patterns):
             old = found.get(name, (0.0, 0))
             found[name] = (old[0] + rss, old[1] + int(fields[11]) + int(fields[12]))
     return found
+
+
+def cpu_times():
+    """(all ticks, steal ticks) of the machine since boot, from /proc/stat: steal is the time the
+    hypervisor ran something else while this VM's CPUs had work."""
+    with open("/proc/stat") as f:
+        fields = [int(x) for x in f.readline().split()[1:]]
+    return sum(fields), fields[7] if len(fields) > 7 else 0

@@ -10,6 +10,7 @@ diagnostic went to ERROR after the start-up, or memory grew (more than SOAK_RSS_
 """
 import os
 import random
+import re
 import shutil
 import signal
 import subprocess
@@ -25,6 +26,25 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 def log(msg):
     print("soak: " + msg, file=sys.stderr, flush=True)
+
+
+def driver_lateness(out, t0):
+    """[(t since t0, seconds behind)] from driver_sim's "behind schedule" warnings in this run's
+    rosout.log (found through the log directory roslaunch names in its output)."""
+    try:
+        with open(os.path.join(out, "roslaunch.log")) as f:
+            head = f.read(4000)
+        logdir = os.path.dirname(re.search(r"logging to (\S+)", head).group(1))
+        with open(os.path.join(logdir, "rosout.log")) as f:
+            lines = f.readlines()
+    except (IOError, OSError, AttributeError):
+        return []
+    found = []
+    for line in lines:
+        m = re.match(r"(\d+\.\d+) WARN .*driver_sim: ([0-9.]+) s behind schedule", line)
+        if m:
+            found.append((float(m.group(1)) - t0, float(m.group(2))))
+    return found
 
 
 def scenario(seconds, rate):
@@ -73,6 +93,7 @@ def main():
     patterns = ({"manager": "__name:=gyro_manager"} if mode == "nodelets" else
                 {"driver_sim": "__name:=driver_sim", "processor": "__name:=processor",
                  "calibrator": "__name:=calibrator"})
+    samples, steal = [], []  # steal: (t, % of the VM's CPU time the hypervisor took in the interval)
     state = {"errors": [], "levels": {}, "processor": {}, "results": [], "delays": [], "heap": []}
     try:
         time.sleep(5)
@@ -120,12 +141,15 @@ def main():
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag, queue_size=100)
         rospy.Subscriber("/calibrator/result", CalibrationResult, on_result, queue_size=10)
         t0 = state["t0"] = time.time()
-        samples = []
+        cpu_before = proc_stats.cpu_times()
         next_report = t0 + 60
         while time.time() - t0 < seconds and launch.poll() is None:
             time.sleep(10)
             now = proc_stats.scan(patterns)
             samples.append((time.time() - t0, now))
+            cpu_now = proc_stats.cpu_times()
+            steal.append((time.time() - t0, 100.0 * (cpu_now[1] - cpu_before[1]) / max(1, cpu_now[0] - cpu_before[0])))
+            cpu_before = cpu_now
             if time.time() > next_report:
                 next_report += 300
                 log("%5.0f s: rss %s MiB; received %s, lost %s, errors %d" % (
@@ -143,9 +167,9 @@ def main():
 
     with open(os.path.join(out, "rss.csv"), "w") as f:
         names = sorted(patterns)
-        f.write("t_s," + ",".join("%s_rss_mib" % n for n in names) + "\n")
-        for t, now in samples:
-            f.write("%.1f,%s\n" % (t, ",".join("%.2f" % now[n][0] if n in now else "" for n in names)))
+        f.write("t_s," + ",".join("%s_rss_mib" % n for n in names) + ",steal_percent\n")
+        for (t, now), (_, st) in zip(samples, steal):
+            f.write("%.1f,%s,%.1f\n" % (t, ",".join("%.2f" % now[n][0] if n in now else "" for n in names), st))
     report = {"seconds": seconds, "mode": mode, "output_rate_hz": output_rate, "nodes": {}}
     ok = True
     warm = [s for s in samples if s[0] >= 0.1 * seconds]
@@ -190,6 +214,18 @@ def main():
         with open(os.path.join(out, "stamp_delay.csv"), "w") as f:
             f.write("t_s,earliest_delay_s,latest_delay_s\n")
             f.writelines("%.1f,%.6f,%.6f\n" % d for d in state["delays"])
+    if steal:
+        report["hypervisor_steal_percent"] = {"mean": round(sum(s for _, s in steal) / len(steal), 1),
+                                              "max_10s": round(max(s for _, s in steal), 1)}
+    # The driver's own lateness (its log): a late source, not the pipeline, when it coincides.
+    behind = driver_lateness(out, state.get("t0", 0.0))
+    report["driver_behind_schedule"] = {"warnings": len(behind), "max_s": max((b for _, b in behind), default=0.0),
+                                        "over_0.5_s": [[round(t, 1), b] for t, b in behind if b > 0.5][:20]}
+    # Each ERROR with the steal of its 10 s interval and the driver's lateness around it.
+    state["errors"] = [list(e) + [next((round(s, 1) for t, s in steal if t >= e[0]), None),
+                                  max((b for t, b in behind if abs(t - e[0]) <= 15.0), default=0.0)]
+                       for e in state["errors"]]
+    report["error_diagnostics_columns"] = ["t_s", "status", "message", "steal_percent", "driver_behind_s"]
     report["error_diagnostics"] = state["errors"][:20]
     report["error_diagnostic_count"] = len(state["errors"])
     report["worst_level"] = state["levels"]
