@@ -4,7 +4,8 @@ calibrator, with the resident memory of the nodes sampled and every diagnostic w
 
 Environment: SOAK_SECONDS (default 3600), SOAK_MODE (nodelets | processes, default nodelets),
 SOAK_RATE (channel rate in Hz, default 10000), SOAK_OUT (default bench_output/soak).
-Writes SOAK_OUT/soak.yaml, soak.md and rss.csv; exits non-zero when the session lost samples, a
+Writes SOAK_OUT/soak.yaml, soak.md, rss.csv (RSS and hypervisor steal), heap.csv (live heap) and
+stamp_delay.csv; exits non-zero when the session lost samples, a
 diagnostic went to ERROR after the start-up, or memory grew (more than SOAK_RSS_GROWTH_MIB, default
 2 MiB, between the end of the first tenth and the end).
 """

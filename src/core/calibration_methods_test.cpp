@@ -1,6 +1,7 @@
 // The calibration methods on fast angle-level sessions (MATH.md section 6), the session's stream
 // synchronisation, and the quality gates.
 #include <deque>
+
 #include <gtest/gtest.h>
 
 #include "core/testing/angle_level_session.h"

@@ -60,7 +60,8 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   stages_ = stages;
   int queue_size = 50000;  // as the processor's: seconds of backlog at 10 kHz, lost by none
   pnh_.param("queue_size", queue_size, queue_size);
-  pnh_.param("heap_trim_period", heap_trim_period_, heap_trim_period_);
+  double heap_trim_period = 10.0;  // s of wall time between malloc_trim calls; <= 0: never
+  pnh_.param("heap_trim_period", heap_trim_period, heap_trim_period);
 
   result_pub_ = pnh_.advertise<CalibrationResult>("result", 1, true);
   ros::NodeHandle in = input_.handle(nh_);
@@ -91,10 +92,7 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   abort_srv_ = pnh_.advertiseService("abort", &CalibratorRos::onAbort, this);
   updater_.setHardwareID("hrg_gyro");
   updater_.add("calibration", this, &CalibratorRos::diagnose);
-  updater_.add("memory", [this](diagnostic_updater::DiagnosticStatusWrapper& stat) {
-    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "process heap");
-    reportProcessHeap(stat, heap_trim_period_);
-  });
+  addProcessHeapDiagnostic(updater_, heap_trim_period);
   diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
 
   bool autostart = true;

@@ -1,7 +1,7 @@
 #include "hrg_gyro/ros/driver_sim_ros.h"
 
 #include <algorithm>
-#include <string>
+#include <cstdio>
 
 #include <rosgraph_msgs/Clock.h>
 #include <std_msgs/Bool.h>
@@ -127,9 +127,12 @@ void DriverSimRos::run() {
   }
   if (stop_ || !ros::ok()) return;
   const double wall = (ros::WallTime::now() - wall_start).toSec();
+  char lateness[64] = "";
+  if (time_scale_ > 0.0 && !use_sim_time_) {
+    std::snprintf(lateness, sizeof lateness, ", at most %.3f s behind schedule", max_behind);
+  }
   ROS_INFO("driver_sim: scenario complete: %u samples, %.1f s simulated in %.1f s of wall time (%.1fx)%s", seq,
-           sim.elapsed(), wall, wall > 0 ? sim.elapsed() / wall : 0.0,
-           time_scale_ > 0.0 && !use_sim_time_ ? (", at most " + std::to_string(max_behind) + " s behind schedule").c_str() : "");
+           sim.elapsed(), wall, wall > 0 ? sim.elapsed() / wall : 0.0, lateness);
   std_msgs::Bool done;
   done.data = true;
   done_pub_.publish(done);

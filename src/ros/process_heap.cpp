@@ -35,10 +35,13 @@ bool trimProcessHeap(double period) {
   return true;
 }
 
-void reportProcessHeap(diagnostic_updater::DiagnosticStatusWrapper& stat, double trim_period) {
-  trimProcessHeap(trim_period);
-  stat.addf("process heap in use (MiB)", "%.2f", processHeapInUseMiB());
-  stat.add("heap trims", trims.load());
+void addProcessHeapDiagnostic(diagnostic_updater::Updater& updater, double trim_period) {
+  updater.add("memory", [trim_period](diagnostic_updater::DiagnosticStatusWrapper& stat) {
+    trimProcessHeap(trim_period);
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "process heap");
+    stat.addf("process heap in use (MiB)", "%.2f", processHeapInUseMiB());
+    stat.add("heap trims", trims.load());
+  });
 }
 
 }  // namespace hrg_gyro

@@ -64,7 +64,8 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   // loses none (a queued message costs a few hundred bytes only while it waits).
   int queue_size = 50000;
   pnh_.param("queue_size", queue_size, queue_size);
-  pnh_.param("heap_trim_period", heap_trim_period_, heap_trim_period_);
+  double heap_trim_period = 10.0;  // s of wall time between malloc_trim calls; <= 0: never
+  pnh_.param("heap_trim_period", heap_trim_period, heap_trim_period);
 
   wave_pub_ = nh_.advertise<WaveState>("wave", queue_size);
   output_pub_ = nh_.advertise<GyroOutput>("output", queue_size);
@@ -87,10 +88,7 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   updater_.add("input", this, &ProcessorRos::diagnoseInput);
   updater_.add("wave", this, &ProcessorRos::diagnoseWave);
   updater_.add("model", this, &ProcessorRos::diagnoseModel);
-  updater_.add("memory", [this](diagnostic_updater::DiagnosticStatusWrapper& stat) {
-    stat.summary(DiagnosticStatus::OK, "process heap");
-    reportProcessHeap(stat, heap_trim_period_);
-  });
+  addProcessHeapDiagnostic(updater_, heap_trim_period);
   channels_sub_ = input_.handle(nh_).subscribe("channels", queue_size, &ProcessorRos::onChannels, this,
                                                ros::TransportHints().tcpNoDelay());
   input_.start();

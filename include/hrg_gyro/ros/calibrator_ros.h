@@ -72,7 +72,6 @@ class CalibratorRos {
   std::string last_result_;
   // Bag loops: a stream going back by more than backward_reset_ s restarts the run.
   double backward_reset_ = 1.0;
-  double heap_trim_period_ = 10.0;  // s of wall time between malloc_trim calls; <= 0: never
   ros::Time last_turntable_stamp_, last_wave_stamp_;
   std::uint64_t resets_ = 0, reported_resets_ = 0;
   bool last_accepted_ = false;

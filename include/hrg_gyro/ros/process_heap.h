@@ -7,7 +7,7 @@
 // sharing a manager trim it once per period between them.
 #pragma once
 
-#include <diagnostic_updater/DiagnosticStatusWrapper.h>
+#include <diagnostic_updater/diagnostic_updater.h>
 
 namespace hrg_gyro {
 
@@ -18,8 +18,8 @@ double processHeapInUseMiB();
 /// time (period <= 0: never). Returns true when it trimmed.
 bool trimProcessHeap(double period);
 
-/// Adds "process heap in use (MiB)" and "heap trims" to a diagnostic status (and trims first when
-/// due), for the nodes that sit on high-rate queues.
-void reportProcessHeap(diagnostic_updater::DiagnosticStatusWrapper& stat, double trim_period);
+/// Adds the "memory" status to a node's updater: OK, "process heap in use (MiB)" and "heap trims";
+/// each update trims first when due. For the nodes that sit on high-rate queues.
+void addProcessHeapDiagnostic(diagnostic_updater::Updater& updater, double trim_period);
 
 }  // namespace hrg_gyro

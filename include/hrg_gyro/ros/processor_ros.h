@@ -47,7 +47,6 @@ class ProcessorRos {
   double configured_rate_variance_ = -1.0;
   double stall_timeout_ = 0.5;
   double quadrature_warn_ = 0.1;
-  double heap_trim_period_ = 10.0;  // s of wall time between malloc_trim calls; <= 0: never
 
   InputThread input_;  // serves channels_sub_
   ros::Subscriber channels_sub_;
