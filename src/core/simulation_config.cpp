@@ -10,7 +10,8 @@ namespace core {
 const std::vector<std::string>& nodeOnlyScenarioKeys() {
   static const std::vector<std::string> keys = {"time_scale",         "clock_period", "frame_id",
                                                 "publish_clock",      "wait_for_subscribers",
-                                                "wait_timeout",       "shutdown_when_done", "queue_size"};
+                                                "wait_timeout",       "shutdown_when_done", "queue_size",
+                                                "max_lag"};
   return keys;
 }
 

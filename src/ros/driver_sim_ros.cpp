@@ -1,6 +1,6 @@
 #include "hrg_gyro/ros/driver_sim_ros.h"
 
-#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include <rosgraph_msgs/Clock.h>
@@ -9,6 +9,7 @@
 #include "hrg_gyro/ChannelAmplitudes.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
+#include "hrg_gyro/core/playback_schedule.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/param_tree.h"
 
@@ -21,6 +22,7 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
       core::SimulationConfig::parse(core::YamlField(params, ""), core::nodeOnlyScenarioKeys()));
   pnh_.param("time_scale", time_scale_, time_scale_);
   pnh_.param("clock_period", clock_period_, clock_period_);
+  pnh_.param("max_lag", max_lag_, max_lag_);
   pnh_.param("frame_id", frame_id_, frame_id_);
   ros::param::param("/use_sim_time", use_sim_time_, false);
   pnh_.param("publish_clock", publish_clock_, use_sim_time_);
@@ -32,6 +34,7 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   int queue_size = 20000;
   pnh_.param("queue_size", queue_size, queue_size);
   if (!(clock_period_ > 0.0)) throw std::invalid_argument("~clock_period must be positive (s)");
+  if (!(max_lag_ > 0.0)) throw std::invalid_argument("~max_lag must be positive (s)");
   if (!use_sim_time_ && time_scale_ != 1.0) {
     ROS_WARN("driver_sim: ~time_scale = %g without /use_sim_time: stamps will run ahead of the wall clock",
              time_scale_);
@@ -89,27 +92,26 @@ void DriverSimRos::run() {
   const core::Nanoseconds origin =
       use_sim_time_ ? 0 : toNanoseconds(ros::Time::now()) - core::toNanoseconds(config_->start_time);
   const ros::WallTime wall_start = ros::WallTime::now();
+  // Wall-clock stamps are due times, so a late thread catches up; under sim time the clock is ours.
+  core::PlaybackSchedule schedule(time_scale_, use_sim_time_ ? max_lag_ : INFINITY);
+  schedule.start(wall_start.toSec());
   core::SimulationSample s;
   double next_clock = 0.0;
   std::uint32_t seq = 0;
-  double max_behind = 0.0;
   while (!stop_ && ros::ok() && sim.next(&s)) {
     const ros::Time stamp = toRosTime(origin + s.stamp);
-    if (time_scale_ > 0.0) {
-      const ros::WallTime due = wall_start + ros::WallDuration(sim.elapsed() / time_scale_);
-      const ros::WallTime now = ros::WallTime::now();
-      if (due > now) {
-        (due - now).sleep();
-      } else {
-        // Behind schedule: the stamps still say when each sample was due (as a hardware clock
-        // would), so consumers see the delay; this says where it came from.
-        const double behind = (now - due).toSec();
-        max_behind = std::max(max_behind, behind);
-        if (behind > 0.1 && !use_sim_time_) {  // under sim time it only slows the clock
-          ROS_WARN_THROTTLE(10.0, "driver_sim: %.3f s behind schedule (this thread was not run in time); "
-                                  "catching up", behind);
-        }
-      }
+    double late = 0.0;
+    const double wait = schedule.waitFor(sim.elapsed(), ros::WallTime::now().toSec(), &late);
+    if (wait > 0.0) {
+      ros::WallDuration(wait).sleep();
+    } else if (late > 0.1 && !use_sim_time_) {
+      // The stamps still say when each sample was due (as a hardware clock would), so consumers
+      // see the delay; this says where it came from.
+      ROS_WARN_THROTTLE(10.0, "driver_sim: %.3f s behind schedule (this thread was not run in time); catching up",
+                        late);
+    } else if (late > max_lag_ && use_sim_time_) {
+      ROS_INFO_THROTTLE(30.0, "driver_sim: %.3f s behind schedule: the simulated clock runs slower than "
+                              "~time_scale (%.1f s let go so far)", late, schedule.slid());
     }
     if (!clock_pub_.getTopic().empty() && sim.elapsed() >= next_clock) {
       rosgraph_msgs::Clock c;
@@ -127,9 +129,12 @@ void DriverSimRos::run() {
   }
   if (stop_ || !ros::ok()) return;
   const double wall = (ros::WallTime::now() - wall_start).toSec();
-  char lateness[64] = "";
+  char lateness[128] = "";
   if (time_scale_ > 0.0 && !use_sim_time_) {
-    std::snprintf(lateness, sizeof lateness, ", at most %.3f s behind schedule", max_behind);
+    std::snprintf(lateness, sizeof lateness, ", at most %.3f s behind schedule", schedule.maxLateness());
+  } else if (time_scale_ > 0.0) {
+    std::snprintf(lateness, sizeof lateness, ", the schedule let go %.3f s in %llu pauses", schedule.slid(),
+                  static_cast<unsigned long long>(schedule.slides()));
   }
   ROS_INFO("driver_sim: scenario complete: %u samples, %.1f s simulated in %.1f s of wall time (%.1fx)%s", seq,
            sim.elapsed(), wall, wall > 0 ? sim.elapsed() / wall : 0.0, lateness);

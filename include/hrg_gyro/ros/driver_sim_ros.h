@@ -4,7 +4,9 @@
 // `rosparam load` into ~), runs core::GyroSimulator in a worker thread and publishes, per output
 // sample: `channels` (ChannelAmplitudes), `turntable/state` (TurntableState) and `truth`
 // (GroundTruth). With /use_sim_time it also drives /clock, `~time_scale` times faster than real
-// time; without it, stamps follow the wall clock from the start. `~done` (std_msgs/Bool, latched)
+// time (a lag beyond `~max_lag` slows the simulated clock instead of being chased, see
+// core::PlaybackSchedule); without it, stamps follow the wall clock from the start and a late
+// thread catches up. `~done` (std_msgs/Bool, latched)
 // turns true when the scenario is over.
 #pragma once
 
@@ -34,6 +36,7 @@ class DriverSimRos {
   std::unique_ptr<core::SimulationConfig> config_;
   ros::Publisher channels_pub_, turntable_pub_, truth_pub_, clock_pub_, done_pub_;
   double time_scale_ = 1.0;
+  double max_lag_ = 0.25;  // s, sim time only
   double clock_period_ = 0.05;  // every subscriber of /clock (every node under sim time) pays for it
   std::string frame_id_ = "gyro_link";
   bool use_sim_time_ = false;
