@@ -2,7 +2,7 @@
 #   make run    install missing Debian packages, build, run the main job, print the summary
 #   make test   install, build, run every unit test and rostest, then catkin_test_results
 #   make bench  install, build, run the benchmarks
-#   make soak   1 h at 10 kHz through the nodes, memory and drops watched
+#   make soak   1 simulated h at 10 kHz through the nodes (sim clock, 2x), memory and drops watched
 #   make fuzz   libFuzzer + ASan/UBSan on the parameter loader and the sample path (FUZZ_SECONDS each)
 # Everything builds in .ws/, a catkin workspace inside the checkout (ignored by git) whose
 # src/hrg_gyro links back to this directory; source .ws/devel/setup.bash to use the package.
@@ -44,8 +44,8 @@ bench: build
 	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) hrg_gyro_benchmarks
 	cd $(WS) && source devel/setup.bash && /usr/bin/python3 $(ROOT)/bench/run_benchmarks.py
 
-# Soak: SOAK_SECONDS (default 3600) of 10 kHz through driver_sim, processor and calibrator with RSS
-# sampled; report in bench_output/soak (see bench/soak.py).
+# Soak: SOAK_SECONDS (default 3600 simulated s) of 10 kHz through driver_sim, processor and calibrator
+# with RSS sampled; SOAK_CLOCK=sim|wall, SOAK_TIME_SCALE (2); report in bench_output/soak (bench/soak.py).
 soak: build
 	cd $(WS) && source devel/setup.bash && /usr/bin/python3 $(ROOT)/bench/soak.py
 
