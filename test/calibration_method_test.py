@@ -68,6 +68,9 @@ class CalibrationMethod(unittest.TestCase):
             p = self.final_result(1)
             self.check_written(p, "correction_matrix")
             self.assertTrue(any(abs(x) > 1e-4 for x in p.correction))
+            # Every sample of the sweep paired (24 angles x 3 quadratures x 2 phases x 0.05 s at
+            # 200 Hz), also when its last raw channels arrive after truth has left the sweep.
+            self.assertEqual(p.samples, 1440)
             r = self.final_result(2)
             self.check_written(r, "dual_rate")
             self.assertEqual(list(r.correction), list(p.correction))  # measured through the new P

@@ -34,6 +34,9 @@ TEST(ParameterFileCrash, SigkillDuringWritesNeverLeavesAPartialFile) {
   ASSERT_NE(::mkdtemp(dir_template), nullptr);
   const std::string path = std::string(dir_template) + "/params.yaml";
   const GyroParameters a = variant(-0.56), b = variant(-0.57);
+  // Two saves first: the backup exists from the second on. (With one, a child killed before it
+  // finished its first save left no .bak: a fresh-clone run failed that way in round 0.)
+  saveParameterFile(path, b);
   saveParameterFile(path, a);
   std::mt19937 rng(42);
   std::uniform_int_distribution<int> delay_us(0, 30000);

@@ -16,6 +16,9 @@
 namespace hrg_gyro {
 namespace {
 
+// Stream seconds after the end of the generator sweep beyond which the channels are given up on.
+constexpr double kSweepChannelsWait = 30.0;
+
 using diagnostic_msgs::DiagnosticStatus;
 
 const std::vector<std::string>& nodeOnlyKeys() {
@@ -179,6 +182,7 @@ bool CalibratorRos::startRun(const std::string& method, std::string* reason) {
     settings.method = method;
     session_ = std::make_unique<core::CalibrationSession>(settings, core::loadParameterFile(parameter_file_));
     skip_waves_until_ = ros::Time();
+    sweep_end_ = last_channels_stamp_ = ros::Time();
     raw_.clear();
     reference_.clear();
     ROS_INFO("calibrator: %s run started (prior %s)", method.c_str(), parameter_file_.c_str());
@@ -211,6 +215,13 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   restartIfTimeWentBack(msg->header.stamp, &last_turntable_stamp_);
   if (!session_) return;
+  if (!sweep_end_.isZero() && (msg->header.stamp - sweep_end_).toSec() > kSweepChannelsWait) {
+    ROS_WARN("calibrator: the raw channels did not reach the end of the generator sweep within %.0f s; "
+             "fitting P with the %llu pairs received", kSweepChannelsWait,
+             static_cast<unsigned long long>(session_->counters().used));
+    endGeneratorSweep();
+    if (!session_) return;
+  }
   session_->addTurntable(toNanoseconds(msg->header.stamp), msg->angle, msg->rate);
   if (session_->shouldFinish()) {
     bool written = false;
@@ -235,8 +246,10 @@ void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
 void CalibratorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!session_ || session_->settings().method != "correction_matrix") return;
+  last_channels_stamp_ = msg->header.stamp;
   raw_[toNanoseconds(msg->header.stamp)] = core::ChannelVector(msg->c_in, msg->c_quad, msg->s_in, msg->s_quad);
   pairGenerator();
+  if (!sweep_end_.isZero() && msg->header.stamp >= sweep_end_) endGeneratorSweep();
 }
 
 void CalibratorRos::onTruth(const GroundTruth::ConstPtr& msg) {
@@ -244,20 +257,27 @@ void CalibratorRos::onTruth(const GroundTruth::ConstPtr& msg) {
   if (!session_ || session_->settings().method != "correction_matrix") return;
   if (!msg->generator) {
     // The truth stream has left the sweep: every generator reference has arrived. The raw channels
-    // that pair with them may still be queued, so pair what is there, then finish.
-    if (!reference_.empty() || session_->counters().used > 0) {
-      session_->generatorSweepEnded();
-      if (session_->shouldFinish()) {
-        bool written = false;
-        std::string message;
-        finishRun(&written, &message);
-      }
+    // that pair with them may still be queued on their own connection (a fresh-clone run lost the
+    // last 87 of 1440 pairs that way, which biased P); wait for the channels to reach this stamp.
+    if (sweep_end_.isZero() && (!reference_.empty() || session_->counters().used > 0)) {
+      sweep_end_ = msg->header.stamp;
+      if (last_channels_stamp_ >= sweep_end_) endGeneratorSweep();
     }
     return;
   }
   reference_[toNanoseconds(msg->header.stamp)] =
       core::idealChannels({msg->amplitude, msg->quadrature, msg->theta, msg->phase});
   pairGenerator();
+}
+
+void CalibratorRos::endGeneratorSweep() {
+  sweep_end_ = ros::Time();
+  session_->generatorSweepEnded();
+  if (session_->shouldFinish()) {
+    bool written = false;
+    std::string message;
+    finishRun(&written, &message);
+  }
 }
 
 void CalibratorRos::pairGenerator() {

@@ -56,6 +56,8 @@ class CalibratorRos {
   /// Fits, gates, writes, publishes, reloads; returns the outcome. Caller holds the mutex.
   core::CalibrationOutcome finishRun(bool* written, std::string* message);
   void pairGenerator();
+  /// The sweep is over and every raw channel of it has arrived (or given up on): fit, maybe finish.
+  void endGeneratorSweep();
   /// The reload worker: calls the processor's ~reload off the callback threads, then starts the
   /// next stage if there is one (it must see the wave through the new model).
   void reloadLoop();
@@ -78,6 +80,9 @@ class CalibratorRos {
 
   // Generator pairs: raw channels and the reference wave, matched by stamp.
   std::map<core::Nanoseconds, core::ChannelVector> raw_, reference_;
+  // Truth and channels come over separate connections: when truth leaves the sweep, the sweep's
+  // last raw channels may still be in transit. The stage ends once the channels reach this stamp.
+  ros::Time sweep_end_, last_channels_stamp_;
 
   InputThread input_;  // serves the four subscriptions below
   ros::Subscriber turntable_sub_, wave_sub_, channels_sub_, truth_sub_;
