@@ -9,7 +9,6 @@
 #include "hrg_gyro/ChannelAmplitudes.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
-#include "hrg_gyro/core/playback_schedule.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/param_tree.h"
 
@@ -35,6 +34,9 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   pnh_.param("queue_size", queue_size, queue_size);
   if (!(clock_period_ > 0.0)) throw std::invalid_argument("~clock_period must be positive (s)");
   if (!(max_lag_ > 0.0)) throw std::invalid_argument("~max_lag must be positive (s)");
+  // Wall-clock stamps are due times, so a late thread catches up; under sim time the clock is ours.
+  // Built here so that a bad ~time_scale is refused at start-up, not thrown in the worker thread.
+  schedule_.emplace(time_scale_, use_sim_time_ ? max_lag_ : INFINITY);
   if (!use_sim_time_ && time_scale_ != 1.0) {
     ROS_WARN("driver_sim: ~time_scale = %g without /use_sim_time: stamps will run ahead of the wall clock",
              time_scale_);
@@ -92,8 +94,7 @@ void DriverSimRos::run() {
   const core::Nanoseconds origin =
       use_sim_time_ ? 0 : toNanoseconds(ros::Time::now()) - core::toNanoseconds(config_->start_time);
   const ros::WallTime wall_start = ros::WallTime::now();
-  // Wall-clock stamps are due times, so a late thread catches up; under sim time the clock is ours.
-  core::PlaybackSchedule schedule(time_scale_, use_sim_time_ ? max_lag_ : INFINITY);
+  core::PlaybackSchedule& schedule = *schedule_;
   schedule.start(wall_start.toSec());
   core::SimulationSample s;
   double next_clock = 0.0;

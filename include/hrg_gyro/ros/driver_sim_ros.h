@@ -12,12 +12,14 @@
 
 #include <atomic>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 
 #include <ros/ros.h>
 
 #include "hrg_gyro/core/gyro_simulator.h"
+#include "hrg_gyro/core/playback_schedule.h"
 
 namespace hrg_gyro {
 
@@ -37,6 +39,7 @@ class DriverSimRos {
   ros::Publisher channels_pub_, turntable_pub_, truth_pub_, clock_pub_, done_pub_;
   double time_scale_ = 1.0;
   double max_lag_ = 0.25;  // s, sim time only
+  std::optional<core::PlaybackSchedule> schedule_;  // built (and validated) with the parameters
   double clock_period_ = 0.05;  // every subscriber of /clock (every node under sim time) pays for it
   std::string frame_id_ = "gyro_link";
   bool use_sim_time_ = false;
