@@ -74,6 +74,11 @@ def driver_completion(lines):
     return None
 
 
+def median(values):
+    values = sorted(values)
+    return values[len(values) // 2] if values else float("nan")
+
+
 def scenario(seconds, rate):
     """The live benchmark's gyro on a dual-rate profile that fills the soak (226 s per pair)."""
     with open(os.path.join(ROOT, "bench", "live_scenario.yaml")) as f:
@@ -219,10 +224,6 @@ def main():
     # Memory is compared in one state of the session: the calibrator holds its buffers until its
     # result, then frees them, so "late" is the tenth before the result (or before the end).
     steady_end = state.get("result_t", samples[-1][0] if samples else 0.0)
-
-    def median(values):
-        values = sorted(values)
-        return values[len(values) // 2] if values else float("nan")
     warm = [s for s in samples if s[0] >= warmup]
     for name in sorted(patterns):
         series = [(t, now[name]) for t, now in samples if name in now]
@@ -230,11 +231,10 @@ def main():
             ok = False
             report["nodes"][name] = "never seen"
             continue
-        after_warmup = [v for t, v in series if t >= warmup] or [series[-1][1]]
         early = median([v[0] for t, v in series if warmup <= t < 2 * warmup])
         late = median([v[0] for t, v in series if steady_end - warmup <= t <= steady_end])
         cpu = 100.0 * (series[-1][1][1] - series[0][1][1]) / proc_stats.CLK_TCK / max(series[-1][0] - series[0][0], 1e-9)
-        node = {"rss_start_mib": round(series[0][1][0], 2), "rss_after_warmup_mib": round(after_warmup[0][0], 2),
+        node = {"rss_start_mib": round(series[0][1][0], 2),
                 "rss_end_mib": round(series[-1][1][0], 2), "rss_max_mib": round(max(v[0] for _, v in series), 2),
                 "rss_early_median_mib": round(early, 2), "rss_late_median_mib": round(late, 2),
                 "growth_mib": round(late - early, 2), "cpu_percent": round(cpu, 1)}
@@ -262,7 +262,7 @@ def main():
                                      "growth": round(heap_steady[-1] - heap_steady[0], 2)}
     lags = sorted(max(abs(e), abs(l)) for _, e, l in state["delays"])
     if lags:
-        report["stamp_delay_s"] = {"windows": len(lags), "median": round(lags[len(lags) // 2], 4),
+        report["stamp_delay_s"] = {"windows": len(lags), "median": round(median(lags), 4),
                                    "p99": round(lags[min(len(lags) - 1, int(0.99 * len(lags)))], 4),
                                    "max": round(lags[-1], 4),
                                    "windows_over_0.1_s": sum(1 for x in lags if x > 0.1),
