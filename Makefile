@@ -19,7 +19,7 @@ JOBS ?= $(shell nproc)
 .PHONY: deps build test run bench fuzz soak clean
 
 deps:
-	@$(ROOT)/scripts/install_deps.sh
+	@bash $(ROOT)/scripts/install_deps.sh
 
 build: deps
 	@mkdir -p $(WS)/src
@@ -36,7 +36,7 @@ test: build
 	cd $(WS) && catkin_test_results build/test_results
 
 run: build
-	cd $(WS) && source devel/setup.bash && $(ROOT)/scripts/run_main_job.sh
+	cd $(WS) && source devel/setup.bash && bash $(ROOT)/scripts/run_main_job.sh
 
 # Benchmarks: Google Benchmark core suites, calibration, offline and live pipelines (about 12 min);
 # figures in bench_output/results.md. BENCH_ONLY=core,... selects parts (see bench/run_benchmarks.py).
@@ -52,8 +52,8 @@ soak: build
 # Fuzzing (clang from Debian): FUZZ_SECONDS per target (default 120), FUZZ_MERGE=1 to grow the
 # checked-in corpus. `make test` replays the corpus without sanitizers (hrg_gyro_fuzz_corpus_test).
 fuzz:
-	@$(ROOT)/scripts/install_deps.sh clang-14 libclang-rt-14-dev
-	$(ROOT)/scripts/run_fuzzers.sh
+	@bash $(ROOT)/scripts/install_deps.sh clang-14 libclang-rt-14-dev
+	bash $(ROOT)/scripts/run_fuzzers.sh
 
 clean:
 	rm -rf $(WS)

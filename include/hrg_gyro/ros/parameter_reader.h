@@ -1,0 +1,61 @@
+// Reads a node's private parameters and keeps account of them, so that a typo in a launch or YAML
+// file never passes silently: a key set in the node's private namespace that nothing reads is an
+// unknown key (warned at start-up), and a key the node reads but nobody set falls back to its
+// default (listed, so a test can prove the shipped parameter template lacks none).
+//
+// Parameters that a core parser reads from the private tree (calibrator settings, simulator
+// scenarios) are declared with claim(): the parser checks their values and refuses unknown keys
+// itself; the reader only accounts for them.
+#pragma once
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include <ros/node_handle.h>
+
+namespace hrg_gyro {
+
+class ParameterReader {
+ public:
+  /// `node` names the node in messages ("processor").
+  ParameterReader(const ros::NodeHandle& private_nh, std::string node);
+
+  /// ~key, or `fallback` when it is not set (then listed by defaultedKeys()).
+  template <typename T>
+  T get(const std::string& key, const T& fallback) {
+    T value = fallback;
+    note(key, pnh_.getParam(key, value));
+    return value;
+  }
+  /// ~key into *value; false (and *value untouched) when it is not set.
+  template <typename T>
+  bool getOptional(const std::string& key, T* value) {
+    const bool set = pnh_.getParam(key, *value);
+    note(key, set);
+    return set;
+  }
+
+  /// Keys read by someone else (a core parser, diagnostic_updater): "a/b" names a leaf, and with
+  /// `subtree` every key below it counts as read (a section whose keys the parser checks itself).
+  void claim(const std::vector<std::string>& keys, bool subtree = false);
+
+  /// Keys set under the private namespace ("a/b" for nested maps) that nothing read or claimed.
+  std::vector<std::string> unknownKeys() const;
+  /// Keys read or claimed as leaves that were not set: their defaults are in force.
+  std::vector<std::string> defaultedKeys() const { return {defaulted_.begin(), defaulted_.end()}; }
+  /// Every key read or claimed as a leaf.
+  std::vector<std::string> readKeys() const { return {read_.begin(), read_.end()}; }
+
+  /// One warning per unknown key (a typo must not pass silently); returns how many.
+  std::size_t warnAboutUnknownKeys() const;
+
+ private:
+  void note(const std::string& key, bool set);
+
+  ros::NodeHandle pnh_;
+  std::string node_;
+  std::set<std::string> read_, subtrees_, defaulted_;
+};
+
+}  // namespace hrg_gyro

@@ -1,0 +1,65 @@
+#include "hrg_gyro/ros/parameter_reader.h"
+
+#include <ros/console.h>
+
+namespace hrg_gyro {
+namespace {
+
+/// Leaf keys of an XmlRpc struct, nested maps joined with '/'.
+void flatten(XmlRpc::XmlRpcValue& value, const std::string& prefix, std::vector<std::string>* out) {
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeStruct || value.size() == 0) {
+    if (!prefix.empty()) out->push_back(prefix);
+    return;
+  }
+  for (auto it = value.begin(); it != value.end(); ++it) {
+    flatten(it->second, prefix.empty() ? it->first : prefix + "/" + it->first, out);
+  }
+}
+
+}  // namespace
+
+ParameterReader::ParameterReader(const ros::NodeHandle& private_nh, std::string node)
+    : pnh_(private_nh), node_(std::move(node)) {}
+
+void ParameterReader::note(const std::string& key, bool set) {
+  read_.insert(key);
+  if (!set) defaulted_.insert(key);
+}
+
+void ParameterReader::claim(const std::vector<std::string>& keys, bool subtree) {
+  for (const std::string& key : keys) {
+    if (subtree) {
+      subtrees_.insert(key);
+    } else {
+      note(key, pnh_.hasParam(key));
+    }
+  }
+}
+
+std::vector<std::string> ParameterReader::unknownKeys() const {
+  XmlRpc::XmlRpcValue tree;
+  std::vector<std::string> keys, unknown;
+  if (pnh_.getParam(pnh_.getNamespace(), tree)) flatten(tree, "", &keys);
+  for (const std::string& key : keys) {
+    bool known = read_.count(key) > 0;
+    // A key read as a whole (a list, or a map read by getParam) covers its leaves; so does a claimed subtree.
+    for (std::size_t slash = key.find('/'); !known && slash != std::string::npos; slash = key.find('/', slash + 1)) {
+      const std::string head = key.substr(0, slash);
+      known = read_.count(head) > 0 || subtrees_.count(head) > 0;
+    }
+    if (!known && subtrees_.count(key) > 0) known = true;
+    if (!known) unknown.push_back(key);
+  }
+  return unknown;
+}
+
+std::size_t ParameterReader::warnAboutUnknownKeys() const {
+  const std::vector<std::string> unknown = unknownKeys();
+  for (const std::string& key : unknown) {
+    ROS_WARN("%s: unknown parameter %s/%s is ignored (a typo? see the node's parameter template)", node_.c_str(),
+             pnh_.getNamespace().c_str(), key.c_str());
+  }
+  return unknown.size();
+}
+
+}  // namespace hrg_gyro
