@@ -15,6 +15,18 @@ std::vector<int> parseEvenOrders(const YamlField& f) {
   return out;
 }
 
+// The keys, listed once: parse() refuses any other, keyPaths() lists them for the node's template check.
+const std::vector<std::string> kPlateauKeys = {"rate_tolerance", "relative_tolerance", "settle_time", "static_rate",
+                                               "max_gap"};
+const std::vector<std::string> kGateKeys = {"min_coverage",     "min_rate_separation",   "max_rate_noise",
+                                            "min_samples",      "max_condition",         "max_relative_residual",
+                                            "max_k0_change",    "max_harmonic_std",      "min_steps",
+                                            "min_dwell_time",   "min_pairs",             "max_p_condition"};
+const std::vector<std::string> kThermalKeys = {"frequency_nodes", "node_count", "interpolation", "slice_width",
+                                               "max_slices"};
+const std::vector<std::string> kScalarKeys = {"method", "scale_factor_orders", "drift_orders", "bins", "window",
+                                              "window_span", "group_tolerance", "auto_finish_idle"};
+
 double positive(const YamlField& parent, const char* key, double fallback) {
   const double v = parent.getDouble(key, fallback);
   if (!(v > 0.0)) parent[key].fail("must be positive");
@@ -23,6 +35,14 @@ double positive(const YamlField& parent, const char* key, double fallback) {
 
 }  // namespace
 
+std::vector<std::string> CalibrationSettings::keyPaths() {
+  std::vector<std::string> keys = kScalarKeys;
+  for (const std::string& k : kPlateauKeys) keys.push_back("plateau/" + k);
+  for (const std::string& k : kGateKeys) keys.push_back("gates/" + k);
+  for (const std::string& k : kThermalKeys) keys.push_back("thermal/" + k);
+  return keys;
+}
+
 bool CalibrationSettings::knownMethod(const std::string& m) {
   return m == "dual_rate" || m == "constant_rate" || m == "step" || m == "correction_matrix" || m == "thermal";
 }
@@ -30,8 +50,8 @@ bool CalibrationSettings::knownMethod(const std::string& m) {
 CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
   CalibrationSettings s;
   root.requireMap();
-  std::vector<std::string> allowed = {"method", "scale_factor_orders", "drift_orders", "bins", "window", "window_span",
-                                      "group_tolerance", "auto_finish_idle", "plateau", "gates", "thermal"};
+  std::vector<std::string> allowed = kScalarKeys;
+  allowed.insert(allowed.end(), {"plateau", "gates", "thermal"});
   allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
   root.rejectUnknownKeys(allowed);
   s.method = root.getString("method", s.method);
@@ -46,7 +66,7 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   s.auto_finish_idle = root.getDouble("auto_finish_idle", s.auto_finish_idle);
   if (root.has("plateau")) {
     const YamlField p = root["plateau"];
-    p.rejectUnknownKeys({"rate_tolerance", "relative_tolerance", "settle_time", "static_rate", "max_gap"});
+    p.rejectUnknownKeys(kPlateauKeys);
     s.plateau.rate_tolerance = positive(p, "rate_tolerance", s.plateau.rate_tolerance);
     s.plateau.relative_tolerance = p.getDouble("relative_tolerance", s.plateau.relative_tolerance);
     if (s.plateau.relative_tolerance < 0.0) p["relative_tolerance"].fail("must be >= 0");
@@ -57,9 +77,7 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   }
   if (root.has("gates")) {
     const YamlField g = root["gates"];
-    g.rejectUnknownKeys({"min_coverage", "min_rate_separation", "max_rate_noise", "min_samples", "max_condition",
-                         "max_relative_residual", "max_k0_change", "max_harmonic_std", "min_steps", "min_dwell_time",
-                         "min_pairs", "max_p_condition"});
+    g.rejectUnknownKeys(kGateKeys);
     QualityLimits& q = s.gates;
     q.min_coverage = g.getDouble("min_coverage", q.min_coverage);
     if (q.min_coverage < 0.0 || q.min_coverage > 1.0) g["min_coverage"].fail("must be in [0, 1]");
@@ -82,7 +100,7 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   }
   if (root.has("thermal")) {
     const YamlField t = root["thermal"];
-    t.rejectUnknownKeys({"frequency_nodes", "node_count", "interpolation", "slice_width", "max_slices"});
+    t.rejectUnknownKeys(kThermalKeys);
     ThermalSettings& ts = s.thermal;
     if (t.has("frequency_nodes")) {
       const YamlField nf = t["frequency_nodes"];

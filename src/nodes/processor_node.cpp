@@ -8,7 +8,9 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh, pnh("~");
   try {
     hrg_gyro::ProcessorRos node(nh, pnh);
-    ros::spin();
+    // Two threads: ~capture_bias waits seconds for its samples; diagnostics and ~reload go on.
+    ros::MultiThreadedSpinner spinner(2);
+    spinner.spin();
   } catch (const std::exception& e) {
     ROS_FATAL("%s", e.what());
     return 1;

@@ -32,21 +32,27 @@ const std::vector<std::string>& nodeOnlyKeys() {
 }  // namespace
 
 CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
-    : nh_(nh), pnh_(pnh), updater_(nh, pnh, pnh.getNamespace()) {
+    : nh_(nh), pnh_(pnh), params_(pnh, "calibrator"), updater_(nh, pnh, pnh.getNamespace()) {
   base_settings_ = core::CalibrationSettings::parse(core::YamlField(privateParameters(pnh_), ""), nodeOnlyKeys());
-  if (!pnh_.getParam("parameter_file", parameter_file_) || parameter_file_.empty()) {
-    throw std::invalid_argument("calibrator: ~parameter_file is required (the file to refresh)");
+  params_.claim(core::CalibrationSettings::keyPaths());
+  params_.claim({"diagnostic_period"});  // read by diagnostic_updater itself
+  parameter_file_ = params_.get<std::string>("parameter_file", "");
+  if (parameter_file_.empty()) throw std::invalid_argument("calibrator: ~parameter_file is required (the file to refresh)");
+  // Empty report file and output directory: derived from the parameter file.
+  report_file_ = params_.get<std::string>("report_file", "");
+  if (report_file_.empty()) {
+    report_file_ = parameter_file_;
+    if (report_file_.size() > 5 && report_file_.substr(report_file_.size() - 5) == ".yaml") {
+      report_file_.resize(report_file_.size() - 5);
+    }
+    report_file_ += ".report.yaml";
   }
-  report_file_ = parameter_file_;
-  if (report_file_.size() > 5 && report_file_.substr(report_file_.size() - 5) == ".yaml") {
-    report_file_.resize(report_file_.size() - 5);
-  }
-  pnh_.param("report_file", report_file_, report_file_ + ".report.yaml");
   // Every file the calibrator writes stays in one directory (by default that of the parameter file).
-  pnh_.param<std::string>("output_directory", output_directory_, core::directoryOf(parameter_file_));
-  pnh_.param<std::string>("reload_service", reload_service_, "processor/reload");
-  pnh_.param("write", write_, write_);
-  pnh_.param("backward_reset", backward_reset_, backward_reset_);
+  output_directory_ = params_.get<std::string>("output_directory", "");
+  if (output_directory_.empty()) output_directory_ = core::directoryOf(parameter_file_);
+  reload_service_ = params_.get<std::string>("reload_service", "processor/reload");
+  write_ = params_.get("write", write_);
+  backward_reset_ = params_.get("backward_reset", backward_reset_);
   if (!(backward_reset_ > 0.0)) throw std::invalid_argument("calibrator: ~backward_reset must be positive (s)");
   for (const std::string& f : {parameter_file_, report_file_}) {
     if (!core::isInsideDirectory(f, output_directory_)) {
@@ -56,15 +62,15 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   }
   core::loadParameterFile(parameter_file_);  // fail early on a bad prior
   std::vector<std::string> stages;
-  if (!pnh_.getParam("stages", stages) || stages.empty()) stages = {base_settings_.method};
+  if (!params_.getOptional("stages", &stages) || stages.empty()) stages = {base_settings_.method};
   for (const std::string& m : stages) {
     if (!core::CalibrationSettings::knownMethod(m)) throw std::invalid_argument("calibrator: unknown method in ~stages: " + m);
   }
   stages_ = stages;
-  int queue_size = 50000;  // as the processor's: seconds of backlog at 10 kHz, lost by none
-  pnh_.param("queue_size", queue_size, queue_size);
-  double heap_trim_period = 10.0;  // s of wall time between malloc_trim calls; <= 0: never
-  pnh_.param("heap_trim_period", heap_trim_period, heap_trim_period);
+  const int queue_size = params_.get("queue_size", 50000);  // as the processor's: seconds of backlog at 10 kHz
+  const double heap_trim_period = params_.get("heap_trim_period", 10.0);  // s of wall time; <= 0: never
+  const bool autostart = params_.get("autostart", true);
+  params_.warnAboutUnknownKeys();
 
   result_pub_ = pnh_.advertise<CalibrationResult>("result", 1, true);
   ros::NodeHandle in = input_.handle(nh_);
@@ -98,8 +104,6 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   addProcessHeapDiagnostic(updater_, heap_trim_period);
   diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
 
-  bool autostart = true;
-  pnh_.param("autostart", autostart, autostart);
   if (autostart) {
     std::lock_guard<std::mutex> lock(mutex_);
     std::string reason;

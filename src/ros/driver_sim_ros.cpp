@@ -15,23 +15,35 @@
 namespace hrg_gyro {
 
 DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_process)
-    : nh_(nh), pnh_(pnh), owns_process_(owns_process) {
+    : nh_(nh), pnh_(pnh), params_(pnh, "driver_sim"), owns_process_(owns_process) {
   const YAML::Node params = privateParameters(pnh_);
   config_ = std::make_unique<core::SimulationConfig>(
       core::SimulationConfig::parse(core::YamlField(params, ""), core::nodeOnlyScenarioKeys()));
-  pnh_.param("time_scale", time_scale_, time_scale_);
-  pnh_.param("clock_period", clock_period_, clock_period_);
-  pnh_.param("max_lag", max_lag_, max_lag_);
-  pnh_.param("frame_id", frame_id_, frame_id_);
+  // The scenario sections are the core parser's (it refuses unknown keys in them).
+  params_.claim({"seed", "start_time", "resonator", "pickoff", "turntable", "generator", "thermal"}, true);
+  time_scale_ = params_.get("time_scale", time_scale_);
+  clock_period_ = params_.get("clock_period", clock_period_);
+  max_lag_ = params_.get("max_lag", max_lag_);
+  frame_id_ = params_.get("frame_id", frame_id_);
   ros::param::param("/use_sim_time", use_sim_time_, false);
-  pnh_.param("publish_clock", publish_clock_, use_sim_time_);
-  pnh_.param("shutdown_when_done", shutdown_when_done_, shutdown_when_done_);
-  pnh_.param("wait_for_subscribers/channels", wait_channels_, 0);
-  pnh_.param("wait_for_subscribers/turntable", wait_turntable_, 0);
-  pnh_.param("wait_for_subscribers/truth", wait_truth_, 0);
-  pnh_.param("wait_timeout", wait_timeout_, wait_timeout_);
-  int queue_size = 20000;
-  pnh_.param("queue_size", queue_size, queue_size);
+  // publish_clock: "auto" (the template's value) or unset means: exactly when /use_sim_time is set.
+  std::string publish_clock = "auto";
+  XmlRpc::XmlRpcValue raw;
+  if (params_.getOptional("publish_clock", &raw)) {
+    if (raw.getType() == XmlRpc::XmlRpcValue::TypeBoolean) {
+      publish_clock = static_cast<bool>(raw) ? "true" : "false";
+    } else if (raw.getType() != XmlRpc::XmlRpcValue::TypeString || static_cast<std::string>(raw) != "auto") {
+      throw std::invalid_argument("~publish_clock must be true, false or auto");
+    }
+  }
+  publish_clock_ = publish_clock == "auto" ? use_sim_time_ : publish_clock == "true";
+  shutdown_when_done_ = params_.get("shutdown_when_done", shutdown_when_done_);
+  wait_channels_ = params_.get("wait_for_subscribers/channels", 0);
+  wait_turntable_ = params_.get("wait_for_subscribers/turntable", 0);
+  wait_truth_ = params_.get("wait_for_subscribers/truth", 0);
+  wait_timeout_ = params_.get("wait_timeout", wait_timeout_);
+  const int queue_size = params_.get("queue_size", 20000);
+  params_.warnAboutUnknownKeys();
   if (!(clock_period_ > 0.0)) throw std::invalid_argument("~clock_period must be positive (s)");
   if (!(max_lag_ > 0.0)) throw std::invalid_argument("~max_lag must be positive (s)");
   // Wall-clock stamps are due times, so a late thread catches up; under sim time the clock is ours.

@@ -1,12 +1,15 @@
 #include "hrg_gyro/ros/processor_ros.h"
 
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include <sensor_msgs/Imu.h>
 
 #include "hrg_gyro/GyroOutput.h"
 #include "hrg_gyro/ModelInfo.h"
 #include "hrg_gyro/WaveState.h"
+#include "hrg_gyro/core/calibration_outcome.h"
 #include "hrg_gyro/core/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/diagnostics_timer.h"
@@ -21,15 +24,22 @@ using diagnostic_msgs::DiagnosticStatus;
 // marker for single axes; a huge variance tells a filter to ignore them).
 constexpr double kUnmeasuredVariance = 1e6;
 
-core::ProcessorConfig processorConfig(const ros::NodeHandle& pnh) {
+// Until this many second differences of alpha have been seen (1 s at 200 Hz), the measured noise
+// is not trusted and ~initial_angular_velocity_variance is reported instead.
+constexpr int kSettledDifferences = 200;
+// Floor of the measured variance: a noiseless input (a simulation without noise) must still not
+// claim a perfect measurement, which filters read as infinitely certain. (1e-6 rad/s)^2.
+constexpr double kMinimumVariance = 1e-12;
+
+core::ProcessorConfig processorConfig(ParameterReader& params) {
   core::ProcessorConfig c;
-  pnh.param("max_gap", c.max_gap, c.max_gap);
-  pnh.param("backward_reset", c.backward_reset, c.backward_reset);
-  pnh.param("max_rate", c.max_rate, c.max_rate);
-  pnh.param("max_consecutive_jumps", c.max_consecutive_jumps, c.max_consecutive_jumps);
-  pnh.param("min_anisotropy", c.limits.min_anisotropy, c.limits.min_anisotropy);
-  pnh.param("min_amplitude", c.limits.min_amplitude, c.limits.min_amplitude);
-  pnh.param("max_amplitude", c.limits.max_amplitude, c.limits.max_amplitude);
+  c.max_gap = params.get("max_gap", c.max_gap);
+  c.backward_reset = params.get("backward_reset", c.backward_reset);
+  c.max_rate = params.get("max_rate", c.max_rate);
+  c.max_consecutive_jumps = params.get("max_consecutive_jumps", c.max_consecutive_jumps);
+  c.limits.min_anisotropy = params.get("min_anisotropy", c.limits.min_anisotropy);
+  c.limits.min_amplitude = params.get("min_amplitude", c.limits.min_amplitude);
+  c.limits.max_amplitude = params.get("max_amplitude", c.limits.max_amplitude);
   if (!(c.max_gap > 0.0) || !(c.backward_reset > 0.0) || !(c.max_rate > 0.0) || c.max_consecutive_jumps < 0 ||
       !(c.limits.min_anisotropy > 0.0 && c.limits.min_anisotropy < 1.0) ||
       !(c.limits.max_amplitude > c.limits.min_amplitude)) {
@@ -40,32 +50,54 @@ core::ProcessorConfig processorConfig(const ros::NodeHandle& pnh) {
   return c;
 }
 
+core::BiasCaptureSettings biasCaptureSettings(ParameterReader& params) {
+  core::BiasCaptureSettings b;
+  b.duration = params.get("bias_capture/duration", b.duration);
+  b.block = params.get("bias_capture/block", b.block);
+  b.max_motion = params.get("bias_capture/max_motion", b.max_motion);
+  b.max_bias = params.get("bias_capture/max_bias", b.max_bias);
+  b.validate();
+  return b;
+}
+
 }  // namespace
 
 ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
-    : nh_(nh), pnh_(pnh), updater_(nh, pnh, pnh.getNamespace()) {
-  if (!pnh_.getParam("parameter_file", parameter_file_) || parameter_file_.empty()) {
-    throw std::invalid_argument("processor: ~parameter_file is required");
-  }
+    : nh_(nh), pnh_(pnh), params_(pnh, "processor"), updater_(nh, pnh, pnh.getNamespace()) {
+  parameter_file_ = params_.get<std::string>("parameter_file", "");
+  if (parameter_file_.empty()) throw std::invalid_argument("processor: ~parameter_file is required (the gyro model)");
   auto params = std::make_shared<const core::GyroParameters>(core::loadParameterFile(parameter_file_));
-  processor_ = std::make_unique<core::GyroProcessor>(processorConfig(pnh_), params);
-  pnh_.param<std::string>("frame_id", frame_id_, "gyro_link");
-  pnh_.param("publish_imu", publish_imu_, publish_imu_);
-  pnh_.param("angular_velocity_variance", configured_rate_variance_, configured_rate_variance_);
-  pnh_.param("stall_timeout", stall_timeout_, stall_timeout_);
-  pnh_.param("quadrature_warn", quadrature_warn_, quadrature_warn_);
-  pnh_.param("expected_rate", expected_rate_, expected_rate_);
+  processor_ = std::make_unique<core::GyroProcessor>(processorConfig(params_), params);
+  frame_id_ = params_.get<std::string>("frame_id", "gyro_link");
+  publish_imu_ = params_.get("publish_imu", publish_imu_);
+  configured_rate_variance_ = params_.get("angular_velocity_variance", configured_rate_variance_);
+  if (configured_rate_variance_ == 0.0 || !std::isfinite(configured_rate_variance_)) {
+    throw std::invalid_argument(
+        "processor: ~angular_velocity_variance must be positive ((rad/s)^2), or negative for the measured noise; "
+        "0 would claim a perfect gyro");
+  }
+  initial_rate_variance_ = params_.get("initial_angular_velocity_variance", initial_rate_variance_);
+  if (!(initial_rate_variance_ > 0.0) || !std::isfinite(initial_rate_variance_)) {
+    throw std::invalid_argument("processor: ~initial_angular_velocity_variance must be positive ((rad/s)^2)");
+  }
+  stall_timeout_ = params_.get("stall_timeout", stall_timeout_);
+  quadrature_warn_ = params_.get("quadrature_warn", quadrature_warn_);
+  expected_rate_ = params_.get("expected_rate", expected_rate_);
   if (!(expected_rate_ > 0.0)) throw std::invalid_argument("processor: ~expected_rate must be positive (Hz)");
-  double tolerance = 0.1;
-  pnh_.param("rate_tolerance", tolerance, tolerance);
+  const double tolerance = params_.get("rate_tolerance", 0.1);
   min_rate_ = expected_rate_ * (1.0 - tolerance);
   max_rate_ = expected_rate_ * (1.0 + tolerance);
   // 5 s of 10 kHz: a host that deschedules the pipeline for a few seconds delays samples but
   // loses none (a queued message costs a few hundred bytes only while it waits).
-  int queue_size = 50000;
-  pnh_.param("queue_size", queue_size, queue_size);
-  double heap_trim_period = 10.0;  // s of wall time between malloc_trim calls; <= 0: never
-  pnh_.param("heap_trim_period", heap_trim_period, heap_trim_period);
+  const int queue_size = params_.get("queue_size", 50000);
+  // s of wall time between malloc_trim calls; <= 0: never
+  const double heap_trim_period = params_.get("heap_trim_period", 10.0);
+  bias_settings_ = biasCaptureSettings(params_);
+  bias_capture_save_ = params_.get("bias_capture/save", bias_capture_save_);
+  bias_capture_timeout_ = params_.get("bias_capture/timeout", 3.0 * bias_settings_.duration + 5.0);
+  const std::string hardware_id = params_.get<std::string>("hardware_id", "hrg_gyro");
+  const double max_delay = params_.get("max_stamp_delay", 1.0);
+  params_.claim({"diagnostic_period"});  // read by diagnostic_updater itself
 
   wave_pub_ = nh_.advertise<WaveState>("wave", queue_size);
   output_pub_ = nh_.advertise<GyroOutput>("output", queue_size);
@@ -73,14 +105,11 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   model_pub_ = pnh_.advertise<ModelInfo>("model", 1, true);
   publishModel(ros::Time(0));
   reload_srv_ = pnh_.advertiseService("reload", &ProcessorRos::onReload, this);
+  capture_srv_ = pnh_.advertiseService("capture_bias", &ProcessorRos::onCaptureBias, this);
 
-  std::string hardware_id;
-  pnh_.param<std::string>("hardware_id", hardware_id, "hrg_gyro");
   updater_.setHardwareID(hardware_id);
   frequency_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
       diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_, 0.0, 5), "channels rate");
-  double max_delay = 1.0;
-  pnh_.param("max_stamp_delay", max_delay, max_delay);
   stamps_ = std::make_unique<diagnostic_updater::TimeStampStatus>(
       diagnostic_updater::TimeStampStatusParam(-max_delay, max_delay), "channels stamps");
   updater_.add(*frequency_);
@@ -89,6 +118,7 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   updater_.add("wave", this, &ProcessorRos::diagnoseWave);
   updater_.add("model", this, &ProcessorRos::diagnoseModel);
   addProcessHeapDiagnostic(updater_, heap_trim_period);
+  params_.warnAboutUnknownKeys();
   channels_sub_ = input_.handle(nh_).subscribe("channels", queue_size, &ProcessorRos::onChannels, this,
                                                ros::TransportHints().tcpNoDelay());
   input_.start();
@@ -118,10 +148,11 @@ void ProcessorRos::publishModel(const ros::Time& since) {
 }
 
 double ProcessorRos::angularVelocityVariance() const {
-  if (configured_rate_variance_ >= 0.0) return configured_rate_variance_;
+  if (configured_rate_variance_ > 0.0) return configured_rate_variance_;
+  if (second_differences_ < kSettledDifferences || !(dt_last_ > 0.0)) return initial_rate_variance_;
   // White angle noise sigma^2 per sample gives second differences of variance 6 sigma^2 and a
   // per-sample rate (difference / dt) of variance 2 sigma^2 / dt^2.
-  return dt_last_ > 0.0 ? (d2_variance_ / 3.0) / (dt_last_ * dt_last_) : kUnmeasuredVariance;
+  return std::max((d2_variance_ / 3.0) / (dt_last_ * dt_last_), kMinimumVariance);
 }
 
 void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
@@ -167,15 +198,20 @@ void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   auto out = boost::make_shared<GyroOutput>(toOutputMessage(wave->header, r));
   output_pub_.publish(out);
 
+  if (capture_ && !capture_->finished() && capture_->add(inc, r.flags)) capture_cv_.notify_all();
+
+  // Noise of alpha from its second differences (running mean, then exponential over ~1000): the
+  // three alphas must be continuous, but the estimate itself survives gaps and resets.
   const bool continuous = !(r.flags & (core::kFlagGap | core::kFlagReset));
   if (continuous) {
     if (history_ >= 2) {
       const double d2 = r.alpha - 2.0 * alpha1_ + alpha2_;
-      d2_variance_ += (d2 * d2 - d2_variance_) * (history_ < 1000 ? 1.0 / (history_ - 1) : 1e-3);
+      ++second_differences_;
+      d2_variance_ += (d2 * d2 - d2_variance_) * (second_differences_ < 1000 ? 1.0 / second_differences_ : 1e-3);
     }
     alpha2_ = alpha1_;
     alpha1_ = r.alpha;
-    if (history_ < 1000) ++history_;
+    if (history_ < 2) ++history_;
     dt_last_ = inc.dt;
   } else {
     history_ = 0;
@@ -207,6 +243,10 @@ bool ProcessorRos::onReload(std_srvs::Trigger::Request&, std_srvs::Trigger::Resp
     return true;
   }
   std::lock_guard<std::mutex> lock(mutex_);
+  if (capture_ && !capture_->finished()) {
+    capture_->abort("the model was reloaded during the capture");
+    capture_cv_.notify_all();
+  }
   processor_->setParameters(params);
   publishModel(last_stamp_);
   ++reloads_;
@@ -218,6 +258,63 @@ bool ProcessorRos::onReload(std_srvs::Trigger::Request&, std_srvs::Trigger::Resp
                 params->drift.orders().size(), params->calibration.method.c_str(), params->calibration.time.c_str());
   res.message = buf;
   ROS_INFO("processor: %s", buf);
+  return true;
+}
+
+bool ProcessorRos::onCaptureBias(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (capture_) {
+    res.success = false;
+    res.message = "a bias capture is already running";
+    return true;
+  }
+  capture_ = std::make_unique<core::BiasCapture>(bias_settings_, processor_->parameters());
+  ROS_INFO("processor: capturing the turn-on bias over %.1f s: keep the gyro still", bias_settings_.duration);
+  // Samples arrive on the input thread; this waits (the lock released) until the capture ends.
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(bias_capture_timeout_);
+  while (!capture_->finished()) {
+    capture_cv_.wait_for(lock, std::chrono::milliseconds(100));
+    if (!ros::ok()) {
+      capture_->abort("shutting down");
+    } else if (!capture_->finished() && ros::WallTime::now() > deadline) {
+      char why[160];
+      std::snprintf(why, sizeof why, "too few outputs: %.2f of %.1f s of input within %.1f s (~bias_capture/timeout)",
+                    capture_->result().seconds, bias_settings_.duration, bias_capture_timeout_);
+      capture_->abort(why);
+    }
+  }
+  const core::BiasCaptureResult result = capture_->result();
+  capture_.reset();
+  if (!result.accepted) {
+    res.success = false;
+    res.message = "bias capture refused, model unchanged: " + result.reason;
+    ROS_WARN("processor: %s", res.message.c_str());
+    return true;
+  }
+  auto params = std::make_shared<core::GyroParameters>(result.parameters);
+  const std::string when = core::utcNow();
+  params->calibration.notes = "D0 from a turn-on bias capture at " + when +
+                              (params->calibration.notes.empty() ? "" : "; " + params->calibration.notes);
+  std::string saved = " (in memory only: ~bias_capture/save is false)";
+  if (bias_capture_save_) {
+    try {
+      core::saveParameterFile(parameter_file_, *params);
+      saved = "; written to " + parameter_file_ + " (previous file kept as .bak)";
+    } catch (const std::exception& e) {
+      res.success = false;
+      res.message = "bias captured but the parameter file could not be written, model unchanged: " +
+                    std::string(e.what());
+      ROS_ERROR("processor: %s", res.message.c_str());
+      return true;
+    }
+  }
+  processor_->setParameters(params);
+  publishModel(last_stamp_);
+  ++bias_captures_;
+  last_bias_capture_ = when + ": " + result.reason;
+  res.success = true;
+  res.message = result.reason + saved;
+  ROS_INFO("processor: bias capture: %s", res.message.c_str());
   return true;
 }
 
@@ -297,6 +394,9 @@ void ProcessorRos::diagnoseModel(diagnostic_updater::DiagnosticStatusWrapper& st
     stat.summary(DiagnosticStatus::WARN, "frequency-dependent model but the input carries no frequency");
   } else if (last_flags_ & core::kFlagFrequencyOutOfRange) {
     stat.summary(DiagnosticStatus::WARN, "resonator frequency outside the model's nodes: end values held");
+  } else if (p.calibration.method == "none") {
+    // A model nobody calibrated carries the nominal scale factor: its output is off by up to percents.
+    stat.summary(DiagnosticStatus::WARN, "uncalibrated model (calibration method: none): nominal K and D");
   } else {
     stat.summary(DiagnosticStatus::OK, "model loaded");
   }
@@ -309,6 +409,8 @@ void ProcessorRos::diagnoseModel(diagnostic_updater::DiagnosticStatusWrapper& st
   stat.add("frequency dependent", p.scale_factor.frequencyDependent() || p.drift.frequencyDependent());
   stat.add("reloads", reloads_);
   stat.add("refused reloads", failed_reloads_);
+  stat.add("bias captures", bias_captures_);
+  stat.add("last bias capture", last_bias_capture_);
 }
 
 }  // namespace hrg_gyro

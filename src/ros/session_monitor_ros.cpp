@@ -15,13 +15,14 @@
 
 namespace hrg_gyro {
 
-SessionMonitorRos::SessionMonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh) {
-  pnh_.param<std::string>("verification_prefix", prefix_, "verify");
-  pnh_.param<std::string>("summary_file", summary_file_, "");
-  pnh_.param<std::string>("prior_parameter_file", prior_file_, "");
-  pnh_.param("shutdown_when_done", shutdown_when_done_, shutdown_when_done_);
-  std::string scenario_ns;
-  pnh_.param<std::string>("scenario_namespace", scenario_ns, "driver_sim");
+SessionMonitorRos::SessionMonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh), pnh_(pnh), params_(pnh, "session_monitor") {
+  prefix_ = params_.get<std::string>("verification_prefix", "verify");
+  summary_file_ = params_.get<std::string>("summary_file", "");
+  prior_file_ = params_.get<std::string>("prior_parameter_file", "");
+  shutdown_when_done_ = params_.get("shutdown_when_done", shutdown_when_done_);
+  const std::string scenario_ns = params_.get<std::string>("scenario_namespace", "driver_sim");
+  params_.warnAboutUnknownKeys();
   scenario_ = std::make_unique<core::SimulationConfig>(core::SimulationConfig::parse(
       core::YamlField(privateParameters(ros::NodeHandle(nh_, scenario_ns)), scenario_ns),
       core::nodeOnlyScenarioKeys()));

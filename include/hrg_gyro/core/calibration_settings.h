@@ -56,6 +56,8 @@ struct CalibrationSettings {
   /// Parses the calibrator settings map. Throws ConfigError naming the key.
   static CalibrationSettings parse(const YamlField& root, const std::vector<std::string>& extra_keys = {});
   static bool knownMethod(const std::string& method);
+  /// Every key parse() reads, nested ones as "section/key" (the calibrator's parameter template lists them all).
+  static std::vector<std::string> keyPaths();
 };
 
 }  // namespace core

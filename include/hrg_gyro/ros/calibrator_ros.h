@@ -30,6 +30,7 @@
 #include "hrg_gyro/WaveState.h"
 #include "hrg_gyro/core/calibration_session.h"
 #include "hrg_gyro/ros/input_thread.h"
+#include "hrg_gyro/ros/parameter_reader.h"
 
 namespace hrg_gyro {
 
@@ -38,6 +39,9 @@ class CalibratorRos {
   /// Throws std::exception for invalid settings or an unreadable prior parameter file.
   CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh);
   ~CalibratorRos();
+
+  /// The private parameters as read at start-up (unknown and defaulted keys).
+  const ParameterReader& parameters() const { return params_; }
 
  private:
   void onTurntable(const TurntableState::ConstPtr& msg);
@@ -63,6 +67,7 @@ class CalibratorRos {
   void reloadLoop();
 
   ros::NodeHandle nh_, pnh_;
+  ParameterReader params_;
   std::mutex mutex_;  // session and state; never held while calling a service
   core::CalibrationSettings base_settings_;
   std::unique_ptr<core::CalibrationSession> session_;

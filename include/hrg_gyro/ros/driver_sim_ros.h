@@ -20,6 +20,7 @@
 
 #include "hrg_gyro/core/gyro_simulator.h"
 #include "hrg_gyro/core/playback_schedule.h"
+#include "hrg_gyro/ros/parameter_reader.h"
 
 namespace hrg_gyro {
 
@@ -29,11 +30,15 @@ class DriverSimRos {
   DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_process);
   ~DriverSimRos();
 
+  /// The private parameters as read at start-up (unknown and defaulted keys).
+  const ParameterReader& parameters() const { return params_; }
+
  private:
   void run();
   bool waitForSubscribers();
 
   ros::NodeHandle nh_, pnh_;
+  ParameterReader params_;
   bool owns_process_;  // a node may shut itself down when done; a nodelet must not
   std::unique_ptr<core::SimulationConfig> config_;
   ros::Publisher channels_pub_, turntable_pub_, truth_pub_, clock_pub_, done_pub_;

@@ -4,9 +4,13 @@
 // identical numbers) and publishes `wave` (WaveState), `output` (GyroOutput) and `imu/data_raw`
 // (sensor_msgs/Imu, REP-145). `~reload` (std_srvs/Trigger) re-reads and validates
 // `~parameter_file` and swaps the model between two samples; a bad file is refused with the reason
-// and the old model stays. Health goes to /diagnostics through diagnostic_updater.
+// and the old model stays. `~capture_bias` (std_srvs/Trigger) averages the output of a still gyro
+// and refreshes D0 (core::BiasCapture), optionally writing the file. Health goes to /diagnostics
+// through diagnostic_updater; private parameters are read through a ParameterReader, which warns
+// about unknown ones.
 #pragma once
 
+#include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -17,8 +21,10 @@
 #include <std_srvs/Trigger.h>
 
 #include "hrg_gyro/ChannelAmplitudes.h"
+#include "hrg_gyro/core/bias_capture.h"
 #include "hrg_gyro/core/gyro_processor.h"
 #include "hrg_gyro/ros/input_thread.h"
+#include "hrg_gyro/ros/parameter_reader.h"
 
 namespace hrg_gyro {
 
@@ -28,9 +34,13 @@ class ProcessorRos {
   ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh);
   ~ProcessorRos();
 
+  /// The private parameters as read at start-up (unknown and defaulted keys).
+  const ParameterReader& parameters() const { return params_; }
+
  private:
   void onChannels(const ChannelAmplitudes::ConstPtr& msg);
   bool onReload(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool onCaptureBias(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   void diagnoseInput(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseWave(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseModel(diagnostic_updater::DiagnosticStatusWrapper& stat);
@@ -39,12 +49,14 @@ class ProcessorRos {
   void publishModel(const ros::Time& since);
 
   ros::NodeHandle nh_, pnh_;
+  ParameterReader params_;
   std::mutex mutex_;  // the model swap and the samples (nodelets may run callbacks concurrently)
   std::unique_ptr<core::GyroProcessor> processor_;
   std::string parameter_file_;
   std::string frame_id_;
   bool publish_imu_ = true;
-  double configured_rate_variance_ = -1.0;
+  double configured_rate_variance_ = -1.0;  // (rad/s)^2; negative: the measured noise
+  double initial_rate_variance_ = 1e-4;     // (rad/s)^2 until the measured noise has settled
   double stall_timeout_ = 0.5;
   double quadrature_warn_ = 0.1;
 
@@ -52,7 +64,16 @@ class ProcessorRos {
   ros::Subscriber channels_sub_;
   ros::Publisher wave_pub_, output_pub_, imu_pub_, model_pub_;
   ros::Time last_stamp_;
-  ros::ServiceServer reload_srv_;
+  ros::ServiceServer reload_srv_, capture_srv_;
+
+  // Turn-on bias capture (one at a time; the service waits on capture_cv_ for the input thread).
+  core::BiasCaptureSettings bias_settings_;
+  bool bias_capture_save_ = false;
+  double bias_capture_timeout_ = 35.0;  // s of wall time
+  std::unique_ptr<core::BiasCapture> capture_;
+  std::condition_variable capture_cv_;
+  std::uint64_t bias_captures_ = 0;
+  std::string last_bias_capture_;
 
   diagnostic_updater::Updater updater_;
   ros::Timer diagnostics_timer_;
@@ -74,7 +95,8 @@ class ProcessorRos {
   std::uint8_t last_flags_ = 0;
   // Angle-noise estimate from second differences of alpha, for the IMU covariance.
   double alpha1_ = 0.0, alpha2_ = 0.0, dt_last_ = 0.0, d2_variance_ = 0.0;
-  int history_ = 0;
+  int history_ = 0;                        // continuous alphas held (0..2)
+  std::uint64_t second_differences_ = 0;   // in the noise estimate
 };
 
 }  // namespace hrg_gyro

@@ -25,6 +25,7 @@
 #include "hrg_gyro/ModelInfo.h"
 #include "hrg_gyro/core/output_evaluator.h"
 #include "hrg_gyro/core/simulation_config.h"
+#include "hrg_gyro/ros/parameter_reader.h"
 
 namespace hrg_gyro {
 
@@ -59,6 +60,7 @@ class SessionMonitorRos {
   void finish();
 
   ros::NodeHandle nh_, pnh_;
+  ParameterReader params_;
   std::mutex mutex_;
   std::string prefix_, summary_file_, prior_file_;
   bool shutdown_when_done_ = false;
