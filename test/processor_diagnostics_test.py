@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Diagnostics of the processor: OK on good input, ERROR naming the cause when every sample is bad
 (NaN, degenerate wave), WARN when some are, ERROR when the input stalls, OK again on recovery;
-and the output never carries a NaN."""
+the output never carries a NaN; the model status warns while the model is uncalibrated; the Imu
+z variance is never 0, from the very first message of a fresh processor."""
 import math
 import os
 import sys
@@ -11,6 +12,8 @@ import unittest
 import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+
+from sensor_msgs.msg import Imu
 
 from hrg_gyro.msg import ChannelAmplitudes, GyroOutput
 
@@ -32,8 +35,10 @@ class Diagnostics(unittest.TestCase):
 
     def on_diag(self, msg):
         for s in msg.status:
-            self.statuses[s.name.split(": ")[-1]] = (s.level, s.message, rospy.get_time(),
-                                                     dict((kv.key, kv.value) for kv in s.values))
+            # the second processor's statuses (namespace fresh) are kept apart as "fresh/<name>"
+            prefix = "fresh/" if "fresh" in s.name.split(": ")[0] else ""
+            self.statuses[prefix + s.name.split(": ")[-1]] = (s.level, s.message, rospy.get_time(),
+                                                              dict((kv.key, kv.value) for kv in s.values))
 
     def on_output(self, msg):
         if any(math.isnan(v) for v in (msg.dalpha, msg.alpha, msg.rate, msg.scale_factor)):
@@ -90,6 +95,30 @@ class Diagnostics(unittest.TestCase):
         level, message = self.status_after("input", start + 1.5)[:2]
         self.assertNotEqual(level, DiagnosticStatus.ERROR, message)
         self.assertEqual(self.nan_outputs, 0)
+
+    def test_imu_variance_never_zero_and_uncalibrated_model_warns(self):
+        # A processor of its own (namespace fresh), so that its very first outputs are seen.
+        imu = util.Latest("/fresh/imu/data_raw", Imu, keep_all=True)
+        pub = rospy.Publisher("/fresh/channels", ChannelAmplitudes, queue_size=1000)
+        util.wait_for(lambda: pub.get_num_connections() > 0 and imu.sub.get_num_connections() > 0, 30,
+                      "the fresh processor")
+        t = time.time()
+        for seq in range(1, 401):
+            t += 0.005
+            pub.publish(channels(seq, t, 0.2 - 0.028 * (t % 100)))
+            time.sleep(0.004)
+        util.wait_for(lambda: imu.count >= 390, 20, "the fresh processor's Imu messages")
+        variances = [m.angular_velocity_covariance[8] for m in imu.all]
+        self.assertTrue(all(v > 0.0 for v in variances), "a zero or negative variance: %s" % variances[:5])
+        # The first ones carry the documented start-up value, later ones the measured noise (this
+        # input is noiseless, so the documented floor).
+        self.assertEqual(variances[0], 1e-4)
+        self.assertEqual(variances[-1], 1e-12)
+        start = rospy.get_time()
+        for name in ("model", "fresh/model"):
+            level, message = self.status_after(name, start)[:2]
+            self.assertEqual(level, DiagnosticStatus.WARN, message)
+            self.assertIn("uncalibrated", message)
 
     def test_memory_status(self):
         # The live heap is reported, and trimmed every ~heap_trim_period (1 s in this launch).
