@@ -1,5 +1,7 @@
 #include "hrg_gyro/ros/parameter_reader.h"
 
+#include <stdexcept>
+
 #include <ros/console.h>
 
 namespace hrg_gyro {
@@ -24,6 +26,13 @@ ParameterReader::ParameterReader(const ros::NodeHandle& private_nh, std::string 
 void ParameterReader::note(const std::string& key, bool set) {
   read_.insert(key);
   if (!set) defaulted_.insert(key);
+}
+
+void ParameterReader::failWrongType(const std::string& key) const {
+  XmlRpc::XmlRpcValue raw;
+  pnh_.getParam(key, raw);
+  throw std::invalid_argument(node_ + ": ~" + key + " has a value of the wrong type (" + raw.toXml() +
+                              "); numbers in exponent form need a sign in YAML: 1.0e+6");
 }
 
 void ParameterReader::claim(const std::vector<std::string>& keys, bool subtree) {

@@ -22,16 +22,19 @@ class ParameterReader {
   ParameterReader(const ros::NodeHandle& private_nh, std::string node);
 
   /// ~key, or `fallback` when it is not set (then listed by defaultedKeys()).
+  /// Throws std::invalid_argument when ~key is set to a value of another type (say "1.0e6",
+  /// which YAML reads as text): a mistyped value must not fall back to the default silently.
   template <typename T>
   T get(const std::string& key, const T& fallback) {
     T value = fallback;
-    note(key, pnh_.getParam(key, value));
+    getOptional(key, &value);
     return value;
   }
-  /// ~key into *value; false (and *value untouched) when it is not set.
+  /// ~key into *value; false (and *value untouched) when it is not set. Throws as get().
   template <typename T>
   bool getOptional(const std::string& key, T* value) {
     const bool set = pnh_.getParam(key, *value);
+    if (!set && pnh_.hasParam(key)) failWrongType(key);
     note(key, set);
     return set;
   }
@@ -52,6 +55,7 @@ class ParameterReader {
 
  private:
   void note(const std::string& key, bool set);
+  [[noreturn]] void failWrongType(const std::string& key) const;
 
   ros::NodeHandle pnh_;
   std::string node_;
