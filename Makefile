@@ -4,6 +4,7 @@
 #   make bench  install, build, run the benchmarks
 #   make soak   1 simulated h at 10 kHz through the nodes (sim clock, 2x), memory and drops watched
 #   make fuzz   libFuzzer + ASan/UBSan on the parameter loader and the sample path (FUZZ_SECONDS each)
+#   make figures  the main job, then the documentation figures docs/figures/*.png from its output
 # Everything builds in .ws/, a catkin workspace inside the checkout (ignored by git) whose
 # src/hrg_gyro links back to this directory; source .ws/devel/setup.bash to use the package.
 # (A dot directory: roslaunch/rosrun search the package tree following links and skip dot dirs.)
@@ -16,7 +17,7 @@ export PATH := /usr/bin:/bin:$(PATH)
 CATKIN_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build test run bench fuzz soak clean
+.PHONY: deps build test run figures bench fuzz soak clean
 
 deps:
 	@bash $(ROOT)/scripts/install_deps.sh
@@ -37,6 +38,11 @@ test: build
 
 run: build
 	cd $(WS) && source devel/setup.bash && bash $(ROOT)/scripts/run_main_job.sh
+
+# The documentation figures (README, docs/testing.md): K(theta) and D(theta) against the binned data,
+# the nonlinearity before/after and an Allan deviation, from the run_output/ of the main job.
+figures: run
+	cd $(WS) && source devel/setup.bash && /usr/bin/python3 $(ROOT)/scripts/make_doc_figures.py
 
 # Benchmarks: Google Benchmark core suites, calibration, offline and live pipelines (about 12 min);
 # figures in bench_output/results.md. BENCH_ONLY=core,... selects parts (see bench/run_benchmarks.py).

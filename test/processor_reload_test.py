@@ -19,7 +19,7 @@ import hrg_test_util as util  # noqa: E402
 
 
 def channels(seq, t, theta):
-    """Ideal channel amplitudes (MATH.md section 2) of A = 1, B = 0.02, tau = 0.3."""
+    """Ideal channel amplitudes (docs/math.md, 'Channel amplitudes') of A = 1, B = 0.02, tau = 0.3."""
     a, b, tau = 1.0, 0.02, 0.3
     m = ChannelAmplitudes()
     m.header.seq = seq

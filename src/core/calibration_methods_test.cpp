@@ -1,5 +1,5 @@
-// The calibration methods on fast angle-level sessions (MATH.md section 6), the session's stream
-// synchronisation, and the quality gates.
+// The calibration methods on fast angle-level sessions (docs/math.md, 'Calibration methods'), the
+// session's stream synchronisation, and the quality gates.
 #include <deque>
 
 #include <gtest/gtest.h>
@@ -14,7 +14,8 @@ using testing::AngleLevelGyro;
 using testing::calibrateAngleLevel;
 using testing::dualRateProfile;
 
-// The reference magnitudes of MATH.md section 6 (with K0 = -0.56, our electrical convention).
+// Reference magnitudes for the methods (K0 = -0.56, our electrical convention): harmonics of a
+// few 1e-4 in K, a drift with a 2theta term, so that drift leaking into K would show.
 AngleLevelGyro referenceGyro() {
   AngleLevelGyro g;
   g.k = HarmonicModel({2, 4}, -0.56, {-6e-4, 2e-3}, {4e-4, 0.0});
@@ -46,7 +47,7 @@ TEST(DualRate, RecoversKAndDAndCancelsTheDrift) {
   const HarmonicFitResult& k = o.scale_factor[0];
   const HarmonicFitResult& d = o.drift[0];
   EXPECT_NEAR(k.mean, -0.56, 1e-7);
-  EXPECT_NEAR(k.cos[0], -6e-4, 1e-7);  // MATH.md: dual rate errs by < 1e-7
+  EXPECT_NEAR(k.cos[0], -6e-4, 1e-7);  // the drift cancels: errors below 1e-7
   EXPECT_NEAR(k.sin[0], 4e-4, 1e-7);
   EXPECT_NEAR(k.cos[1], 2e-3, 1e-7);
   EXPECT_NEAR(d.mean, 1e-5, 1e-9);
@@ -103,7 +104,7 @@ TEST(ConstantRate, DriftHarmonicsLeakIntoKByDkOverOmega) {
   ASSERT_TRUE(o.accepted) << o.reason;
   const HarmonicFitResult& k = o.scale_factor[0];
   const double omega = 0.05 + g.earth_rate;
-  // MATH.md: constant rate errs by D_k / Omega in the harmonics (2e-5 / 0.05 = 4e-4 here)...
+  // the method's known weakness: D_k / Omega leaks into the harmonics (2e-5 / 0.05 = 4e-4 here)...
   EXPECT_NEAR(k.cos[0], -6e-4 + 2e-5 / omega, 1e-7);
   EXPECT_NEAR(k.sin[0], 4e-4 - 1e-5 / omega, 1e-7);
   // ... and is unbiased where D has no harmonic, once the Earth rate is scaled by K.

@@ -119,7 +119,8 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
     out << YAML::EndMap;
   }
   out << YAML::Key << "quadrature_ratio" << YAML::Value << formatDouble(o.quadrature_ratio);
-  // Root causes read from the K harmonics (first order, MATH.md section 3); see defect_diagnosis.h.
+  // Root causes read from the K harmonics (first order, docs/math.md 'Pickoff defects to first
+  // order'); see defect_diagnosis.h.
   out << YAML::Key << "diagnosis" << YAML::Value << YAML::BeginSeq;
   for (const DefectDiagnosis& d : o.diagnosis) {
     out << YAML::BeginMap;

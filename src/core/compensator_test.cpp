@@ -1,5 +1,6 @@
 // The compensation step recovers the body rotation from a wave angle that obeys
-// d theta = K(theta) (d alpha + Omega_E dt) + D(theta) dt (MATH.md section 5).
+// d theta = K(theta) (d alpha + Omega_E dt) + D(theta) dt (docs/math.md, 'Dynamics and
+// compensation').
 #include <gtest/gtest.h>
 
 #include "hrg_gyro/core/compensator.h"

@@ -1,5 +1,5 @@
-// The correction matrix P (MATH.md section 4): exact recovery on linear defects, removal of the
-// 2 theta harmonics, the paper's Z_m typo, and refusal of a sweep that cannot determine P.
+// The correction matrix P (docs/math.md, 'Correction matrix'): exact recovery on linear defects,
+// removal of the 2 theta harmonics, the paper's Z_m typo, and refusal of a sweep that cannot determine P.
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>

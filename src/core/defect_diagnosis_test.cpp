@@ -14,7 +14,8 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-// The README's worked example: dual_rate.yaml with an isotropic resonator, pickoff defects only.
+// The worked example of docs/calibration.md ('Reading the root-cause diagnosis'): dual_rate.yaml
+// with an isotropic resonator, pickoff defects only.
 SimulationConfig pickoffOnlyScenario() {
   SimulationConfig c = SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/diagnosis.yaml",
                                               nodeOnlyScenarioKeys());

@@ -1,4 +1,4 @@
-// Demodulation of the eight-pickoff channels: the exact closed form of MATH.md section 2.
+// Demodulation of the eight-pickoff channels: the exact closed form (docs/math.md, 'Channel amplitudes').
 #include <gtest/gtest.h>
 
 #include <random>

@@ -1,5 +1,6 @@
-// The corrected first-order predictions of MATH.md section 3, checked against the signal-level
-// simulation (eight sensors, N = 32 samples per period, exact demodulation), one defect at a time.
+// The corrected first-order predictions (docs/math.md, 'Pickoff defects to first order'), checked
+// against the signal-level simulation (eight sensors, N = 32 samples per period, exact
+// demodulation), one defect at a time.
 #include <gtest/gtest.h>
 
 #include "core/testing/angle_sweep.h"
@@ -69,7 +70,7 @@ TEST(PickoffDefects, CapacitiveNonlinearityGivesCos4ThetaWithThreeQuarters) {
   expectCapacitive(0.01, 1e-4);
   expectCapacitive(0.05, 1e-3);
   const double e1 = expectCapacitive(0.1, 3e-3);
-  // Measured 1.10 % at a = 0.2 (MATH.md: "about 1 %"); confirmed by an independent numpy demodulation.
+  // Measured 1.10 % at a = 0.2; confirmed by an independent numpy demodulation.
   const double e2 = expectCapacitive(0.2, 1.2e-2);
   // The deviation is the next term of the series, O(a^4): it grows as a^2 relative to the a^2 term.
   EXPECT_NEAR(e2 / e1, 4.0, 0.2);

@@ -27,7 +27,8 @@ Eigen::MatrixXd linearNodes(const std::vector<double>& v0, const std::vector<dou
   return m;
 }
 
-/// The reference magnitudes of MATH.md section 6, each coefficient moving with the frequency:
+/// The reference magnitudes of the calibration-method tests (docs/math.md, 'Calibration methods'),
+/// each coefficient moving with the frequency:
 /// over the +-4 Hz of the ramp the K terms move by 4..14 ppm of K0 and D0 by 20 %.
 AngleLevelGyro thermalGyro(double f_start, double f_end, double duration) {
   AngleLevelGyro g;

@@ -54,7 +54,8 @@ WaveStatus estimateWave(const ChannelVector& z, const WaveLimits& limits, WaveSt
   w.sin_component = s;
   w.phase_error = 2.0 * (ac * bc + as * bs);
   // Rotate the channels onto the antinode: Ac cos th + As sin th = A cos tau and
-  // Bc cos th + Bs sin th = -A sin tau (MATH.md section 2 with the quadrature terms cancelling).
+  // Bc cos th + Bs sin th = -A sin tau (the channel amplitudes of docs/math.md with the quadrature
+  // terms cancelling).
   // (cos th, sin th) up to a positive factor, which atan2 ignores, from the half-angle identities
   // tan th = s / (h + r) = (h - r) / s, taking the better-conditioned one: no trigonometry.
   double ct, st;

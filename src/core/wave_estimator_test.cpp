@@ -1,4 +1,4 @@
-// Wave state from Z (MATH.md section 2) and unwrapping.
+// Wave state from Z (docs/math.md, 'Wave angle') and unwrapping.
 #include <gtest/gtest.h>
 
 #include <limits>

@@ -1,4 +1,4 @@
-// The four calibration methods (MATH.md section 6 and section 4):
+// The four calibration methods (docs/math.md, 'Calibration methods' and 'Correction matrix'):
 //   DualRateMethod         theta-binned rates at two table rates; drift cancels (method 3)
 //   ConstantRateMethod     one table rate and a dwell for the rest rate; drift leaks into K (method 2)
 //   StepMethod             steps of the table angle between dwells; the dwells give D (method 1)

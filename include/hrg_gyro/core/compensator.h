@@ -1,6 +1,7 @@
 // The compensation step: from two consecutive wave angles to the body-angle increment.
 //
-//   dalpha = (dtheta - D(theta_mid, f) dt) / K(theta_mid, f)      (MATH.md section 5)
+//   dalpha = (dtheta - D(theta_mid, f) dt) / K(theta_mid, f)
+// (docs/math.md, 'Dynamics and compensation').
 // theta_mid is the midpoint of the step, f the resonator frequency at the midpoint. dalpha is the
 // inertial increment (what a gyro measures); the increment of the Earth-fixed turntable angle is
 // dalpha - Omega_E sin(latitude) dt. The self-consistent sign has no leading minus: the paper's

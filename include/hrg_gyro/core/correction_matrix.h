@@ -1,7 +1,7 @@
 // The amplitude correction Z~ = (E - P) Z of the paper's first refinement stage, and its estimation.
 //
 // Misplacement and gain errors map the channels exactly linearly, so an exact P exists with
-// (E - P) = M^-1 and the structure (MATH.md section 4)
+// (E - P) = M^-1 and the structure (docs/math.md, 'Correction matrix')
 //   P = [ p1 0 p3 0 ; 0 p1 0 p3 ; -p4 0 p2 0 ; 0 -p4 0 p2 ]   acting on (Ac, Bc, As, Bs),
 // p1, p2 ~ channel gain errors, p3, p4 ~ misplacement half-sums. After (E - P) Z the 2 theta
 // harmonics of the scale factor vanish; the 4 theta term of the pickoff nonlinearity stays and

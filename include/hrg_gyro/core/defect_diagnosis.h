@@ -1,4 +1,5 @@
-// Root-cause diagnosis from the fitted scale-factor harmonics (MATH.md section 3, first order):
+// Root-cause diagnosis from the fitted scale-factor harmonics, to first order (docs/math.md,
+// 'Pickoff defects to first order'):
 //   K(theta) / K0 = 1 - (gc - gs) F cos 2theta - (dc - ds) F sin 2theta - (3 a^2 / 4) cos 4theta
 // so the cos 2theta term reads the channel gain mismatch gc - gs, the sin 2theta term the
 // misplacement difference dc - ds (rad) and the cos 4theta term the pickoff ratio a = A/d0;
@@ -10,7 +11,7 @@
 // the scale factor). Caveat: the resonator's own anisotropy also makes 2theta terms; the diagnosis
 // attributes everything to the pickoffs (the generator-mode P fit separates the two).
 //
-// Uncertainties combine the fit's standard errors with the first-order truncation (MATH.md: better
+// Uncertainties combine the fit's standard errors with the first-order truncation (better
 // than 1e-3 relative for defects <= 1e-3, 1 % at A/d0 = 0.2), taken as kTruncation of each value.
 #pragma once
 

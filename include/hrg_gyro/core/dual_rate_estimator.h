@@ -1,11 +1,13 @@
-// The dual-rate method (MATH.md section 6, method 3): drift cancels between two plateau groups.
+// The dual-rate method (method 3 of docs/math.md, 'Calibration methods'): drift cancels between two
+// plateau groups.
 //
 // Each group g at effective rate R_g (table rate + Earth rate for calibration) measures, per wave
 // angle bin, r_g(theta) = K(theta) R_g + D(theta). Per bin (pairing by theta, not by time):
 //   K = (r1 - r2) / (R1 - R2),   D = (r2 R1 - r1 R2) / (R1 - R2)  [= r1 - K R1].
 // The harmonic fit is done per group first, each with its own smoothing correction (bin width and
 // window, which differ when |R1| != |R2|), and the coefficients are then combined with the same
-// linear formulas; that removes the ~1e-6 residual MATH.md warns about for same-sign rates.
+// linear formulas; that removes the ~1e-6 residual that pairing the smoothed curves would leave for
+// same-sign rates.
 #pragma once
 
 #include <vector>

@@ -13,7 +13,7 @@ namespace hrg_gyro {
 namespace core {
 
 /// Nominal electrical scale factor of an uncalibrated gyro: K0 = -2 k with the Bryan factor
-/// k ~ 0.28 of a hemispherical shell (see README, "Conventions").
+/// k ~ 0.28 of a hemispherical shell (see docs/math.md, "Conventions").
 constexpr double kNominalScaleFactor = -0.56;
 
 struct EarthRateSettings {

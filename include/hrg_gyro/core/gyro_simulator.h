@@ -1,7 +1,8 @@
 // The simulated gyro on its turntable: the resonator dynamics, the signal-level pickoff and
 // demodulation, and the ground truth, one output sample at a time.
 //
-// Dynamics (MATH.md section 5): d theta/dt = K(theta) (Omega_table(t) + Omega_E) + D(theta) with the
+// Dynamics (docs/math.md, 'Dynamics and compensation'):
+//   d theta/dt = K(theta) (Omega_table(t) + Omega_E) + D(theta) with the
 // resonator's intrinsic K and D, integrated by RK4 over each resonator period. The table rate is
 // piecewise linear, so the RK4 stages see it exactly. Each period is then sampled N times through
 // the eight pickoffs and demodulated (SignalSynthesizer); `periods_per_output` periods are averaged

@@ -1,5 +1,5 @@
-// The parameter file: one YAML schema (SPEC section 5), read by the processor, written by the
-// calibrator.
+// The parameter file: one YAML schema (docs/ros_api.md, 'Parameter file'), read by the processor,
+// written by the calibrator.
 //
 // Reading validates every key and names the offending one in the error (ConfigError::key()).
 // Writing is round-trip exact (shortest text that reads back to the same double) and atomic: the

@@ -1,6 +1,7 @@
 // The eight capacitive pickoffs around the resonator rim and the channels they form.
 //
-// Sensor i nominally sits at phi_i = i pi/4. Its real defects (MATH.md section 3): an angular
+// Sensor i nominally sits at phi_i = i pi/4. Its real defects (docs/math.md, 'Pickoff defects to first
+// order'): an angular
 // misplacement delta_i (it reads the rim at phi_i + delta_i), a gain error g_i, the capacitive
 // nonlinearity h(r) = r / (1 - r/d0) of a gap d0 (amplitude-to-gap ratio A/d0), and additive white
 // noise. The cosine channel is c = (d0 - d2 + d4 - d6)/4, the sine channel s = (d1 - d3 + d5 - d7)/4.
@@ -33,7 +34,8 @@ struct PickoffDefects {
   double noise = 0.0;  ///< standard deviation of the additive noise of one sensor sample, amplitude units
 };
 
-/// Half-sums and mean gains that drive the first-order defect formulas of MATH.md section 3.
+/// Half-sums and mean gains that drive the first-order defect formulas (docs/math.md, 'Pickoff defects
+/// to first order').
 struct PickoffSignature {
   double dc = 0.0;  ///< (delta0 + delta2 + delta4 + delta6) / 2, rad
   double ds = 0.0;  ///< (delta1 + delta3 + delta5 + delta7) / 2, rad

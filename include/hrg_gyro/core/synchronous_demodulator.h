@@ -1,6 +1,7 @@
 // Synchronous demodulation of the two channels over whole periods of the resonator.
 //
-// Ac = (2/T) int c cos(wt), Bc = (2/T) int c sin(wt), and likewise As, Bs from s (MATH.md section 2),
+// Ac = (2/T) int c cos(wt), Bc = (2/T) int c sin(wt), and likewise As, Bs from s (docs/math.md,
+// 'Channel amplitudes'),
 // as sums over N samples per period taken at carrier phases 2 pi (j + 1/2) / N (the reference is
 // locked to the resonator, so the sample grid always spans exactly one period, centred on it). The sum is exact for every
 // carrier harmonic m with m != +-1 mod N; the capacitive nonlinearity puts energy at the odd

@@ -13,8 +13,8 @@
 //   D(theta, T)  = D(theta, f(T)) + drift(theta) (T - Tref)         intrinsic drift, rad/s
 // (the resonator's own K and D may already be frequency dependent; they are evaluated at f(T)).
 //
-// Simplification, documented in the README: the signal is still sampled and demodulated at the
-// nominal f0; only the reported frequency follows f(T). Demodulation is synchronous with the drive,
+// Simplification, documented in docs/simulation.md: the signal is still sampled and demodulated at
+// the nominal f0; only the reported frequency follows f(T). Demodulation is synchronous with the drive,
 // so the amplitudes do not depend on the carrier frequency; what matters for the calibration is
 // that the reported f is a faithful temperature proxy.
 #pragma once

@@ -1,11 +1,12 @@
 // The standing wave of the resonator's second mode and the exact channel amplitudes it produces.
 //
-// Deflection at case angle phi (MATH.md section 1):
+// Deflection at case angle phi (docs/math.md, 'The standing wave'):
 //   r(t, phi) = A cos(2 phi - theta) cos(w t + tau) + B sin(2 phi - theta) sin(w t + tau)
 // theta is the electrical wave angle (antinode at phi = theta / 2), A the main amplitude, B the
 // quadrature amplitude and tau the temporal phase. An ideal pickoff and demodulator turn this wave
-// into Z = (Ac, Bc, As, Bs) with the closed form of MATH.md section 2 (the paper's printed set has
-// the sign of tau flipped and cos/sin swapped in Bs). Z_m of the correction-matrix fit is this map.
+// into Z = (Ac, Bc, As, Bs) with the closed form of docs/math.md, 'Channel amplitudes' (the paper's
+// printed set has the sign of tau flipped and cos/sin swapped in Bs). Z_m of the correction-matrix
+// fit is this map.
 #pragma once
 
 #include <Eigen/Core>
@@ -25,7 +26,8 @@ struct WaveParameters {
   double phase = 0.0;       ///< temporal phase tau, rad
 };
 
-/// Exact demodulated channel amplitudes of an ideal pickoff for the given wave (MATH.md section 2).
+/// Exact demodulated channel amplitudes of an ideal pickoff for the given wave (docs/math.md,
+/// 'Channel amplitudes').
 ChannelVector idealChannels(const WaveParameters& wave);
 
 }  // namespace core
