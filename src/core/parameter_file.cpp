@@ -1,16 +1,11 @@
 #include "hrg_gyro/core/parameter_file.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <vector>
+
+#include "hrg_gyro/core/atomic_file.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -18,8 +13,6 @@ namespace {
 
 enum class ModelKind { kScaleFactor, kDrift };
 
-/// Largest plausible drift coefficient, rad/s: catches unit slips (deg/h entered as rad/s) early.
-constexpr double kMaxDriftCoefficient = 0.1;
 constexpr int kMaxHarmonicOrder = 64;
 
 std::vector<int> parseOrders(const YamlField& f) {
@@ -53,6 +46,10 @@ HarmonicModel parseModel(const YamlField& f, ModelKind kind) {
   FrequencyInterpolator interp;
   if (f.has("frequency_nodes")) {
     const YamlField nf = f["frequency_nodes"];
+    // Before any per-node work: the spline set-up and the overshoot check cost the cube of the count.
+    if (nf.isSequence() && nf.size() > kMaxFrequencyNodes) {
+      nf.fail("at most " + std::to_string(kMaxFrequencyNodes) + " frequency nodes, got " + std::to_string(nf.size()));
+    }
     const std::vector<double> nodes = nf.asDoubles();
     if (nodes.size() < 2) nf.fail("give at least 2 frequency nodes, or omit the key for a frequency-independent model");
     for (std::size_t j = 0; j < nodes.size(); ++j) {
@@ -96,13 +93,18 @@ HarmonicModel parseModel(const YamlField& f, ModelKind kind) {
         f["mean"].fail("K0 must be negative (electrical wave angle lags the body rotation, K0 = -2k); got " +
                        formatDouble(m0) + where);
       }
+      if (std::abs(m0) < kMinScaleFactorMagnitude || std::abs(m0) > kMaxScaleFactorMagnitude) {
+        f["mean"].fail("|K0| must be in [" + formatDouble(kMinScaleFactorMagnitude) + ", " +
+                       formatDouble(kMaxScaleFactorMagnitude) + "] (K0 = -2k, Bryan factor k below 1; -0.56 for a "
+                       "hemisphere); got " + formatDouble(m0) + where);
+      }
       if (harmonics >= 0.5 * std::abs(m0)) {
         f.fail("harmonics too large: sum of |cos| + |sin| = " + formatDouble(harmonics) +
                " must stay below |K0|/2 so that K(theta) keeps its sign" + where);
       }
-    } else if (std::abs(m0) + harmonics > kMaxDriftCoefficient) {
-      f.fail("drift coefficients add up to " + formatDouble(std::abs(m0) + harmonics) +
-             " rad/s, above the plausible limit of 0.1 rad/s (units are rad/s of electrical angle)" + where);
+    } else if (std::abs(m0) + harmonics > kMaxDriftMagnitude) {
+      f.fail("drift coefficients add up to " + formatDouble(std::abs(m0) + harmonics) + " rad/s, above the plausible limit of " +
+             formatDouble(kMaxDriftMagnitude) + " rad/s (units are rad/s of electrical angle)" + where);
     }
   };
   for (std::size_t j = 0; j < nodes; ++j) {
@@ -165,50 +167,6 @@ void emitModel(YAML::Emitter& out, const HarmonicModel& m) {
     out << YAML::EndSeq;
   }
   out << YAML::EndMap;
-}
-
-[[noreturn]] void throwErrno(const std::string& what, const std::string& path) {
-  throw std::runtime_error(what + " '" + path + "': " + std::strerror(errno));
-}
-
-void fsyncDirectoryOf(const std::string& path) {
-  const std::size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
-  if (fd < 0) throwErrno("cannot open directory", dir);
-  ::fsync(fd);
-  ::close(fd);
-}
-
-void writeAll(int fd, const std::string& text, const std::string& path) {
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      throwErrno("cannot write", path);
-    }
-    done += static_cast<std::size_t>(n);
-  }
-}
-
-/// Replaces <path>.bak with the current file, atomically (a hard link where possible, else a copy).
-void keepBackup(const std::string& path) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) return;  // nothing to back up yet
-  const std::string bak = path + ".bak", bak_tmp = path + ".bak.tmp";
-  ::unlink(bak_tmp.c_str());
-  if (::link(path.c_str(), bak_tmp.c_str()) != 0) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    const int fd = ::open(bak_tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd < 0) throwErrno("cannot create backup", bak_tmp);
-    writeAll(fd, ss.str(), bak_tmp);
-    ::fsync(fd);
-    ::close(fd);
-  }
-  if (::rename(bak_tmp.c_str(), bak.c_str()) != 0) throwErrno("cannot rename backup to", bak);
 }
 
 }  // namespace
@@ -275,13 +233,14 @@ GyroParameters parseParameterText(const std::string& text) {
 }
 
 GyroParameters loadParameterFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError("", "cannot read parameter file '" + path + "': " + std::strerror(errno));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw ConfigError("", "error while reading parameter file '" + path + "'");
+  std::string text;
   try {
-    return parseParameterText(ss.str());
+    text = readBoundedRegularFile(path, kMaxParameterFileBytes, "parameter file");
+  } catch (const std::runtime_error& e) {
+    throw ConfigError("", e.what());
+  }
+  try {
+    return parseParameterText(text);
   } catch (const ConfigError& e) {
     throw ConfigError(e.key(), e.problem() + " (in '" + path + "')");
   }
@@ -332,27 +291,14 @@ void saveParameterFile(const std::string& path, const GyroParameters& parameters
   } catch (const ConfigError& e) {
     throw std::runtime_error(std::string("refusing to write invalid parameters: ") + e.what());
   }
-  std::string tmp = path + ".tmp.XXXXXX";
-  std::vector<char> name(tmp.begin(), tmp.end());
-  name.push_back('\0');
-  const int fd = ::mkstemp(name.data());
-  if (fd < 0) throwErrno("cannot create temporary file next to", path);
-  tmp.assign(name.data());
-  bool fd_open = true;
-  try {
-    writeAll(fd, text, tmp);
-    if (::fchmod(fd, 0644) != 0 || ::fsync(fd) != 0) throwErrno("cannot sync", tmp);
-    fd_open = false;
-    if (::close(fd) != 0) throwErrno("cannot close", tmp);
-    if (loadParameterFile(tmp) != parameters) throw std::runtime_error("written file reads back differently: " + tmp);
-    if (options.keep_backup) keepBackup(path);
-    if (::rename(tmp.c_str(), path.c_str()) != 0) throwErrno("cannot rename over", path);
-    fsyncDirectoryOf(path);
-  } catch (...) {
-    if (fd_open) ::close(fd);
-    ::unlink(tmp.c_str());
-    throw;
-  }
+  OutputFileOptions file_options;
+  file_options.keep_backup = options.keep_backup;
+  AtomicOutputFile file(path, file_options);
+  file.write(text);
+  // What is on disk, read back through the same bounded reader the processor uses.
+  file.commit([&](const std::string& temporary) {
+    if (loadParameterFile(temporary) != parameters) throw std::runtime_error("written file reads back differently: " + temporary);
+  });
 }
 
 }  // namespace core

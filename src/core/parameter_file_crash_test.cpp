@@ -11,6 +11,7 @@
 #include <chrono>
 #include <filesystem>
 #include <random>
+#include <set>
 #include <string>
 #include <thread>
 
@@ -60,7 +61,12 @@ TEST(ParameterFileCrash, SigkillDuringWritesNeverLeavesAPartialFile) {
     EXPECT_TRUE(backup == a || backup == b) << "round " << round;
   }
   EXPECT_EQ(kills_during_writes, 60);
-  // Left-over temporary files (path.tmp.XXXXXX) are possible after a kill; they are never read.
+  // A kill can leave temporaries (params.yaml.tmp.<pid>.XXXXXX); they are never read, and the next
+  // write removes them, since their writers are gone.
+  saveParameterFile(path, a);
+  std::set<std::string> listing;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_template)) listing.insert(entry.path().filename());
+  EXPECT_EQ(listing, (std::set<std::string>{"params.yaml", "params.yaml.bak"}));
   std::filesystem::remove_all(dir_template);
 }
 

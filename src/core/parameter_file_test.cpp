@@ -1,8 +1,13 @@
 // Parameter file: round trips, key-by-key rejections with the key named, atomic save with backup.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <chrono>
 
 #include <cstdio>
 #include <filesystem>
@@ -239,6 +244,163 @@ TEST(ParameterFile, UnwritableDirectoryFailsCleanly) {
   chmod(dir.path().c_str(), 0555);
   EXPECT_THROW(saveParameterFile(path, sampleParameters()), std::runtime_error);
   chmod(dir.path().c_str(), 0755);
+}
+
+// A frequency-dependent scale factor with `nodes` nodes, spaced 1 Hz from 4990 Hz.
+std::string withFrequencyNodes(std::size_t nodes) {
+  std::string list, means, zeros;
+  for (std::size_t j = 0; j < nodes; ++j) {
+    const std::string sep = j == 0 ? "" : ", ";
+    list += sep + std::to_string(4990 + j) + ".0";
+    means += sep + "-0.56";
+    zeros += sep + "0.0";
+  }
+  return replaced("  orders: [2, 4]\n  mean: -0.56\n  cos: [1.0e-3, 2.0e-4]\n  sin: [0.0, -1.0e-4]\n",
+                  "  orders: [2]\n  frequency_nodes: [" + list + "]\n  mean: [" + means + "]\n  cos: [[" + zeros +
+                      "]]\n  sin: [[" + zeros + "]]\n");
+}
+
+TEST(ParameterFile, DuplicateKeysAreRefusedWithTheirPath) {
+  // yaml-cpp keeps the first of two equal keys; the second must not be dropped without a word.
+  expectRejected(std::string(kValid) + "earth_rate:\n  enabled: false\n  latitude: 0.1\n", "earth_rate", "more than once");
+  expectRejected(replaced("  mean: -0.56", "  mean: -0.56\n  mean: -0.57"), "scale_factor.mean", "more than once");
+  expectRejected(replaced("  latitude: 0.9", "  latitude: 0.9\n  enabled: false"), "earth_rate.enabled", "more than once");
+}
+
+TEST(ParameterFile, FrequencyNodeCountIsLimitedBeforeAnyWork) {
+  EXPECT_NO_THROW(parseParameterText(withFrequencyNodes(kMaxFrequencyNodes)));
+  expectRejected(withFrequencyNodes(kMaxFrequencyNodes + 1), "scale_factor.frequency_nodes", "at most 64 frequency nodes");
+  // 20000 nodes used to end in bad_alloc after minutes of cubic work: now refused at once.
+  const std::string huge = withFrequencyNodes(20000);
+  const auto start = std::chrono::steady_clock::now();
+  expectRejected(huge, "scale_factor.frequency_nodes", "got 20000");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+}
+
+TEST(ParameterFile, ScaleFactorMeanMustBePhysical) {
+  // -1e308 made the output stop integrating, -1e-300 made the processor reject most samples.
+  for (const char* k0 : {"-1.0e308", "-1.0e-300", "-2.5", "-0.005"}) {
+    expectRejected(replaced("  mean: -0.56", std::string("  mean: ") + k0), "scale_factor.mean", "|K0| must be in [0.01, 2.0]");
+  }
+  for (const char* k0 : {"-0.01", "-2.0", "-0.3", "-1.12"}) {
+    EXPECT_NO_THROW(parseParameterText(replaced("  mean: -0.56", std::string("  mean: ") + k0))) << k0;
+  }
+  // The same bound at every frequency node.
+  const std::string nodes = replaced(
+      "  orders: [2, 4]\n  mean: -0.56\n  cos: [1.0e-3, 2.0e-4]\n  sin: [0.0, -1.0e-4]\n",
+      "  orders: [2]\n  frequency_nodes: [4990.0, 5010.0]\n  interpolation: piecewise_linear\n"
+      "  mean: [-0.56, -1.0e-300]\n  cos: [[0.0, 0.0]]\n  sin: [[0.0, 0.0]]\n");
+  expectRejected(nodes, "scale_factor.mean", "at frequency node 1");
+}
+
+/// Runs loadParameterFile(path) in a child limited to 5 s and 512 MiB; returns its message, or how
+/// the child died (a read that hangs or grows without bound fails the test instead of the machine).
+std::string loadInChild(const std::string& path) {
+  int fds[2];
+  if (::pipe(fds) != 0) return "pipe failed";
+  const pid_t child = ::fork();
+  if (child == 0) {
+    ::close(fds[0]);
+    ::alarm(5);
+    const rlimit memory{512u << 20, 512u << 20};
+    ::setrlimit(RLIMIT_AS, &memory);
+    std::string outcome = "loaded";
+    try {
+      loadParameterFile(path);
+    } catch (const ConfigError& e) {
+      outcome = e.what();
+    } catch (const std::exception& e) {
+      outcome = std::string("not a ConfigError: ") + e.what();
+    }
+    if (::write(fds[1], outcome.data(), outcome.size()) < 0) ::_exit(2);
+    ::_exit(0);
+  }
+  ::close(fds[1]);
+  std::string outcome;
+  char buffer[512];
+  ssize_t n;
+  while ((n = ::read(fds[0], buffer, sizeof buffer)) > 0) outcome.append(buffer, static_cast<std::size_t>(n));
+  ::close(fds[0]);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  if (WIFSIGNALED(status)) return "child killed by signal " + std::to_string(WTERMSIG(status));
+  return outcome;
+}
+
+TEST(ParameterFile, OnlyABoundedRegularFileIsRead) {
+  TempDir dir;
+  ASSERT_EQ(::mkfifo(dir.file("fifo.yaml").c_str(), 0644), 0);
+  const std::string fifo = loadInChild(dir.file("fifo.yaml"));
+  EXPECT_NE(fifo.find("is a FIFO"), std::string::npos) << fifo;
+  const std::string zero = loadInChild("/dev/zero");
+  EXPECT_NE(zero.find("is a character device"), std::string::npos) << zero;
+  const std::string directory = loadInChild(dir.path());
+  EXPECT_NE(directory.find("is a directory, not a parameter file"), std::string::npos) << directory;
+  // Size: a valid file padded with a comment to exactly the limit loads; one byte more is refused.
+  std::string text = kValid;
+  const std::string padding = "#" + std::string(kMaxParameterFileBytes - text.size() - 2, 'x') + "\n";
+  text += padding;
+  {
+    std::ofstream(dir.file("limit.yaml"), std::ios::binary) << text;
+    std::ofstream(dir.file("over.yaml"), std::ios::binary) << text << "\n";
+  }
+  ASSERT_EQ(std::filesystem::file_size(dir.file("limit.yaml")), kMaxParameterFileBytes);
+  EXPECT_NO_THROW(loadParameterFile(dir.file("limit.yaml")));
+  const std::string over = loadInChild(dir.file("over.yaml"));
+  EXPECT_NE(over.find("above the limit of 1048576 bytes"), std::string::npos) << over;
+}
+
+TEST(ParameterFile, SaveKeepsTheModeAndTheSymbolicLink) {
+  TempDir dir;
+  std::filesystem::create_directories(dir.file("deployed"));
+  const std::string target = dir.file("deployed/params.yaml"), link = dir.file("params.yaml");
+  saveParameterFile(target, sampleParameters());
+  ASSERT_EQ(::chmod(target.c_str(), 0640), 0);
+  ASSERT_EQ(::symlink("deployed/params.yaml", link.c_str()), 0);
+  GyroParameters second = sampleParameters();
+  second.correction.p[0] = 5e-4;
+  saveParameterFile(link, second);
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  EXPECT_TRUE(loadParameterFile(target) == second);
+  EXPECT_TRUE(loadParameterFile(target + ".bak") == sampleParameters());
+  EXPECT_FALSE(std::filesystem::exists(link + ".bak"));
+  struct stat st {};
+  ASSERT_EQ(::stat(target.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 07777, 0640u);
+}
+
+// Two calibrators saving one file: before, they collided on one fixed backup temporary name.
+TEST(ParameterFile, TwoWritersOfOneFileBothSucceed) {
+  TempDir dir;
+  const std::string path = dir.file("params.yaml");
+  GyroParameters a = sampleParameters(), b = sampleParameters();
+  b.correction.p[0] = 5e-4;
+  saveParameterFile(path, a);
+  pid_t children[2];
+  for (int c = 0; c < 2; ++c) {
+    children[c] = ::fork();
+    ASSERT_GE(children[c], 0);
+    if (children[c] == 0) {
+      try {
+        for (int i = 0; i < 150; ++i) saveParameterFile(path, c == 0 ? a : b);
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "writer %d: %s\n", c, e.what());
+        ::_exit(1);
+      }
+      ::_exit(0);
+    }
+  }
+  for (pid_t child : children) {
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "a writer failed (see its message above)";
+  }
+  const GyroParameters now = loadParameterFile(path), backup = loadParameterFile(path + ".bak");
+  EXPECT_TRUE(now == a || now == b);
+  EXPECT_TRUE(backup == a || backup == b);
+  std::set<std::string> listing;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) listing.insert(entry.path().filename());
+  EXPECT_EQ(listing, (std::set<std::string>{"params.yaml", "params.yaml.bak"}));
 }
 
 TEST(ParameterFile, ShippedConfigurationFilesAreValid) {

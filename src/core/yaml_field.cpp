@@ -49,6 +49,7 @@ void YamlField::rejectUnknownKeys(std::initializer_list<const char*> allowed) co
 void YamlField::rejectUnknownKeys(const std::vector<std::string>& allowed) const {
   requireMap();
   const std::set<std::string> ok(allowed.begin(), allowed.end());
+  std::set<std::string> seen;
   for (const auto& kv : node_) {
     // A key that is itself a list or a map ({a: 1}: 2) has no name to check: refuse it here rather
     // than let yaml-cpp's conversion error escape as something other than a ConfigError.
@@ -61,6 +62,11 @@ void YamlField::rejectUnknownKeys(const std::vector<std::string>& allowed) const
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
       throw ConfigError(path_.empty() ? key : path_ + "." + key, "unknown key (allowed here: " + list + ")");
+    }
+    // yaml-cpp keeps every pair of a map but looks a key up to its first occurrence: a second one
+    // (a pasted block, a merge gone wrong) would be ignored without a word.
+    if (!seen.insert(key).second) {
+      throw ConfigError(path_.empty() ? key : path_ + "." + key, "key given more than once in the same map");
     }
   }
 }

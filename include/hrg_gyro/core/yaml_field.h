@@ -46,7 +46,8 @@ class YamlField {
   /// Throws unless this node is a map (with its path in the message).
   const YamlField& requireMap() const;
   const YamlField& requireSequence() const;
-  /// Throws for any key not in the allowed list (catches typos such as "scale_factr").
+  /// Throws for any key not in the allowed list (catches typos such as "scale_factr") and for a key
+  /// given twice in this map (yaml-cpp would silently use the first).
   void rejectUnknownKeys(std::initializer_list<const char*> allowed) const;
   void rejectUnknownKeys(const std::vector<std::string>& allowed) const;
 

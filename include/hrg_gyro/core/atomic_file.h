@@ -1,0 +1,118 @@
+// Files written whole or not at all, and files read with a bound.
+//
+// AtomicOutputFile is the one way the core (and the tools) replace a file: the new content goes to
+// a uniquely named temporary beside the target, is flushed to disk and only then renamed over the
+// target. A reader therefore finds the complete old file or the complete new one; a failure at any
+// step (disk full, verification refused, a kill) leaves an existing file untouched. A target that is
+// a symbolic link is followed: the file the link points to is replaced and the link stays a link.
+// The replaced file keeps its mode (and, where the writer may set them, its owner and group).
+// Temporaries that a killed writer left behind are removed by the next write of the same file.
+//
+// readBoundedRegularFile is the matching reader for configuration: regular files only (no FIFO,
+// device or directory), never more than a stated number of bytes.
+#pragma once
+
+#include <sys/types.h>
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace hrg_gyro {
+namespace core {
+
+/// Mode given to a file that did not exist before, narrowed by the process umask like any newly
+/// created file (umask 022: 0644, umask 027: 0640, umask 077: 0600). A replaced file keeps its own.
+constexpr mode_t kNewOutputFileMode = 0644;
+
+struct OutputFileOptions {
+  /// Keep the replaced file as <target>.bak, beside the (link-resolved) target.
+  bool keep_backup = false;
+};
+
+class AtomicOutputFile {
+ public:
+  /// Called with the temporary's path after it is complete and synced, before it replaces the
+  /// target; throwing aborts the write (the target stays as it was).
+  using Verifier = std::function<void(const std::string& temporary_path)>;
+
+  /// Resolves `path`, refuses a target that exists and is not a regular file, removes stale
+  /// temporaries of earlier killed writes and creates the temporary. Throws std::runtime_error.
+  explicit AtomicOutputFile(const std::string& path, const OutputFileOptions& options = {});
+  /// Not committed: the temporary is removed and the target left as it was.
+  ~AtomicOutputFile();
+  AtomicOutputFile(const AtomicOutputFile&) = delete;
+  AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
+
+  /// Where the content goes. Write errors are reported by commit(), naming the target.
+  std::ostream& stream();
+  void write(const std::string& text);
+
+  /// Flushes the temporary, gives it the old file's mode (owner and group where allowed), syncs
+  /// it, runs `verify`, links the old file under a backup temporary if asked, renames the
+  /// temporary over the target, then the backup temporary to <target>.bak, and syncs the
+  /// directory. Throws std::runtime_error on any failure, after removing the temporaries; up to
+  /// the target's rename the target and its backup are untouched.
+  void commit(const Verifier& verify = {});
+  /// Drops the temporary; the target is untouched. Safe to call more than once.
+  void discard() noexcept;
+
+  const std::string& requestedPath() const { return requested_path_; }
+  /// The file that commit() replaces: requestedPath() with symbolic links followed.
+  const std::string& targetPath() const { return target_path_; }
+  const std::string& temporaryPath() const { return temporary_path_; }
+
+ private:
+  class Buffer;
+
+  std::string requested_path_, target_path_, temporary_path_;
+  OutputFileOptions options_;
+  bool target_existed_ = false;
+  mode_t target_mode_ = 0;
+  uid_t target_uid_ = 0;
+  gid_t target_gid_ = 0;
+  int fd_ = -1;
+  bool finished_ = false;  // committed or discarded
+  std::unique_ptr<Buffer> buffer_;
+  std::unique_ptr<std::ostream> stream_;
+};
+
+/// The whole content at once (see AtomicOutputFile).
+void writeFileAtomically(const std::string& path, const std::string& contents, const OutputFileOptions& options = {},
+                         const AtomicOutputFile::Verifier& verify = {});
+
+/// `path` with symbolic links in its last component followed (to at most 40 levels), relative link
+/// targets taken relative to the link's directory. A path that does not exist (or a dangling link's
+/// missing target) is returned as is: that is where a new file would be created.
+std::string resolveOutputTarget(const std::string& path);
+
+/// Refuses (std::runtime_error, naming both paths) an output that is the same file as one of the
+/// inputs or as another output: same device and inode after following links for existing files,
+/// same link-resolved absolute path for an output that does not exist yet. Tools call it before
+/// they open anything, so that `--out` can never overwrite the file being read.
+void checkDistinct(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
+
+/// The content of a regular file of at most `max_bytes`. Refuses without blocking a directory, a
+/// FIFO, a device or a socket, and a file above the limit (also one that grows past it while being
+/// read). `what` names the file in messages ("parameter file"). Throws std::runtime_error.
+std::string readBoundedRegularFile(const std::string& path, std::size_t max_bytes, const std::string& what);
+
+/// Fault injection for the tests: the steps at which an AtomicOutputFile can fail.
+namespace fault_injection {
+enum class OutputFileStep {
+  kWrite,   ///< writing the temporary (a full disk)
+  kSync,    ///< fsync of the temporary
+  kBackup,  ///< linking the current target under the backup's temporary name
+  kRename,  ///< renaming the temporary over the target (the backup's temporary link exists)
+};
+/// Called at each step with the target path; a non-zero return is taken as that step's errno.
+/// An empty function (the default) injects nothing. Not thread-safe: set it only in tests.
+using OutputFileFault = std::function<int(OutputFileStep step, const std::string& target_path)>;
+void setOutputFileFault(OutputFileFault fault);
+}  // namespace fault_injection
+
+}  // namespace core
+}  // namespace hrg_gyro
