@@ -23,10 +23,18 @@ HRG_BAG = subprocess.check_output(["catkin_find", "--first-only", "--libexec", "
                                   universal_newlines=True).strip()
 
 
-def hrg_bag(*args, timeout=600):
-    p = subprocess.run([HRG_BAG] + list(args), stdout=subprocess.PIPE,
+HRG_SESSION = subprocess.check_output(["catkin_find", "--first-only", "--libexec", "hrg_gyro", "hrg_session"],
+                                      universal_newlines=True).strip()
+
+
+def run(tool, *args, timeout=600):
+    p = subprocess.run([tool] + list(args), stdout=subprocess.PIPE,
                        stderr=subprocess.PIPE, universal_newlines=True, timeout=timeout)
     return p.returncode, p.stdout, p.stderr
+
+
+def hrg_bag(*args, timeout=600):
+    return run(HRG_BAG, *args, timeout=timeout)
 
 
 class HrgBagCli(unittest.TestCase):
@@ -50,6 +58,14 @@ class HrgBagCli(unittest.TestCase):
         for f in fragments:
             self.assertIn(f, result[2])
         self.assertNotIn("terminate called", result[2])
+
+    def assertRefused(self, result, option, why, args):
+        """Bad usage: exit 2 (not a signal, not 0), stderr names the option and the reason."""
+        code, _, err = result
+        self.assertEqual(code, 2, "%s -> exit %d (negative: killed by a signal)\n%s" % (args, code, err))
+        self.assertIn(option, err, args)
+        self.assertIn(why, err, args)
+        self.assertNotIn("terminate called", err, args)
 
     def test_help_for_the_tool_and_every_subcommand(self):
         code, out, _ = hrg_bag("--help")
@@ -204,6 +220,118 @@ class HrgBagCli(unittest.TestCase):
             rows = sum(1 for _ in f) - 1
         with rosbag.Bag(bag) as b:
             self.assertEqual(rows, b.get_message_count(topic_filters=["/channels"]))
+
+    def test_every_subcommand_refuses_bad_arguments_naming_the_option(self):
+        bag, params = self.short, self.params
+        scenario = os.path.join(self.pkg, "test/scenarios/short_session.yaml")
+        common = {
+            "simulate": ["simulate", "--scenario", scenario, "--out", self.path("bad_args.bag")],
+            "info": ["info", bag],
+            "process": ["process", bag, "--params", params, "--csv", self.path("bad_args.csv")],
+            "calibrate": ["calibrate", bag, "--method", "dual_rate", "--params", params,
+                          "--out", self.path("bad_args.yaml")],
+            "allan": ["allan", bag, "--params", params],
+        }
+        limits = [  # the processor node refuses each of these (core::validate), so must every subcommand
+            (["--max-gap", "-1"], "--max-gap", "positive"),
+            (["--max-gap", "0"], "--max-gap", "positive"),
+            (["--max-gap", "12x"], "--max-gap", "finite number"),
+            (["--max-gap", "nan"], "--max-gap", "finite number"),
+            (["--max-gap", "inf"], "--max-gap", "finite number"),
+            (["--backward-reset", "-5"], "--backward-reset", "positive"),
+            (["--max-rate", "0"], "--max-rate", "positive"),
+            (["--max-rate", "abc"], "--max-rate", "finite number"),
+            (["--min-anisotropy", "2"], "--min-anisotropy", "between 0 and 1"),
+            (["--min-anisotropy", "0"], "--min-anisotropy", "between 0 and 1"),
+            (["--min-amplitude", "-1"], "--min-amplitude", ">= 0"),
+            (["--max-amplitude", "0"], "--max-amplitude", "above --min-amplitude"),
+            (["--min-amplitude", "5", "--max-amplitude", "1"], "--max-amplitude", "above --min-amplitude"),
+            (["--max-gap"], "--max-gap", "missing"),
+        ]
+        cases = []
+        for sub in ("process", "calibrate", "allan"):
+            cases += [(common[sub] + extra, option, why) for extra, option, why in limits]
+        for sub in ("process", "simulate"):
+            cases.append((common[sub] + ["--compression", "zip"], "--compression", "zip"))
+        cases += [
+            (common["simulate"] + ["--seed", "1e99"], "--seed", "whole number"),
+            (common["simulate"] + ["--seed", "-1"], "--seed", "whole number"),
+            (common["simulate"] + ["--seed", "12x"], "--seed", "whole number"),
+            (common["simulate"] + ["--seed", "0x10"], "--seed", "whole number"),
+            (common["simulate"] + ["--seed", "18446744073709551616"], "--seed", "whole number"),
+            (common["simulate"] + ["--frame-id", ""], "--frame-id", "empty"),
+            (["simulate", "--out", self.path("bad_args.bag")], "--scenario", "required"),
+            (common["info"] + ["--gap", "abc"], "--gap", "finite number"),
+            (common["info"] + ["--gap", "3x"], "--gap", "finite number"),
+            (common["info"] + ["--gap", "0.5"], "--gap", "above 1"),
+            (common["info"] + ["--channels-topic", ""], "--channels-topic", "empty"),
+            (["info"], "BAG", "required"),
+            (common["process"] + ["--frame-id", ""], "--frame-id", "empty"),
+            (["process", bag], "--params", "required"),
+            (common["calibrate"] + ["--method", "bogus"], "--method", "unknown method"),
+            (common["calibrate"] + ["--plot", self.path("x.png")], "--plot", "--report"),
+            (["calibrate", bag, "--method", "step"], "--out", "required"),
+            (common["allan"] + ["--plot", self.path("x.png")], "--plot", "--csv"),
+            (common["allan"] + ["--csv"], "--csv", "missing"),
+        ]
+        for args, option, why in cases:
+            self.assertRefused(hrg_bag(*args), option, why, args)
+        self.assertFalse(os.path.exists(self.path("bad_args.bag")), "a refused simulate writes nothing")
+        self.assertFalse(os.path.exists(self.path("bad_args.csv")), "a refused process writes nothing")
+        self.assertFalse(os.path.exists(self.path("bad_args.yaml")), "a refused calibrate writes nothing")
+
+    def test_calibrate_config_errors_name_the_file_and_key(self):
+        config = self.path("bad_settings.yaml")
+        with open(config, "w") as f:
+            f.write("bins: 0\n")
+        self.assertRefused(hrg_bag("calibrate", self.short, "--out", self.path("c.yaml"), "--config", config),
+                           "--config", "bins", ["--config", config])
+
+    def test_process_exits_1_with_the_counts_when_no_sample_is_accepted(self):
+        # A plausible-amplitude window that the simulated wave (amplitude about 1) never enters.
+        code, _, err = hrg_bag("process", self.short, "--params", self.params, "--csv", self.path("none.csv"),
+                               "--min-amplitude", "1e5", "--max-amplitude", "1e6")
+        self.assertEqual(code, 1, err)
+        self.assertIn("no sample accepted", err)
+        with rosbag.Bag(self.short) as bag:
+            n = bag.get_message_count(topic_filters=["/channels"])
+        self.assertIn("%d amplitude out of range" % n, err)
+        # the same limits inside the node's rules and the wave's range: accepted, exit 0
+        code, _, err = hrg_bag("process", self.short, "--params", self.params, "--min-amplitude", "0.001",
+                               "--max-amplitude", "1e3", "--max-gap", "0.5", "--max-rate", "10")
+        self.assertEqual(code, 0, err)
+
+    def test_hrg_session_refuses_bad_arguments_naming_the_option(self):
+        base = ["--calibration", os.path.join(self.pkg, "test/scenarios/short_session.yaml"),
+                "--verification", os.path.join(self.pkg, "test/scenarios/short_session.yaml"),
+                "--params", self.params, "--out", self.path("session.yaml")]
+        cases = [
+            (["--window", "abc"], "--window", "finite number"),
+            (["--window", "2x"], "--window", "finite number"),
+            (["--window", "0"], "--window", "positive"),
+            (["--window", "-1"], "--window", "positive"),
+            (["--bins", "12x"], "--bins", "whole number"),
+            (["--bins", "0"], "--bins", "[8, 4096]"),
+            (["--bins", "99999999999"], "--bins", "[8, 4096]"),
+            (["--orders", "3"], "--orders", "even"),
+            (["--orders", "4,2"], "--orders", "increasing"),
+            (["--orders", "2,x"], "--orders", "whole number"),
+            (["--drift-orders", "2x"], "--drift-orders", "whole number"),
+            (["--drift-orders", "0"], "--drift-orders", "[2, 64]"),
+            (["--evaluation-orders", "2,3"], "--evaluation-orders", "even"),
+            (["--evaluation-orders", "0"], "--evaluation-orders", "[2, 64]"),
+            (["--method", "bogus"], "--method", "unknown method"),
+            (["--bins"], "--bins", "missing"),
+            (["--frobnicate", "1"], "--frobnicate", "not expected"),
+        ]
+        for extra, option, why in cases:
+            self.assertRefused(run(HRG_SESSION, *(base + extra)), option, why, extra)
+        self.assertRefused(run(HRG_SESSION, *base[2:]), "--calibration", "required", base[2:])
+        self.assertFalse(os.path.exists(self.path("session.yaml")))
+        code, out, _ = run(HRG_SESSION, "--help")
+        self.assertEqual(code, 0)
+        for option in ("--window", "--bins", "--orders", "--method", "--evaluation-orders"):
+            self.assertIn(option, out)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,9 @@
 #include "hrg_gyro/core/gyro_processor.h"
 
 #include <cmath>
+#include <string>
+
+#include "hrg_gyro/core/yaml_field.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -9,7 +12,33 @@ namespace {
 
 double largestMean(const HarmonicModel& k) { return k.nodeValues().row(0).cwiseAbs().maxCoeff(); }
 
+void requirePositive(const char* key, double value, const char* unit) {
+  if (!(std::isfinite(value) && value > 0.0)) {
+    throw ConfigError(key, std::string("must be a positive number of ") + unit + ", got " + formatDouble(value));
+  }
+}
+
 }  // namespace
+
+void validate(const ProcessorConfig& c) {
+  requirePositive("max_gap", c.max_gap, "seconds");
+  requirePositive("backward_reset", c.backward_reset, "seconds");
+  requirePositive("max_rate", c.max_rate, "rad/s");
+  if (c.max_consecutive_jumps < 0) {
+    throw ConfigError("max_consecutive_jumps", "must be >= 0, got " + std::to_string(c.max_consecutive_jumps));
+  }
+  const WaveLimits& l = c.limits;
+  if (!(l.min_anisotropy > 0.0 && l.min_anisotropy < 1.0)) {
+    throw ConfigError("min_anisotropy", "must be strictly between 0 and 1, got " + formatDouble(l.min_anisotropy));
+  }
+  if (!(std::isfinite(l.min_amplitude) && l.min_amplitude >= 0.0)) {
+    throw ConfigError("min_amplitude", "must be a finite amplitude >= 0, got " + formatDouble(l.min_amplitude));
+  }
+  if (!(std::isfinite(l.max_amplitude) && l.max_amplitude > l.min_amplitude)) {
+    throw ConfigError("max_amplitude", "must be finite and above min_amplitude (" + formatDouble(l.min_amplitude) +
+                                           "), got " + formatDouble(l.max_amplitude));
+  }
+}
 
 GyroProcessor::GyroProcessor(const ProcessorConfig& config, std::shared_ptr<const GyroParameters> parameters)
     : config_(config), compensator_(std::move(parameters)), max_abs_k0_(largestMean(compensator_.parameters().scale_factor)) {}

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "hrg_gyro/core/gyro_processor.h"
+#include "hrg_gyro/core/yaml_field.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -184,6 +185,53 @@ TEST(ProcessorModelSwap, ANewCorrectionMatrixDoesNotStepTheAngle) {
   // (P also shears the motion slightly, by ~1e-3 relative; without the re-read the step would be 1.8e-3.)
   EXPECT_NEAR(r.alpha - alpha1, -0.001 / -0.56, 1e-5);
   EXPECT_FALSE(r.flags & kFlagGap);
+}
+
+
+// The limits' one rule set (the node and hrg_bag both apply it): each refusal names its key.
+TEST(ProcessorConfigValidation, AcceptsTheDefaultsAndNamesTheKeyOfEachRefusal) {
+  EXPECT_NO_THROW(validate(ProcessorConfig{}));
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
+  struct Case {
+    const char* key;
+    void (*spoil)(ProcessorConfig&);
+  };
+  const Case cases[] = {
+      {"max_gap", [](ProcessorConfig& c) { c.max_gap = 0.0; }},
+      {"max_gap", [](ProcessorConfig& c) { c.max_gap = -1.0; }},
+      {"backward_reset", [](ProcessorConfig& c) { c.backward_reset = -5.0; }},
+      {"max_rate", [](ProcessorConfig& c) { c.max_rate = 0.0; }},
+      {"max_consecutive_jumps", [](ProcessorConfig& c) { c.max_consecutive_jumps = -1; }},
+      {"min_anisotropy", [](ProcessorConfig& c) { c.limits.min_anisotropy = 2.0; }},
+      {"min_anisotropy", [](ProcessorConfig& c) { c.limits.min_anisotropy = 0.0; }},
+      {"min_amplitude", [](ProcessorConfig& c) { c.limits.min_amplitude = -1.0; }},
+      {"max_amplitude", [](ProcessorConfig& c) { c.limits.max_amplitude = 0.0; }},
+      {"max_amplitude", [](ProcessorConfig& c) {
+         c.limits.min_amplitude = 5.0;
+         c.limits.max_amplitude = 1.0;
+       }},
+  };
+  for (const Case& k : cases) {
+    ProcessorConfig c;
+    k.spoil(c);
+    try {
+      validate(c);
+      ADD_FAILURE() << "accepted a bad " << k.key;
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), k.key) << e.what();
+    }
+  }
+  for (double bad : {inf, nan}) {
+    ProcessorConfig c;
+    c.max_rate = bad;
+    EXPECT_THROW(validate(c), ConfigError);
+    c = ProcessorConfig{};
+    c.limits.max_amplitude = bad;
+    EXPECT_THROW(validate(c), ConfigError);
+    c = ProcessorConfig{};
+    c.limits.min_anisotropy = bad;
+    EXPECT_THROW(validate(c), ConfigError);
+  }
 }
 
 }  // namespace

@@ -40,12 +40,10 @@ core::ProcessorConfig processorConfig(ParameterReader& params) {
   c.limits.min_anisotropy = params.get("min_anisotropy", c.limits.min_anisotropy);
   c.limits.min_amplitude = params.get("min_amplitude", c.limits.min_amplitude);
   c.limits.max_amplitude = params.get("max_amplitude", c.limits.max_amplitude);
-  if (!(c.max_gap > 0.0) || !(c.backward_reset > 0.0) || !(c.max_rate > 0.0) || c.max_consecutive_jumps < 0 ||
-      !(c.limits.min_anisotropy > 0.0 && c.limits.min_anisotropy < 1.0) ||
-      !(c.limits.max_amplitude > c.limits.min_amplitude)) {
-    throw std::invalid_argument(
-        "processor: invalid limits (~max_gap, ~backward_reset, ~max_rate > 0; ~max_consecutive_jumps >= 0; "
-        "0 < ~min_anisotropy < 1; ~max_amplitude > ~min_amplitude)");
+  try {
+    core::validate(c);  // the same rules as hrg_bag process
+  } catch (const core::ConfigError& e) {
+    throw std::invalid_argument("processor: ~" + e.key() + ": " + e.problem());
   }
   return c;
 }

@@ -1,13 +1,18 @@
 // hrg_session: the calibrate-then-verify session of `make run`, without ROS.
 //   hrg_session --calibration dual_rate.yaml --verification verification.yaml --params P.yaml [--out OUT.yaml]
+// Every argument is checked before anything runs: numbers whole (CLI11 plus tools/cli_checks.h),
+// the calibration settings by the calibrator's own parser (CalibrationSettings::parse).
 // Simulates the calibration scenario through the processor (with P.yaml) into the calibrator,
 // writes the refreshed parameters (atomically) when the quality gates accept them, then runs the
 // verification scenario through an uncalibrated and a calibrated processor and prints the summary.
 #include <cstring>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "cli_checks.h"
 #include "hrg_gyro/core/calibration_session.h"
 #include "hrg_gyro/core/offline_pipeline.h"
 #include "hrg_gyro/core/parameter_file.h"
@@ -17,67 +22,93 @@ using namespace hrg_gyro::core;
 
 namespace {
 
-void usage(std::ostream& out) {
-  out << "usage: hrg_session --calibration SCENARIO.yaml --verification SCENARIO.yaml --params PARAMS.yaml\n"
-         "                   [--out NEW_PARAMS.yaml] [--method dual_rate|constant_rate|step]\n"
-         "                   [--orders 2,4,6,8] [--drift-orders 2,4] [--evaluation-orders 2,4,...,12]\n"
-         "                   [--window SECONDS] [--bins N]\n"
-         "Calibrates a simulated gyro without ROS and verifies the result against the ground truth.\n";
+/// Thrown for an argument the core's settings parser refuses; names the option.
+struct ArgumentError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// The calibration settings the options give, through the calibrator's own settings parser (the
+/// node's rules: even increasing orders in [2, 64], bins in [8, 4096], window > 0, known method).
+CalibrationSettings checkedSettings(const std::string& method, const std::vector<int>& orders,
+                                    const std::vector<int>& drift_orders, int bins, double window) {
+  YAML::Node n;
+  n["method"] = method;
+  for (int order : orders) n["scale_factor_orders"].push_back(order);
+  for (int order : drift_orders) n["drift_orders"].push_back(order);
+  n["bins"] = bins;
+  n["window"] = window;
+  try {
+    return CalibrationSettings::parse(YamlField(n, ""));
+  } catch (const ConfigError& e) {
+    static const std::pair<const char*, const char*> kOptions[] = {
+        {"method", "--method"}, {"scale_factor_orders", "--orders"}, {"drift_orders", "--drift-orders"},
+        {"bins", "--bins"},     {"window", "--window"}};
+    for (const auto& ko : kOptions) {
+      if (e.key().rfind(ko.first, 0) == 0) throw ArgumentError(ko.second + e.key().substr(std::strlen(ko.first)) + ": " + e.problem());
+    }
+    throw ArgumentError(e.what());
+  }
+}
+
+/// The evaluator's harmonic orders follow the same rules as the calibrator's.
+std::vector<int> checkedEvaluationOrders(const std::vector<int>& orders) {
+  YAML::Node n;
+  for (int order : orders) n["scale_factor_orders"].push_back(order);
+  try {
+    return CalibrationSettings::parse(YamlField(n, "")).scale_factor_orders;
+  } catch (const ConfigError& e) {
+    throw ArgumentError("--evaluation-orders" + e.key().substr(std::strlen("scale_factor_orders")) + ": " + e.problem());
+  }
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  using hrg_gyro::tools::finiteNumber;
+  using hrg_gyro::tools::wholeNumber;
   std::string calibration, verification, params, out, method = "dual_rate";
-  CalibrationSettings settings;
-  EvaluationSettings evaluation;
-  auto parseOrders = [](const std::string& text) {
-    std::vector<int> orders;
-    std::size_t pos = 0;
-    while (pos < text.size()) {
-      const std::size_t comma = text.find(',', pos);
-      orders.push_back(std::stoi(text.substr(pos, comma - pos)));
-      pos = comma == std::string::npos ? text.size() : comma + 1;
-    }
-    return orders;
+  const CalibrationSettings defaults;
+  std::vector<int> orders = defaults.scale_factor_orders, drift_orders = defaults.drift_orders;
+  std::vector<int> evaluation_orders = EvaluationSettings().orders;
+  int bins = defaults.bins;
+  double window = defaults.window;
+
+  CLI::App app("Calibrates a simulated gyro without ROS and verifies the result against the ground truth.",
+               "hrg_session");
+  app.get_formatter()->label("Usage", "usage");
+  app.get_formatter()->column_width(34);
+  app.add_option("--calibration", calibration, "calibration scenario (YAML, the driver_sim parameters)")->required();
+  app.add_option("--verification", verification, "verification scenario (YAML)")->required();
+  app.add_option("--params", params, "parameter file of the gyro before calibration")->required();
+  app.add_option("--out", out, "calibrated parameter file, written atomically when the gates accept")
+      ->check(hrg_gyro::tools::notEmpty());
+  app.add_option("--method", method, "dual_rate|constant_rate|step|correction_matrix|thermal")->capture_default_str();
+  auto orders_option = [&](const char* name, std::vector<int>* target, const char* meaning) {
+    app.add_option(name, *target, meaning)->delimiter(',')->transform(wholeNumber(2, 64))->capture_default_str();
   };
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        std::cerr << "hrg_session: " << a << " needs a value\n";
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--calibration") calibration = value();
-    else if (a == "--verification") verification = value();
-    else if (a == "--params") params = value();
-    else if (a == "--out") out = value();
-    else if (a == "--method") method = value();
-    else if (a == "--orders") settings.scale_factor_orders = parseOrders(value());
-    else if (a == "--drift-orders") settings.drift_orders = parseOrders(value());
-    else if (a == "--evaluation-orders") evaluation.orders = parseOrders(value());
-    else if (a == "--window") settings.window = std::stod(value());
-    else if (a == "--bins") settings.bins = std::stoi(value());
-    else if (a == "-h" || a == "--help") {
-      usage(std::cout);
-      return 0;
-    } else {
-      std::cerr << "hrg_session: unknown argument '" << a << "'\n";
-      usage(std::cerr);
-      return 2;
-    }
-  }
-  if (calibration.empty() || verification.empty() || params.empty()) {
-    usage(std::cerr);
-    return 2;
-  }
+  orders_option("--orders", &orders, "scale-factor harmonic orders, even, increasing, e.g. 2,4,6,8");
+  orders_option("--drift-orders", &drift_orders, "drift harmonic orders, even, increasing, e.g. 2,4");
+  orders_option("--evaluation-orders", &evaluation_orders, "harmonic orders of the verification's K_rel fit");
+  app.add_option("--window", window, "s, > 0: longest averaging window of the calibration")
+      ->transform(finiteNumber())
+      ->capture_default_str();
+  app.add_option("--bins", bins, "wave-angle bins over [0, pi), in [8, 4096]")
+      ->transform(wholeNumber(8, 4096))
+      ->capture_default_str();
+  app.footer(
+      "Simulates the calibration scenario through the processor into the calibrator, writes the refreshed\n"
+      "parameters when the quality gates accept them, then runs the verification scenario through an\n"
+      "uncalibrated and a calibrated processor and prints the summary.\n"
+      "Exit 0 accepted and verified, 1 refused or not verified, 2 bad usage or unreadable input.");
+  const int parsed = hrg_gyro::tools::parseCommandLine(app, argc, argv);
+  if (parsed >= 0) return parsed;
   try {
+    CalibrationSettings settings = checkedSettings(method, orders, drift_orders, bins, window);
+    EvaluationSettings evaluation;
+    evaluation.orders = checkedEvaluationOrders(evaluation_orders);
     const SimulationConfig cal_scenario = SimulationConfig::load(calibration, nodeOnlyScenarioKeys());
     const SimulationConfig ver_scenario = SimulationConfig::load(verification, nodeOnlyScenarioKeys());
     const auto uncalibrated = std::make_shared<const GyroParameters>(loadParameterFile(params));
-    settings.method = method;
     std::cerr << "hrg_session: simulating and calibrating " << calibration << " ...\n";
     const OfflineCalibration cal = calibrateOnSimulation(cal_scenario, uncalibrated, settings);
     SessionSummary summary;

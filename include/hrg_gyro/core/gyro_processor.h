@@ -34,6 +34,12 @@ struct ProcessorConfig {
   int max_consecutive_jumps = 5;
 };
 
+/// The one rule set for the processor's limits, shared by the processor node and `hrg_bag`:
+/// max_gap, backward_reset and max_rate finite and positive; max_consecutive_jumps >= 0;
+/// 0 < min_anisotropy < 1; 0 <= min_amplitude < max_amplitude, both finite. Throws ConfigError
+/// (yaml_field.h) whose key() is the node's parameter name (max_gap, min_amplitude, ...).
+void validate(const ProcessorConfig& config);
+
 struct ChannelSample {
   Nanoseconds stamp = 0;
   ChannelVector z = ChannelVector::Zero();

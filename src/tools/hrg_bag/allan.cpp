@@ -7,31 +7,29 @@
 #include <memory>
 #include <vector>
 
+#include "../cli_checks.h"
 #include "bag_tools.h"
 #include "hrg_gyro/core/allan_deviation.h"
 #include "hrg_gyro/core/parameter_file.h"
 
 namespace hrg_gyro {
 
-int allanCommand(int argc, char** argv) {
+namespace {
+
+struct AllanOptions {
+  std::string bag, params, csv, plot;
+  bag_tools::GyroTopics topics;
+  core::ProcessorConfig processor;
+};
+
+int runAllan(const AllanOptions& o) {
   using namespace bag_tools;
-  std::vector<std::string> valued{"params", "csv", "plot", "channels-topic"};
-  valued.insert(valued.end(), kProcessorOptions.begin(), kProcessorOptions.end());
-  const Args args(argc, argv, valued, {});
-  if (args.help() || args.positional().size() != 1) {
-    std::cout << "usage: hrg_bag allan BAG [--params P.yaml] [--csv OUT.csv] [--plot OUT.png]\n"
-                 "Processes the bag's channels (with P.yaml, default the nominal model) and computes the\n"
-                 "overlapping Allan deviation of the compensated rate from the integrated angle over its\n"
-                 "longest continuous stretch (no gap or reset). Prints the readings: angle white noise Q\n"
-                 "(slope -1), angle random walk N (slope -1/2, at tau = 1 s), bias instability B (flat\n"
-                 "bottom / 0.664), each with the tau range it was read from, or 'not identified'.\n";
-    return args.help() ? 0 : 2;
-  }
+  checkProcessorConfig(o.processor);
   const auto params = std::make_shared<const core::GyroParameters>(
-      args.has("params") ? core::loadParameterFile(args.get("params")) : core::GyroParameters());
-  const std::unique_ptr<rosbag::Bag> bag = openBag(args.positional()[0]);
-  const GyroTopics topics = findTopics(*bag, args, true, false);
-  core::GyroProcessor processor(processorConfig(args), params);
+      o.params.empty() ? core::GyroParameters() : core::loadParameterFile(o.params));
+  const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
+  const GyroTopics topics = findTopics(*bag, o.topics, true, false);
+  core::GyroProcessor processor(o.processor, params);
   // Continuous stretches of the integrated angle; the longest one is analysed.
   std::vector<double> current, best, dts;
   replayChannels(*bag, topics.channels, processor, [&](const ChannelAmplitudes&, const core::ProcessorResult& r) {
@@ -63,9 +61,9 @@ int allanCommand(int argc, char** argv) {
   reading("angle white noise Q", a.angle_white_noise, 180.0 / M_PI * 3600.0, "arcsec", 1.0, "rad");
   reading("angle random walk N", a.angle_random_walk, 180.0 / M_PI * 60.0, "deg/sqrt(h)", 1.0, "rad/sqrt(s)");
   reading("bias instability B", a.bias_instability, kDegPerHour, "deg/h", 1.0, "rad/s");
-  if (args.has("csv")) {
-    std::ofstream csv(args.get("csv"));
-    if (!csv) throw UsageError("cannot write " + args.get("csv"));
+  if (!o.csv.empty()) {
+    std::ofstream csv(o.csv);
+    if (!csv) throw UsageError("cannot write " + o.csv);
     csv << "tau,deviation,error,clusters\n";
     char line[128];
     for (const core::AllanPoint& p : a.curve) {
@@ -74,13 +72,36 @@ int allanCommand(int argc, char** argv) {
       csv << line;
     }
   }
-  if (args.has("plot")) {
-    if (!args.has("csv")) throw UsageError("--plot needs --csv (the plot is drawn from the CSV)");
-    if (runPlotter({"allan", args.get("csv"), args.get("plot")}) != 0) {
+  if (!o.plot.empty()) {
+    if (runPlotter({"allan", o.csv, o.plot}) != 0) {
       std::cerr << "allan: plotting failed (is python3-matplotlib installed?)\n";
     }
   }
   return 0;
 }
 
+}  // namespace
+
+namespace bag_tools {
+
+Command addAllanCommand(CLI::App& root) {
+  auto o = std::make_shared<AllanOptions>();
+  CLI::App* cmd = root.add_subcommand("allan", "overlapping Allan deviation of the compensated rate");
+  cmd->add_option("BAG", o->bag, "input bag with the gyro's channels (a static session)")->required();
+  cmd->add_option("--params", o->params, "parameter file (default: the nominal model)")->check(tools::notEmpty());
+  CLI::Option* csv = cmd->add_option("--csv", o->csv, "output CSV: tau (s), deviation and its error (rad/s), clusters")
+      ->check(tools::notEmpty());
+  cmd->add_option("--plot", o->plot, "PNG drawn from the CSV")->needs(csv)->check(tools::notEmpty());
+  addTopicOptions(*cmd, &o->topics, false);
+  addProcessorOptions(*cmd, &o->processor);
+  cmd->footer(
+      "Computes the overlapping Allan deviation of the compensated rate from the integrated angle over its\n"
+      "longest continuous stretch (no gap or reset). Prints the readings: angle white noise Q (slope -1),\n"
+      "angle random walk N (slope -1/2, at tau = 1 s), bias instability B (flat bottom / 0.664), each\n"
+      "with the tau range it was read from, or 'not identified'.\n"
+      "Exit 0 success, 2 bad usage, unreadable input or fewer than 100 continuous samples.");
+  return [o] { return runAllan(*o); };
+}
+
+}  // namespace bag_tools
 }  // namespace hrg_gyro

@@ -14,7 +14,9 @@
 
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
+#include "hrg_gyro/core/yaml_field.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "../cli_checks.h"
 
 namespace hrg_gyro {
 namespace bag_tools {
@@ -26,51 +28,13 @@ double now() {
 
 }  // namespace
 
-Args::Args(int argc, char** argv, const std::vector<std::string>& valued, const std::vector<std::string>& flags) {
-  for (int i = 0; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "-h" || a == "--help") {
-      help_ = true;
-    } else if (a.rfind("--", 0) == 0) {
-      const std::string key = a.substr(2);
-      if (std::find(flags.begin(), flags.end(), key) != flags.end()) {
-        flags_[key] = true;
-      } else if (std::find(valued.begin(), valued.end(), key) != valued.end()) {
-        if (i + 1 >= argc) throw UsageError("option --" + key + " needs a value");
-        values_[key] = argv[++i];
-      } else {
-        throw UsageError("unknown option " + a);
-      }
-    } else {
-      positional_.push_back(a);
-    }
-  }
+void addCompressionOption(CLI::App& command, std::string* compression) {
+  command.add_option("--compression", *compression, "chunk compression of the written bag")
+      ->check(CLI::IsMember({"none", "lz4", "bz2"}))
+      ->capture_default_str();
 }
 
-std::string Args::get(const std::string& key, const std::string& fallback) const {
-  const auto it = values_.find(key);
-  return it == values_.end() ? fallback : it->second;
-}
-
-std::string Args::require(const std::string& key) const {
-  if (!has(key)) throw UsageError("option --" + key + " is required");
-  return get(key);
-}
-
-double Args::getDouble(const std::string& key, double fallback) const {
-  if (!has(key)) return fallback;
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(get(key), &used);
-    if (used != get(key).size() || !std::isfinite(v)) throw std::invalid_argument("");
-    return v;
-  } catch (const std::exception&) {
-    throw UsageError("option --" + key + " expects a number, got '" + get(key) + "'");
-  }
-}
-
-std::unique_ptr<rosbag::Bag> createBag(const std::string& path, const Args& args) {
-  const std::string name = args.get("compression", "lz4");
+std::unique_ptr<rosbag::Bag> createBag(const std::string& path, const std::string& name) {
   rosbag::compression::CompressionType type;
   if (name == "none") {
     type = rosbag::compression::Uncompressed;
@@ -111,13 +75,24 @@ std::unique_ptr<rosbag::Bag> openBag(const std::string& path) {
   return bag;
 }
 
-GyroTopics findTopics(const rosbag::Bag& bag, const Args& args, bool need_channels, bool need_turntable) {
+void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_truth) {
+  command.add_option("--channels-topic", chosen->channels,
+                     "hrg_gyro/ChannelAmplitudes topic (default: the only one in the bag)")
+      ->check(tools::notEmpty());
+  if (!turntable_and_truth) return;
+  command.add_option("--turntable-topic", chosen->turntable,
+                     "hrg_gyro/TurntableState topic (default: the only one in the bag)")
+      ->check(tools::notEmpty());
+  command.add_option("--truth-topic", chosen->truth, "hrg_gyro/GroundTruth topic (default: the only one in the bag)")
+      ->check(tools::notEmpty());
+}
+
+GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable) {
   rosbag::View all(bag);
   std::map<std::string, std::string> types;
   for (const rosbag::ConnectionInfo* c : all.getConnections()) types[c->topic] = c->datatype;
-  auto pick = [&](const std::string& option, const std::string& type, bool required) {
-    if (args.has(option)) {
-      const std::string topic = args.get(option);
+  auto pick = [&](const std::string& topic, const std::string& option, const std::string& type, bool required) {
+    if (!topic.empty()) {
       const auto it = types.find(topic);
       if (it == types.end()) throw UsageError("topic " + topic + " (--" + option + ") is not in the bag");
       if (it->second != type) throw UsageError("topic " + topic + " has type " + it->second + ", expected " + type);
@@ -141,9 +116,9 @@ GyroTopics findTopics(const rosbag::Bag& bag, const Args& args, bool need_channe
     return found.front();
   };
   GyroTopics t;
-  t.channels = pick("channels-topic", ros::message_traits::datatype<ChannelAmplitudes>(), need_channels);
-  t.turntable = pick("turntable-topic", ros::message_traits::datatype<TurntableState>(), need_turntable);
-  t.truth = pick("truth-topic", ros::message_traits::datatype<GroundTruth>(), false);
+  t.channels = pick(chosen.channels, "channels-topic", ros::message_traits::datatype<ChannelAmplitudes>(), need_channels);
+  t.turntable = pick(chosen.turntable, "turntable-topic", ros::message_traits::datatype<TurntableState>(), need_turntable);
+  t.truth = pick(chosen.truth, "truth-topic", ros::message_traits::datatype<GroundTruth>(), false);
   return t;
 }
 
@@ -170,18 +145,37 @@ void Progress::finish(std::uint64_t items) {
                static_cast<unsigned long>(items), dt, items / std::max(1e-9, dt));
 }
 
-const std::vector<std::string> kProcessorOptions = {"max-gap", "backward-reset", "max-rate", "min-anisotropy",
-                                                    "min-amplitude", "max-amplitude"};
+void addProcessorOptions(CLI::App& command, core::ProcessorConfig* c) {
+  const std::string group = "Processor limits (the processor node's parameters; same rules)";
+  auto number = [&](const char* name, double* value, const char* meaning) {
+    command.add_option(name, *value, meaning)->transform(tools::finiteNumber())->capture_default_str()->group(group);
+  };
+  number("--max-gap", &c->max_gap, "s, > 0: a forward stamp step above this is a gap, not integrated across");
+  number("--backward-reset", &c->backward_reset, "s, > 0: a backward stamp jump above this resets the angle");
+  number("--max-rate", &c->max_rate, "rad/s, > 0: body rate above which a wave-angle step is a glitch");
+  number("--min-anisotropy", &c->limits.min_anisotropy,
+         "in (0, 1): floor of (A^2 - B^2)/(A^2 + B^2); a rounder wave is rejected");
+  number("--min-amplitude", &c->limits.min_amplitude, "amplitude units, >= 0: smaller wave amplitudes are rejected");
+  number("--max-amplitude", &c->limits.max_amplitude,
+         "amplitude units, > --min-amplitude: larger wave amplitudes are rejected");
+}
 
-core::ProcessorConfig processorConfig(const Args& args) {
-  core::ProcessorConfig c;
-  c.max_gap = args.getDouble("max-gap", c.max_gap);
-  c.backward_reset = args.getDouble("backward-reset", c.backward_reset);
-  c.max_rate = args.getDouble("max-rate", c.max_rate);
-  c.limits.min_anisotropy = args.getDouble("min-anisotropy", c.limits.min_anisotropy);
-  c.limits.min_amplitude = args.getDouble("min-amplitude", c.limits.min_amplitude);
-  c.limits.max_amplitude = args.getDouble("max-amplitude", c.limits.max_amplitude);
-  return c;
+void checkProcessorConfig(const core::ProcessorConfig& config) {
+  try {
+    core::validate(config);
+  } catch (const core::ConfigError& e) {
+    // The core names the node's parameters (max_gap); here they are options (--max-gap).
+    auto option = [](std::string key) {
+      std::replace(key.begin(), key.end(), '_', '-');
+      return "--" + key;
+    };
+    std::string problem = e.problem();
+    for (const char* key : {"min_amplitude", "max_amplitude"}) {
+      const std::size_t at = problem.find(key);
+      if (at != std::string::npos) problem.replace(at, std::string(key).size(), option(key));
+    }
+    throw UsageError(option(e.key()) + ": " + problem);
+  }
 }
 
 std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, core::GyroProcessor& processor,

@@ -1,16 +1,16 @@
-// Shared plumbing of the hrg_bag subcommands: arguments, opening bags with clear errors, finding
+// Shared plumbing of the hrg_bag subcommands: their common options, opening bags with clear errors, finding
 // the gyro topics by type, progress on stderr, and the replay of a bag's channels through the
 // same core::GyroProcessor the processor node runs.
 #pragma once
 
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
@@ -25,36 +25,31 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// "--key value" options, "--flag" switches and positional arguments.
-class Args {
- public:
-  /// `valued` and `flags` list the accepted options (without "--"); anything else is refused.
-  Args(int argc, char** argv, const std::vector<std::string>& valued, const std::vector<std::string>& flags);
-  bool help() const { return help_; }
-  bool has(const std::string& key) const { return values_.count(key) > 0; }
-  std::string get(const std::string& key, const std::string& fallback = "") const;
-  std::string require(const std::string& key) const;
-  double getDouble(const std::string& key, double fallback) const;
-  bool flag(const std::string& name) const { return flags_.count(name) > 0; }
-  const std::vector<std::string>& positional() const { return positional_; }
+/// One subcommand, run after its options have been parsed into the state it holds. Returns the
+/// exit code.
+using Command = std::function<int()>;
 
- private:
-  std::map<std::string, std::string> values_;
-  std::map<std::string, bool> flags_;
-  std::vector<std::string> positional_;
-  bool help_ = false;
-};
+/// The subcommands; each adds itself (options, help) to the hrg_bag command line.
+Command addSimulateCommand(CLI::App& root);
+Command addInfoCommand(CLI::App& root);
+Command addProcessCommand(CLI::App& root);
+Command addCalibrateCommand(CLI::App& root);
+Command addAllanCommand(CLI::App& root);
 
 /// Opens a bag for reading; missing, unindexed, truncated or corrupt files become UsageErrors
 /// that say which.
 std::unique_ptr<rosbag::Bag> openBag(const std::string& path);
 
-/// The topics of the gyro in a bag. Explicit options win; otherwise the single topic of the right
-/// type is taken. Throws UsageError when a required topic is missing, ambiguous or of the wrong type.
+/// The topics of the gyro in a bag (also the --channels-topic, --turntable-topic and --truth-topic
+/// options: empty means "the single topic of the right type").
 struct GyroTopics {
   std::string channels, turntable, truth;
 };
-GyroTopics findTopics(const rosbag::Bag& bag, const Args& args, bool need_channels, bool need_turntable);
+/// Adds --channels-topic and, when asked, --turntable-topic and --truth-topic.
+void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_truth);
+/// Explicit topics win; otherwise the single topic of the right type is taken. Throws UsageError
+/// when a required topic is missing, ambiguous or of the wrong type.
+GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable);
 
 /// Percentage and rate on stderr, at most twice a second.
 class Progress {
@@ -71,13 +66,17 @@ class Progress {
   bool tty_;
 };
 
-/// The processor's limits from command-line options (the node's parameter names and defaults).
-core::ProcessorConfig processorConfig(const Args& args);
-extern const std::vector<std::string> kProcessorOptions;
+/// The processor's limits as options (the node's parameter names with dashes, its defaults):
+/// --max-gap, --backward-reset, --max-rate, --min-anisotropy, --min-amplitude, --max-amplitude.
+void addProcessorOptions(CLI::App& command, core::ProcessorConfig* config);
+/// The node's rules for those limits (core::validate): a refusal is a UsageError naming the option.
+void checkProcessorConfig(const core::ProcessorConfig& config);
 
-/// Opens `path` for writing with the chunk compression named by --compression (none, lz4, bz2;
-/// default lz4: readers then decompress whole chunks instead of seeking for every message).
-std::unique_ptr<rosbag::Bag> createBag(const std::string& path, const Args& args);
+/// --compression none|lz4|bz2 (default lz4: readers then decompress whole chunks instead of
+/// seeking for every message).
+void addCompressionOption(CLI::App& command, std::string* compression);
+/// Opens `path` for writing with that chunk compression.
+std::unique_ptr<rosbag::Bag> createBag(const std::string& path, const std::string& compression);
 
 /// Replays the channels topic of `bag` in record order through `processor`, calling `sink` with
 /// every input message and its result.

@@ -5,6 +5,7 @@
 #include <map>
 #include <memory>
 
+#include "../cli_checks.h"
 #include "bag_tools.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
@@ -14,44 +15,42 @@
 
 namespace hrg_gyro {
 
-int calibrateCommand(int argc, char** argv) {
+namespace {
+
+struct CalibrateOptions {
+  std::string bag, method, params, out, report, plot, config;
+  bag_tools::GyroTopics topics;
+  core::ProcessorConfig processor;
+};
+
+int runCalibrate(const CalibrateOptions& o) {
   using namespace bag_tools;
-  std::vector<std::string> valued{"method", "params", "out", "report", "plot", "config", "channels-topic",
-                                  "turntable-topic", "truth-topic"};
-  valued.insert(valued.end(), kProcessorOptions.begin(), kProcessorOptions.end());
-  const Args args(argc, argv, valued, {});
-  if (args.help() || args.positional().size() != 1) {
-    std::cout << "usage: hrg_bag calibrate BAG --method dual_rate|constant_rate|step|correction_matrix|thermal --out OUT.yaml\n"
-                 "       [--params IN.yaml] [--config SETTINGS.yaml] [--report REPORT.yaml] [--plot OUT.png]\n"
-                 "Processes the bag's channels with IN.yaml (default: the nominal model at latitude 0) and runs\n"
-                 "the calibrator's method with its quality gates on the turntable plateaus. SETTINGS.yaml holds\n"
-                 "calibrator parameters (bins, window, gates/..., thermal/..., as the node's). OUT.yaml is written\n"
-                 "atomically only when every gate passes; thermal writes K and D as splines over the resonator\n"
-                 "frequency (the bag's channels must carry it). Exit 0 accepted, 1 refused, 2 bad input.\n";
-    return args.help() ? 0 : 2;
-  }
+  checkProcessorConfig(o.processor);
   core::CalibrationSettings settings;
-  if (args.has("config")) {
+  if (!o.config.empty()) {
     YAML::Node root;
     try {
-      root = YAML::LoadFile(args.get("config"));
+      root = YAML::LoadFile(o.config);
     } catch (const YAML::Exception& e) {
-      throw UsageError("cannot read --config " + args.get("config") + ": " + e.what());
+      throw UsageError("cannot read --config " + o.config + ": " + e.what());
     }
-    settings = core::CalibrationSettings::parse(core::YamlField(root, ""));
+    try {
+      settings = core::CalibrationSettings::parse(core::YamlField(root, ""));
+    } catch (const core::ConfigError& e) {
+      throw UsageError("--config " + o.config + ": " + e.what());
+    }
   }
-  settings.method = args.get("method", settings.method);
-  if (!core::CalibrationSettings::knownMethod(settings.method)) throw UsageError("unknown --method " + settings.method);
-  const std::string out_path = args.require("out");
+  if (!o.method.empty()) settings.method = o.method;
+  const std::string& out_path = o.out;
   const auto prior = std::make_shared<const core::GyroParameters>(
-      args.has("params") ? core::loadParameterFile(args.get("params")) : core::GyroParameters());
-  const std::unique_ptr<rosbag::Bag> bag = openBag(args.positional()[0]);
-  const GyroTopics topics = findTopics(*bag, args, true, settings.method != "correction_matrix");
+      o.params.empty() ? core::GyroParameters() : core::loadParameterFile(o.params));
+  const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
+  const GyroTopics topics = findTopics(*bag, o.topics, true, settings.method != "correction_matrix");
   if (settings.method == "correction_matrix" && topics.truth.empty()) {
     throw UsageError("the correction matrix needs the generator reference (a GroundTruth topic)");
   }
 
-  core::GyroProcessor processor(processorConfig(args), prior);
+  core::GyroProcessor processor(o.processor, prior);
   core::CalibrationSession session(settings, *prior);
   std::map<core::Nanoseconds, core::ChannelVector> raw;
   std::vector<std::string> wanted{topics.channels};
@@ -91,37 +90,79 @@ int calibrateCommand(int argc, char** argv) {
     throw UsageError(std::string("bag read error (truncated?): ") + e.what());
   }
   progress.finish(n);
-  core::CalibrationOutcome o = session.finish();
-  o.parameters.calibration.source = args.positional()[0];
-  if (args.has("report")) {
-    std::ofstream report(args.get("report"));
-    report << core::emitCalibrationReport(o);
-    if (!report) throw UsageError("cannot write " + args.get("report"));
+  core::CalibrationOutcome outcome = session.finish();
+  outcome.parameters.calibration.source = o.bag;
+  if (!o.report.empty()) {
+    std::ofstream report(o.report);
+    report << core::emitCalibrationReport(outcome);
+    if (!report) throw UsageError("cannot write " + o.report);
   }
-  std::cout << "calibrate: " << o.method << " " << (o.accepted ? "ACCEPTED" : "REFUSED");
-  if (!o.accepted) std::cout << ": " << o.reason;
+  std::cout << "calibrate: " << outcome.method << " " << (outcome.accepted ? "ACCEPTED" : "REFUSED");
+  if (!outcome.accepted) std::cout << ": " << outcome.reason;
   std::cout << "\n";
-  for (const core::GateResult& g : o.gates) {
+  for (const core::GateResult& g : outcome.gates) {
     std::cout << "  " << (g.passed ? "pass" : "FAIL") << "  " << g.name << ": " << g.message << "\n";
   }
-  for (const std::string& note : o.notes) std::cout << "  note: " << note << "\n";
-  for (const core::DefectDiagnosis& d : o.diagnosis) {
+  for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
+  for (const core::DefectDiagnosis& d : outcome.diagnosis) {
     std::cout << "calibrate: root-cause diagnosis (first order, read against the P in force) " << core::describe(d);
   }
-  if (o.accepted) {
-    core::saveParameterFile(out_path, o.parameters);
-    std::cout << "calibrate: wrote " << out_path << " (peak nonlinearity of the new K: " << o.nonlinearity_ppm
+  if (outcome.accepted) {
+    core::saveParameterFile(out_path, outcome.parameters);
+    std::cout << "calibrate: wrote " << out_path << " (peak nonlinearity of the new K: " << outcome.nonlinearity_ppm
               << " ppm)\n";
   } else {
     std::cout << "calibrate: " << out_path << " not written\n";
   }
-  if (args.has("plot")) {
-    if (!args.has("report")) throw UsageError("--plot needs --report (the plot is drawn from the report)");
-    if (runPlotter({"calibration", args.get("report"), args.get("plot")}) != 0) {
+  if (!o.plot.empty()) {
+    if (runPlotter({"calibration", o.report, o.plot}) != 0) {
       std::cerr << "calibrate: plotting failed (is python3-matplotlib installed?)\n";
     }
   }
-  return o.accepted ? 0 : 1;
+  return outcome.accepted ? 0 : 1;
 }
+
+/// --method: the calibrator's methods, checked against the core's list.
+CLI::Validator knownMethod() {
+  return CLI::Validator(
+      [](std::string& m) -> std::string {
+        if (core::CalibrationSettings::knownMethod(m)) return "";
+        return "unknown method '" + m + "' (dual_rate, constant_rate, step, correction_matrix, thermal)";
+      },
+      "");
+}
+
+}  // namespace
+
+namespace bag_tools {
+
+Command addCalibrateCommand(CLI::App& root) {
+  auto o = std::make_shared<CalibrateOptions>();
+  CLI::App* cmd = root.add_subcommand("calibrate", "the calibrator offline, with its quality gates");
+  cmd->add_option("BAG", o->bag, "input bag: channels, turntable state (and the generator reference)")->required();
+  cmd->add_option("--method", o->method,
+                  "dual_rate|constant_rate|step|correction_matrix|thermal (default: --config's, else dual_rate)")
+      ->check(knownMethod());
+  cmd->add_option("--out", o->out, "calibrated parameter file, written atomically only when every gate passes")
+      ->required()
+      ->check(tools::notEmpty());
+  cmd->add_option("--params", o->params, "prior parameter file (default: the nominal model at latitude 0)")
+      ->check(tools::notEmpty());
+  cmd->add_option("--config", o->config, "calibrator settings (YAML: bins, window, gates/..., thermal/..., as the node's)")
+      ->check(tools::notEmpty());
+  CLI::Option* report = cmd->add_option("--report", o->report, "calibration report (YAML), written either way")
+      ->check(tools::notEmpty());
+  cmd->add_option("--plot", o->plot, "PNG drawn from the report")->needs(report)->check(tools::notEmpty());
+  addTopicOptions(*cmd, &o->topics, true);
+  addProcessorOptions(*cmd, &o->processor);
+  cmd->footer(
+      "Processes the bag's channels with the prior parameters and runs the calibrator's method with its\n"
+      "quality gates on the turntable plateaus. Thermal writes K and D as splines over the resonator\n"
+      "frequency (the bag's channels must carry it).\n"
+      "Exit 0 accepted, 1 refused by a gate, 2 bad usage or unreadable input.");
+  return [o] { return runCalibrate(*o); };
+}
+
+}  // namespace bag_tools
 
 }  // namespace hrg_gyro

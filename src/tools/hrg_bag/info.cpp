@@ -7,6 +7,7 @@
 #include <map>
 #include <vector>
 
+#include "../cli_checks.h"
 #include "bag_tools.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
@@ -56,36 +57,32 @@ StampStats scan(const rosbag::Bag& bag, const std::string& topic) {
   return s;
 }
 
-}  // namespace
+struct InfoOptions {
+  std::string bag;
+  bag_tools::GyroTopics topics;
+  double gap_factor = 3.0;
+};
 
-int infoCommand(int argc, char** argv) {
+int runInfo(const InfoOptions& o) {
   using namespace bag_tools;
-  const Args args(argc, argv, {"channels-topic", "turntable-topic", "truth-topic", "gap"}, {});
-  if (args.help() || args.positional().size() != 1) {
-    std::cout << "usage: hrg_bag info BAG [--channels-topic T] [--turntable-topic T] [--truth-topic T] [--gap FACTOR]\n"
-                 "Validates a gyro bag: topics and types, counts, rates and dt histogram, gaps (dt above FACTOR x\n"
-                 "the median, default 3), stamp order, lost sequence numbers, header vs record time.\n"
-                 "Exit 1 when the bag cannot be processed as it is (no channels, bad stamps), 0 otherwise.\n";
-    return args.help() ? 0 : 2;
-  }
-  const std::unique_ptr<rosbag::Bag> bag = openBag(args.positional()[0]);
+  const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
   rosbag::View all(*bag);
   std::map<std::string, std::pair<std::string, std::uint64_t>> topics;
   for (const rosbag::ConnectionInfo* c : all.getConnections()) topics[c->topic].first = c->datatype;
   for (const auto& kv : topics) topics[kv.first].second = rosbag::View(*bag, rosbag::TopicQuery(kv.first)).size();
-  std::printf("bag %s: %.3f s, %u messages\n", args.positional()[0].c_str(),
+  std::printf("bag %s: %.3f s, %u messages\n", o.bag.c_str(),
               (all.getEndTime() - all.getBeginTime()).toSec(), all.size());
   for (const auto& kv : topics) std::printf("  %-28s %-34s %10lu\n", kv.first.c_str(), kv.second.first.c_str(),
                                             static_cast<unsigned long>(kv.second.second));
   int errors = 0, warnings = 0;
   GyroTopics t;
   try {
-    t = findTopics(*bag, args, true, false);
+    t = findTopics(*bag, o.topics, true, false);
   } catch (const UsageError& e) {
     std::printf("ERROR: %s\n", e.what());
     return 1;
   }
-  const double gap_factor = args.getDouble("gap", 3.0);
+  const double gap_factor = o.gap_factor;
   auto report = [&](const std::string& name, const StampStats& s, bool required) {
     std::printf("%s (%s): %lu messages\n", name.c_str(), name.c_str(), static_cast<unsigned long>(s.count));
     if (s.dts.empty()) {
@@ -139,4 +136,26 @@ int infoCommand(int argc, char** argv) {
   return errors ? 1 : 0;
 }
 
+}  // namespace
+
+namespace bag_tools {
+
+Command addInfoCommand(CLI::App& root) {
+  auto o = std::make_shared<InfoOptions>();
+  CLI::App* cmd = root.add_subcommand("info", "is this a usable gyro bag? rates, gaps, stamp order, losses");
+  cmd->add_option("BAG", o->bag, "the bag to validate")->required();
+  addTopicOptions(*cmd, &o->topics, true);
+  cmd->add_option("--gap", o->gap_factor, "> 1: a stamp step above this many median steps counts as a gap")
+      ->transform(tools::finiteNumber())
+      ->check(tools::above(1.0))
+      ->capture_default_str();
+  cmd->footer(
+      "Validates a gyro bag: topics and types, counts, rates and dt histogram, gaps, stamp order, lost\n"
+      "sequence numbers, header vs record time.\n"
+      "Exit 0 usable, 1 when the bag cannot be processed as it is (no channels, bad stamps),\n"
+      "2 bad usage or unreadable bag.");
+  return [o] { return runInfo(*o); };
+}
+
+}  // namespace bag_tools
 }  // namespace hrg_gyro

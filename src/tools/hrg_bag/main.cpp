@@ -1,57 +1,47 @@
-// hrg_bag: recorded gyro sessions without a ROS master. One executable, one subcommand per job.
-#include <cstring>
+// hrg_bag: recorded gyro sessions without a ROS master. One executable, one subcommand per job;
+// the command line (CLI11) and its --help come from the same option definitions.
 #include <iostream>
+#include <map>
 #include <string>
 
+#include "../cli_checks.h"
 #include "bag_tools.h"
 #include "hrg_gyro/core/yaml_field.h"
 
-namespace hrg_gyro {
-int simulateCommand(int argc, char** argv);
-int infoCommand(int argc, char** argv);
-int processCommand(int argc, char** argv);
-int calibrateCommand(int argc, char** argv);
-int allanCommand(int argc, char** argv);
-}  // namespace hrg_gyro
-
-namespace {
-
-void usage(std::ostream& out) {
-  out << "usage: hrg_bag <command> [options]   (hrg_bag <command> --help for each)\n"
-         "  simulate   --scenario FILE.yaml --out OUT.bag [--seed N]      the simulator into a bag\n"
-         "  info       BAG                                                validate a gyro bag\n"
-         "  process    BAG --params P.yaml [--out OUT.bag] [--csv OUT.csv] the processor offline\n"
-         "  calibrate  BAG --method M [--params IN.yaml] --out OUT.yaml    the calibrator offline\n"
-         "             [--report REPORT.yaml] [--plot OUT.png]\n"
-         "  allan      BAG [--params P.yaml] [--csv OUT.csv] [--plot OUT.png]  Allan deviation\n"
-         "Exit codes: 0 success, 1 refused or invalid data, 2 bad usage or unreadable input.\n";
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
-  if (argc < 2 || !std::strcmp(argv[1], "-h") || !std::strcmp(argv[1], "--help")) {
-    usage(std::cout);
-    return argc < 2 ? 2 : 0;
+  using namespace hrg_gyro::bag_tools;
+  CLI::App app("Recorded gyro sessions without a ROS master (hrg_bag <command> --help for each).", "hrg_bag");
+  app.get_formatter()->label("Usage", "usage");
+  app.get_formatter()->column_width(34);
+  app.footer("Exit codes: 0 success, 1 refused or invalid data, 2 bad usage or unreadable input.");
+  app.require_subcommand(1);
+  const std::map<std::string, Command> commands = {
+      {"simulate", addSimulateCommand(app)},   {"info", addInfoCommand(app)}, {"process", addProcessCommand(app)},
+      {"calibrate", addCalibrateCommand(app)}, {"allan", addAllanCommand(app)},
+  };
+  if (argc < 2) {
+    std::cerr << app.help();
+    return 2;
   }
-  const std::string command = argv[1];
+  if (argv[1][0] != '-' && commands.count(argv[1]) == 0) {
+    // CLI11 would only say that a subcommand is required; name what was typed instead.
+    std::cerr << "hrg_bag: unknown command '" << argv[1] << "'\n" << app.help();
+    return 2;
+  }
+  const int parsed = hrg_gyro::tools::parseCommandLine(app, argc, argv);
+  if (parsed >= 0) return parsed;
+  std::string name;
+  for (const auto& kv : commands) {
+    if (app.got_subcommand(kv.first)) name = kv.first;
+  }
   try {
-    if (command == "simulate") return hrg_gyro::simulateCommand(argc - 2, argv + 2);
-    if (command == "info") return hrg_gyro::infoCommand(argc - 2, argv + 2);
-    if (command == "process") return hrg_gyro::processCommand(argc - 2, argv + 2);
-    if (command == "calibrate") return hrg_gyro::calibrateCommand(argc - 2, argv + 2);
-    if (command == "allan") return hrg_gyro::allanCommand(argc - 2, argv + 2);
-    std::cerr << "hrg_bag: unknown command '" << command << "'\n";
-    usage(std::cerr);
-    return 2;
-  } catch (const hrg_gyro::bag_tools::UsageError& e) {
-    std::cerr << "hrg_bag " << command << ": " << e.what() << "\n";
-    return 2;
+    return commands.at(name)();
+  } catch (const UsageError& e) {
+    std::cerr << "hrg_bag " << name << ": " << e.what() << "\n";
   } catch (const hrg_gyro::core::ConfigError& e) {
-    std::cerr << "hrg_bag " << command << ": " << e.what() << "\n";
-    return 2;
+    std::cerr << "hrg_bag " << name << ": " << e.what() << "\n";
   } catch (const std::exception& e) {
-    std::cerr << "hrg_bag " << command << ": " << e.what() << "\n";
-    return 2;
+    std::cerr << "hrg_bag " << name << ": " << e.what() << "\n";
   }
+  return 2;
 }

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <memory>
 
+#include "../cli_checks.h"
 #include "bag_tools.h"
 #include "hrg_gyro/core/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
@@ -67,41 +68,33 @@ class CsvRow {
   bool first_ = true;
 };
 
-}  // namespace
+struct ProcessOptions {
+  std::string bag, params, out, csv, frame_id = "gyro_link", compression = "lz4";
+  bag_tools::GyroTopics topics;
+  core::ProcessorConfig processor;
+};
 
-int processCommand(int argc, char** argv) {
+int runProcess(const ProcessOptions& o) {
   using namespace bag_tools;
-  std::vector<std::string> valued{"params", "out", "csv", "channels-topic", "frame-id", "compression"};
-  valued.insert(valued.end(), kProcessorOptions.begin(), kProcessorOptions.end());
-  const Args args(argc, argv, valued, {});
-  if (args.help() || args.positional().size() != 1) {
-    std::cout << "usage: hrg_bag process BAG --params P.yaml [--out OUT.bag] [--csv OUT.csv] [--channels-topic T]\n"
-                 "       [--frame-id ID] [--max-gap S] [--backward-reset S] [--max-rate R] [--min-anisotropy X]\n"
-                 "       [--min-amplitude A] [--max-amplitude A] [--compression lz4|bz2|none]\n"
-                 "Runs the processor on the bag's channels: OUT.bag gets /wave and /output (recorded at the\n"
-                 "input's record time), OUT.csv one row per input sample with its verdict (numbers in the shortest\n"
-                 "form that reads back exactly). With neither, only the summary (a dry run).\n";
-    return args.help() ? 0 : 2;
-  }
-  const auto params = std::make_shared<const core::GyroParameters>(core::loadParameterFile(args.require("params")));
-  const std::unique_ptr<rosbag::Bag> in = openBag(args.positional()[0]);
-  const GyroTopics topics = findTopics(*in, args, true, false);
+  checkProcessorConfig(o.processor);
+  const auto params = std::make_shared<const core::GyroParameters>(core::loadParameterFile(o.params));
+  const std::unique_ptr<rosbag::Bag> in = openBag(o.bag);
+  const GyroTopics topics = findTopics(*in, o.topics, true, false);
   std::unique_ptr<rosbag::Bag> out;
-  if (args.has("out")) out = createBag(args.get("out"), args);
+  if (!o.out.empty()) out = createBag(o.out, o.compression);
   std::ofstream csv;
-  if (args.has("csv")) {
-    csv.open(args.get("csv"));
-    if (!csv) throw UsageError("cannot write " + args.get("csv"));
+  if (!o.csv.empty()) {
+    csv.open(o.csv);
+    if (!csv) throw UsageError("cannot write " + o.csv);
     csv << "stamp,seq,status,dt,dtheta,dalpha,dalpha_earth_fixed,alpha,rate,theta_mid,frequency,scale_factor,drift,"
            "rejected_before,flags,theta,amplitude,quadrature,phase\n";
   }
-  const std::string frame = args.get("frame-id", "gyro_link");
-  core::GyroProcessor processor(processorConfig(args), params);
+    core::GyroProcessor processor(o.processor, params);
   std::uint64_t outputs = 0;
   CsvRow row;
   std::string csv_buffer;
   replayChannels(*in, topics.channels, processor, [&](const ChannelAmplitudes& msg, const core::ProcessorResult& r) {
-    const WaveState wave = toWaveMessage(msg, r.wave, frame);
+    const WaveState wave = toWaveMessage(msg, r.wave, o.frame_id);
     const GyroOutput output = toOutputMessage(wave.header, r);
     if (out && r.has_wave) out->write("/wave", msg.header.stamp, wave);
     if (out && r.has_output) out->write("/output", msg.header.stamp, output);
@@ -144,13 +137,48 @@ int processCommand(int argc, char** argv) {
   if (csv.is_open()) {
     csv << csv_buffer;
     csv.close();
-    if (!csv) throw UsageError("error writing " + args.get("csv"));
+    if (!csv) throw UsageError("error writing " + o.csv);
   }
   if (out) out->close();
   const core::ProcessorCounters& c = processor.counters();
   std::cerr << "process: " << c.received << " samples, " << outputs << " outputs, " << c.rejected()
             << " rejected, " << c.gaps << " gaps, " << c.resets << " resets\n";
+  if (c.accepted == 0) {
+    // Nothing usable: an output file of rejections only is not a successful run.
+    std::cerr << "process: no sample accepted (" << c.non_finite << " non-finite, " << c.no_signal << " no signal, "
+              << c.degenerate << " degenerate, " << c.amplitude_out_of_range << " amplitude out of range, "
+              << c.zero_stamp << " zero stamp, " << c.duplicate << " duplicate, " << c.out_of_order
+              << " out of order, " << c.jumps << " jumps)\n";
+    return 1;
+  }
   return 0;
 }
+
+}  // namespace
+
+namespace bag_tools {
+
+Command addProcessCommand(CLI::App& root) {
+  auto o = std::make_shared<ProcessOptions>();
+  CLI::App* cmd = root.add_subcommand("process", "the processor offline: /wave and /output into a bag, or a CSV");
+  cmd->add_option("BAG", o->bag, "input bag with the gyro's channels")->required();
+  cmd->add_option("--params", o->params, "parameter file (YAML) of the gyro, as the processor node's")->required();
+  cmd->add_option("--out", o->out, "output bag: /wave and /output, recorded at the input's record time")
+      ->check(tools::notEmpty());
+  cmd->add_option("--csv", o->csv, "output CSV: one row per input sample with its verdict")->check(tools::notEmpty());
+  cmd->add_option("--frame-id", o->frame_id, "frame_id of the written messages")
+      ->check(tools::notEmpty())
+      ->capture_default_str();
+  addCompressionOption(*cmd, &o->compression);
+  addTopicOptions(*cmd, &o->topics, false);
+  addProcessorOptions(*cmd, &o->processor);
+  cmd->footer(
+      "Runs the processor on the bag's channels. Numbers in the CSV are in the shortest form that reads\n"
+      "back exactly. With neither --out nor --csv, only the summary (a dry run).\n"
+      "Exit 0 success, 1 when no sample was accepted, 2 bad usage or unreadable input.");
+  return [o] { return runProcess(*o); };
+}
+
+}  // namespace bag_tools
 
 }  // namespace hrg_gyro

@@ -1,33 +1,28 @@
 // hrg_bag simulate: the simulator without a master, straight into a bag, as fast as it runs.
 #include <iostream>
 
+#include "../cli_checks.h"
 #include "bag_tools.h"
 #include "hrg_gyro/core/gyro_simulator.h"
 #include "hrg_gyro/ros/conversions.h"
 
 namespace hrg_gyro {
 
-int simulateCommand(int argc, char** argv) {
+namespace {
+
+struct SimulateOptions {
+  std::string scenario, out, frame_id = "gyro_link", compression = "lz4";
+  std::uint64_t seed = 0;
+  CLI::Option* seed_option = nullptr;
+  bool no_truth = false;
+};
+
+int runSimulate(const SimulateOptions& o) {
   using namespace bag_tools;
-  const Args args(argc, argv, {"scenario", "out", "seed", "frame-id", "compression"}, {"no-truth"});
-  if (args.help()) {
-    std::cout << "usage: hrg_bag simulate --scenario FILE.yaml --out OUT.bag [--seed N] [--frame-id ID] [--no-truth]\n"
-                 "       [--compression lz4|bz2|none]\n"
-                 "Runs the simulated gyro of a scenario (the driver_sim parameters) and writes /channels,\n"
-                 "/turntable/state and /truth (unless --no-truth), stamped and recorded at simulated time. Chunks are LZ4-compressed\n"
-                 "by default (several times faster to read back; every rosbag reader handles it).\n";
-    return 0;
-  }
-  core::SimulationConfig config =
-      core::SimulationConfig::load(args.require("scenario"), core::nodeOnlyScenarioKeys());
-  if (args.has("seed")) {
-    const double seed = args.getDouble("seed", 0.0);
-    if (seed < 0 || seed != std::floor(seed)) throw UsageError("--seed must be a non-negative integer");
-    config.seed = static_cast<std::uint64_t>(seed);
-  }
-  const std::string frame = args.get("frame-id", "gyro_link");
-  const bool truth = !args.flag("no-truth");
-  const std::unique_ptr<rosbag::Bag> out = createBag(args.require("out"), args);
+  core::SimulationConfig config = core::SimulationConfig::load(o.scenario, core::nodeOnlyScenarioKeys());
+  if (*o.seed_option) config.seed = o.seed;
+  const bool truth = !o.no_truth;
+  const std::unique_ptr<rosbag::Bag> out = createBag(o.out, o.compression);
   rosbag::Bag& bag = *out;
   core::GyroSimulator sim(config);
   Progress progress("simulate", sim.duration());
@@ -35,7 +30,7 @@ int simulateCommand(int argc, char** argv) {
   std::uint32_t seq = 0;
   while (sim.next(&s)) {
     const ros::Time stamp = toRosTime(s.stamp);
-    const ChannelAmplitudes ch = toChannelsMessage(s, stamp, seq++, frame);
+    const ChannelAmplitudes ch = toChannelsMessage(s, stamp, seq++, o.frame_id);
     bag.write("/channels", stamp, ch);
     bag.write("/turntable/state", stamp, toTurntableMessage(s, ch.header));
     if (truth) bag.write("/truth", stamp, toTruthMessage(s, ch.header));
@@ -43,8 +38,33 @@ int simulateCommand(int argc, char** argv) {
   }
   bag.close();
   progress.finish(seq);
-  std::cerr << "simulate: " << sim.elapsed() << " s of session written to " << args.get("out") << "\n";
+  std::cerr << "simulate: " << sim.elapsed() << " s of session written to " << o.out << "\n";
   return 0;
 }
 
+}  // namespace
+
+namespace bag_tools {
+
+Command addSimulateCommand(CLI::App& root) {
+  auto o = std::make_shared<SimulateOptions>();
+  CLI::App* cmd = root.add_subcommand("simulate", "the simulator without a master, straight into a bag");
+  cmd->add_option("--scenario", o->scenario, "scenario file (YAML, the driver_sim parameters)")->required();
+  cmd->add_option("--out", o->out, "output bag")->required()->check(tools::notEmpty());
+  o->seed_option = cmd->add_option("--seed", o->seed, "noise seed, a whole number >= 0 (default: the scenario's)")
+                       ->transform(tools::unsignedWholeNumber());
+  cmd->add_option("--frame-id", o->frame_id, "frame_id of the written messages")
+      ->check(tools::notEmpty())
+      ->capture_default_str();
+  cmd->add_flag("--no-truth", o->no_truth, "do not write /truth");
+  addCompressionOption(*cmd, &o->compression);
+  cmd->footer(
+      "Runs the simulated gyro of a scenario and writes /channels, /turntable/state and /truth (unless\n"
+      "--no-truth), stamped and recorded at simulated time, as fast as it runs. Chunks are LZ4-compressed\n"
+      "by default (several times faster to read back; every rosbag reader handles it).\n"
+      "Exit 0 success, 2 bad usage or unreadable scenario.");
+  return [o] { return runSimulate(*o); };
+}
+
+}  // namespace bag_tools
 }  // namespace hrg_gyro
