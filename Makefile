@@ -34,6 +34,8 @@ build: deps
 test: build
 	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) tests
 	cd $(WS) && source devel/setup.bash && catkin_make $(CATKIN_ARGS) -j1 run_tests
+	@# The package as a user installs it (fresh prefix, only the install space sourced) and catkin_lint.
+	bash $(ROOT)/test/install_space/run.sh $(WS)
 	cd $(WS) && catkin_test_results build/test_results
 
 run: build
