@@ -1,0 +1,71 @@
+#!/usr/bin/env python3
+"""~capture_bias: at rest, D0 is refreshed so that the output averages the vertical Earth rate
+of the model's latitude, the file is rewritten with a backup and the new model is published;
+while the table turns, the capture is refused and nothing changes."""
+import math
+import os
+import sys
+import unittest
+
+import rospy
+import rostest
+import yaml
+from std_srvs.srv import Trigger
+
+from hrg_gyro.msg import GyroOutput, ModelInfo, TurntableState
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import hrg_test_util as util  # noqa: E402
+
+EARTH = 7.2921150e-5 * math.sin(0.9)  # the parameter file's latitude
+
+
+class BiasCapture(unittest.TestCase):
+    def mean_rate(self, out, seconds):
+        """Mean output rate over the next `seconds` of sim time."""
+        start = rospy.get_time()
+        first = out.count
+        util.wait_for(lambda: rospy.get_time() > start + seconds, 60, "%.0f s of sim time" % seconds)
+        msgs = out.all[first:]
+        return sum(m.dalpha for m in msgs) / sum(m.dt for m in msgs)
+
+    def test_capture_at_rest_then_refused_while_turning(self):
+        path = rospy.get_param("~parameter_file")
+        out = util.Latest("/gyro/output", GyroOutput, keep_all=True)
+        models = util.Latest("/gyro/processor/model", ModelInfo, keep_all=True)
+        table = util.Latest("/gyro/turntable/state", TurntableState)
+        util.wait_for(lambda: out.count > 100 and models.count >= 1, 60, "outputs")
+        before = self.mean_rate(out, 3.0)
+        self.assertGreater(abs(before - EARTH), 5e-6, "the uncalibrated D0 should leave a visible bias")
+
+        rospy.wait_for_service("/gyro/processor/capture_bias", timeout=10)
+        capture = rospy.ServiceProxy("/gyro/processor/capture_bias", Trigger)
+        r = capture()
+        self.assertTrue(r.success, r.message)
+        self.assertIn("D0", r.message)
+        self.assertIn("written to", r.message)
+        after = self.mean_rate(out, 5.0)
+        self.assertLess(abs(after - EARTH), 1e-6, "mean rate %.3e rad/s, Earth %.3e" % (after, EARTH))
+        util.wait_for(lambda: models.count >= 2, 10, "the new model on ~model")
+        with open(path) as f:
+            written = yaml.safe_load(f)
+        self.assertNotEqual(written["drift"]["mean"], 0.0)
+        self.assertIn("bias capture", written["calibration"]["notes"])
+        self.assertTrue(os.path.exists(path + ".bak"))
+        with open(path + ".bak") as f:
+            self.assertEqual(yaml.safe_load(f)["drift"]["mean"], 0.0)
+
+        # Now the table turns: the capture is refused and the file stays as it is.
+        util.wait_for(lambda: table.msg and abs(table.msg.rate) > 0.04, 60, "the table to turn")
+        with open(path) as f:
+            text = f.read()
+        r = capture()
+        self.assertFalse(r.success, r.message)
+        self.assertIn("refused", r.message)
+        with open(path) as f:
+            self.assertEqual(f.read(), text)
+
+
+if __name__ == "__main__":
+    rospy.init_node("bias_capture_test")
+    rostest.rosrun("hrg_gyro", "bias_capture", BiasCapture)
