@@ -1,6 +1,7 @@
 // Google Benchmark suites of the ROS-free core: the per-sample pipeline and its parts, the fits,
 // and the simulator's real-time factor. `make bench` runs them (Release build) and writes JSON.
 #include <benchmark/benchmark.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <memory>
@@ -180,10 +181,23 @@ void BM_CorrectionMatrixFit(benchmark::State& state) {
 }
 BENCHMARK(BM_CorrectionMatrixFit)->Arg(24)->Arg(1000);
 
+// The shipped scenario: beside an installed benchmark (lib/hrg_gyro -> share/hrg_gyro/config), else
+// in the source tree it was built from.
+std::string scenarioPath(const std::string& name) {
+  char self[4096];
+  const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
+  if (n > 0) {
+    std::string dir(self, static_cast<std::size_t>(n));
+    dir.erase(dir.find_last_of('/'));
+    const std::string installed = dir + "/../../share/hrg_gyro/config/scenarios/" + name;
+    if (::access(installed.c_str(), R_OK) == 0) return installed;
+  }
+  return std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/" + name;
+}
+
 // Real-time factor of the signal-level simulator: simulated seconds per wall second (counter rtf).
 void BM_SimulatorRealTimeFactor(benchmark::State& state) {
-  SimulationConfig config = SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/dual_rate.yaml",
-                                                   nodeOnlyScenarioKeys());
+  SimulationConfig config = SimulationConfig::load(scenarioPath("dual_rate.yaml"), nodeOnlyScenarioKeys());
   config.resonator.frequency = 5000.0;
   config.resonator.samples_per_period = 32;
   config.resonator.periods_per_output = static_cast<int>(state.range(0));  // 5: 1 kHz output
