@@ -4,6 +4,7 @@ of the model's latitude, the file is rewritten with a backup and the new model i
 while the table turns, the capture is refused and nothing changes."""
 import math
 import os
+import shutil
 import sys
 import unittest
 
@@ -22,21 +23,28 @@ EARTH = 7.2921150e-5 * math.sin(0.9)  # the parameter file's latitude
 
 class BiasCapture(unittest.TestCase):
     def mean_rate(self, out, seconds):
-        """Mean output rate over the next `seconds` of sim time."""
+        """Mean output rate over the next `seconds` of sim time, from the integrated angle alpha of the
+        first and last outputs (exact whatever this subscriber may have missed in between)."""
         start = rospy.get_time()
         first = out.count
         util.wait_for(lambda: rospy.get_time() > start + seconds, 60, "%.0f s of sim time" % seconds)
-        msgs = out.all[first:]
-        return sum(m.dalpha for m in msgs) / sum(m.dt for m in msgs)
+        a, b = out.all[first], out.all[-1]
+        return (b.alpha - a.alpha) / (b.header.stamp - a.header.stamp).to_sec()
 
     def test_capture_at_rest_then_refused_while_turning(self):
         path = rospy.get_param("~parameter_file")
+        # Start from the uncalibrated model whatever an earlier run left in the work directory.
+        shutil.copy(rospy.get_param("~template"), path)
+        rospy.wait_for_service("/gyro/processor/reload", timeout=30)
+        self.assertTrue(rospy.ServiceProxy("/gyro/processor/reload", Trigger)().success)
         out = util.Latest("/gyro/output", GyroOutput, keep_all=True)
         models = util.Latest("/gyro/processor/model", ModelInfo, keep_all=True)
         table = util.Latest("/gyro/turntable/state", TurntableState)
         util.wait_for(lambda: out.count > 100 and models.count >= 1, 60, "outputs")
-        before = self.mean_rate(out, 3.0)
-        self.assertGreater(abs(before - EARTH), 5e-6, "the uncalibrated D0 should leave a visible bias")
+        # The simulated gyro's white angle noise (about 9e-6 rad per output) leaves sqrt(2) 9e-6 / T on
+        # a mean rate over T seconds: 1.3e-6 rad/s over 10 s, 6e-7 over 20 s (capture and check alike).
+        before = self.mean_rate(out, 10.0)
+        self.assertGreater(abs(before - EARTH), 2e-5, "the uncalibrated D0 should leave a visible bias")
 
         rospy.wait_for_service("/gyro/processor/capture_bias", timeout=10)
         capture = rospy.ServiceProxy("/gyro/processor/capture_bias", Trigger)
@@ -44,8 +52,9 @@ class BiasCapture(unittest.TestCase):
         self.assertTrue(r.success, r.message)
         self.assertIn("D0", r.message)
         self.assertIn("written to", r.message)
-        after = self.mean_rate(out, 5.0)
-        self.assertLess(abs(after - EARTH), 1e-6, "mean rate %.3e rad/s, Earth %.3e" % (after, EARTH))
+        after = self.mean_rate(out, 20.0)
+        self.assertLess(abs(after - EARTH), 4e-6, "mean rate %.3e rad/s, Earth %.3e (before %.3e)" % (after, EARTH, before))
+        rospy.loginfo("bias capture: mean rate before %.4e, after %.4e rad/s, Earth %.4e", before, after, EARTH)
         util.wait_for(lambda: models.count >= 2, 10, "the new model on ~model")
         with open(path) as f:
             written = yaml.safe_load(f)
