@@ -145,6 +145,17 @@ TEST(CalibrationMethodKind, ParameterTemplateAndDocsListEveryMethod) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(yaml, m, std::regex(R"(\nmethod:[^#\n]*#([^\n]*))")));
   expectEveryMethodNamed(m[1].str(), "config/calibrator.yaml (method comment)");
+  // The calibrator's parameter table and the command lines of the offline tools.
+  const std::string ros_api = readSourceFile("docs/ros_api.md");
+  ASSERT_TRUE(std::regex_search(ros_api, m, std::regex(R"(\n\| `method` \|[^\n]*)")));
+  expectEveryMethodNamed(m[0].str(), "docs/ros_api.md (method parameter)");
+  const std::string sessions = readSourceFile("docs/recorded_sessions.md");
+  for (const char* tool : {"hrg_bag calibrate BAG --method", "[--method "}) {
+    const std::size_t at = sessions.find(tool);
+    ASSERT_NE(at, std::string::npos) << tool;
+    expectEveryMethodNamed(sessions.substr(at, sessions.find('\n', at) - at),
+                           std::string("docs/recorded_sessions.md: ") + tool);
+  }
   // docs/calibration.md: one row of the method table per method.
   const std::string doc = readSourceFile("docs/calibration.md");
   for (CalibrationMethodKind k : allCalibrationMethods()) {
