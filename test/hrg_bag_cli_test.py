@@ -7,6 +7,7 @@ import csv
 import filecmp
 import math
 import os
+import re
 import shutil
 import subprocess
 import unittest
@@ -279,6 +280,19 @@ class HrgBagCli(unittest.TestCase):
         self.assertFalse(os.path.exists(self.path("bad_args.bag")), "a refused simulate writes nothing")
         self.assertFalse(os.path.exists(self.path("bad_args.csv")), "a refused process writes nothing")
         self.assertFalse(os.path.exists(self.path("bad_args.yaml")), "a refused calibrate writes nothing")
+
+    def test_every_tool_lists_the_core_methods_in_its_help(self):
+        # The refusal of an unknown method prints the core's one list; each --help names all of it.
+        common = ["--calibration", self.params, "--verification", self.params, "--params", self.params]
+        for tool, refused, helped in (
+                ("hrg_bag calibrate", hrg_bag("calibrate", self.short, "--out", self.path("m.yaml"), "--method", "x"),
+                 hrg_bag("calibrate", "--help")),
+                ("hrg_session", run(HRG_SESSION, *(common + ["--method", "x"])), run(HRG_SESSION, "--help"))):
+            match = re.search(r"unknown method 'x' \(([a-z_, ]+)\)", refused[2])
+            self.assertTrue(match, "%s: %s" % (tool, refused[2]))
+            methods = match.group(1).split(", ")
+            self.assertEqual(len(methods), 5, methods)
+            self.assertIn("|".join(methods), helped[1], tool)
 
     def test_calibrate_config_errors_name_the_file_and_key(self):
         config = self.path("bad_settings.yaml")

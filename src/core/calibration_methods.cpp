@@ -48,7 +48,7 @@ void finishModel(CalibrationOutcome* o, const HarmonicFitResult& k, const Harmon
   o->parameters = prior;
   o->parameters.scale_factor = k_model;
   o->parameters.drift = toModel(d);
-  o->parameters.calibration.method = o->method;
+  o->parameters.calibration.method = ParameterOrigin::calibratedBy(o->method);
   o->parameters.calibration.time = utcNow();
   o->decide();
 }
@@ -68,12 +68,19 @@ GroupSummary summarize(const RateGroup& g, double min_bin_time) {
 
 std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettings& s, const GyroParameters& prior) {
   const double k0 = std::abs(prior.scale_factor.meanAt(NAN));
-  if (s.method == "dual_rate") return std::make_unique<DualRateMethod>(s, k0);
-  if (s.method == "constant_rate") return std::make_unique<ConstantRateMethod>(s, k0);
-  if (s.method == "step") return std::make_unique<StepMethod>(s);
-  if (s.method == "correction_matrix") return std::make_unique<CorrectionMatrixMethod>(s);
-  if (s.method == "thermal") return std::make_unique<ThermalMethod>(s, k0);
-  throw std::invalid_argument("unknown calibration method '" + s.method + "'");
+  switch (s.method) {
+    case CalibrationMethodKind::kDualRate:
+      return std::make_unique<DualRateMethod>(s, k0);
+    case CalibrationMethodKind::kConstantRate:
+      return std::make_unique<ConstantRateMethod>(s, k0);
+    case CalibrationMethodKind::kStep:
+      return std::make_unique<StepMethod>(s);
+    case CalibrationMethodKind::kCorrectionMatrix:
+      return std::make_unique<CorrectionMatrixMethod>(s);
+    case CalibrationMethodKind::kThermal:
+      return std::make_unique<ThermalMethod>(s, k0);
+  }
+  throw std::invalid_argument("calibration method out of range");
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -110,7 +117,7 @@ CalibrationProgress DualRateMethod::progress() const {
 
 CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
   CalibrationOutcome o;
-  o.method = name();
+  o.method = kind();
   const QualityLimits& q = settings_.gates;
   const auto order = groups_.byDuration();
   for (std::size_t i : order) o.plateaus.push_back(summarize(groups_.groups()[i], minBinTime()));
@@ -200,7 +207,7 @@ CalibrationProgress ConstantRateMethod::progress() const {
 
 CalibrationOutcome ConstantRateMethod::finish(const GyroParameters& prior) const {
   CalibrationOutcome o;
-  o.method = name();
+  o.method = kind();
   const QualityLimits& q = settings_.gates;
   o.samples = samples_;
   o.gate("samples", samples_ >= q.min_samples, static_cast<double>(samples_), static_cast<double>(q.min_samples),
@@ -354,7 +361,7 @@ CalibrationOutcome StepMethod::finish(const GyroParameters& prior) const {
   StepMethod m = *this;
   m.closeDwell();
   CalibrationOutcome o;
-  o.method = name();
+  o.method = kind();
   const QualityLimits& q = settings_.gates;
   o.samples = m.samples_;
   o.duration = m.dwell_time_ + m.step_time_sum_;
@@ -435,7 +442,7 @@ CalibrationProgress CorrectionMatrixMethod::progress() const {
 
 CalibrationOutcome CorrectionMatrixMethod::finish(const GyroParameters& prior) const {
   CalibrationOutcome o;
-  o.method = name();
+  o.method = kind();
   const QualityLimits& q = settings_.gates;
   o.samples = estimator_.pairs();
   o.has_correction = true;
@@ -463,7 +470,7 @@ CalibrationOutcome CorrectionMatrixMethod::finish(const GyroParameters& prior) c
                                             std::vector<double>(k.orders().size(), 0.0));
   o.parameters.drift = HarmonicModel(d.orders(), d.meanAt(NAN), std::vector<double>(d.orders().size(), 0.0),
                                      std::vector<double>(d.orders().size(), 0.0));
-  o.parameters.calibration.method = name();
+  o.parameters.calibration.method = ParameterOrigin::calibratedBy(kind());
   o.parameters.calibration.time = utcNow();
   o.notes.push_back("K and D harmonics reset to zero with the new P: run dual_rate next (two-stage refinement)");
   o.decide();

@@ -33,7 +33,7 @@ GyroParameters priorFor(const AngleLevelGyro& g) {
 
 CalibrationSettings settings(const std::string& method) {
   CalibrationSettings s;
-  s.method = method;
+  s.method = parseCalibrationMethod(method);
   s.scale_factor_orders = {2, 4};
   s.drift_orders = {2};
   return s;
@@ -56,7 +56,7 @@ TEST(DualRate, RecoversKAndDAndCancelsTheDrift) {
   EXPECT_NEAR(o.coverage, 1.0, 1e-12);
   EXPECT_EQ(o.plateaus.size(), 2u);
   EXPECT_TRUE(o.parameters.scale_factor == toModel(k));
-  EXPECT_EQ(o.parameters.calibration.method, "dual_rate");
+  EXPECT_EQ(o.parameters.calibration.method, ParameterOrigin::calibratedBy(CalibrationMethodKind::kDualRate));
   EXPECT_GT(o.error_bound, 0.0);
 }
 

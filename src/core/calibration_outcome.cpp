@@ -86,7 +86,7 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
   YAML::Emitter out;
   out << YAML::Comment("hrg_gyro calibration report. K dimensionless, D in rad/s, angles in rad.");
   out << YAML::BeginMap;
-  out << YAML::Key << "method" << YAML::Value << o.method;
+  out << YAML::Key << "method" << YAML::Value << nameOf(o.method);
   out << YAML::Key << "accepted" << YAML::Value << o.accepted;
   out << YAML::Key << "reason" << YAML::Value << YAML::DoubleQuoted << o.reason;
   out << YAML::Key << "coverage" << YAML::Value << formatDouble(o.coverage);

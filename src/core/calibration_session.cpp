@@ -110,7 +110,7 @@ void CalibrationSession::classify(const WaveRecord& w) {
 
 bool CalibrationSession::shouldFinish() const {
   if (settings_.auto_finish_idle <= 0.0 || !method_->complete()) return false;
-  if (settings_.method == "correction_matrix") return generator_ended_;
+  if (traitsOf(settings_.method).uses_generator_pairs) return generator_ended_;
   if (turntable_.empty()) return false;
   const TurntableRecord& last = turntable_.back();
   return last.plateau.is_static && toSeconds(last.stamp - last.plateau.start) >= settings_.auto_finish_idle;

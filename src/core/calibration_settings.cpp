@@ -1,5 +1,7 @@
 #include "hrg_gyro/core/calibration_settings.h"
 
+#include <stdexcept>
+
 namespace hrg_gyro {
 namespace core {
 namespace {
@@ -43,10 +45,6 @@ std::vector<std::string> CalibrationSettings::keyPaths() {
   return keys;
 }
 
-bool CalibrationSettings::knownMethod(const std::string& m) {
-  return m == "dual_rate" || m == "constant_rate" || m == "step" || m == "correction_matrix" || m == "thermal";
-}
-
 CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
   CalibrationSettings s;
   root.requireMap();
@@ -54,8 +52,13 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   allowed.insert(allowed.end(), {"plateau", "gates", "thermal"});
   allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
   root.rejectUnknownKeys(allowed);
-  s.method = root.getString("method", s.method);
-  if (!knownMethod(s.method)) root["method"].fail("unknown method '" + s.method + "' (dual_rate, constant_rate, step, correction_matrix, thermal)");
+  if (root.has("method")) {
+    try {
+      s.method = parseCalibrationMethod(root["method"].asString());
+    } catch (const std::invalid_argument& e) {
+      root["method"].fail(e.what());
+    }
+  }
   if (root.has("scale_factor_orders")) s.scale_factor_orders = parseEvenOrders(root["scale_factor_orders"]);
   if (root.has("drift_orders")) s.drift_orders = parseEvenOrders(root["drift_orders"]);
   s.bins = static_cast<int>(root.getInteger("bins", s.bins));

@@ -81,7 +81,7 @@ TEST(EndToEnd, CorrectionMatrixStageRemovesThe2ThetaSignature) {
   const SimulationConfig gen = shippedScenario("generator.yaml");
   const auto before = uncalibrated();
   CalibrationSettings settings;
-  settings.method = "correction_matrix";
+  settings.method = CalibrationMethodKind::kCorrectionMatrix;
   const OfflineCalibration run = calibrateOnSimulation(gen, before, settings);
   ASSERT_TRUE(run.outcome.accepted) << run.outcome.reason;
   // After P the effective K(theta) keeps only the 4 theta (capacitive) term at first order.

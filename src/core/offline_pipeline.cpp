@@ -1,5 +1,7 @@
 #include "hrg_gyro/core/offline_pipeline.h"
 
+#include "hrg_gyro/core/generator_pairing.h"
+
 namespace hrg_gyro {
 namespace core {
 
@@ -9,16 +11,19 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
   GyroSimulator sim(scenario);
   GyroProcessor proc(processor, parameters);
   CalibrationSession session(calibration, *parameters);
+  GeneratorPairing pairing([&session](Nanoseconds t, const ChannelVector& raw, const ChannelVector& reference) {
+    session.addGeneratorPair(t, raw, reference);
+  });
   SimulationSample s;
   while (sim.next(&s)) {
     if (s.truth.generator) {
-      session.addGeneratorPair(s.stamp, s.z,
-                               idealChannels({s.truth.amplitude, s.truth.quadrature, s.truth.theta, s.truth.phase}));
+      pairing.addRaw(s.stamp, s.z);
+      pairing.addReference(s.stamp, {s.truth.amplitude, s.truth.quadrature, s.truth.theta, s.truth.phase});
       continue;
     }
     session.addTurntable(s.stamp, s.truth.table_angle, s.truth.table_rate);
     const ProcessorResult r = proc.process({s.stamp, s.z, s.frequency, s.temperature});
-    if (r.has_wave) session.addWave(s.stamp, r.wave.theta, s.frequency, r.wave.quadrature / r.wave.amplitude);
+    if (r.has_wave) session.addWave(s.stamp, r.wave.theta, s.frequency, quadratureRatio(r.wave.quadrature, r.wave.amplitude));
   }
   OfflineCalibration out;
   out.outcome = session.finish();

@@ -207,7 +207,13 @@ GyroParameters parseParameters(const YAML::Node& root) {
     const YamlField cal = doc["calibration"];
     cal.requireMap();
     cal.rejectUnknownKeys({"method", "time", "source", "notes"});
-    p.calibration.method = cal.getString("method", "none");
+    if (cal.has("method")) {
+      try {
+        p.calibration.method = ParameterOrigin::parse(cal["method"].asString());
+      } catch (const std::invalid_argument& e) {
+        cal["method"].fail(e.what());
+      }
+    }
     p.calibration.time = cal.getString("time", "");
     p.calibration.source = cal.getString("source", "");
     p.calibration.notes = cal.getString("notes", "");
@@ -274,7 +280,7 @@ std::string emitParameters(const GyroParameters& p) {
       << YAML::Comment("rad; vertical Earth rate = 7.2921150e-5 sin(latitude) rad/s");
   out << YAML::EndMap;
   out << YAML::Key << "calibration" << YAML::Comment("provenance") << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "method" << YAML::Value << p.calibration.method;
+  out << YAML::Key << "method" << YAML::Value << p.calibration.method.name();
   out << YAML::Key << "time" << YAML::Value << YAML::DoubleQuoted << p.calibration.time;
   out << YAML::Key << "source" << YAML::Value << YAML::DoubleQuoted << p.calibration.source;
   out << YAML::Key << "notes" << YAML::Value << YAML::DoubleQuoted << p.calibration.notes;

@@ -25,7 +25,7 @@ GyroParameters variant(double k0) {
   GyroParameters p;
   p.scale_factor = HarmonicModel({2, 4, 6, 8}, k0, {1e-4, -2e-5, 3e-6, 1e-7}, {-5e-5, 1e-5, 0.0, 2e-7});
   p.drift = HarmonicModel({2, 4}, 1e-5, {2e-5, 1e-6}, {-1e-5, 0.0});
-  p.calibration.method = "dual_rate";
+  p.calibration.method = ParameterOrigin::calibratedBy(CalibrationMethodKind::kDualRate);
   p.calibration.notes = std::string(4000, 'x');  // a file of several pages: many write() points
   return p;
 }

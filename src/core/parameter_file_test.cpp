@@ -51,7 +51,7 @@ GyroParameters sampleParameters() {
   p.drift = HarmonicModel({2, 4}, 1.0e-5, {2.0e-5, 3e-7}, {-1.0e-5, 0.0});
   p.correction.p = {1.1e-3, -2.2e-3, 4.5e-4, -3.3e-4};
   p.earth_rate.latitude = 0.9302;
-  p.calibration.method = "dual_rate";
+  p.calibration.method = ParameterOrigin::calibratedBy(CalibrationMethodKind::kDualRate);
   p.calibration.time = "2026-11-21T10:00:00Z";
   p.calibration.source = "live";
   p.calibration.notes = "test: \"quoted\", colon: yes";
@@ -101,7 +101,7 @@ TEST(ParameterFile, ValidTextParses) {
   EXPECT_DOUBLE_EQ(p.scale_factor(0.0), -0.56 + 1e-3 + 2e-4);
   EXPECT_DOUBLE_EQ(p.drift.meanAt(NAN), 1e-5);
   EXPECT_TRUE(p.earth_rate.enabled);
-  EXPECT_EQ(p.calibration.method, "none");
+  EXPECT_TRUE(p.calibration.method.isNone());
 }
 
 TEST(ParameterFile, RoundTripIsExact) {

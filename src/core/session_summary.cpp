@@ -44,7 +44,8 @@ void printModel(std::ostream& out, const char* title, const char* unit, double s
 void printSessionSummary(std::ostream& out, const SessionSummary& s) {
   const CalibrationOutcome& c = s.calibration;
   out << "\n=== hrg_gyro session summary ===\n";
-  out << "calibration: method " << c.method << ", " << (c.accepted ? "ACCEPTED" : "REFUSED");
+  out << "calibration: method " << (s.has_calibration ? nameOf(c.method) : ParameterOrigin::none().name()) << ", "
+      << (c.accepted ? "ACCEPTED" : "REFUSED");
   if (!c.accepted) out << " (" << c.reason << ")";
   out << line(", %.0f s of data, coverage %.1f %%, smoothing factor %.6f (corrected)\n", c.duration,
               100 * c.coverage, c.smoothing_factor, 0.0);

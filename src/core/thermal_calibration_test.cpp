@@ -51,7 +51,7 @@ GyroParameters prior() {
 
 CalibrationSettings thermalSettings() {
   CalibrationSettings s;
-  s.method = "thermal";
+  s.method = CalibrationMethodKind::kThermal;
   s.scale_factor_orders = {2, 4};
   s.drift_orders = {2};
   return s;
@@ -90,7 +90,7 @@ TEST(Thermal, RecoversFrequencyDependentKAndDAcrossARamp) {
   const HarmonicModel& d = o.parameters.drift;
   EXPECT_TRUE(k.frequencyDependent());
   EXPECT_EQ(k.interpolator().nodes(), o.frequency_nodes);
-  EXPECT_EQ(o.parameters.calibration.method, "thermal");
+  EXPECT_EQ(o.parameters.calibration.method, ParameterOrigin::calibratedBy(CalibrationMethodKind::kThermal));
   for (std::size_t j = 0; j < 3; ++j) {
     const double f = o.frequency_nodes[j];
     std::vector<double> truth_k(g.k.termCount()), truth_d(g.d.termCount());
@@ -119,7 +119,7 @@ TEST(Thermal, AFrequencyIndependentModelLeavesPpmThatTheSplineRemoves) {
   AngleLevelGyro g = thermalGyro(4996.0, 5004.0, kRampProfile.duration());
   g.noise = 4.9e-6;
   CalibrationSettings dual = thermalSettings();
-  dual.method = "dual_rate";
+  dual.method = CalibrationMethodKind::kDualRate;
   CalibrationSession thermal_session(thermalSettings(), prior()), dual_session(dual, prior());
   testing::runAngleLevel(g, kRampProfile, [&](Nanoseconds t, double angle, double rate, double theta, double f) {
     for (CalibrationSession* s : {&thermal_session, &dual_session}) {
@@ -265,12 +265,12 @@ TEST(Thermal, SettingsNameBadKeys) {
       YAML::Load("{method: thermal, thermal: {frequency_nodes: [4990, 5000, 5010], interpolation: piecewise_linear,"
                  " slice_width: 0.25, max_slices: 64}}"),
       ""));
-  EXPECT_EQ(s.method, "thermal");
+  EXPECT_EQ(s.method, CalibrationMethodKind::kThermal);
   EXPECT_EQ(s.thermal.frequency_nodes, (std::vector<double>{4990, 5000, 5010}));
   EXPECT_EQ(s.thermal.interpolation, Interpolation::kPiecewiseLinear);
   EXPECT_EQ(s.thermal.slice_width, 0.25);
   EXPECT_EQ(s.thermal.max_slices, 64);
-  EXPECT_TRUE(CalibrationSettings::knownMethod("thermal"));
+  EXPECT_EQ(findCalibrationMethod("thermal"), CalibrationMethodKind::kThermal);
 }
 
 }  // namespace

@@ -43,7 +43,7 @@ TEST(ThermalEndToEnd, RampCalibrationBringsTheResidualBelowOnePpmAcrossTheRange)
   const auto prior = std::make_shared<const GyroParameters>(
       loadParameterFile(std::string(HRG_GYRO_SOURCE_DIR) + "/config/params_uncalibrated.yaml"));
   CalibrationSettings thermal_settings, dual_settings;
-  thermal_settings.method = "thermal";
+  thermal_settings.method = CalibrationMethodKind::kThermal;
   GyroSimulator sim(cal);
   GyroProcessor processor(ProcessorConfig{}, prior);
   CalibrationSession thermal_session(thermal_settings, *prior), dual_session(dual_settings, *prior);

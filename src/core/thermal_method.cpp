@@ -106,7 +106,7 @@ CalibrationProgress ThermalMethod::progress() const {
 
 CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   CalibrationOutcome o;
-  o.method = name();
+  o.method = kind();
   const QualityLimits& q = settings_.gates;
   const ThermalSettings& ts = settings_.thermal;
   const auto order = rates_.byDuration();
@@ -231,7 +231,7 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   o.parameters = prior;
   o.parameters.scale_factor = e.k_model;
   o.parameters.drift = e.d_model;
-  o.parameters.calibration.method = o.method;
+  o.parameters.calibration.method = ParameterOrigin::calibratedBy(o.method);
   o.parameters.calibration.time = utcNow();
   o.notes.push_back("K and D are splines (" + std::string(toString(ts.interpolation)) + ") over " +
                     std::to_string(n.size()) + " frequency nodes " + formatShort(n.front(), 8) + ".." + formatShort(n.back(), 8) +

@@ -17,5 +17,10 @@ ChannelVector idealChannels(const WaveParameters& w) {
   return z;
 }
 
+double quadratureRatio(double quadrature, double amplitude) {
+  if (!(amplitude > 0.0) || !std::isfinite(amplitude) || !std::isfinite(quadrature)) return NAN;
+  return quadrature / amplitude;
+}
+
 }  // namespace core
 }  // namespace hrg_gyro

@@ -32,7 +32,13 @@ const std::vector<std::string>& nodeOnlyKeys() {
 }  // namespace
 
 CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
-    : nh_(nh), pnh_(pnh), params_(pnh, "calibrator"), updater_(nh, pnh, pnh.getNamespace()) {
+    : nh_(nh),
+      pnh_(pnh),
+      params_(pnh, "calibrator"),
+      pairing_([this](core::Nanoseconds t, const core::ChannelVector& raw, const core::ChannelVector& reference) {
+        session()->addGeneratorPair(t, raw, reference);
+      }),
+      updater_(nh, pnh, pnh.getNamespace()) {
   base_settings_ = core::CalibrationSettings::parse(core::YamlField(privateParameters(pnh_), ""), nodeOnlyKeys());
   params_.claim(core::CalibrationSettings::keyPaths());
   params_.claim({"diagnostic_period"});  // read by diagnostic_updater itself
@@ -40,13 +46,7 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   if (parameter_file_.empty()) throw std::invalid_argument("calibrator: ~parameter_file is required (the file to refresh)");
   // Empty report file and output directory: derived from the parameter file.
   report_file_ = params_.get<std::string>("report_file", "");
-  if (report_file_.empty()) {
-    report_file_ = parameter_file_;
-    if (report_file_.size() > 5 && report_file_.substr(report_file_.size() - 5) == ".yaml") {
-      report_file_.resize(report_file_.size() - 5);
-    }
-    report_file_ += ".report.yaml";
-  }
+  if (report_file_.empty()) report_file_ = core::StagedCalibration::defaultReportPath(parameter_file_);
   // Every file the calibrator writes stays in one directory (by default that of the parameter file).
   output_directory_ = params_.get<std::string>("output_directory", "");
   if (output_directory_.empty()) output_directory_ = core::directoryOf(parameter_file_);
@@ -61,12 +61,17 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     }
   }
   core::loadParameterFile(parameter_file_);  // fail early on a bad prior
-  std::vector<std::string> stages;
-  if (!params_.getOptional("stages", &stages) || stages.empty()) stages = {base_settings_.method};
-  for (const std::string& m : stages) {
-    if (!core::CalibrationSettings::knownMethod(m)) throw std::invalid_argument("calibrator: unknown method in ~stages: " + m);
+  std::vector<std::string> stage_names;
+  std::vector<core::CalibrationMethodKind> stages;
+  params_.getOptional("stages", &stage_names);
+  for (const std::string& m : stage_names) {
+    try {
+      stages.push_back(core::parseCalibrationMethod(m));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("calibrator: ~stages: ") + e.what());
+    }
   }
-  stages_ = stages;
+  calibration_ = std::make_unique<core::StagedCalibration>(base_settings_, stages);
   const int queue_size = params_.get("queue_size", 50000);  // as the processor's: seconds of backlog at 10 kHz
   const double heap_trim_period = params_.get("heap_trim_period", 10.0);  // s of wall time; <= 0: never
   const bool autostart = params_.get("autostart", true);
@@ -77,7 +82,7 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   turntable_sub_ = in.subscribe("turntable/state", queue_size, &CalibratorRos::onTurntable, this,
                                 ros::TransportHints().tcpNoDelay());
   wave_sub_ = in.subscribe("wave", queue_size, &CalibratorRos::onWave, this, ros::TransportHints().tcpNoDelay());
-  if (std::find(stages_.begin(), stages_.end(), "correction_matrix") != stages_.end()) {
+  if (calibration_->usesGeneratorPairs()) {
     channels_sub_ = in.subscribe("channels", queue_size, &CalibratorRos::onChannels, this,
                                  ros::TransportHints().tcpNoDelay());
     truth_sub_ = in.subscribe("truth", queue_size, &CalibratorRos::onTruth, this, ros::TransportHints().tcpNoDelay());
@@ -107,7 +112,7 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   if (autostart) {
     std::lock_guard<std::mutex> lock(mutex_);
     std::string reason;
-    if (!startRun(stages_[next_stage_++], &reason)) throw std::runtime_error("calibrator: " + reason);
+    if (!startRun(false, &reason)) throw std::runtime_error("calibrator: " + reason);
   }
   // Threads last: a constructor that throws must not leave a joinable thread behind.
   reload_worker_ = std::thread(&CalibratorRos::reloadLoop, this);
@@ -173,28 +178,31 @@ void CalibratorRos::reloadLoop() {
       }
       std::lock_guard<std::mutex> lock(mutex_);
       std::string reason;
-      if (next_stage_ < stages_.size() && startRun(stages_[next_stage_++], &reason) && known) {
+      if (calibration_->hasNextStage() && startRun(false, &reason) && known) {
         skip_waves_until_ = since;
       }
     }
   }
 }
 
-bool CalibratorRos::startRun(const std::string& method, std::string* reason) {
+bool CalibratorRos::startRun(bool restart, std::string* reason) {
+  const std::string method = core::nameOf(restart ? calibration_->current() : calibration_->nextStage());
   try {
-    core::CalibrationSettings settings = base_settings_;
-    settings.method = method;
-    session_ = std::make_unique<core::CalibrationSession>(settings, core::loadParameterFile(parameter_file_));
+    const core::GyroParameters prior = core::loadParameterFile(parameter_file_);
+    if (restart) {
+      calibration_->restartStage(prior);
+    } else {
+      calibration_->startNextStage(prior);
+    }
     skip_waves_until_ = ros::Time();
     sweep_end_ = last_channels_stamp_ = ros::Time();
-    raw_.clear();
-    reference_.clear();
+    pairing_.clear();
     ROS_INFO("calibrator: %s run started (prior %s)", method.c_str(), parameter_file_.c_str());
     return true;
   } catch (const std::exception& e) {
     *reason = std::string("cannot start ") + method + ": " + e.what();
     ROS_ERROR("calibrator: %s", reason->c_str());
-    session_.reset();
+    calibration_->abort();
     return false;
   }
 }
@@ -202,15 +210,14 @@ bool CalibratorRos::startRun(const std::string& method, std::string* reason) {
 bool CalibratorRos::restartIfTimeWentBack(const ros::Time& stamp, ros::Time* last) {
   const bool back = !last->isZero() && (*last - stamp).toSec() > backward_reset_;
   *last = stamp;
-  if (!back || !session_) return false;
+  if (!back || !session()) return false;
   // A looping bag (or a restarted driver): the bins hold the previous pass, and the new data would
   // all be dropped as out of order. Start the same method again from the prior.
-  const std::string method = session_->settings().method;
   ++resets_;
   ROS_WARN("calibrator: time went backwards by more than %.1f s (bag loop?): %s run restarted", backward_reset_,
-           method.c_str());
+           core::nameOf(session()->settings().method).c_str());
   std::string reason;
-  startRun(method, &reason);
+  startRun(true, &reason);
   last_turntable_stamp_ = last_wave_stamp_ = stamp;
   return true;
 }
@@ -218,16 +225,16 @@ bool CalibratorRos::restartIfTimeWentBack(const ros::Time& stamp, ros::Time* las
 void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   restartIfTimeWentBack(msg->header.stamp, &last_turntable_stamp_);
-  if (!session_) return;
+  if (!session()) return;
   if (!sweep_end_.isZero() && (msg->header.stamp - sweep_end_).toSec() > kSweepChannelsWait) {
     ROS_WARN("calibrator: the raw channels did not reach the end of the generator sweep within %.0f s; "
              "fitting P with the %llu pairs received", kSweepChannelsWait,
-             static_cast<unsigned long long>(session_->counters().used));
+             static_cast<unsigned long long>(session()->counters().used));
     endGeneratorSweep();
-    if (!session_) return;
+    if (!session()) return;
   }
-  session_->addTurntable(toNanoseconds(msg->header.stamp), msg->angle, msg->rate);
-  if (session_->shouldFinish()) {
+  session()->addTurntable(toNanoseconds(msg->header.stamp), msg->angle, msg->rate);
+  if (session()->shouldFinish()) {
     bool written = false;
     std::string message;
     finishRun(&written, &message);
@@ -237,72 +244,52 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
 void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   restartIfTimeWentBack(msg->header.stamp, &last_wave_stamp_);
-  if (session_ && !skip_waves_until_.isZero() && msg->header.stamp <= skip_waves_until_) {
+  if (session() && !skip_waves_until_.isZero() && msg->header.stamp <= skip_waves_until_) {
     ++skipped_old_model_;
     return;
   }
-  if (session_) {
-    session_->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency,
-                      msg->amplitude > 0.0 ? msg->quadrature / msg->amplitude : NAN);
+  if (session()) {
+    session()->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency,
+                       core::quadratureRatio(msg->quadrature, msg->amplitude));
   }
 }
 
 void CalibratorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!session_ || session_->settings().method != "correction_matrix") return;
+  if (!session() || !core::traitsOf(session()->settings().method).uses_generator_pairs) return;
   last_channels_stamp_ = msg->header.stamp;
-  raw_[toNanoseconds(msg->header.stamp)] = core::ChannelVector(msg->c_in, msg->c_quad, msg->s_in, msg->s_quad);
-  pairGenerator();
+  pairing_.addRaw(toNanoseconds(msg->header.stamp), core::ChannelVector(msg->c_in, msg->c_quad, msg->s_in, msg->s_quad));
   if (!sweep_end_.isZero() && msg->header.stamp >= sweep_end_) endGeneratorSweep();
 }
 
 void CalibratorRos::onTruth(const GroundTruth::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!session_ || session_->settings().method != "correction_matrix") return;
+  if (!session() || !core::traitsOf(session()->settings().method).uses_generator_pairs) return;
   if (!msg->generator) {
     // The truth stream has left the sweep: every generator reference has arrived. The raw channels
     // that pair with them may still be queued on their own connection (a fresh-clone run lost the
     // last 87 of 1440 pairs that way, which biased P); wait for the channels to reach this stamp.
-    if (sweep_end_.isZero() && (!reference_.empty() || session_->counters().used > 0)) {
+    if (sweep_end_.isZero() && (pairing_.waitingReferences() > 0 || session()->counters().used > 0)) {
       sweep_end_ = msg->header.stamp;
       if (last_channels_stamp_ >= sweep_end_) endGeneratorSweep();
     }
     return;
   }
-  reference_[toNanoseconds(msg->header.stamp)] =
-      core::idealChannels({msg->amplitude, msg->quadrature, msg->theta, msg->phase});
-  pairGenerator();
+  pairing_.addReference(toNanoseconds(msg->header.stamp), {msg->amplitude, msg->quadrature, msg->theta, msg->phase});
 }
 
 void CalibratorRos::endGeneratorSweep() {
   sweep_end_ = ros::Time();
-  session_->generatorSweepEnded();
-  if (session_->shouldFinish()) {
+  session()->generatorSweepEnded();
+  if (session()->shouldFinish()) {
     bool written = false;
     std::string message;
     finishRun(&written, &message);
   }
 }
 
-void CalibratorRos::pairGenerator() {
-  // Both streams carry the driver's stamps: pair exactly, forget what can no longer pair.
-  while (!raw_.empty() && !reference_.empty()) {
-    const core::Nanoseconds a = raw_.begin()->first, b = reference_.begin()->first;
-    if (a == b) {
-      session_->addGeneratorPair(a, raw_.begin()->second, reference_.begin()->second);
-      raw_.erase(raw_.begin());
-      reference_.erase(reference_.begin());
-    } else if (a < b) {
-      raw_.erase(raw_.begin());
-    } else {
-      reference_.erase(reference_.begin());
-    }
-  }
-  while (raw_.size() > 10000) raw_.erase(raw_.begin());
-}
-
 core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* message) {
-  core::CalibrationOutcome o = session_->finish();
+  core::CalibrationOutcome o = calibration_->finishStage();
   *written = false;
   if (o.accepted && write_) {
     try {
@@ -318,10 +305,7 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
     *message = o.accepted ? "accepted, not written (~write is false)" : "refused: " + o.reason;
   }
   {
-    // One report per method, so a two-stage session keeps both.
-    std::string path = report_file_;
-    const std::size_t dot = path.rfind(".report.yaml");
-    if (dot != std::string::npos) path.insert(dot, "." + o.method);
+    const std::string path = core::StagedCalibration::stageReportPath(report_file_, o.method);
     std::ofstream report(path);
     report << core::emitCalibrationReport(o);
     if (!report) ROS_WARN("calibrator: cannot write the report %s", path.c_str());
@@ -331,21 +315,20 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
   last_accepted_ = o.accepted && *written;
   last_result_ = *message;
   if (*written) {
-    ROS_INFO("calibrator: %s %s (peak nonlinearity of the new K: %.1f ppm, coverage %.1f %%)", o.method.c_str(),
+    ROS_INFO("calibrator: %s %s (peak nonlinearity of the new K: %.1f ppm, coverage %.1f %%)", core::nameOf(o.method).c_str(),
              message->c_str(), o.nonlinearity_ppm, 100 * o.coverage);
   } else {
-    ROS_WARN("calibrator: %s %s", o.method.c_str(), message->c_str());
+    ROS_WARN("calibrator: %s %s", core::nameOf(o.method).c_str(), message->c_str());
   }
   for (const core::DefectDiagnosis& d : o.diagnosis) {
     ROS_INFO("calibrator: root-cause diagnosis (first order, read against the P in force) %s",
              core::describe(d).c_str());
   }
-  session_.reset();
-  const bool more = *written && next_stage_ < stages_.size();
+  const bool more = *written && calibration_->hasNextStage();
   if (*written) {
     {
       std::lock_guard<std::mutex> lock(reload_mutex_);
-      reload_requests_.push_back({more, o.parameters.calibration.method + " " + o.parameters.calibration.time});
+      reload_requests_.push_back({more, o.parameters.calibration.method.name() + " " + o.parameters.calibration.time});
     }
     reload_cv_.notify_one();
   }
@@ -355,25 +338,25 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
 bool CalibratorRos::onStart(StartCalibration::Request& req, StartCalibration::Response& res) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (req.method.empty()) {
-    next_stage_ = 0;
+    calibration_->rewind();
   } else {
-    if (!core::CalibrationSettings::knownMethod(req.method)) {
+    try {
+      calibration_->rewind({core::parseCalibrationMethod(req.method)});
+    } catch (const std::invalid_argument& e) {
       res.success = false;
-      res.message = "unknown method '" + req.method + "' (dual_rate, constant_rate, step, correction_matrix, thermal)";
+      res.message = e.what();
       return true;
     }
-    stages_ = {req.method};
-    next_stage_ = 0;
   }
   std::string reason;
-  res.success = startRun(stages_[next_stage_++], &reason);
-  res.message = res.success ? "started " + session_->settings().method : reason;
+  res.success = startRun(false, &reason);
+  res.message = res.success ? "started " + core::nameOf(session()->settings().method) : reason;
   return true;
 }
 
 bool CalibratorRos::onFinish(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!session_) {
+  if (!session()) {
     res.success = false;
     res.message = "no calibration run in progress";
     return true;
@@ -388,18 +371,17 @@ bool CalibratorRos::onFinish(std_srvs::Trigger::Request&, std_srvs::Trigger::Res
 
 bool CalibratorRos::onAbort(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   std::lock_guard<std::mutex> lock(mutex_);
-  res.success = session_ != nullptr;
-  res.message = session_ ? "aborted " + session_->settings().method + ": nothing written" : "no run in progress";
-  session_.reset();
-  next_stage_ = stages_.size();
+  res.success = session() != nullptr;
+  res.message = session() ? "aborted " + core::nameOf(session()->settings().method) + ": nothing written" : "no run in progress";
+  calibration_->abort();
   return true;
 }
 
 void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (session_) {
-    const core::CalibrationProgress p = session_->progress();
-    const core::SessionCounters& c = session_->counters();
+  if (session()) {
+    const core::CalibrationProgress p = session()->progress();
+    const core::SessionCounters& c = session()->counters();
     if (c.turntable == 0 && c.wave > 100) {
       stat.summary(DiagnosticStatus::WARN, "wave samples but no turntable state: check turntable/state");
     } else if (resets_ > reported_resets_) {
@@ -408,7 +390,7 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
     } else {
       stat.summaryf(DiagnosticStatus::OK, "%s %.0f %%", p.summary.c_str(), 100 * p.fraction);
     }
-    stat.add("method", session_->settings().method);
+    stat.add("method", core::nameOf(session()->settings().method));
     stat.add("progress", p.fraction);
     stat.add("turntable states", c.turntable);
     stat.add("wave samples", c.wave);

@@ -124,7 +124,7 @@ CalibrationResult toMessage(const core::CalibrationOutcome& o, bool written, con
                             const ros::Time& stamp) {
   CalibrationResult m;
   m.header.stamp = stamp;
-  m.method = o.method;
+  m.method = core::nameOf(o.method);
   m.accepted = o.accepted;
   m.written = written;
   m.reason = o.reason;
@@ -189,7 +189,7 @@ CalibrationResult toMessage(const core::CalibrationOutcome& o, bool written, con
 
 core::CalibrationOutcome fromMessage(const CalibrationResult& m) {
   core::CalibrationOutcome o;
-  o.method = m.method;
+  o.method = core::parseCalibrationMethod(m.method);
   o.accepted = m.accepted;
   o.reason = m.reason;
   for (const HarmonicEstimate& h : m.scale_factor) {

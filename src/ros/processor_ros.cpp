@@ -122,7 +122,7 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   input_.start();
   diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
   ROS_INFO("processor: %s (K0 %.6f, %zu K harmonics, calibration %s)", parameter_file_.c_str(),
-           params->scale_factor.meanAt(NAN), params->scale_factor.orders().size(), params->calibration.method.c_str());
+           params->scale_factor.meanAt(NAN), params->scale_factor.orders().size(), params->calibration.method.name().c_str());
 }
 
 ProcessorRos::~ProcessorRos() {
@@ -136,7 +136,7 @@ void ProcessorRos::publishModel(const ros::Time& since) {
   m.header.stamp = since;
   m.header.frame_id = frame_id_;
   m.parameter_file = parameter_file_;
-  m.calibration_method = p.calibration.method;
+  m.calibration_method = p.calibration.method.name();
   m.calibration_time = p.calibration.time;
   m.k0 = p.scale_factor.meanAt(NAN);
   m.k_harmonics = static_cast<std::uint32_t>(p.scale_factor.orders().size());
@@ -253,7 +253,7 @@ bool ProcessorRos::onReload(std_srvs::Trigger::Request&, std_srvs::Trigger::Resp
   char buf[256];
   std::snprintf(buf, sizeof buf, "loaded %s: K0 %.9f, %zu K harmonics, %zu D harmonics, calibration %s %s",
                 parameter_file_.c_str(), params->scale_factor.meanAt(NAN), params->scale_factor.orders().size(),
-                params->drift.orders().size(), params->calibration.method.c_str(), params->calibration.time.c_str());
+                params->drift.orders().size(), params->calibration.method.name().c_str(), params->calibration.time.c_str());
   res.message = buf;
   ROS_INFO("processor: %s", buf);
   return true;
@@ -392,14 +392,14 @@ void ProcessorRos::diagnoseModel(diagnostic_updater::DiagnosticStatusWrapper& st
     stat.summary(DiagnosticStatus::WARN, "frequency-dependent model but the input carries no frequency");
   } else if (last_flags_ & core::kFlagFrequencyOutOfRange) {
     stat.summary(DiagnosticStatus::WARN, "resonator frequency outside the model's nodes: end values held");
-  } else if (p.calibration.method == "none") {
+  } else if (p.calibration.method.isNone()) {
     // A model nobody calibrated carries the nominal scale factor: its output is off by up to percents.
     stat.summary(DiagnosticStatus::WARN, "uncalibrated model (calibration method: none): nominal K and D");
   } else {
     stat.summary(DiagnosticStatus::OK, "model loaded");
   }
   stat.add("parameter file", parameter_file_);
-  stat.add("calibration method", p.calibration.method);
+  stat.add("calibration method", p.calibration.method.name());
   stat.add("calibration time", p.calibration.time);
   stat.add("K0", p.scale_factor.meanAt(NAN));
   stat.add("K harmonics", p.scale_factor.orders().size());

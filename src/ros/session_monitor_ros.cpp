@@ -2,11 +2,13 @@
 
 #include <cstdint>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include <std_msgs/String.h>
 #include <yaml-cpp/yaml.h>
 
+#include "hrg_gyro/core/calibration_method_kind.h"
 #include "hrg_gyro/core/effective_model.h"
 #include "hrg_gyro/core/parameter_file.h"
 #include "hrg_gyro/core/session_summary.h"
@@ -96,13 +98,20 @@ void SessionMonitorRos::match(Track* track) {
 
 void SessionMonitorRos::onResult(const CalibrationResult::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (msg->method == "correction_matrix" && result_) return;  // keep the K/D stage for the summary
+  const std::optional<core::CalibrationMethodKind> method = core::findCalibrationMethod(msg->method);
+  if (!method) {
+    ROS_WARN("session_monitor: ignoring a calibration result of unknown method '%s'", msg->method.c_str());
+    return;
+  }
+  if (!core::traitsOf(*method).estimates_k_and_d && result_) return;  // keep the K/D stage for the summary
   result_ = msg;
 }
 
 void SessionMonitorRos::onModel(const ModelInfo::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (msg->calibration_method != "none" && msg->calibration_method != "correction_matrix") {
+  // The calibrated K and D apply from here (not a nominal model, nor P alone before its K/D stage).
+  const std::optional<core::CalibrationMethodKind> method = core::findCalibrationMethod(msg->calibration_method);
+  if (method && core::traitsOf(*method).estimates_k_and_d) {
     model_since_ = toNanoseconds(msg->header.stamp);
   }
 }
@@ -131,12 +140,12 @@ void SessionMonitorRos::finish() {
     if (!result_->scale_factor.empty()) k_orders.assign(result_->scale_factor[0].orders.begin(), result_->scale_factor[0].orders.end());
     if (!result_->drift.empty()) d_orders.assign(result_->drift[0].orders.begin(), result_->drift[0].orders.end());
   } else {
-    s.calibration.method = "none";
+    s.has_calibration = false;
     s.calibration.reason = "no calibration result received";
   }
   core::CorrectionMatrix p;
   if (!prior_file_.empty()) p = core::loadParameterFile(prior_file_).correction;
-  if (result_ && result_->method != "correction_matrix") {
+  if (result_ && s.has_calibration && core::traitsOf(s.calibration.method).estimates_k_and_d) {
     for (int i = 0; i < 4; ++i) p.p[i] = result_->correction[i];  // the P the K/D stage measured through
   }
   s.injected = core::computeEffectiveModel(*scenario_, p, k_orders, d_orders);

@@ -66,8 +66,8 @@ std::vector<int> checkedEvaluationOrders(const std::vector<int>& orders) {
 int main(int argc, char** argv) {
   using hrg_gyro::tools::finiteNumber;
   using hrg_gyro::tools::wholeNumber;
-  std::string calibration, verification, params, out, method = "dual_rate";
   const CalibrationSettings defaults;
+  std::string calibration, verification, params, out, method = nameOf(defaults.method);
   std::vector<int> orders = defaults.scale_factor_orders, drift_orders = defaults.drift_orders;
   std::vector<int> evaluation_orders = EvaluationSettings().orders;
   int bins = defaults.bins;
@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
   app.add_option("--params", params, "parameter file of the gyro before calibration")->required();
   app.add_option("--out", out, "calibrated parameter file, written atomically when the gates accept")
       ->check(hrg_gyro::tools::notEmpty());
-  app.add_option("--method", method, "dual_rate|constant_rate|step|correction_matrix|thermal")->capture_default_str();
+  app.add_option("--method", method, calibrationMethodNames("|"))->capture_default_str();
   auto orders_option = [&](const char* name, std::vector<int>* target, const char* meaning) {
     app.add_option(name, *target, meaning)->delimiter(',')->transform(wholeNumber(2, 64))->capture_default_str();
   };

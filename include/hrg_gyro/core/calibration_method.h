@@ -35,7 +35,7 @@ struct CalibrationProgress {
 class CalibrationMethod {
  public:
   virtual ~CalibrationMethod() = default;
-  virtual std::string name() const = 0;
+  virtual CalibrationMethodKind kind() const = 0;
   virtual void addSample(const PlateauSample& sample) = 0;
   /// Generator pairs: raw channel amplitudes and the known wave's ideal ones.
   virtual void addGeneratorPair(const ChannelVector& /*raw*/, const ChannelVector& /*reference*/) {}
@@ -44,8 +44,7 @@ class CalibrationMethod {
   virtual CalibrationOutcome finish(const GyroParameters& prior) const = 0;
 };
 
-/// The method named in the settings (throws std::invalid_argument for an unknown name); `prior`
-/// is the parameter set the data are measured with.
+/// The method the settings choose; `prior` is the parameter set the data are measured with.
 std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettings& settings,
                                                          const GyroParameters& prior);
 

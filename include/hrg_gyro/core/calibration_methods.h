@@ -21,7 +21,7 @@ class DualRateMethod : public CalibrationMethod {
  public:
   /// k0: the prior's mean scale factor (the angle rate per table rate, for the window length).
   DualRateMethod(const CalibrationSettings& settings, double k0);
-  std::string name() const override { return "dual_rate"; }
+  CalibrationMethodKind kind() const override { return CalibrationMethodKind::kDualRate; }
   void addSample(const PlateauSample& s) override;
   bool complete() const override;
   CalibrationProgress progress() const override;
@@ -37,7 +37,7 @@ class DualRateMethod : public CalibrationMethod {
 class ConstantRateMethod : public CalibrationMethod {
  public:
   ConstantRateMethod(const CalibrationSettings& settings, double k0);
-  std::string name() const override { return "constant_rate"; }
+  CalibrationMethodKind kind() const override { return CalibrationMethodKind::kConstantRate; }
   void addSample(const PlateauSample& s) override;
   bool complete() const override;
   CalibrationProgress progress() const override;
@@ -59,7 +59,7 @@ class ConstantRateMethod : public CalibrationMethod {
 class StepMethod : public CalibrationMethod {
  public:
   explicit StepMethod(const CalibrationSettings& settings);
-  std::string name() const override { return "step"; }
+  CalibrationMethodKind kind() const override { return CalibrationMethodKind::kStep; }
   void addSample(const PlateauSample& s) override;
   bool complete() const override;
   CalibrationProgress progress() const override;
@@ -91,7 +91,7 @@ class StepMethod : public CalibrationMethod {
 class CorrectionMatrixMethod : public CalibrationMethod {
  public:
   explicit CorrectionMatrixMethod(const CalibrationSettings& settings) : settings_(settings) {}
-  std::string name() const override { return "correction_matrix"; }
+  CalibrationMethodKind kind() const override { return CalibrationMethodKind::kCorrectionMatrix; }
   void addSample(const PlateauSample&) override {}
   void addGeneratorPair(const ChannelVector& raw, const ChannelVector& reference) override;
   bool complete() const override;

@@ -34,7 +34,7 @@ struct GateResult {
 };
 
 struct CalibrationOutcome {
-  std::string method;
+  CalibrationMethodKind method = CalibrationMethodKind::kDualRate;
   bool accepted = false;
   std::string reason;               ///< first failed gate, or why no estimate exists
   GyroParameters parameters;        ///< prior with the new estimates (meaningful when accepted)

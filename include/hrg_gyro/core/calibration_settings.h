@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "hrg_gyro/core/calibration_method_kind.h"
 #include "hrg_gyro/core/frequency_interpolator.h"
 #include "hrg_gyro/core/plateau_detector.h"
 #include "hrg_gyro/core/yaml_field.h"
@@ -41,7 +42,7 @@ struct ThermalSettings {
 };
 
 struct CalibrationSettings {
-  std::string method = "dual_rate";  ///< dual_rate | constant_rate | step | correction_matrix | thermal
+  CalibrationMethodKind method = CalibrationMethodKind::kDualRate;
   std::vector<int> scale_factor_orders{2, 4, 6, 8};
   std::vector<int> drift_orders{2, 4};
   int bins = 128;            ///< theta bins over [0, pi)
@@ -55,7 +56,6 @@ struct CalibrationSettings {
 
   /// Parses the calibrator settings map. Throws ConfigError naming the key.
   static CalibrationSettings parse(const YamlField& root, const std::vector<std::string>& extra_keys = {});
-  static bool knownMethod(const std::string& method);
   /// Every key parse() reads, nested ones as "section/key" (the calibrator's parameter template lists them all).
   static std::vector<std::string> keyPaths();
 };

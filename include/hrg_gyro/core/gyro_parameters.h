@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "hrg_gyro/core/calibration_method_kind.h"
 #include "hrg_gyro/core/correction_matrix.h"
 #include "hrg_gyro/core/harmonic_model.h"
 #include "hrg_gyro/core/units.h"
@@ -25,9 +26,9 @@ struct EarthRateSettings {
 
 /// Provenance of a parameter set, written by the calibrator.
 struct CalibrationProvenance {
-  std::string method = "none";  ///< none | manual | dual_rate | constant_rate | step | correction_matrix | thermal
-  std::string time;             ///< ISO 8601 UTC
-  std::string source;           ///< "live" or the bag it came from
+  ParameterOrigin method;  ///< none, manual or the calibration method (its text form in the file)
+  std::string time;        ///< ISO 8601 UTC
+  std::string source;      ///< "live" or the bag it came from
   std::string notes;
   bool operator==(const CalibrationProvenance& o) const {
     return method == o.method && time == o.time && source == o.source && notes == o.notes;

@@ -18,6 +18,7 @@ namespace core {
 struct SessionSummary {
   EffectiveModel injected;          ///< what a perfect calibration would find
   CalibrationOutcome calibration;
+  bool has_calibration = true;      ///< false: no calibration result arrived (printed as method none)
   EvaluationResult before, after;   ///< measured on the verification profile
   std::vector<std::string> warnings;  ///< printed before the machine-readable last line
 };

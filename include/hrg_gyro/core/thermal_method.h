@@ -29,7 +29,7 @@ class ThermalMethod : public CalibrationMethod {
  public:
   /// k0: the prior's mean scale factor (the angle rate per table rate, for the window length).
   ThermalMethod(const CalibrationSettings& settings, double k0);
-  std::string name() const override { return "thermal"; }
+  CalibrationMethodKind kind() const override { return CalibrationMethodKind::kThermal; }
   void addSample(const PlateauSample& s) override;
   bool complete() const override;
   CalibrationProgress progress() const override;

@@ -30,5 +30,9 @@ struct WaveParameters {
 /// 'Channel amplitudes').
 ChannelVector idealChannels(const WaveParameters& wave);
 
+/// B/A of a wave, as the calibration averages it for the defect diagnosis: NaN (not averaged)
+/// when the amplitude is not positive or either value is not finite.
+double quadratureRatio(double quadrature, double amplitude);
+
 }  // namespace core
 }  // namespace hrg_gyro

@@ -7,7 +7,8 @@
 // `~result`; when every quality gate passes, the parameter file is rewritten atomically (previous
 // kept as .bak), a report is written next to it and the processor's `~reload` is called. `~stages`
 // runs several methods in a row: [correction_matrix, dual_rate] is the paper's two-stage
-// refinement (P first, then the residual K and D measured through the new P).
+// refinement (P first, then the residual K and D measured through the new P). The calibration
+// itself (stages, generator pairing, reports' names) is the core's: this class wires it to ROS.
 #pragma once
 
 #include <condition_variable>
@@ -28,7 +29,8 @@
 #include "hrg_gyro/StartCalibration.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
-#include "hrg_gyro/core/calibration_session.h"
+#include "hrg_gyro/core/generator_pairing.h"
+#include "hrg_gyro/core/staged_calibration.h"
 #include "hrg_gyro/ros/input_thread.h"
 #include "hrg_gyro/ros/parameter_reader.h"
 
@@ -53,13 +55,14 @@ class CalibratorRos {
   bool onAbort(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
-  /// Starts a run of `method` with the current parameter file as prior; false + reason on failure.
   /// Restarts the current run when `stamp` is more than ~backward_reset s before `*last`; updates `*last`.
   bool restartIfTimeWentBack(const ros::Time& stamp, ros::Time* last);
-  bool startRun(const std::string& method, std::string* reason);
+  /// Starts the next stage (or, with `restart`, the stage in progress again) with the current
+  /// parameter file as prior; false + reason on failure (then no stage is left).
+  bool startRun(bool restart, std::string* reason);
+  core::CalibrationSession* session() { return calibration_->session(); }
   /// Fits, gates, writes, publishes, reloads; returns the outcome. Caller holds the mutex.
   core::CalibrationOutcome finishRun(bool* written, std::string* message);
-  void pairGenerator();
   /// The sweep is over and every raw channel of it has arrived (or given up on): fit, maybe finish.
   void endGeneratorSweep();
   /// The reload worker: calls the processor's ~reload off the callback threads, then starts the
@@ -70,9 +73,7 @@ class CalibratorRos {
   ParameterReader params_;
   std::mutex mutex_;  // session and state; never held while calling a service
   core::CalibrationSettings base_settings_;
-  std::unique_ptr<core::CalibrationSession> session_;
-  std::vector<std::string> stages_;
-  std::size_t next_stage_ = 0;
+  std::unique_ptr<core::StagedCalibration> calibration_;  // the stages and the run in progress
   std::string parameter_file_, report_file_, output_directory_, reload_service_;
   bool write_ = true;
   std::uint64_t runs_ = 0;
@@ -83,8 +84,8 @@ class CalibratorRos {
   std::uint64_t resets_ = 0, reported_resets_ = 0;
   bool last_accepted_ = false;
 
-  // Generator pairs: raw channels and the reference wave, matched by stamp.
-  std::map<core::Nanoseconds, core::ChannelVector> raw_, reference_;
+  // Generator pairs: raw channels and the reference wave, matched by stamp, into the run.
+  core::GeneratorPairing pairing_;
   // Truth and channels come over separate connections: when truth leaves the sweep, the sweep's
   // last raw channels may still be in transit. The stage ends once the channels reach this stamp.
   ros::Time sweep_end_, last_channels_stamp_;

@@ -2,14 +2,15 @@
 // live nodes, fed from the bag in record order, with the same quality gates.
 #include <fstream>
 #include <iostream>
-#include <map>
 #include <memory>
+#include <stdexcept>
 
 #include "../cli_checks.h"
 #include "bag_tools.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/core/calibration_session.h"
+#include "hrg_gyro/core/generator_pairing.h"
 #include "hrg_gyro/core/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
 
@@ -40,19 +41,23 @@ int runCalibrate(const CalibrateOptions& o) {
       throw UsageError("--config " + o.config + ": " + e.what());
     }
   }
-  if (!o.method.empty()) settings.method = o.method;
+  if (!o.method.empty()) settings.method = core::parseCalibrationMethod(o.method);  // checked by --method's validator
+  const core::CalibrationMethodTraits& method = core::traitsOf(settings.method);
   const std::string& out_path = o.out;
   const auto prior = std::make_shared<const core::GyroParameters>(
       o.params.empty() ? core::GyroParameters() : core::loadParameterFile(o.params));
   const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
-  const GyroTopics topics = findTopics(*bag, o.topics, true, settings.method != "correction_matrix");
-  if (settings.method == "correction_matrix" && topics.truth.empty()) {
-    throw UsageError("the correction matrix needs the generator reference (a GroundTruth topic)");
+  const GyroTopics topics = findTopics(*bag, o.topics, true, method.needs_turntable);
+  if (method.uses_generator_pairs && topics.truth.empty()) {
+    throw UsageError(std::string(method.name) + " needs the generator reference (a GroundTruth topic)");
   }
 
   core::GyroProcessor processor(o.processor, prior);
   core::CalibrationSession session(settings, *prior);
-  std::map<core::Nanoseconds, core::ChannelVector> raw;
+  core::GeneratorPairing pairing(
+      [&session](core::Nanoseconds t, const core::ChannelVector& raw, const core::ChannelVector& reference) {
+        session.addGeneratorPair(t, raw, reference);
+      });
   std::vector<std::string> wanted{topics.channels};
   if (!topics.turntable.empty()) wanted.push_back(topics.turntable);
   if (!topics.truth.empty()) wanted.push_back(topics.truth);
@@ -67,23 +72,21 @@ int runCalibrate(const CalibrateOptions& o) {
         const ChannelAmplitudes::ConstPtr c = m.instantiate<ChannelAmplitudes>();
         if (!c) continue;
         const core::ChannelSample in = fromMessage(*c);
-        if (settings.method == "correction_matrix") {
-          raw[in.stamp] = in.z;
+        if (method.uses_generator_pairs) {
+          pairing.addRaw(in.stamp, in.z);
           continue;
         }
         const core::ProcessorResult r = processor.process(in);
-        if (r.has_wave) session.addWave(in.stamp, r.wave.theta, in.frequency, r.wave.quadrature / r.wave.amplitude);
+        if (r.has_wave) {
+          session.addWave(in.stamp, r.wave.theta, in.frequency, core::quadratureRatio(r.wave.quadrature, r.wave.amplitude));
+        }
       } else if (m.getTopic() == topics.turntable) {
         const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
         if (t) session.addTurntable(toNanoseconds(t->header.stamp), t->angle, t->rate);
       } else {
         const GroundTruth::ConstPtr g = m.instantiate<GroundTruth>();
         if (!g || !g->generator) continue;
-        const core::Nanoseconds t = toNanoseconds(g->header.stamp);
-        const auto it = raw.find(t);
-        if (it == raw.end()) continue;
-        session.addGeneratorPair(t, it->second, core::idealChannels({g->amplitude, g->quadrature, g->theta, g->phase}));
-        raw.erase(raw.begin(), std::next(it));
+        pairing.addReference(toNanoseconds(g->header.stamp), {g->amplitude, g->quadrature, g->theta, g->phase});
       }
     }
   } catch (const rosbag::BagException& e) {
@@ -97,7 +100,7 @@ int runCalibrate(const CalibrateOptions& o) {
     report << core::emitCalibrationReport(outcome);
     if (!report) throw UsageError("cannot write " + o.report);
   }
-  std::cout << "calibrate: " << outcome.method << " " << (outcome.accepted ? "ACCEPTED" : "REFUSED");
+  std::cout << "calibrate: " << core::nameOf(outcome.method) << " " << (outcome.accepted ? "ACCEPTED" : "REFUSED");
   if (!outcome.accepted) std::cout << ": " << outcome.reason;
   std::cout << "\n";
   for (const core::GateResult& g : outcome.gates) {
@@ -126,8 +129,12 @@ int runCalibrate(const CalibrateOptions& o) {
 CLI::Validator knownMethod() {
   return CLI::Validator(
       [](std::string& m) -> std::string {
-        if (core::CalibrationSettings::knownMethod(m)) return "";
-        return "unknown method '" + m + "' (dual_rate, constant_rate, step, correction_matrix, thermal)";
+        try {
+          core::parseCalibrationMethod(m);
+          return "";
+        } catch (const std::invalid_argument& e) {
+          return e.what();
+        }
       },
       "");
 }
@@ -141,7 +148,8 @@ Command addCalibrateCommand(CLI::App& root) {
   CLI::App* cmd = root.add_subcommand("calibrate", "the calibrator offline, with its quality gates");
   cmd->add_option("BAG", o->bag, "input bag: channels, turntable state (and the generator reference)")->required();
   cmd->add_option("--method", o->method,
-                  "dual_rate|constant_rate|step|correction_matrix|thermal (default: --config's, else dual_rate)")
+                  core::calibrationMethodNames("|") + " (default: --config's, else " +
+                      core::nameOf(core::CalibrationSettings().method) + ")")
       ->check(knownMethod());
   cmd->add_option("--out", o->out, "calibrated parameter file, written atomically only when every gate passes")
       ->required()
