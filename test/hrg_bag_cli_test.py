@@ -4,6 +4,7 @@ documented chain simulate -> info -> calibrate -> process on config/scenarios/du
 bad bags (missing, truncated/unindexed, wrong types, no channels topic) answered by a clear error
 and a non-zero exit, never a crash. Needs no master; run as a rostest for the package environment."""
 import csv
+import errno
 import filecmp
 import math
 import os
@@ -28,14 +29,45 @@ HRG_SESSION = subprocess.check_output(["catkin_find", "--first-only", "--libexec
                                       universal_newlines=True).strip()
 
 
-def run(tool, *args, timeout=600):
+def run(tool, *args, timeout=600, env=None):
     p = subprocess.run([tool] + list(args), stdout=subprocess.PIPE,
-                       stderr=subprocess.PIPE, universal_newlines=True, timeout=timeout)
+                       stderr=subprocess.PIPE, universal_newlines=True, timeout=timeout, env=env)
     return p.returncode, p.stdout, p.stderr
 
 
-def hrg_bag(*args, timeout=600):
-    return run(HRG_BAG, *args, timeout=timeout)
+def hrg_bag(*args, timeout=600, env=None):
+    return run(HRG_BAG, *args, timeout=timeout, env=env)
+
+
+def snapshot(directory):
+    """Every name in `directory` with its content: what a refused or failed write must not change."""
+    state = {}
+    for name in sorted(os.listdir(directory)):
+        path = os.path.join(directory, name)
+        if os.path.islink(path):
+            state[name] = ("link", os.readlink(path))
+        elif os.path.isdir(path):
+            state[name] = ("dir",)
+        else:
+            with open(path, "rb") as f:
+                state[name] = ("file", f.read())
+    return state
+
+
+def fill(directory, leave_bytes):
+    """Fills the file system of `directory` until at most `leave_bytes` are free; returns the filler."""
+    filler = os.path.join(directory, "filler")
+    st = os.statvfs(directory)
+    free = st.f_bavail * st.f_frsize
+    with open(filler, "ab") as f:
+        try:
+            f.write(b"\0" * max(0, free - leave_bytes))
+            f.flush()
+            os.fsync(f.fileno())
+        except OSError as e:
+            if e.errno != errno.ENOSPC:
+                raise
+    return filler
 
 
 class HrgBagCli(unittest.TestCase):
@@ -346,6 +378,133 @@ class HrgBagCli(unittest.TestCase):
         self.assertEqual(code, 0)
         for option in ("--window", "--bins", "--orders", "--method", "--evaluation-orders"):
             self.assertIn(option, out)
+
+    def test_an_output_that_is_an_input_or_a_directory_is_refused_before_any_work(self):
+        # The red-team cases: each would have destroyed the recording (or the scenario) being read.
+        d = self.path("same_file")
+        os.makedirs(os.path.join(d, "outdir"))
+        rec, params, scenario = (os.path.join(d, n) for n in ("rec.bag", "p.yaml", "s.yaml"))
+        shutil.copy(self.short, rec)
+        shutil.copy(self.params, params)
+        shutil.copy(os.path.join(self.pkg, "test/scenarios/short_session.yaml"), scenario)
+        os.symlink("rec.bag", os.path.join(d, "link_to_rec.bag"))
+        os.link(rec, os.path.join(d, "hard_link.bag"))
+        before = snapshot(d)
+        cal = ["calibrate", rec, "--method", "dual_rate", "--params", params]
+        cases = [
+            (["process", rec, "--params", params, "--out", rec], "same file"),
+            (["process", rec, "--params", params, "--csv", rec], "same file"),
+            (["process", rec, "--params", params, "--out", os.path.join(d, "link_to_rec.bag")], "same file"),
+            (["process", rec, "--params", params, "--out", os.path.join(d, "hard_link.bag")], "same file"),
+            (["process", rec, "--params", params, "--csv", os.path.join(d, "./../same_file/rec.bag")], "same file"),
+            (["process", rec, "--params", params, "--out", params], "same file"),
+            (["process", rec, "--params", params, "--out", os.path.join(d, "o.bag"), "--csv",
+              os.path.join(d, "o.bag")], "are the same file"),
+            (["allan", rec, "--csv", rec], "same file"),
+            (["allan", rec, "--csv", os.path.join(d, "a.csv"), "--plot", os.path.join(d, "a.csv")], "same file"),
+            (cal + ["--out", rec], "same file"),
+            (cal + ["--out", os.path.join(d, "c.yaml"), "--report", rec], "same file"),
+            (cal + ["--out", params], "same file"),
+            (["simulate", "--scenario", scenario, "--out", scenario], "same file"),
+            (["process", rec, "--params", params, "--out", os.path.join(d, "outdir")], "is a directory"),
+            (["process", rec, "--params", params, "--csv", os.path.join(d, "outdir")], "is a directory"),
+            (cal + ["--out", os.path.join(d, "outdir")], "is a directory"),
+            (["simulate", "--scenario", scenario, "--out", os.path.join(d, "outdir")], "is a directory"),
+        ]
+        for args, why in cases:
+            code, _, err = hrg_bag(*args)
+            self.assertEqual(code, 2, "%s -> exit %d\n%s" % (args, code, err))
+            self.assertIn(why, err, args)
+            self.assertNotIn("terminate called", err, args)
+            if why == "same file":
+                self.assertIn(args[-1], err, "the message names the output: %s" % args)
+            self.assertEqual(snapshot(d), before, "nothing changed, no .bak, no temporary: %s" % (args,))
+        session = ["--calibration", scenario, "--verification", scenario, "--params", params]
+        for out, why in ((params, "same file"), (scenario, "same file"), (os.path.join(d, "outdir"), "not a regular")):
+            code, _, err = run(HRG_SESSION, *(session + ["--out", out]))
+            self.assertEqual(code, 2, err)
+            self.assertIn("--out", err)
+            self.assertIn(why, err)
+            self.assertEqual(snapshot(d), before)
+
+    def test_outputs_replace_their_files_only_when_complete(self):
+        d = self.path("replace")
+        os.makedirs(d)
+        out_bag, out_csv = os.path.join(d, "out.bag"), os.path.join(d, "out.csv")
+        for p in (out_bag, out_csv):
+            with open(p, "w") as f:
+                f.write("previous\n")
+            os.chmod(p, 0o640)
+        code, _, err = hrg_bag("process", self.short, "--params", self.params, "--out", out_bag, "--csv", out_csv)
+        self.assertEqual(code, 0, err)
+        self.assertEqual(sorted(os.listdir(d)), ["out.bag", "out.csv"], "no temporary left")
+        with rosbag.Bag(out_bag) as bag:
+            self.assertGreater(bag.get_message_count(topic_filters=["/output"]), 6000)
+        self.assertEqual(os.stat(out_bag).st_mode & 0o777, 0o640, "a replaced file keeps its mode")
+        # A plot replaces its file only when the plotter succeeded: here its matplotlib is broken.
+        plot = os.path.join(d, "allan.png")
+        with open(plot, "w") as f:
+            f.write("previous plot\n")
+        broken = os.path.join(d, "broken_python")
+        os.makedirs(os.path.join(broken, "matplotlib"))
+        with open(os.path.join(broken, "matplotlib", "__init__.py"), "w") as f:
+            f.write("raise ImportError('matplotlib made unusable by the test')\n")
+        env = dict(os.environ, PYTHONPATH=broken)
+        code, _, err = hrg_bag("allan", self.short, "--params", self.params, "--csv", os.path.join(d, "a.csv"),
+                               "--plot", plot, env=env)
+        self.assertEqual(code, 3, err)
+        self.assertIn("not written", err)
+        with open(plot) as f:
+            self.assertEqual(f.read(), "previous plot\n")
+        self.assertEqual(sorted(n for n in os.listdir(d) if "allan.png" in n), ["allan.png"], "no temporary left")
+        code, _, err = hrg_bag("allan", self.short, "--params", self.params, "--csv", os.path.join(d, "a.csv"),
+                               "--plot", plot)
+        self.assertEqual(code, 0, err)
+        with open(plot, "rb") as f:
+            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n", "a PNG replaced the old file")
+        self.assertEqual(sorted(n for n in os.listdir(d) if "allan.png" in n), ["allan.png"])
+
+    def test_a_full_disk_fails_with_exit_3_and_leaves_the_target_as_it_was(self):
+        disk = self.path("full_disk")
+        os.makedirs(disk)
+        mount = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", disk], stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, universal_newlines=True)
+        if mount.returncode != 0:
+            self.skipTest("cannot mount a 64 KiB tmpfs to fill (needs root): " + mount.stdout.strip())
+        try:
+            existing = {n: os.path.join(disk, n) for n in ("old.bag", "old.csv", "old.report.yaml", "old_allan.csv")}
+            for p in existing.values():
+                with open(p, "w") as f:
+                    f.write("previous content\n")
+            new = {n: os.path.join(disk, n) for n in ("new.bag", "new.csv", "new.report.yaml", "new_allan.csv")}
+            process = ["process", self.short, "--params", self.params]
+            calibrate = ["calibrate", self.short, "--method", "dual_rate", "--params", self.params,
+                         "--out", self.path("never_accepted.yaml")]
+            allan = ["allan", self.short, "--params", self.params]
+            cases = []
+            for kind in ("new", "old"):
+                paths = new if kind == "new" else existing
+                cases += [
+                    process + ["--out", paths[kind + ".bag"]],
+                    process + ["--csv", paths[kind + ".csv"]],
+                    calibrate + ["--report", paths[kind + ".report.yaml"]],
+                    allan + ["--csv", paths[kind + "_allan.csv"]],
+                ]
+            # Nothing free at all, then 24 KiB free: the large outputs then fail in the middle of the
+            # bag or the CSV (a small report or Allan CSV may then fit, and is not tried).
+            for leave in (0, 24 * 1024):
+                filler = fill(disk, leave)
+                before = snapshot(disk)
+                for args in (cases if leave == 0 else [c for c in cases if c[0] == "process"]):
+                    code, _, err = hrg_bag(*args)
+                    self.assertEqual(code, 3, "%s, %d bytes free -> exit %d\n%s" % (args, leave, code, err))
+                    self.assertIn(args[-1], err)
+                    self.assertIn("No space left on device", err, args)
+                    self.assertNotIn("terminate called", err)
+                    self.assertEqual(snapshot(disk), before, "target untouched, no temporary: %s" % (args,))
+                os.remove(filler)
+        finally:
+            subprocess.run(["umount", disk])
 
 
 if __name__ == "__main__":

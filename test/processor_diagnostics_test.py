@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 """Diagnostics of the processor: OK on good input, ERROR naming the cause when every sample is bad
-(NaN, degenerate wave), WARN when some are, ERROR when the input stalls, OK again on recovery;
+(NaN, degenerate wave, amplitudes out of range), WARN when some are or while messages are lost
+(sequence gaps), ERROR when the input stalls, OK again on recovery;
 the output never carries a NaN; the model status warns while the model is uncalibrated; the Imu
 z variance is never 0, from the very first message of a fresh processor."""
 import math
 import os
+import subprocess
 import sys
 import time
 import unittest
@@ -12,10 +14,12 @@ import unittest
 import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from std_srvs.srv import Trigger
 
 from sensor_msgs.msg import Imu
 
 from hrg_gyro.msg import ChannelAmplitudes, GyroOutput
+from hrg_gyro.srv import StartCalibration
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hrg_test_util as util  # noqa: E402
@@ -44,8 +48,11 @@ class Diagnostics(unittest.TestCase):
         if any(math.isnan(v) for v in (msg.dalpha, msg.alpha, msg.rate, msg.scale_factor)):
             self.nan_outputs += 1
 
-    def feed(self, seconds, mutate=None):
+    def feed(self, seconds, mutate=None, lose_every=0):
+        """Publishes good channels for `seconds` (changed by `mutate`); with lose_every = n, two
+        sequence numbers are skipped after every n-th message, as if two messages had been lost."""
         end = time.time() + seconds
+        n = 0
         while time.time() < end:
             self.seq += 1
             self.t += 0.005
@@ -53,6 +60,9 @@ class Diagnostics(unittest.TestCase):
             if mutate:
                 mutate(m)
             self.pub.publish(m)
+            n += 1
+            if lose_every and n % lose_every == 0:
+                self.pub.impl.seq += 2  # rospy numbers the headers itself: skip two numbers there
             time.sleep(0.005)
 
     def status_after(self, name, since):
@@ -95,6 +105,73 @@ class Diagnostics(unittest.TestCase):
         level, message = self.status_after("input", start + 1.5)[:2]
         self.assertNotEqual(level, DiagnosticStatus.ERROR, message)
         self.assertEqual(self.nan_outputs, 0)
+
+    def test_huge_amplitudes_and_lost_messages_are_named(self):
+        self.feed(2.0)
+
+        def huge(m):  # finite, but the wave's energy overflows a double
+            m.c_in, m.c_quad, m.s_in, m.s_quad = (v * 1e300 for v in (m.c_in, m.c_quad, m.s_in, m.s_quad))
+        start = rospy.get_time()
+        self.feed(2.5, huge)
+        level, message = self.status_after("wave", start + 1.2)[:2]
+        self.assertEqual(level, DiagnosticStatus.ERROR, message)
+        self.assertIn("amplitude out of range", message)
+        self.assertNotIn("non-finite", message)
+
+        self.feed(1.5)
+        lost_before = int(self.status_after("input", rospy.get_time())[3]["lost (sequence gaps)"])
+        start = rospy.get_time()
+        self.feed(2.5, lose_every=20)
+        level, message, _, values = self.status_after("input", start + 1.2)
+        self.assertEqual(level, DiagnosticStatus.WARN, message)
+        self.assertIn("lost (sequence gaps)", message)
+        self.assertGreater(int(values["lost (sequence gaps)"]), lost_before)
+        start = rospy.get_time()
+        self.feed(2.5)  # no new loss: the warning clears
+        level, message = self.status_after("input", start + 1.5)[:2]
+        self.assertEqual(level, DiagnosticStatus.OK, message)
+
+    def test_calibrator_refuses_start_while_a_run_is_in_progress(self):
+        rospy.wait_for_service("/cal/calibrator/start", 30)
+        start = rospy.ServiceProxy("/cal/calibrator/start", StartCalibration)
+        abort = rospy.ServiceProxy("/cal/calibrator/abort", Trigger)
+        r = start(method="")  # the autostarted run is in progress
+        self.assertFalse(r.success, r.message)
+        self.assertIn("a run is in progress", r.message)
+        self.assertIn("~finish or ~abort it first", r.message)
+        self.assertTrue(abort().success)
+        r = start(method="step")
+        self.assertTrue(r.success, r.message)
+        r = start(method="dual_rate")
+        self.assertFalse(r.success, "a second ~start must not discard the step run: " + r.message)
+        self.assertIn("(step)", r.message)
+        self.assertTrue(abort().success)
+
+    def test_a_nodelet_that_fails_to_start_logs_why(self):
+        # A manager of the test's own, whose log (stderr) is read back; a processor nodelet with a
+        # missing model is loaded into it.
+        log_path = os.path.join("/tmp", "hrg_gyro_test_manager_%d.log" % os.getpid())
+        missing = "/nonexistent/hrg_gyro_params.yaml"
+        rospy.set_param("/broken_processor/parameter_file", missing)
+        with open(log_path, "w") as log:
+            manager = subprocess.Popen(["rosrun", "nodelet", "nodelet", "manager", "__name:=test_manager"],
+                                       stdout=log, stderr=subprocess.STDOUT)
+        try:
+            rospy.wait_for_service("/test_manager/load_nodelet", 30)
+            load = subprocess.run(["rosrun", "nodelet", "nodelet", "load", "hrg_gyro/Processor", "/test_manager",
+                                   "__name:=broken_processor", "--no-bond"], stdout=subprocess.PIPE,
+                                  stderr=subprocess.STDOUT, universal_newlines=True, timeout=60)
+            self.assertNotEqual(load.returncode, 0, load.stdout)
+
+            def fatal_line():
+                with open(log_path) as f:
+                    return [l for l in f if "FATAL" in l and "broken_processor failed to start" in l]
+            lines = util.wait_for(fatal_line, 20, "the manager to log why the nodelet failed")
+            self.assertIn(missing, lines[0], "the reason is in the log")
+        finally:
+            manager.terminate()
+            manager.wait(timeout=20)
+            os.remove(log_path)
 
     def test_imu_variance_never_zero_and_uncalibrated_model_warns(self):
         # A processor of its own (namespace fresh), so that its very first outputs are seen.

@@ -2,7 +2,8 @@
 """Time faults on the live processor (sim time driven by this test): zero, duplicate and
 out-of-order stamps are dropped and counted; a forward gap is not integrated across (FLAG_GAP,
 dalpha 0); a /clock jump back resets the state (FLAG_RESET, alpha restarts); processing carries on
-after each fault, no output is NaN, and the input diagnostic counts every case."""
+after each fault, no output is NaN, and the input diagnostic counts every case; with /clock stopped
+the diagnostics go on and report the input as stalled."""
 import math
 import os
 import sys
@@ -11,7 +12,7 @@ import unittest
 
 import rospy
 import rostest
-from diagnostic_msgs.msg import DiagnosticArray
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rosgraph_msgs.msg import Clock
 
 from hrg_gyro.msg import ChannelAmplitudes, GyroOutput
@@ -28,6 +29,7 @@ class TimeFaults(unittest.TestCase):
     def setUp(self):
         self.outputs = []
         self.input_status = None
+        self.input_summary = None
         rospy.Subscriber("/output", GyroOutput, self.outputs.append, queue_size=10000)
         rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diag)
         self.clock = rospy.Publisher("/clock", Clock, queue_size=1000)
@@ -42,6 +44,7 @@ class TimeFaults(unittest.TestCase):
         for s in msg.status:
             if s.name.endswith(": input"):
                 self.input_status = dict((kv.key, kv.value) for kv in s.values)
+                self.input_summary = (s.level, s.message, time.time())
 
     def tick(self, t):
         self.clock.publish(Clock(clock=rospy.Time.from_sec(t)))
@@ -106,6 +109,20 @@ class TimeFaults(unittest.TestCase):
         self.assertEqual(s["gaps not integrated"], "1")
         self.assertEqual(s["resets (time went backwards)"], "1")
         self.assertAlmostEqual(float(s["largest gap (s)"]), 0.5 + DT, places=6)
+
+    def test_stopped_clock_is_reported_as_stalled(self):
+        # A paused player stops /clock and the input together: diagnostics go on (on the wall
+        # clock) and say that the input stalled once ~stall_timeout (5 s) of wall time has passed.
+        self.good(100)
+        stop = time.time()
+        deadline = stop + 15.0
+
+        def stalled():
+            s = self.input_summary
+            return s if s and s[2] > stop + 5.0 and "stalled" in s[1] else None
+        level, message, when = util.wait_for(stalled, deadline - time.time(), "'input stalled' with /clock stopped")
+        self.assertEqual(level, DiagnosticStatus.ERROR, message)
+        self.assertLess(when - stop, 8.0, "reported within ~stall_timeout plus two diagnostic periods")
 
 
 if __name__ == "__main__":

@@ -63,6 +63,12 @@ std::string baseNameOf(const std::string& path) {
 bool allDigits(const std::string& s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
 }
+/// An OutputFileOptions::temporary_suffix: empty, or a dot followed by letters, digits and dots.
+bool isTemporarySuffix(const std::string& s) {
+  return s.empty() || (s.size() <= 16 && s[0] == '.' && std::all_of(s.begin(), s.end(), [](unsigned char c) {
+                         return std::isalnum(c) != 0 || c == '.';
+                       }));
+}
 bool isMkstempSuffix(const std::string& s) {
   return s.size() == 6 && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isalnum(c) != 0; });
 }
@@ -78,7 +84,9 @@ long temporaryOwner(const std::string& name, const std::string& base) {
     const std::size_t dot = rest.find('.');
     if (dot == std::string::npos) return isMkstempSuffix(rest) && prefix == base + ".tmp." ? 0 : -1;
     const std::string pid = rest.substr(0, dot), suffix = rest.substr(dot + 1);
-    if (pid.size() > 9 || !allDigits(pid) || !isMkstempSuffix(suffix)) return -1;
+    // The six random characters, then possibly the writer's temporary_suffix (".png").
+    const std::string random = suffix.substr(0, 6), extension = suffix.size() > 6 ? suffix.substr(6) : "";
+    if (pid.size() > 9 || !allDigits(pid) || !isMkstempSuffix(random) || !isTemporarySuffix(extension)) return -1;
     const long owner = std::strtol(pid.c_str(), nullptr, 10);
     return owner > 0 ? owner : -1;
   }
@@ -142,13 +150,14 @@ void syncDirectory(const std::string& dir) {
   ::close(fd);
 }
 
-/// A unique temporary beside `target`: <target><infix>.<pid>.XXXXXX, created 0600 by mkstemp so
-/// that nobody else can read it while it is written.
-int createTemporary(const std::string& target, const std::string& infix, std::string* name) {
-  std::string pattern = target + infix + "." + std::to_string(::getpid()) + ".XXXXXX";
+/// A unique temporary beside `target`: <target><infix>.<pid>.XXXXXX<suffix>, created 0600 by
+/// mkstemp so that nobody else can read it while it is written.
+int createTemporary(const std::string& target, const std::string& infix, std::string* name,
+                    const std::string& suffix = "") {
+  std::string pattern = target + infix + "." + std::to_string(::getpid()) + ".XXXXXX" + suffix;
   std::vector<char> buffer(pattern.begin(), pattern.end());
   buffer.push_back('\0');
-  const int fd = ::mkostemp(buffer.data(), O_CLOEXEC);
+  const int fd = ::mkostemps(buffer.data(), static_cast<int>(suffix.size()), O_CLOEXEC);
   if (fd < 0) fail("cannot create a temporary file beside '" + target + "'", errno);
   name->assign(buffer.data());
   return fd;
@@ -264,6 +273,9 @@ class AtomicOutputFile::Buffer : public std::streambuf {
 AtomicOutputFile::AtomicOutputFile(const std::string& path, const OutputFileOptions& options)
     : requested_path_(path), options_(options) {
   if (path.empty()) throw std::runtime_error("empty output file name");
+  if (!isTemporarySuffix(options.temporary_suffix)) {
+    throw std::invalid_argument("temporary suffix '" + options.temporary_suffix + "' is not a dot and letters or digits");
+  }
   target_path_ = resolveOutputTarget(path);
   struct stat st {};
   if (::stat(target_path_.c_str(), &st) == 0) {
@@ -279,7 +291,7 @@ AtomicOutputFile::AtomicOutputFile(const std::string& path, const OutputFileOpti
     fail("cannot inspect '" + target_path_ + "'", errno);
   }
   removeStaleTemporaries(target_path_, now());
-  fd_ = createTemporary(target_path_, ".tmp", &temporary_path_);
+  fd_ = createTemporary(target_path_, ".tmp", &temporary_path_, options.temporary_suffix);
   buffer_ = std::make_unique<Buffer>(fd_, target_path_);
   stream_ = std::make_unique<std::ostream>(buffer_.get());
 }

@@ -258,6 +258,39 @@ TEST_F(AtomicFile, StaleTemporariesOfKilledWritersAreRemovedAtTheNextWrite) {
   EXPECT_EQ(listing(), expected);
 }
 
+TEST_F(AtomicFile, ContentWrittenByNameThroughASuffixedTemporaryIsCommitted) {
+  // Another program (a plotter choosing its format by the extension, rosbag) writes the temporary
+  // by name; commit() gives it the mode and renames it, discard() removes it.
+  writeText(at("plot.png"), "old");
+  {
+    AtomicOutputFile file(at("plot.png"), OutputFileOptions{false, ".png"});
+    EXPECT_EQ(file.temporaryPath().substr(file.temporaryPath().size() - 4), ".png");
+    EXPECT_EQ(file.temporaryPath().rfind(at("plot.png.tmp."), 0), 0u);
+    writeText(file.temporaryPath(), "drawn");
+    EXPECT_EQ(readText(at("plot.png")), "old");
+    file.commit();
+  }
+  EXPECT_EQ(readText(at("plot.png")), "drawn");
+  EXPECT_EQ(listing(), std::set<std::string>{"plot.png"});
+  {
+    AtomicOutputFile file(at("plot.png"), OutputFileOptions{false, ".png"});
+    writeText(file.temporaryPath(), "half");
+  }
+  EXPECT_EQ(readText(at("plot.png")), "drawn");
+  EXPECT_EQ(listing(), std::set<std::string>{"plot.png"});
+  EXPECT_THROW(AtomicOutputFile(at("x"), OutputFileOptions{false, "/../y"}), std::invalid_argument);
+  // A suffixed temporary of a killed writer is recognised as ours and removed at the next write.
+  const pid_t gone = ::fork();
+  ASSERT_GE(gone, 0);
+  if (gone == 0) ::_exit(0);
+  ASSERT_EQ(::waitpid(gone, nullptr, 0), gone);
+  const std::string stale = "plot.png.tmp." + std::to_string(gone) + ".Ab12Cd.png";
+  writeText(at(stale), "leftover");
+  fs::last_write_time(at(stale), fs::file_time_type::clock::now() - std::chrono::hours(2));
+  writeFileAtomically(at("plot.png"), "again");
+  EXPECT_EQ(listing(), std::set<std::string>{"plot.png"});
+}
+
 // A failure at each step (a full disk, a failing sync, a refused verification, a failing backup or
 // rename) leaves the old file exactly as it was, and no temporary behind.
 TEST_F(AtomicFile, FailureAtAnyStepLeavesTheOldFileIntact) {

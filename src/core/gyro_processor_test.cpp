@@ -58,15 +58,16 @@ TEST_F(ProcessorTest, RejectsBadValuesCountsThemAndRecovers) {
   bad.z = idealChannels({1.0, 1.0, 0.3, 0.0});
   EXPECT_EQ(proc_.process(bad).wave_status, WaveStatus::kDegenerate);
   bad = at(1005 * kMs);
-  bad.z *= 1e300;
-  EXPECT_EQ(proc_.process(bad).wave_status, WaveStatus::kNonFinite);
+  bad.z *= 1e300;  // finite, but its energy overflows: out of range
+  EXPECT_EQ(proc_.process(bad).wave_status, WaveStatus::kAmplitudeOutOfRange);
   const ProcessorResult r = proc_.process(at(1006 * kMs));
   ASSERT_TRUE(r.has_output);
   expectFinite(r);
   EXPECT_EQ(r.rejected_before, 4u);
   EXPECT_NEAR(r.increment.dt, 0.005, 1e-15);  // the increment spans the rejected samples
   EXPECT_NEAR(r.alpha, -0.028 * 0.006 / -0.56, 1e-12);  // nothing lost
-  EXPECT_EQ(proc_.counters().non_finite, 2u);
+  EXPECT_EQ(proc_.counters().non_finite, 1u);
+  EXPECT_EQ(proc_.counters().amplitude_out_of_range, 1u);
   EXPECT_EQ(proc_.counters().no_signal, 1u);
   EXPECT_EQ(proc_.counters().degenerate, 1u);
 }
@@ -160,6 +161,47 @@ TEST_F(ProcessorTest, FlagsMissingOrOutOfRangeFrequency) {
   s = at(1003 * kMs);
   s.frequency = 6000.0;
   EXPECT_TRUE(proc.process(s).flags & kFlagFrequencyOutOfRange);
+}
+
+TEST_F(ProcessorTest, ModelWithFrequencyNodesInKOnlyIsInRangeInsideTheNodes) {
+  // D frequency independent (one constant node): only K's nodes bound the valid range.
+  auto p = std::make_shared<GyroParameters>();
+  Eigen::MatrixXd v(1, 2);
+  v << -0.56, -0.57;
+  p->scale_factor = HarmonicModel({}, FrequencyInterpolator({4990.0, 5010.0}), v);
+  ASSERT_FALSE(p->drift.frequencyDependent());
+  GyroProcessor proc(ProcessorConfig{}, p);
+  proc.process(at(1000 * kMs));
+  for (int i = 1; i <= 20; ++i) {
+    const ProcessorResult r = proc.process(at((1000 + i) * kMs));  // 5000 Hz, inside the nodes
+    ASSERT_TRUE(r.has_output);
+    EXPECT_FALSE(r.flags & kFlagFrequencyOutOfRange) << i;
+  }
+  EXPECT_EQ(proc.counters().frequency_out_of_range, 0u);
+  ChannelSample s = at(1021 * kMs);
+  s.frequency = 5020.0;  // midpoint 5010: still the last node
+  EXPECT_FALSE(proc.process(s).flags & kFlagFrequencyOutOfRange);
+  s = at(1022 * kMs);
+  s.frequency = 5030.0;
+  EXPECT_TRUE(proc.process(s).flags & kFlagFrequencyOutOfRange);
+  // The same with the roles swapped: nodes in D only.
+  auto q = std::make_shared<GyroParameters>();
+  Eigen::MatrixXd dv(1, 2);
+  dv << 1e-5, 2e-5;
+  q->drift = HarmonicModel({}, FrequencyInterpolator({4990.0, 5010.0}), dv);
+  GyroProcessor proc_d(ProcessorConfig{}, q);
+  proc_d.process(at(1000 * kMs));
+  EXPECT_FALSE(proc_d.process(at(1001 * kMs)).flags & kFlagFrequencyOutOfRange);
+}
+
+TEST(FrequencyInterpolatorRange, ASingleNodeIsValidAtEveryFiniteFrequency) {
+  const FrequencyInterpolator constant;
+  EXPECT_TRUE(constant.inRange(5000.0));
+  EXPECT_TRUE(constant.inRange(0.0));
+  EXPECT_FALSE(constant.inRange(NAN));
+  const FrequencyInterpolator nodes({4990.0, 5010.0});
+  EXPECT_TRUE(nodes.inRange(5000.0));
+  EXPECT_FALSE(nodes.inRange(5011.0));
 }
 
 }  // namespace

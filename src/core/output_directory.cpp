@@ -1,7 +1,10 @@
 #include "hrg_gyro/core/output_directory.h"
 
 #include <filesystem>
+#include <stdexcept>
 #include <system_error>
+
+#include "hrg_gyro/core/atomic_file.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -13,9 +16,15 @@ std::string directoryOf(const std::string& path) {
 
 bool isInsideDirectory(const std::string& path, const std::string& directory) {
   namespace fs = std::filesystem;
+  std::string target;
+  try {
+    target = resolveOutputTarget(path);  // the file a write would really replace
+  } catch (const std::runtime_error&) {
+    return false;  // a link loop, an unreadable link: nowhere a write could safely go
+  }
   std::error_code ec_dir, ec_parent;
   const fs::path dir = fs::canonical(directory, ec_dir);
-  const fs::path parent = fs::canonical(directoryOf(path), ec_parent);
+  const fs::path parent = fs::canonical(directoryOf(target), ec_parent);
   if (ec_dir || ec_parent) return false;
   // Component-wise prefix: /a/bc is not inside /a/b.
   auto d = dir.begin(), p = parent.begin();

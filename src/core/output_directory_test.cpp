@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 
 namespace hrg_gyro {
 namespace core {
@@ -36,6 +37,21 @@ TEST_F(OutputDirectory, RefusesEscapesByDotDotLinksAndPrefixes) {
   EXPECT_FALSE(isInsideDirectory(at("out/link/params.yaml"), at("out")));  // a link leading out
   EXPECT_FALSE(isInsideDirectory(at("outer/params.yaml"), at("out")));     // a name prefix is not a parent
   EXPECT_FALSE(isInsideDirectory("/etc/passwd", at("out")));
+}
+
+TEST_F(OutputDirectory, FollowsALinkAtTheFileItself) {
+  // The writer replaces the file a link points to: a link inside the directory is judged by its
+  // destination, relative or absolute, dangling (the file a write would create) or not.
+  fs::create_symlink(root_ / "outside" / "params.yaml", root_ / "out" / "absolute.yaml");
+  fs::create_symlink("../outside/report.yaml", root_ / "out" / "relative.yaml");
+  std::ofstream(root_ / "outside" / "params.yaml") << "k: 1\n";
+  EXPECT_FALSE(isInsideDirectory(at("out/absolute.yaml"), at("out")));
+  EXPECT_FALSE(isInsideDirectory(at("out/relative.yaml"), at("out")));  // dangling, leads out
+  fs::create_symlink("sub/params.yaml", root_ / "out" / "inside.yaml");
+  EXPECT_TRUE(isInsideDirectory(at("out/inside.yaml"), at("out")));
+  fs::create_symlink("loop_b.yaml", root_ / "out" / "loop_a.yaml");
+  fs::create_symlink("loop_a.yaml", root_ / "out" / "loop_b.yaml");
+  EXPECT_FALSE(isInsideDirectory(at("out/loop_a.yaml"), at("out")));
 }
 
 TEST_F(OutputDirectory, RefusesWhatDoesNotExist) {

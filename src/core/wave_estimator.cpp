@@ -32,7 +32,12 @@ void WaveState::rebase(double continuous_theta) {
 WaveStatus estimateWave(const ChannelVector& z, const WaveLimits& limits, WaveState* state) {
   const double ac = z[kAc], bc = z[kBc], as = z[kAs], bs = z[kBs];
   const double e = ac * ac + bc * bc + as * as + bs * bs;
-  if (!std::isfinite(e)) return WaveStatus::kNonFinite;  // also catches any NaN component
+  if (!std::isfinite(e)) {
+    // Any NaN or infinite component; else finite amplitudes so huge (1e300) that their energy
+    // overflows: those are a value out of range, not a non-finite input.
+    const bool finite = std::isfinite(ac) && std::isfinite(bc) && std::isfinite(as) && std::isfinite(bs);
+    return finite ? WaveStatus::kAmplitudeOutOfRange : WaveStatus::kNonFinite;
+  }
   if (e <= limits.min_energy) return WaveStatus::kNoSignal;
   const double r = ac * ac + bc * bc - as * as - bs * bs;
   const double s = 2.0 * (ac * as + bc * bs);

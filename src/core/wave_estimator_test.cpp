@@ -56,7 +56,11 @@ TEST(WaveEstimator, DegenerateAndBadInputNeverGiveNaN) {
   s.theta = 123.0;  // must stay untouched on rejection
   EXPECT_EQ(estimateWave(ChannelVector(nan, 0, 1, 0), WaveLimits{}, &s), WaveStatus::kNonFinite);
   EXPECT_EQ(estimateWave(ChannelVector(inf, 0, 1, 0), WaveLimits{}, &s), WaveStatus::kNonFinite);
-  EXPECT_EQ(estimateWave(ChannelVector(1e200, 1e200, 0, 0), WaveLimits{}, &s), WaveStatus::kNonFinite);
+  // Finite but so large that the energy overflows: out of range, not "non-finite".
+  EXPECT_EQ(estimateWave(ChannelVector(1e200, 1e200, 0, 0), WaveLimits{}, &s), WaveStatus::kAmplitudeOutOfRange);
+  EXPECT_EQ(estimateWave(idealChannels({1e300, 1e298, 0.3, 0.1}), WaveLimits{}, &s), WaveStatus::kAmplitudeOutOfRange);
+  EXPECT_EQ(estimateWave(ChannelVector(-1e300, 0, 1e300, 0), WaveLimits{}, &s), WaveStatus::kAmplitudeOutOfRange);
+  EXPECT_EQ(estimateWave(ChannelVector(1e300, inf, 0, 0), WaveLimits{}, &s), WaveStatus::kNonFinite);
   EXPECT_EQ(estimateWave(ChannelVector::Zero(), WaveLimits{}, &s), WaveStatus::kNoSignal);
   // A = B: a travelling wave, theta undefined.
   EXPECT_EQ(estimateWave(idealChannels({1.0, 1.0, 0.3, 0.1}), WaveLimits{}, &s), WaveStatus::kDegenerate);

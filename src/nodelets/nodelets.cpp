@@ -1,7 +1,9 @@
 // The four wrappers as nodelets, for zero-copy pipelines in one manager. Each owns the same wrapper
 // class as its node. The driver never shuts the manager down when its scenario ends; the session
 // monitor does when ~shutdown_when_done asks for it (demos and tests).
+#include <exception>
 #include <memory>
+#include <utility>
 
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
@@ -13,24 +15,40 @@
 
 namespace hrg_gyro {
 
-class DriverSimNodelet : public nodelet::Nodelet {
-  void onInit() override { impl_ = std::make_unique<DriverSimRos>(getNodeHandle(), getPrivateNodeHandle(), false); }
-  std::unique_ptr<DriverSimRos> impl_;
+/// The common part of the four nodelets: the wrapper they own, built in onInit. The nodelet
+/// manager reports a failed load without the exception's message, so the reason is logged here
+/// (FATAL, under the nodelet's name) before the exception goes on to fail the load as before.
+template <class Wrapper>
+class WrapperNodelet : public nodelet::Nodelet {
+ protected:
+  template <class... Args>
+  void create(Args&&... args) {
+    try {
+      impl_ = std::make_unique<Wrapper>(std::forward<Args>(args)...);
+    } catch (const std::exception& e) {
+      NODELET_FATAL("%s failed to start: %s", getName().c_str(), e.what());
+      throw;
+    }
+  }
+
+ private:
+  std::unique_ptr<Wrapper> impl_;
 };
 
-class ProcessorNodelet : public nodelet::Nodelet {
-  void onInit() override { impl_ = std::make_unique<ProcessorRos>(getNodeHandle(), getPrivateNodeHandle()); }
-  std::unique_ptr<ProcessorRos> impl_;
+class DriverSimNodelet : public WrapperNodelet<DriverSimRos> {
+  void onInit() override { create(getNodeHandle(), getPrivateNodeHandle(), false); }
 };
 
-class CalibratorNodelet : public nodelet::Nodelet {
-  void onInit() override { impl_ = std::make_unique<CalibratorRos>(getNodeHandle(), getPrivateNodeHandle()); }
-  std::unique_ptr<CalibratorRos> impl_;
+class ProcessorNodelet : public WrapperNodelet<ProcessorRos> {
+  void onInit() override { create(getNodeHandle(), getPrivateNodeHandle()); }
 };
 
-class SessionMonitorNodelet : public nodelet::Nodelet {
-  void onInit() override { impl_ = std::make_unique<SessionMonitorRos>(getNodeHandle(), getPrivateNodeHandle()); }
-  std::unique_ptr<SessionMonitorRos> impl_;
+class CalibratorNodelet : public WrapperNodelet<CalibratorRos> {
+  void onInit() override { create(getNodeHandle(), getPrivateNodeHandle()); }
+};
+
+class SessionMonitorNodelet : public WrapperNodelet<SessionMonitorRos> {
+  void onInit() override { create(getNodeHandle(), getPrivateNodeHandle()); }
 };
 
 }  // namespace hrg_gyro

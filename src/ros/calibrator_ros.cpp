@@ -6,6 +6,7 @@
 
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/ModelInfo.h"
+#include "hrg_gyro/core/atomic_file.h"
 #include "hrg_gyro/core/output_directory.h"
 #include "hrg_gyro/core/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
@@ -55,8 +56,16 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   backward_reset_ = params_.get("backward_reset", backward_reset_);
   if (!(backward_reset_ > 0.0)) throw std::invalid_argument("calibrator: ~backward_reset must be positive (s)");
   for (const std::string& f : {parameter_file_, report_file_}) {
+    // Links followed, also a link at the file itself: the writer replaces the file it points to.
     if (!core::isInsideDirectory(f, output_directory_)) {
-      throw std::invalid_argument("calibrator: '" + f + "' is outside ~output_directory '" + output_directory_ +
+      std::string target = f;
+      try {
+        target = core::resolveOutputTarget(f);
+      } catch (const std::runtime_error& e) {
+        target = e.what();  // a link loop
+      }
+      throw std::invalid_argument("calibrator: '" + f + "'" + (target != f ? " (a link to '" + target + "')" : "") +
+                                  " is outside ~output_directory '" + output_directory_ +
                                   "' (or its directory does not exist)");
     }
   }
@@ -337,6 +346,12 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
 
 bool CalibratorRos::onStart(StartCalibration::Request& req, StartCalibration::Response& res) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (session_) {
+    // Starting over would silently throw away the data gathered so far.
+    res.success = false;
+    res.message = "a run is in progress (" + session_->settings().method + "): ~finish or ~abort it first";
+    return true;
+  }
   if (req.method.empty()) {
     calibration_->rewind();
   } else {

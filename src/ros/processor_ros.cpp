@@ -1,5 +1,6 @@
 #include "hrg_gyro/ros/processor_ros.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -161,6 +162,7 @@ void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   last_seq_ = msg->header.seq;
   seen_input_ = true;
   last_input_ = ros::Time::now();
+  last_input_wall_ = ros::WallTime::now();
   last_stamp_ = msg->header.stamp;
 
   const core::ChannelSample in = fromMessage(*msg);
@@ -319,11 +321,19 @@ bool ProcessorRos::onCaptureBias(std_srvs::Trigger::Request&, std_srvs::Trigger:
 void ProcessorRos::diagnoseInput(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   std::lock_guard<std::mutex> lock(mutex_);
   const core::ProcessorCounters& c = processor_->counters();
-  const double since = seen_input_ ? (ros::Time::now() - last_input_).toSec() : INFINITY;
+  // The longer of ROS and wall time: under sim time a stopped /clock stops the first.
+  const double since = seen_input_ ? std::max((ros::Time::now() - last_input_).toSec(),
+                                              (ros::WallTime::now() - last_input_wall_).toSec())
+                                   : INFINITY;
+  const std::uint64_t lost = dropped_ - dropped_reported_;
+  dropped_reported_ = dropped_;
   if (!seen_input_) {
     stat.summary(DiagnosticStatus::ERROR, "no channel amplitudes received yet");
   } else if (since > stall_timeout_) {
     stat.summaryf(DiagnosticStatus::ERROR, "input stalled: no channel amplitudes for %.2f s", since);
+  } else if (lost > 0) {
+    stat.summaryf(DiagnosticStatus::WARN, "%lu messages lost (sequence gaps) since the last report",
+                  static_cast<unsigned long>(lost));
   } else if (c.zero_stamp + c.duplicate + c.out_of_order > reported_.zero_stamp + reported_.duplicate + reported_.out_of_order) {
     stat.summary(DiagnosticStatus::WARN, "samples with zero, duplicate or out-of-order stamps dropped");
   } else if (c.gaps > reported_.gaps || c.resets > reported_.resets) {

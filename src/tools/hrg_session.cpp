@@ -5,6 +5,8 @@
 // Simulates the calibration scenario through the processor (with P.yaml) into the calibrator,
 // writes the refreshed parameters (atomically) when the quality gates accept them, then runs the
 // verification scenario through an uncalibrated and a calibrated processor and prints the summary.
+#include <sys/stat.h>
+
 #include <cstring>
 #include <iostream>
 #include <memory>
@@ -13,6 +15,7 @@
 #include <vector>
 
 #include "cli_checks.h"
+#include "hrg_gyro/core/atomic_file.h"
 #include "hrg_gyro/core/calibration_session.h"
 #include "hrg_gyro/core/offline_pipeline.h"
 #include "hrg_gyro/core/parameter_file.h"
@@ -99,10 +102,22 @@ int main(int argc, char** argv) {
       "Simulates the calibration scenario through the processor into the calibrator, writes the refreshed\n"
       "parameters when the quality gates accept them, then runs the verification scenario through an\n"
       "uncalibrated and a calibrated processor and prints the summary.\n"
-      "Exit 0 accepted and verified, 1 refused or not verified, 2 bad usage or unreadable input.");
+      "--out is replaced atomically (the previous file kept as .bak) and may not be one of the inputs.\n"
+      "Exit 0 accepted and verified, 1 refused or not verified, 2 bad usage or unreadable input, 3 --out\n"
+      "could not be written (an existing file unchanged).");
   const int parsed = hrg_gyro::tools::parseCommandLine(app, argc, argv);
   if (parsed >= 0) return parsed;
   try {
+    try {
+      // Before anything runs: --out must not be one of the files read.
+      struct stat st {};
+      if (!out.empty() && ::stat(out.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+        throw std::runtime_error("'" + out + "' exists and is not a regular file (a directory?)");
+      }
+      if (!out.empty()) checkDistinct({calibration, verification, params}, {out});
+    } catch (const std::runtime_error& e) {
+      throw ArgumentError(std::string("--out refused: ") + e.what());
+    }
     CalibrationSettings settings = checkedSettings(method, orders, drift_orders, bins, window);
     EvaluationSettings evaluation;
     evaluation.orders = checkedEvaluationOrders(evaluation_orders);
@@ -119,7 +134,12 @@ int main(int argc, char** argv) {
     if (cal.outcome.accepted) {
       calibrated = std::make_shared<const GyroParameters>(cal.outcome.parameters);
       if (!out.empty()) {
-        saveParameterFile(out, *calibrated);
+        try {
+          saveParameterFile(out, *calibrated);
+        } catch (const std::exception& e) {
+          std::cerr << "hrg_session: the calibration was accepted but not written: " << e.what() << "\n";
+          return 3;
+        }
         std::cerr << "hrg_session: wrote " << out << "\n";
       }
     }

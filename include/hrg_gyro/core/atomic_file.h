@@ -31,6 +31,9 @@ constexpr mode_t kNewOutputFileMode = 0644;
 struct OutputFileOptions {
   /// Keep the replaced file as <target>.bak, beside the (link-resolved) target.
   bool keep_backup = false;
+  /// Appended to the temporary's name (".png"): for content written by another program that
+  /// chooses its format by the name's extension. Letters, digits and dots only.
+  std::string temporary_suffix;
 };
 
 class AtomicOutputFile {
@@ -47,7 +50,9 @@ class AtomicOutputFile {
   AtomicOutputFile(const AtomicOutputFile&) = delete;
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 
-  /// Where the content goes. Write errors are reported by commit(), naming the target.
+  /// Where the content goes. Write errors are reported by commit(), naming the target. Content may
+  /// instead be written to temporaryPath() by name (a rosbag::Bag, a plotting program), as long as
+  /// the file is truncated and rewritten in place, not replaced; commit() then syncs and renames it.
   std::ostream& stream();
   void write(const std::string& text);
 

@@ -9,6 +9,7 @@
 // not extrapolated beyond the temperatures it was calibrated at); inRange() tells the caller.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -33,7 +34,12 @@ class FrequencyInterpolator {
   const std::vector<double>& nodes() const { return nodes_; }
   std::size_t size() const { return nodes_.size(); }
   Interpolation kind() const { return kind_; }
-  bool inRange(double f) const { return f >= nodes_.front() && f <= nodes_.back(); }
+  /// True when `f` lies within the nodes, where nothing is held. A single node is a constant,
+  /// valid at every finite frequency (its one "node" is no calibrated range).
+  bool inRange(double f) const {
+    if (nodes_.size() == 1) return std::isfinite(f);
+    return f >= nodes_.front() && f <= nodes_.back();
+  }
 
   /// Writes size() weights such that value(f) = sum_j w[j] y_j. A non-finite f gets the weights of
   /// the first node (callers flag the missing frequency).

@@ -11,8 +11,10 @@ namespace core {
 /// The directory part of a path ("." for a bare file name).
 std::string directoryOf(const std::string& path);
 
-/// True when the file `path` would be created inside `directory` (or a subdirectory of it). Both
-/// the directory and the file's parent directory must exist; links are resolved.
+/// True when the file `path` would be written inside `directory` (or a subdirectory of it). Both
+/// the directory and the file's parent directory must exist; links are resolved, including a link
+/// at `path` itself (the writer replaces the file it points to, see resolveOutputTarget): a link
+/// inside the directory that points outside is outside. A link loop is outside too.
 bool isInsideDirectory(const std::string& path, const std::string& directory);
 
 }  // namespace core

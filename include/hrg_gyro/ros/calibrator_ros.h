@@ -95,7 +95,7 @@ class CalibratorRos {
   ros::Publisher result_pub_;
   ros::ServiceServer start_srv_, finish_srv_, abort_srv_;
   diagnostic_updater::Updater updater_;
-  ros::Timer diagnostics_timer_;
+  ros::WallTimer diagnostics_timer_;
 
   std::mutex reload_mutex_;
   std::condition_variable reload_cv_;

@@ -76,7 +76,7 @@ class ProcessorRos {
   std::string last_bias_capture_;
 
   diagnostic_updater::Updater updater_;
-  ros::Timer diagnostics_timer_;
+  ros::WallTimer diagnostics_timer_;
   double expected_rate_ = 200.0;
   double min_rate_ = 0.0, max_rate_ = 0.0;
   std::unique_ptr<diagnostic_updater::FrequencyStatus> frequency_;
@@ -84,9 +84,10 @@ class ProcessorRos {
 
   // Health since the last diagnostics report.
   ros::Time last_input_;
+  ros::WallTime last_input_wall_;  // a stopped /clock must not hide a stall
   bool seen_input_ = false;
   std::uint32_t last_seq_ = 0;
-  std::uint64_t dropped_ = 0;
+  std::uint64_t dropped_ = 0, dropped_reported_ = 0;
   core::ProcessorCounters reported_;
   std::uint64_t reloads_ = 0, failed_reloads_ = 0;
   std::string last_reload_error_;

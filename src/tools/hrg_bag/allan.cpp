@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <vector>
@@ -25,6 +24,7 @@ struct AllanOptions {
 int runAllan(const AllanOptions& o) {
   using namespace bag_tools;
   checkProcessorConfig(o.processor);
+  checkOutputPaths({o.bag, o.params}, {o.csv, o.plot});
   const auto params = std::make_shared<const core::GyroParameters>(
       o.params.empty() ? core::GyroParameters() : core::loadParameterFile(o.params));
   const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
@@ -62,8 +62,8 @@ int runAllan(const AllanOptions& o) {
   reading("angle random walk N", a.angle_random_walk, 180.0 / M_PI * 60.0, "deg/sqrt(h)", 1.0, "rad/sqrt(s)");
   reading("bias instability B", a.bias_instability, kDegPerHour, "deg/h", 1.0, "rad/s");
   if (!o.csv.empty()) {
-    std::ofstream csv(o.csv);
-    if (!csv) throw UsageError("cannot write " + o.csv);
+    OutputText csv_file(o.csv);
+    std::ostream& csv = csv_file.stream();
     csv << "tau,deviation,error,clusters\n";
     char line[128];
     for (const core::AllanPoint& p : a.curve) {
@@ -71,12 +71,9 @@ int runAllan(const AllanOptions& o) {
                     static_cast<unsigned long>(p.clusters));
       csv << line;
     }
+    csv_file.commit();
   }
-  if (!o.plot.empty()) {
-    if (runPlotter({"allan", o.csv, o.plot}) != 0) {
-      std::cerr << "allan: plotting failed (is python3-matplotlib installed?)\n";
-    }
-  }
+  if (!o.plot.empty()) plot("allan", o.csv, o.plot);
   return 0;
 }
 
@@ -99,7 +96,9 @@ Command addAllanCommand(CLI::App& root) {
       "longest continuous stretch (no gap or reset). Prints the readings: angle white noise Q (slope -1),\n"
       "angle random walk N (slope -1/2, at tau = 1 s), bias instability B (flat bottom / 0.664), each\n"
       "with the tau range it was read from, or 'not identified'.\n"
-      "Exit 0 success, 2 bad usage, unreadable input or fewer than 100 continuous samples.");
+      "The CSV and the plot replace their paths only when complete.\n"
+      "Exit 0 success, 2 bad usage, unreadable input or fewer than 100 continuous samples, 3 an output\n"
+      "could not be written (nothing left at its path, an existing file unchanged).");
   return [o] { return runAllan(*o); };
 }
 

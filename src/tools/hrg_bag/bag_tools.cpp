@@ -1,12 +1,16 @@
 #include "bag_tools.h"
 
+#include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 
 #include <ros/package.h>
@@ -14,6 +18,7 @@
 
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
+#include "hrg_gyro/core/output_directory.h"
 #include "hrg_gyro/core/yaml_field.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "../cli_checks.h"
@@ -34,25 +39,112 @@ void addCompressionOption(CLI::App& command, std::string* compression) {
       ->capture_default_str();
 }
 
-std::unique_ptr<rosbag::Bag> createBag(const std::string& path, const std::string& name) {
-  rosbag::compression::CompressionType type;
-  if (name == "none") {
-    type = rosbag::compression::Uncompressed;
-  } else if (name == "lz4") {
-    type = rosbag::compression::LZ4;
-  } else if (name == "bz2") {
-    type = rosbag::compression::BZ2;
-  } else {
-    throw UsageError("--compression must be none, lz4 or bz2, got '" + name + "'");
-  }
-  auto bag = std::make_unique<rosbag::Bag>();
+namespace {
+
+rosbag::compression::CompressionType compressionType(const std::string& name) {
+  if (name == "none") return rosbag::compression::Uncompressed;
+  if (name == "lz4") return rosbag::compression::LZ4;
+  if (name == "bz2") return rosbag::compression::BZ2;
+  throw UsageError("--compression must be none, lz4 or bz2, got '" + name + "'");
+}
+
+core::AtomicOutputFile& openOutput(std::unique_ptr<core::AtomicOutputFile>* file, const std::string& path,
+                                   const core::OutputFileOptions& options = {}) {
   try {
-    bag->open(path, rosbag::bagmode::Write);
-  } catch (const rosbag::BagException& e) {
-    throw UsageError("cannot write " + path + ": " + e.what());
+    *file = std::make_unique<core::AtomicOutputFile>(path, options);
+  } catch (const std::exception& e) {
+    throw OutputError(std::string("cannot write ") + path + ": " + e.what());
   }
-  bag->setCompression(type);
-  return bag;
+  return **file;
+}
+
+}  // namespace
+
+void checkOutputPaths(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs) {
+  std::vector<std::string> given_inputs, given_outputs;
+  for (const std::string& p : inputs) {
+    if (!p.empty()) given_inputs.push_back(p);
+  }
+  for (const std::string& p : outputs) {
+    if (p.empty()) continue;
+    given_outputs.push_back(p);
+    struct stat st {};
+    if (::stat(p.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+      throw UsageError("output '" + p + "' " + (S_ISDIR(st.st_mode) ? "is a directory" : "is not a regular file") +
+                       ": give a file name");
+    }
+  }
+  try {
+    core::checkDistinct(given_inputs, given_outputs);
+  } catch (const std::runtime_error& e) {
+    throw UsageError(std::string("refused: ") + e.what());
+  }
+}
+
+OutputBag::OutputBag(const std::string& path, const std::string& compression) : path_(path) {
+  const rosbag::compression::CompressionType type = compressionType(compression);
+  openOutput(&file_, path);
+  bag_ = std::make_unique<rosbag::Bag>();
+  try {
+    // rosbag truncates and rewrites the temporary in place; file_ renames it on commit.
+    bag_->open(file_->temporaryPath(), rosbag::bagmode::Write);
+    bag_->setCompression(type);
+  } catch (const rosbag::BagException& e) {
+    failed(e.what(), errno);
+  }
+}
+
+OutputBag::~OutputBag() { abandon(); }
+
+void OutputBag::abandon() noexcept {
+  if (!bag_) return;
+  try {
+    bag_->close();
+    bag_.reset();
+  } catch (...) {
+    (void)bag_.release();  // see the header: its destructor would throw again
+  }
+}
+
+void OutputBag::failed(const std::string& why, int error) {
+  // rosbag reports a short write without its reason; a full file system is the usual one.
+  std::string reason = why;
+  struct statvfs fs {};
+  const bool nearly_full = ::statvfs(core::directoryOf(file_->targetPath()).c_str(), &fs) == 0 &&
+                           static_cast<double>(fs.f_bavail) * fs.f_frsize < 1024.0 * 1024.0;
+  if (error == ENOSPC || error == EDQUOT || nearly_full) {
+    reason += std::string(": ") + std::strerror(error == EDQUOT ? EDQUOT : ENOSPC);
+  } else if (error != 0) {
+    reason += std::string(" (") + std::strerror(error) + ")";
+  }
+  abandon();
+  file_->discard();
+  throw OutputError("cannot write " + path_ + ": " + reason + " (nothing written" +
+                    (::access(path_.c_str(), F_OK) == 0 ? "; the existing file is unchanged)" : ")"));
+}
+
+void OutputBag::commit() {
+  try {
+    bag_->close();  // writes the index; a full disk shows here at the latest
+    bag_.reset();
+  } catch (const rosbag::BagException& e) {
+    failed(e.what(), errno);
+  }
+  try {
+    file_->commit();
+  } catch (const std::exception& e) {
+    throw OutputError(e.what());
+  }
+}
+
+OutputText::OutputText(const std::string& path) : path_(path) { openOutput(&file_, path); }
+
+void OutputText::commit() {
+  try {
+    file_->commit();
+  } catch (const std::exception& e) {
+    throw OutputError(e.what());
+  }
 }
 
 std::unique_ptr<rosbag::Bag> openBag(const std::string& path) {
@@ -217,6 +309,8 @@ std::string plotScript() {
 
 }  // namespace
 
+namespace {
+
 int runPlotter(const std::vector<std::string>& arguments) {
   const std::string script = plotScript();
   std::vector<std::string> argv_s{"/usr/bin/python3", script};
@@ -233,6 +327,37 @@ int runPlotter(const std::vector<std::string>& arguments) {
   int status = 0;
   ::waitpid(pid, &status, 0);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/// The extension of `path` (".png"), which the plotter reads to choose the image format; ".png"
+/// when there is none fit for a temporary's name.
+std::string imageExtension(const std::string& path) {
+  const std::size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return ".png";
+  const std::string extension = path.substr(dot);
+  const bool plain = extension.size() >= 2 && extension.size() <= 8 &&
+                     std::all_of(extension.begin() + 1, extension.end(), [](unsigned char c) { return std::isalnum(c) != 0; });
+  return plain ? extension : ".png";
+}
+
+}  // namespace
+
+void plot(const std::string& kind, const std::string& input, const std::string& png) {
+  core::OutputFileOptions options;
+  options.temporary_suffix = imageExtension(png);
+  std::unique_ptr<core::AtomicOutputFile> file;
+  openOutput(&file, png, options);
+  if (runPlotter({kind, input, file->temporaryPath()}) != 0) {
+    throw OutputError("plot " + png + " not written: the plotter failed (is python3-matplotlib installed?)");
+  }
+  try {
+    file->commit([&](const std::string& temporary) {
+      struct stat st {};
+      if (::stat(temporary.c_str(), &st) != 0 || st.st_size == 0) throw std::runtime_error("the plotter wrote nothing");
+    });
+  } catch (const std::exception& e) {
+    throw OutputError("plot " + png + " not written: " + e.what());
+  }
 }
 
 }  // namespace bag_tools

@@ -3,6 +3,7 @@
 // same core::GyroProcessor the processor node runs.
 #pragma once
 
+#include <cerrno>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -15,6 +16,7 @@
 #include <rosbag/view.h>
 
 #include "hrg_gyro/ChannelAmplitudes.h"
+#include "hrg_gyro/core/atomic_file.h"
 #include "hrg_gyro/core/gyro_processor.h"
 
 namespace hrg_gyro {
@@ -24,6 +26,14 @@ namespace bag_tools {
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+/// An output that could not be written (a full disk, a write or rename error, a plotter that
+/// failed): message printed, exit code 3. Nothing is left at the output's path; a file that was
+/// there before is unchanged.
+struct OutputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+constexpr int kExitOutputError = 3;
 
 /// One subcommand, run after its options have been parsed into the state it holds. Returns the
 /// exit code.
@@ -75,8 +85,58 @@ void checkProcessorConfig(const core::ProcessorConfig& config);
 /// --compression none|lz4|bz2 (default lz4: readers then decompress whole chunks instead of
 /// seeking for every message).
 void addCompressionOption(CLI::App& command, std::string* compression);
-/// Opens `path` for writing with that chunk compression.
-std::unique_ptr<rosbag::Bag> createBag(const std::string& path, const std::string& compression);
+/// Checked before anything is read or written; a refusal is a UsageError (exit 2) naming the
+/// paths: an output that is the same file as an input or as another output (core::checkDistinct:
+/// links followed, hard links, other spellings), or one that exists and is not a regular file (a
+/// directory). Empty paths (options not given) are skipped.
+void checkOutputPaths(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
+
+/// A bag written whole or not at all: the rosbag::Bag writes a temporary beside `path`
+/// (core::AtomicOutputFile), and commit() closes it and renames it over `path`. Every rosbag error
+/// while writing or closing becomes an OutputError naming `path`. Destroyed without a commit (an
+/// error, a refusal), the temporary is removed and `path` is left as it was.
+class OutputBag {
+ public:
+  OutputBag(const std::string& path, const std::string& compression);
+  ~OutputBag();
+  OutputBag(const OutputBag&) = delete;
+  OutputBag& operator=(const OutputBag&) = delete;
+
+  template <class Message>
+  void write(const std::string& topic, const ros::Time& time, const Message& message) {
+    try {
+      bag_->write(topic, time, message);
+    } catch (const rosbag::BagException& e) {
+      failed(e.what(), errno);
+    }
+  }
+  void commit();
+
+ private:
+  /// `error`: errno right after the failure (rosbag's messages do not say why a write failed).
+  [[noreturn]] void failed(const std::string& why, int error);
+  /// Closes the bag after a failure, swallowing its errors. A bag whose close fails is left
+  /// unclosed on purpose: rosbag::Bag's destructor would retry the close, and an exception
+  /// escaping a destructor ends the process with a signal instead of an exit code.
+  void abandon() noexcept;
+
+  std::string path_;
+  std::unique_ptr<core::AtomicOutputFile> file_;
+  std::unique_ptr<rosbag::Bag> bag_;
+};
+
+/// A text output (CSV, report) written whole or not at all, like OutputBag.
+class OutputText {
+ public:
+  explicit OutputText(const std::string& path);
+  std::ostream& stream() { return file_->stream(); }
+  /// Renames the complete file over the path; OutputError on any failure (the path unchanged).
+  void commit();
+
+ private:
+  std::string path_;
+  std::unique_ptr<core::AtomicOutputFile> file_;
+};
 
 /// Replays the channels topic of `bag` in record order through `processor`, calling `sink` with
 /// every input message and its result.
@@ -84,8 +144,10 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
                              const std::function<void(const ChannelAmplitudes&, const core::ProcessorResult&)>& sink,
                              const std::string& progress_label);
 
-/// Runs scripts/plot_calibration.py (found through the package path) without a shell.
-int runPlotter(const std::vector<std::string>& arguments);
+/// Runs scripts/plot_calibration.py (found through the package path) without a shell: `kind`
+/// (calibration, allan) drawn from `input` into `png`. The plotter writes a temporary beside `png`
+/// that replaces it only when the plotter succeeded; otherwise OutputError and `png` unchanged.
+void plot(const std::string& kind, const std::string& input, const std::string& png);
 
 }  // namespace bag_tools
 }  // namespace hrg_gyro

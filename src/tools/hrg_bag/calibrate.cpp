@@ -1,6 +1,5 @@
 // hrg_bag calibrate: the calibrator offline -- the processor and the calibration session of the
 // live nodes, fed from the bag in record order, with the same quality gates.
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
@@ -27,6 +26,7 @@ struct CalibrateOptions {
 int runCalibrate(const CalibrateOptions& o) {
   using namespace bag_tools;
   checkProcessorConfig(o.processor);
+  checkOutputPaths({o.bag, o.params, o.config}, {o.out, o.report, o.plot});
   core::CalibrationSettings settings;
   if (!o.config.empty()) {
     YAML::Node root;
@@ -96,9 +96,9 @@ int runCalibrate(const CalibrateOptions& o) {
   core::CalibrationOutcome outcome = session.finish();
   outcome.parameters.calibration.source = o.bag;
   if (!o.report.empty()) {
-    std::ofstream report(o.report);
-    report << core::emitCalibrationReport(outcome);
-    if (!report) throw UsageError("cannot write " + o.report);
+    OutputText report(o.report);
+    report.stream() << core::emitCalibrationReport(outcome);
+    report.commit();
   }
   std::cout << "calibrate: " << core::nameOf(outcome.method) << " " << (outcome.accepted ? "ACCEPTED" : "REFUSED");
   if (!outcome.accepted) std::cout << ": " << outcome.reason;
@@ -111,17 +111,17 @@ int runCalibrate(const CalibrateOptions& o) {
     std::cout << "calibrate: root-cause diagnosis (first order, read against the P in force) " << core::describe(d);
   }
   if (outcome.accepted) {
-    core::saveParameterFile(out_path, outcome.parameters);
+    try {
+      core::saveParameterFile(out_path, outcome.parameters);
+    } catch (const std::exception& e) {
+      throw OutputError(std::string("the calibration was accepted but not written: ") + e.what());
+    }
     std::cout << "calibrate: wrote " << out_path << " (peak nonlinearity of the new K: " << outcome.nonlinearity_ppm
               << " ppm)\n";
   } else {
     std::cout << "calibrate: " << out_path << " not written\n";
   }
-  if (!o.plot.empty()) {
-    if (runPlotter({"calibration", o.report, o.plot}) != 0) {
-      std::cerr << "calibrate: plotting failed (is python3-matplotlib installed?)\n";
-    }
-  }
+  if (!o.plot.empty()) plot("calibration", o.report, o.plot);
   return outcome.accepted ? 0 : 1;
 }
 
@@ -167,7 +167,10 @@ Command addCalibrateCommand(CLI::App& root) {
       "Processes the bag's channels with the prior parameters and runs the calibrator's method with its\n"
       "quality gates on the turntable plateaus. Thermal writes K and D as splines over the resonator\n"
       "frequency (the bag's channels must carry it).\n"
-      "Exit 0 accepted, 1 refused by a gate, 2 bad usage or unreadable input.");
+      "Every output replaces its path only when complete; an output that is the same file as an input\n"
+      "or another output is refused before anything runs.\n"
+      "Exit 0 accepted, 1 refused by a gate, 2 bad usage or unreadable input, 3 an output could not\n"
+      "be written (nothing left at its path, an existing file unchanged).");
   return [o] { return runCalibrate(*o); };
 }
 

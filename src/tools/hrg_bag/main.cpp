@@ -13,7 +13,9 @@ int main(int argc, char** argv) {
   CLI::App app("Recorded gyro sessions without a ROS master (hrg_bag <command> --help for each).", "hrg_bag");
   app.get_formatter()->label("Usage", "usage");
   app.get_formatter()->column_width(34);
-  app.footer("Exit codes: 0 success, 1 refused or invalid data, 2 bad usage or unreadable input.");
+  app.footer(
+      "Exit codes: 0 success, 1 refused or invalid data, 2 bad usage or unreadable input, 3 an output could\n"
+      "not be written (nothing is left at its path; an existing file is unchanged).");
   app.require_subcommand(1);
   const std::map<std::string, Command> commands = {
       {"simulate", addSimulateCommand(app)},   {"info", addInfoCommand(app)}, {"process", addProcessCommand(app)},
@@ -36,6 +38,9 @@ int main(int argc, char** argv) {
   }
   try {
     return commands.at(name)();
+  } catch (const OutputError& e) {
+    std::cerr << "hrg_bag " << name << ": " << e.what() << "\n";
+    return kExitOutputError;
   } catch (const UsageError& e) {
     std::cerr << "hrg_bag " << name << ": " << e.what() << "\n";
   } catch (const hrg_gyro::core::ConfigError& e) {

@@ -2,7 +2,6 @@
 // conversions as the node, so the output is bit for bit the node's on the same input.
 #include <charconv>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -77,19 +76,21 @@ struct ProcessOptions {
 int runProcess(const ProcessOptions& o) {
   using namespace bag_tools;
   checkProcessorConfig(o.processor);
+  checkOutputPaths({o.bag, o.params}, {o.out, o.csv});
   const auto params = std::make_shared<const core::GyroParameters>(core::loadParameterFile(o.params));
   const std::unique_ptr<rosbag::Bag> in = openBag(o.bag);
   const GyroTopics topics = findTopics(*in, o.topics, true, false);
-  std::unique_ptr<rosbag::Bag> out;
-  if (!o.out.empty()) out = createBag(o.out, o.compression);
-  std::ofstream csv;
+  // Both outputs are temporaries until the whole bag has been processed.
+  std::unique_ptr<OutputBag> out;
+  if (!o.out.empty()) out = std::make_unique<OutputBag>(o.out, o.compression);
+  std::unique_ptr<OutputText> csv_file;
   if (!o.csv.empty()) {
-    csv.open(o.csv);
-    if (!csv) throw UsageError("cannot write " + o.csv);
-    csv << "stamp,seq,status,dt,dtheta,dalpha,dalpha_earth_fixed,alpha,rate,theta_mid,frequency,scale_factor,drift,"
+    csv_file = std::make_unique<OutputText>(o.csv);
+    csv_file->stream()
+        << "stamp,seq,status,dt,dtheta,dalpha,dalpha_earth_fixed,alpha,rate,theta_mid,frequency,scale_factor,drift,"
            "rejected_before,flags,theta,amplitude,quadrature,phase\n";
   }
-    core::GyroProcessor processor(o.processor, params);
+  core::GyroProcessor processor(o.processor, params);
   std::uint64_t outputs = 0;
   CsvRow row;
   std::string csv_buffer;
@@ -99,7 +100,7 @@ int runProcess(const ProcessOptions& o) {
     if (out && r.has_wave) out->write("/wave", msg.header.stamp, wave);
     if (out && r.has_output) out->write("/output", msg.header.stamp, output);
     outputs += r.has_output ? 1 : 0;
-    if (csv.is_open()) {
+    if (csv_file) {
       row.clear();
       row.stamp(msg.header.stamp.sec, msg.header.stamp.nsec);
       row.integer(msg.header.seq);
@@ -129,17 +130,16 @@ int runProcess(const ProcessOptions& o) {
       row.end();
       csv_buffer += row.line();
       if (csv_buffer.size() > (1u << 20)) {
-        csv << csv_buffer;
+        csv_file->stream() << csv_buffer;
         csv_buffer.clear();
       }
     }
   }, "process");
-  if (csv.is_open()) {
-    csv << csv_buffer;
-    csv.close();
-    if (!csv) throw UsageError("error writing " + o.csv);
+  if (csv_file) {
+    csv_file->stream() << csv_buffer;
+    csv_file->commit();
   }
-  if (out) out->close();
+  if (out) out->commit();
   const core::ProcessorCounters& c = processor.counters();
   std::cerr << "process: " << c.received << " samples, " << outputs << " outputs, " << c.rejected()
             << " rejected, " << c.gaps << " gaps, " << c.resets << " resets\n";
@@ -175,7 +175,10 @@ Command addProcessCommand(CLI::App& root) {
   cmd->footer(
       "Runs the processor on the bag's channels. Numbers in the CSV are in the shortest form that reads\n"
       "back exactly. With neither --out nor --csv, only the summary (a dry run).\n"
-      "Exit 0 success, 1 when no sample was accepted, 2 bad usage or unreadable input.");
+      "Outputs are written to temporaries and renamed over --out/--csv only when complete; an output\n"
+      "that is the same file as an input or as the other output is refused.\n"
+      "Exit 0 success, 1 when no sample was accepted, 2 bad usage or unreadable input, 3 an output\n"
+      "could not be written (nothing left at its path, an existing file unchanged).");
   return [o] { return runProcess(*o); };
 }
 

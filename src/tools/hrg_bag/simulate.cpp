@@ -19,11 +19,11 @@ struct SimulateOptions {
 
 int runSimulate(const SimulateOptions& o) {
   using namespace bag_tools;
+  checkOutputPaths({o.scenario}, {o.out});
   core::SimulationConfig config = core::SimulationConfig::load(o.scenario, core::nodeOnlyScenarioKeys());
   if (*o.seed_option) config.seed = o.seed;
   const bool truth = !o.no_truth;
-  const std::unique_ptr<rosbag::Bag> out = createBag(o.out, o.compression);
-  rosbag::Bag& bag = *out;
+  OutputBag bag(o.out, o.compression);
   core::GyroSimulator sim(config);
   Progress progress("simulate", sim.duration());
   core::SimulationSample s;
@@ -36,7 +36,7 @@ int runSimulate(const SimulateOptions& o) {
     if (truth) bag.write("/truth", stamp, toTruthMessage(s, ch.header));
     progress.update(sim.elapsed(), seq);
   }
-  bag.close();
+  bag.commit();
   progress.finish(seq);
   std::cerr << "simulate: " << sim.elapsed() << " s of session written to " << o.out << "\n";
   return 0;
@@ -62,7 +62,9 @@ Command addSimulateCommand(CLI::App& root) {
       "Runs the simulated gyro of a scenario and writes /channels, /turntable/state and /truth (unless\n"
       "--no-truth), stamped and recorded at simulated time, as fast as it runs. Chunks are LZ4-compressed\n"
       "by default (several times faster to read back; every rosbag reader handles it).\n"
-      "Exit 0 success, 2 bad usage or unreadable scenario.");
+      "The bag is written to a temporary and renamed over --out when complete.\n"
+      "Exit 0 success, 2 bad usage or unreadable scenario (or --out is the scenario file), 3 the bag\n"
+      "could not be written (nothing left at --out, an existing file unchanged).");
   return [o] { return runSimulate(*o); };
 }
 
