@@ -346,10 +346,11 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
 
 bool CalibratorRos::onStart(StartCalibration::Request& req, StartCalibration::Response& res) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (session_) {
+  if (session()) {
     // Starting over would silently throw away the data gathered so far.
     res.success = false;
-    res.message = "a run is in progress (" + session_->settings().method + "): ~finish or ~abort it first";
+    res.message = "a run is in progress (" + core::nameOf(session()->settings().method) +
+                  "): ~finish or ~abort it first";
     return true;
   }
   if (req.method.empty()) {
