@@ -25,6 +25,25 @@ std::vector<double> HarmonicFitResult::termStds() const {
   return t;
 }
 
+HarmonicFitResult selectOrders(const HarmonicFitResult& fit, const std::vector<int>& orders) {
+  HarmonicFitResult r = fit;
+  r.orders = orders;
+  r.cos.clear();
+  r.sin.clear();
+  r.cos_std.clear();
+  r.sin_std.clear();
+  for (int k : orders) {
+    const auto it = std::find(fit.orders.begin(), fit.orders.end(), k);
+    const bool found = it != fit.orders.end();
+    const std::size_t j = static_cast<std::size_t>(it - fit.orders.begin());
+    r.cos.push_back(found ? fit.cos[j] : 0.0);
+    r.sin.push_back(found ? fit.sin[j] : 0.0);
+    r.cos_std.push_back(found ? fit.cos_std[j] : 0.0);
+    r.sin_std.push_back(found ? fit.sin_std[j] : 0.0);
+  }
+  return r;
+}
+
 HarmonicFitResult fitHarmonics(const std::vector<FitPoint>& points, const std::vector<int>& orders,
                                const std::vector<double>& extra_attenuation, double max_condition,
                                const Eigen::MatrixXd* value_covariance) {
