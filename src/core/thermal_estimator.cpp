@@ -76,7 +76,7 @@ HarmonicFitResult nodeFit(const Layout& layout, const std::vector<int>& orders, 
 
 }  // namespace
 
-ThermalEstimate estimateThermal(const SlicedRateGroup& group1, double rate1, const SlicedRateGroup& group2,
+ThermalEstimate estimateThermal(const RateGroup& group1, double rate1, const RateGroup& group2,
                                 double rate2, const FrequencyInterpolator& interpolator, int bins,
                                 const std::vector<int>& k_orders, const std::vector<int>& d_orders,
                                 double min_bin_time, double max_condition) {
@@ -92,7 +92,7 @@ ThermalEstimate estimateThermal(const SlicedRateGroup& group1, double rate1, con
   const std::vector<int> orders = mergeOrders(k_orders, d_orders);
   const Layout layout{orders.size(), 1 + 2 * orders.size(), interpolator.size()};
   const std::size_t p = layout.columns();
-  const SlicedRateGroup* groups[2] = {&group1, &group2};
+  const RateGroup* groups[2] = {&group1, &group2};
   const double rates[2] = {rate1, rate2};
   std::vector<double> weights(layout.nodes), basis(layout.terms);
 

@@ -37,7 +37,7 @@ void ThermalMethod::addSample(const PlateauSample& s) {
     ++out_of_range_;
     return;
   }
-  if (!rates_.add(s.stamp, s.theta, s.frequency, s.plateau.id, s.plateau.rate, s.table_rate)) {
+  if (!rates_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.table_rate, s.frequency)) {
     ++slice_limit_;
     return;
   }
@@ -56,7 +56,7 @@ std::vector<double> ThermalMethod::nodes() const {
   return n;
 }
 
-std::vector<double> ThermalMethod::intervalCoverage(const SlicedRateGroup& group,
+std::vector<double> ThermalMethod::intervalCoverage(const RateGroup& group,
                                                     const std::vector<double>& nodes) const {
   const std::size_t intervals = nodes.size() - 1;
   std::vector<std::vector<double>> swept(intervals, std::vector<double>(rates_.binCount(), 0.0));
@@ -111,7 +111,7 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   const ThermalSettings& ts = settings_.thermal;
   const auto order = rates_.byDuration();
   for (std::size_t i : order) {
-    const SlicedRateGroup& g = rates_.groups()[i];
+    const RateGroup& g = rates_.groups()[i];
     GroupSummary sum;
     sum.rate = g.meanRate();
     sum.rate_std = g.rateStd();
@@ -159,8 +159,8 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   o.gate("node_spacing", narrowest >= ts.slice_width, narrowest, ts.slice_width,
          "narrowest node interval " + formatShort(narrowest) + " Hz against frequency slices of " + formatShort(ts.slice_width) +
              " Hz (use fewer nodes, a finer thermal/slice_width, or the dual_rate method)");
-  const SlicedRateGroup& g1 = rates_.groups()[order[0]];
-  const SlicedRateGroup& g2 = rates_.groups()[order[1]];
+  const RateGroup& g1 = rates_.groups()[order[0]];
+  const RateGroup& g2 = rates_.groups()[order[1]];
   const double w1 = g1.meanRate(), w2 = g2.meanRate();
   o.duration = g1.totalTime() + g2.totalTime();
   std::size_t worst = 0;
@@ -217,7 +217,7 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   o.gate("harmonic_std", hstd <= q.max_harmonic_std, hstd, q.max_harmonic_std,
          "largest K harmonic standard error at any node is " + formatShort(hstd * 1e6) + " ppm of |K0|");
   double sigma = 0.0;
-  for (const SlicedRateGroup* g : {&g1, &g2}) {
+  for (const RateGroup* g : {&g1, &g2}) {
     double noise_time = 0.0, time = 0.0;
     for (const auto& kv : g->slices) {
       noise_time += kv.second.windowNoise() * kv.second.totalTime();

@@ -3,7 +3,7 @@
 // Why: the resonator frequency f tracks temperature, and K and D drift with it; a model calibrated
 // at one temperature leaves ppm-level nonlinearity and scale-factor errors at another. This method
 // takes dual-rate plateaus recorded while the temperature moves (a ramp, or soaks at several
-// temperatures), bins theta per frequency slice (FrequencySlicedRates) and fits every coefficient
+// temperatures), bins theta per frequency slice (RateGroups with a slice width) and fits every coefficient
 // of K and D as a spline over f (ThermalEstimate). The written parameter file carries
 // frequency_nodes, and the processor evaluates K and D at each sample's frequency.
 //
@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "hrg_gyro/core/calibration_method.h"
-#include "hrg_gyro/core/frequency_sliced_rates.h"
+#include "hrg_gyro/core/rate_groups.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -40,12 +40,12 @@ class ThermalMethod : public CalibrationMethod {
   /// The explicit nodes, or node_count nodes evenly over the frequencies seen (empty if none).
   std::vector<double> nodes() const;
   /// Per node interval: fraction of theta bins the group swept for at least minBinTime().
-  std::vector<double> intervalCoverage(const SlicedRateGroup& group, const std::vector<double>& nodes) const;
+  std::vector<double> intervalCoverage(const RateGroup& group, const std::vector<double>& nodes) const;
   /// Smallest coverage over the intervals and the two main groups; `worst` gets the interval.
   double worstCoverage(const std::vector<double>& nodes, std::size_t* worst) const;
 
   CalibrationSettings settings_;
-  FrequencySlicedRates rates_;
+  RateGroups rates_;
   std::uint64_t samples_ = 0, no_frequency_ = 0, out_of_range_ = 0, slice_limit_ = 0;
   double f_min_ = std::numeric_limits<double>::infinity(), f_max_ = -std::numeric_limits<double>::infinity();
 };
