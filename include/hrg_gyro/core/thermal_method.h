@@ -21,6 +21,7 @@
 
 #include "hrg_gyro/core/calibration_method.h"
 #include "hrg_gyro/core/rate_groups.h"
+#include "hrg_gyro/core/thermal_estimator.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -43,6 +44,21 @@ class ThermalMethod : public CalibrationMethod {
   std::vector<double> intervalCoverage(const RateGroup& group, const std::vector<double>& nodes) const;
   /// Smallest coverage over the intervals and the two main groups; `worst` gets the interval.
   double worstCoverage(const std::vector<double>& nodes, std::size_t* worst) const;
+
+  // The phases of finish(), in its order.
+  /// One summary per rate group, most data first.
+  void summarizeGroups(CalibrationOutcome* o) const;
+  /// Notes on the samples left out (no frequency, outside the nodes, beyond the slice limit).
+  void noteDroppedSamples(CalibrationOutcome* o) const;
+  /// Gates on the data of the two main groups g1, g2 at the nodes n: node spacing, coverage, rate
+  /// separation and noise.
+  void gateData(const std::vector<double>& n, const RateGroup& g1, const RateGroup& g2, CalibrationOutcome* o) const;
+  /// Gates on the fit at every node (K0 sign and change, residual, harmonic standard error) and the
+  /// peak nonlinearity; returns the steepest node's K slope for the error bound.
+  double gateNodes(const std::vector<double>& n, const ThermalEstimate& e, const GyroParameters& prior,
+                   CalibrationOutcome* o) const;
+  /// The paper-style error bound of the window method with the steepest node's model.
+  double errorBound(double slope, const RateGroup& g1, const RateGroup& g2) const;
 
   CalibrationSettings settings_;
   RateGroups rates_;
