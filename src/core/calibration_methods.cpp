@@ -57,10 +57,10 @@ GroupSummary summarize(const RateGroup& g, double min_bin_time) {
   GroupSummary s;
   s.rate = g.meanRate();
   s.rate_std = g.rateStd();
-  s.duration = g.rates.totalTime();
-  s.samples = g.rates.samples();
-  s.coverage = g.rates.coverage(min_bin_time);
-  s.turns = g.rates.thetaSwept() / kPi;
+  s.duration = g.rates().totalTime();
+  s.samples = g.rates().samples();
+  s.coverage = g.rates().coverage(min_bin_time);
+  s.turns = g.rates().thetaSwept() / kPi;
   return s;
 }
 
@@ -106,7 +106,7 @@ CalibrationProgress DualRateMethod::progress() const {
   double worst = order.size() >= 2 ? 1.0 : 0.0;
   for (std::size_t i = 0; i < order.size() && i < 2; ++i) {
     const RateGroup& g = groups_.groups()[order[i]];
-    const double cov = g.rates.coverage(minBinTime());
+    const double cov = g.rates().coverage(minBinTime());
     worst = std::min(worst, cov);
     s << ", " << formatShort(g.meanRate()) << " rad/s: coverage " << formatShort(100 * cov) << " %";
   }
@@ -133,8 +133,8 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
   const RateGroup& g1 = groups_.groups()[order[0]];
   const RateGroup& g2 = groups_.groups()[order[1]];
   const double w1 = g1.meanRate(), w2 = g2.meanRate();
-  o.duration = g1.rates.totalTime() + g2.rates.totalTime();
-  o.coverage = std::min(g1.rates.coverage(minBinTime()), g2.rates.coverage(minBinTime()));
+  o.duration = g1.rates().totalTime() + g2.rates().totalTime();
+  o.coverage = std::min(g1.rates().coverage(minBinTime()), g2.rates().coverage(minBinTime()));
   o.gate("coverage", o.coverage >= q.min_coverage, o.coverage, q.min_coverage,
          "theta bins covered by both plateaus: " + formatShort(100 * o.coverage) + " %");
   o.gate("rate_separation", std::abs(w1 - w2) >= q.min_rate_separation, std::abs(w1 - w2), q.min_rate_separation,
@@ -143,7 +143,7 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
   o.gate("rate_noise", noise <= q.max_rate_noise, noise, q.max_rate_noise,
          "reported table rate scatters by " + formatShort(100 * noise) + " % within a plateau");
   const double earth = prior.earth_rate.verticalRate();
-  const DualRateEstimate e = estimateDualRate(g1.rates, w1 + earth, g2.rates, w2 + earth,
+  const DualRateEstimate e = estimateDualRate(g1.rates(), w1 + earth, g2.rates(), w2 + earth,
                                               settings_.scale_factor_orders, settings_.drift_orders, minBinTime());
   if (!e.ok) {
     o.gate("fit", false, 0.0, 0.0, e.reason);
@@ -154,8 +154,8 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
   o.smoothing_factor = e.smoothing_factor;
   // Paper-style bound per bin: K changing over one window, plus the angle noise of the two window
   // means at each end of a bin (drift cancels in this method).
-  const double tau = std::max(g1.rates.effectiveWindow(), g2.rates.effectiveWindow());
-  const double sigma = std::max(g1.rates.windowNoise(), g2.rates.windowNoise());
+  const double tau = std::max(g1.rates().effectiveWindow(), g2.rates().effectiveWindow());
+  const double sigma = std::max(g1.rates().windowNoise(), g2.rates().windowNoise());
   o.error_bound = slopeBound(e.k) * std::abs(e.k.mean) * std::max(std::abs(w1), std::abs(w2)) * tau +
                   2.0 * std::sqrt(2.0) * sigma / (std::abs(w1 - w2) * tau);
   finishModel(&o, e.k, e.d, prior, q);
@@ -197,7 +197,7 @@ bool ConstantRateMethod::complete() const { return progress().fraction >= 1.0; }
 CalibrationProgress ConstantRateMethod::progress() const {
   CalibrationProgress p;
   const auto order = groups_.byDuration();
-  const double cov = order.empty() ? 0.0 : groups_.groups()[order[0]].rates.coverage(minBinTime());
+  const double cov = order.empty() ? 0.0 : groups_.groups()[order[0]].rates().coverage(minBinTime());
   const double dwell = dwellTime();
   p.fraction = std::min(std::min(1.0, cov / settings_.gates.min_coverage),
                         settings_.gates.min_dwell_time > 0 ? std::min(1.0, dwell / settings_.gates.min_dwell_time) : 1.0);
@@ -230,8 +230,8 @@ CalibrationOutcome ConstantRateMethod::finish(const GyroParameters& prior) const
   const RateGroup& g = groups_.groups()[order[0]];
   for (std::size_t i : order) o.plateaus.push_back(summarize(groups_.groups()[i], minBinTime()));
   const double rest = ssum / wsum, w = g.meanRate();
-  o.duration = g.rates.totalTime() + dwell;
-  o.coverage = g.rates.coverage(minBinTime());
+  o.duration = g.rates().totalTime() + dwell;
+  o.coverage = g.rates().coverage(minBinTime());
   o.gate("coverage", o.coverage >= q.min_coverage, o.coverage, q.min_coverage,
          "theta bins covered: " + formatShort(100 * o.coverage) + " %");
   o.gate("rate", std::abs(w) >= q.min_rate_separation, std::abs(w), q.min_rate_separation,
@@ -239,7 +239,7 @@ CalibrationOutcome ConstantRateMethod::finish(const GyroParameters& prior) const
   const double noise = g.rateStd() / std::abs(w);
   o.gate("rate_noise", noise <= q.max_rate_noise, noise, q.max_rate_noise,
          "reported table rate scatters by " + formatShort(100 * noise) + " %");
-  HarmonicFitResult fit = fitBinnedRates(g.rates, settings_.scale_factor_orders, minBinTime());
+  HarmonicFitResult fit = fitBinnedRates(g.rates(), settings_.scale_factor_orders, minBinTime());
   if (!fit.ok) {
     o.gate("fit", false, 0.0, 0.0, fit.reason);
     o.decide();
@@ -262,10 +262,10 @@ CalibrationOutcome ConstantRateMethod::finish(const GyroParameters& prior) const
     k.sin_std[j] /= std::abs(w + earth);
   }
   k.residual_rms = fit.residual_rms / std::abs(w + earth);
-  for (int b = 0; b < g.rates.binCount(); ++b) {
-    if (g.rates.binTime(b) < minBinTime()) continue;
-    o.binned.push_back({g.rates.binCenter(b), k.mean + (g.rates.binRate(b) - fit.mean) / (w + earth), 0.0,
-                        g.rates.binTime(b)});
+  for (int b = 0; b < g.rates().binCount(); ++b) {
+    if (g.rates().binTime(b) < minBinTime()) continue;
+    o.binned.push_back({g.rates().binCenter(b), k.mean + (g.rates().binRate(b) - fit.mean) / (w + earth), 0.0,
+                        g.rates().binTime(b)});
   }
   HarmonicFitResult d;
   d.ok = true;
@@ -273,9 +273,9 @@ CalibrationOutcome ConstantRateMethod::finish(const GyroParameters& prior) const
   d.points = 1;
   o.notes.push_back("constant_rate measures D only at the dwell angle: D(theta) harmonics are not separable from "
                     "K(theta) and leak into it by D_k / Omega; the drift model written is the constant D0");
-  const double tau = g.rates.effectiveWindow();
+  const double tau = g.rates().effectiveWindow();
   o.error_bound = slopeBound(k) * std::abs(k.mean) * std::abs(w) * tau + std::abs(d.mean) / std::abs(w) +
-                  2.0 * g.rates.windowNoise() / (std::abs(w) * tau);
+                  2.0 * g.rates().windowNoise() / (std::abs(w) * tau);
   finishModel(&o, k, d, prior, q);
   return o;
 }

@@ -3,8 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
+#include "hrg_gyro/core/weighted_least_squares.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -39,23 +38,21 @@ CorrectionMatrixEstimator::Result CorrectionMatrixEstimator::solve(double max_co
     r.reason = "need at least 2 generator pairs, have " + std::to_string(pairs_);
     return r;
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(jtj_);
-  const double lmin = eig.eigenvalues().minCoeff(), lmax = eig.eigenvalues().maxCoeff();
-  r.condition_number = lmin > 0.0 ? std::sqrt(lmax / lmin) : INFINITY;
-  if (!(r.condition_number <= max_condition)) {
+  const LeastSquaresSolution fit = solveNormalEquations(jtj_, jty_, ColumnScaling::kNone, max_condition);
+  r.condition_number = fit.condition_number;
+  if (!fit.ok) {
     r.reason = "generator sweep does not determine p1..p4 (condition number " +
                std::to_string(r.condition_number) + "): spread theta over [0, pi)";
     return r;
   }
-  const Eigen::Matrix4d inv = jtj_.inverse();
-  const Eigen::Vector4d p = inv * jty_;
-  const double rss = std::max(0.0, yty_ - 2.0 * p.dot(jty_) + p.dot(jtj_ * p));
-  const double dof = 4.0 * static_cast<double>(pairs_) - 4.0;
-  const double sigma2 = rss / dof;
-  r.residual_rms = std::sqrt(rss / (4.0 * static_cast<double>(pairs_)));
+  const Eigen::VectorXd& p = fit.coefficients;
+  const double rss = residualSquaresFromNormal(yty_, jtj_, jty_, p);
+  const std::size_t channels = 4 * pairs_;
+  const Eigen::MatrixXd cov = residualCovariance(fit.normal_inverse, residualVariance(rss, channels, 4));
+  r.residual_rms = std::sqrt(rss / static_cast<double>(channels));
   for (int i = 0; i < 4; ++i) {
     r.correction.p[i] = p[i];
-    r.standard_error[i] = std::sqrt(std::max(0.0, sigma2 * inv(i, i)));
+    r.standard_error[i] = std::sqrt(std::max(0.0, cov(i, i)));
   }
   r.ok = std::isfinite(p.sum());
   if (!r.ok) r.reason = "non-finite solution";

@@ -39,29 +39,6 @@ HarmonicFitResult fitBinnedRates(const ThetaBinnedRates& group, const std::vecto
 
 HarmonicModel toModel(const HarmonicFitResult& fit) { return HarmonicModel(fit.orders, fit.mean, fit.cos, fit.sin); }
 
-namespace {
-
-// Selects `orders` out of a fit over `all` orders (coefficients and standard errors).
-HarmonicFitResult select(const HarmonicFitResult& all, const std::vector<int>& orders) {
-  HarmonicFitResult r = all;
-  r.orders = orders;
-  r.cos.clear();
-  r.sin.clear();
-  r.cos_std.clear();
-  r.sin_std.clear();
-  for (int k : orders) {
-    const auto it = std::find(all.orders.begin(), all.orders.end(), k);
-    const std::size_t j = static_cast<std::size_t>(it - all.orders.begin());
-    r.cos.push_back(all.cos[j]);
-    r.sin.push_back(all.sin[j]);
-    r.cos_std.push_back(all.cos_std[j]);
-    r.sin_std.push_back(all.sin_std[j]);
-  }
-  return r;
-}
-
-}  // namespace
-
 DualRateEstimate estimateDualRate(const ThetaBinnedRates& g1, double r1, const ThetaBinnedRates& g2, double r2,
                                   const std::vector<int>& k_orders, const std::vector<int>& d_orders,
                                   double min_bin_time, double max_condition) {
@@ -135,8 +112,8 @@ DualRateEstimate estimateDualRate(const ThetaBinnedRates& g1, double r1, const T
   k.residual_rms = n > 0 ? std::sqrt(k_ss / n) : 0.0;
   d.residual_rms = n > 0 ? std::sqrt(d_ss / n) : 0.0;
   k.points = d.points = e.binned.size();
-  e.k = select(k, k_orders);
-  e.d = select(d, d_orders);
+  e.k = selectOrders(k, k_orders);
+  e.d = selectOrders(d, d_orders);
   e.ok = true;
   return e;
 }

@@ -10,29 +10,6 @@
 
 namespace hrg_gyro {
 namespace core {
-namespace {
-
-HarmonicFitResult selectOrders(const HarmonicFitResult& all, const std::vector<int>& orders) {
-  HarmonicFitResult r = all;
-  r.orders = orders;
-  r.cos.clear();
-  r.sin.clear();
-  r.cos_std.clear();
-  r.sin_std.clear();
-  for (int k : orders) {
-    const auto it = std::find(all.orders.begin(), all.orders.end(), k);
-    const bool found = it != all.orders.end();
-    const std::size_t j = static_cast<std::size_t>(it - all.orders.begin());
-    r.cos.push_back(found ? all.cos[j] : 0.0);
-    r.sin.push_back(found ? all.sin[j] : 0.0);
-    r.cos_std.push_back(0.0);
-    r.sin_std.push_back(0.0);
-  }
-  return r;
-}
-
-}  // namespace
-
 EffectiveModel computeEffectiveModel(const SimulationConfig& config, const CorrectionMatrix& correction,
                                      const std::vector<int>& k_orders, const std::vector<int>& d_orders) {
   PickoffDefects noiseless = config.pickoff;
@@ -66,8 +43,13 @@ EffectiveModel computeEffectiveModel(const SimulationConfig& config, const Corre
   const HarmonicFitResult k_all = fitHarmonics(kp, all, {}, INFINITY);
   const HarmonicFitResult d_all = fitHarmonics(dp, all, {}, INFINITY);
   EffectiveModel e;
+  // The reference is exact: the harmonics carry no standard errors.
   e.scale_factor = selectOrders(k_all, k_orders);
   e.drift = selectOrders(d_all, d_orders);
+  for (HarmonicFitResult* f : {&e.scale_factor, &e.drift}) {
+    std::fill(f->cos_std.begin(), f->cos_std.end(), 0.0);
+    std::fill(f->sin_std.begin(), f->sin_std.end(), 0.0);
+  }
   e.nonlinearity_ppm = 1e6 * toModel(k_all).peakDeviation() / std::abs(k_all.mean);
   return e;
 }

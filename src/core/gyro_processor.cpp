@@ -79,59 +79,121 @@ void GyroProcessor::countRejection(WaveStatus status) {
   }
 }
 
+// The phases of process(), inline: process() is the per-sample hot path.
+
+inline void GyroProcessor::reject(SampleVerdict verdict, ProcessorResult* r) {
+  ++rejected_since_output_;
+  r->verdict = verdict;
+}
+
+inline bool GyroProcessor::admitStamp(Nanoseconds stamp, Nanoseconds* dt_ns, ProcessorResult* r) {
+  if (stamp <= 0) {
+    ++counters_.zero_stamp;
+    reject(SampleVerdict::kRejectedStamp, r);
+    return false;
+  }
+  if (!has_previous_) return true;
+  *dt_ns = stamp - previous_stamp_;
+  if (*dt_ns == 0) {
+    ++counters_.duplicate;
+    reject(SampleVerdict::kDuplicate, r);
+    return false;
+  }
+  if (*dt_ns < 0) {
+    if (toSeconds(-*dt_ns) <= config_.backward_reset) {
+      ++counters_.out_of_order;
+      reject(SampleVerdict::kOutOfOrder, r);
+      return false;
+    }
+    ++counters_.resets;  // time jumped back (bag loop): start over
+    reset();
+    pending_flags_ |= kFlagReset;
+  }
+  return true;
+}
+
+inline void GyroProcessor::remember(const ChannelSample& in, const WaveState& wave) {
+  has_previous_ = true;
+  previous_stamp_ = in.stamp;
+  previous_frequency_ = in.frequency;
+  previous_z_ = in.z;
+  previous_cos_ = wave.cos_theta;
+  previous_sin_ = wave.sin_theta;
+  ++counters_.accepted;
+}
+
+inline void GyroProcessor::anchor(const ChannelSample& in, WaveState* wave, ProcessorResult* r) {
+  wave->rebase(unwrapper_.unwrap(wave->theta));
+  remember(in, *wave);
+  r->verdict = SampleVerdict::kFirst;
+  r->has_wave = true;
+  r->wave = *wave;
+  r->alpha = alpha_;
+}
+
+inline bool GyroProcessor::admitStep(double dt, double step, std::uint8_t* flags, bool* integrate) {
+  if (dt > config_.max_gap) {
+    ++counters_.gaps;
+    if (dt > counters_.largest_gap) counters_.largest_gap = dt;
+    *flags |= kFlagGap;
+    *integrate = false;
+  } else {
+    const double limit = max_abs_k0_ * config_.max_rate * dt;
+    if (std::abs(step) > limit) {
+      if (++consecutive_jumps_ <= config_.max_consecutive_jumps) {
+        ++counters_.jumps;
+        return false;
+      }
+      *flags |= kFlagGap;  // the jump persists: take the new angle as a re-anchor
+      *integrate = false;
+    }
+  }
+  consecutive_jumps_ = 0;
+  return true;
+}
+
+inline std::uint8_t GyroProcessor::frequencyFlags(double f_mid) {
+  const GyroParameters& p = compensator_.parameters();
+  if (p.scale_factor.frequencyDependent() || p.drift.frequencyDependent()) {
+    if (std::isnan(f_mid)) {
+      ++counters_.frequency_unknown;
+      return kFlagFrequencyUnknown;
+    }
+    if (!p.scale_factor.interpolator().inRange(f_mid) || !p.drift.interpolator().inRange(f_mid)) {
+      ++counters_.frequency_out_of_range;
+      return kFlagFrequencyOutOfRange;
+    }
+  }
+  return 0;
+}
+
+inline AngleIncrement GyroProcessor::reanchorIncrement(double theta, double dt, double f_mid, const WaveState& wave) {
+  AngleIncrement increment;
+  increment.dt = dt;
+  increment.theta_mid = theta;
+  increment.frequency = f_mid;
+  const AngleIncrement at =
+      compensator_.step(theta, theta, 0.0, f_mid, wave.cos_theta, wave.sin_theta, wave.cos_theta, wave.sin_theta);
+  increment.scale_factor = at.scale_factor;
+  increment.drift = at.drift;
+  return increment;
+}
+
 ProcessorResult GyroProcessor::process(const ChannelSample& in) {
   ProcessorResult r;
   ++counters_.received;
-  if (in.stamp <= 0) {
-    ++counters_.zero_stamp;
-    ++rejected_since_output_;
-    r.verdict = SampleVerdict::kRejectedStamp;
-    return r;
-  }
   Nanoseconds dt_ns = 0;
-  if (has_previous_) {
-    dt_ns = in.stamp - previous_stamp_;
-    if (dt_ns == 0) {
-      ++counters_.duplicate;
-      ++rejected_since_output_;
-      r.verdict = SampleVerdict::kDuplicate;
-      return r;
-    }
-    if (dt_ns < 0) {
-      if (toSeconds(-dt_ns) <= config_.backward_reset) {
-        ++counters_.out_of_order;
-        ++rejected_since_output_;
-        r.verdict = SampleVerdict::kOutOfOrder;
-        return r;
-      }
-      ++counters_.resets;  // time jumped back (bag loop): start over
-      reset();
-      pending_flags_ |= kFlagReset;
-    }
-  }
+  if (!admitStamp(in.stamp, &dt_ns, &r)) return r;
 
   WaveState wave;
   r.wave_status = estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &wave);
   if (r.wave_status != WaveStatus::kOk) {
     countRejection(r.wave_status);
-    ++rejected_since_output_;
-    r.verdict = SampleVerdict::kRejectedValue;
+    reject(SampleVerdict::kRejectedValue, &r);
     return r;
   }
-
   if (!has_previous_) {
-    wave.rebase(unwrapper_.unwrap(wave.theta));
-    has_previous_ = true;
-    previous_stamp_ = in.stamp;
-    previous_frequency_ = in.frequency;
-    previous_z_ = in.z;
-    previous_cos_ = wave.cos_theta;
-    previous_sin_ = wave.sin_theta;
-    ++counters_.accepted;
-    r.verdict = SampleVerdict::kFirst;
-    r.has_wave = true;
-    r.wave = wave;
-    r.alpha = alpha_;
+    anchor(in, &wave, &r);
     return r;
   }
 
@@ -140,59 +202,23 @@ ProcessorResult GyroProcessor::process(const ChannelSample& in) {
   const double theta = wave.theta + kPi * std::round((previous_theta - wave.theta) / kPi);
   std::uint8_t flags = pending_flags_;
   bool integrate = true;
-  if (dt > config_.max_gap) {
-    ++counters_.gaps;
-    if (dt > counters_.largest_gap) counters_.largest_gap = dt;
-    flags |= kFlagGap;
-    integrate = false;
-  } else {
-    const double limit = max_abs_k0_ * config_.max_rate * dt;
-    if (std::abs(theta - previous_theta) > limit) {
-      if (++consecutive_jumps_ <= config_.max_consecutive_jumps) {
-        ++counters_.jumps;
-        ++rejected_since_output_;
-        r.verdict = SampleVerdict::kRejectedJump;
-        return r;
-      }
-      flags |= kFlagGap;  // the jump persists: take the new angle as a re-anchor
-      integrate = false;
-    }
+  if (!admitStep(dt, theta - previous_theta, &flags, &integrate)) {
+    reject(SampleVerdict::kRejectedJump, &r);
+    return r;
   }
-  consecutive_jumps_ = 0;
   unwrapper_.unwrap(theta);
   wave.rebase(theta);
 
   const double f_mid = 0.5 * (in.frequency + previous_frequency_);
-  const GyroParameters& p = compensator_.parameters();
-  if (p.scale_factor.frequencyDependent() || p.drift.frequencyDependent()) {
-    if (std::isnan(f_mid)) {
-      flags |= kFlagFrequencyUnknown;
-      ++counters_.frequency_unknown;
-    } else if (!p.scale_factor.interpolator().inRange(f_mid) || !p.drift.interpolator().inRange(f_mid)) {
-      flags |= kFlagFrequencyOutOfRange;
-      ++counters_.frequency_out_of_range;
-    }
-  }
+  flags |= frequencyFlags(f_mid);
   if (integrate) {
     r.increment = compensator_.step(previous_theta, theta, dt, f_mid, previous_cos_, previous_sin_, wave.cos_theta,
                                     wave.sin_theta);
     alpha_ += r.increment.dalpha;
   } else {
-    r.increment = AngleIncrement();
-    r.increment.dt = dt;
-    r.increment.theta_mid = theta;
-    r.increment.frequency = f_mid;
-    const AngleIncrement at =
-        compensator_.step(theta, theta, 0.0, f_mid, wave.cos_theta, wave.sin_theta, wave.cos_theta, wave.sin_theta);
-    r.increment.scale_factor = at.scale_factor;
-    r.increment.drift = at.drift;
+    r.increment = reanchorIncrement(theta, dt, f_mid, wave);
   }
-  previous_stamp_ = in.stamp;
-  previous_frequency_ = in.frequency;
-  previous_z_ = in.z;
-  previous_cos_ = wave.cos_theta;
-  previous_sin_ = wave.sin_theta;
-  ++counters_.accepted;
+  remember(in, wave);
   ++counters_.outputs;
   r.verdict = SampleVerdict::kAccepted;
   r.has_wave = true;

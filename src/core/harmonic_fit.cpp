@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 
 #include "hrg_gyro/core/units.h"
+#include "hrg_gyro/core/weighted_least_squares.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -22,6 +23,25 @@ std::vector<double> HarmonicFitResult::termStds() const {
   t.insert(t.end(), cos_std.begin(), cos_std.end());
   t.insert(t.end(), sin_std.begin(), sin_std.end());
   return t;
+}
+
+HarmonicFitResult selectOrders(const HarmonicFitResult& fit, const std::vector<int>& orders) {
+  HarmonicFitResult r = fit;
+  r.orders = orders;
+  r.cos.clear();
+  r.sin.clear();
+  r.cos_std.clear();
+  r.sin_std.clear();
+  for (int k : orders) {
+    const auto it = std::find(fit.orders.begin(), fit.orders.end(), k);
+    const bool found = it != fit.orders.end();
+    const std::size_t j = static_cast<std::size_t>(it - fit.orders.begin());
+    r.cos.push_back(found ? fit.cos[j] : 0.0);
+    r.sin.push_back(found ? fit.sin[j] : 0.0);
+    r.cos_std.push_back(found ? fit.cos_std[j] : 0.0);
+    r.sin_std.push_back(found ? fit.sin_std[j] : 0.0);
+  }
+  return r;
 }
 
 HarmonicFitResult fitHarmonics(const std::vector<FitPoint>& points, const std::vector<int>& orders,
@@ -72,33 +92,22 @@ HarmonicFitResult fitHarmonics(const std::vector<FitPoint>& points, const std::v
   }
   const Eigen::MatrixXd a = sw.asDiagonal() * x;
   const Eigen::VectorXd b = sw.asDiagonal() * y;
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a);
-  const Eigen::VectorXd sv = svd.singularValues();
-  r.condition_number = sv(sv.size() - 1) > 0.0 ? sv(0) / sv(sv.size() - 1) : INFINITY;
-  if (!(r.condition_number <= max_condition)) {
+  const LeastSquaresSolution fit = solveWeightedDesign(a, b, max_condition);
+  r.condition_number = fit.condition_number;
+  if (!fit.ok) {
     r.reason = "ill-conditioned harmonic fit (condition number " + std::to_string(r.condition_number) +
                "): the points do not cover theta well enough for these orders";
     return r;
   }
-  const Eigen::VectorXd c = a.colPivHouseholderQr().solve(b);
-  const Eigen::VectorXd weighted_residual = b - a * c;
+  const Eigen::VectorXd& c = fit.coefficients;
   const Eigen::VectorXd residual = y - x * c;
-  const double sigma2 = weighted_residual.squaredNorm() / static_cast<double>(n - p);
-  const Eigen::MatrixXd a_inv = (a.transpose() * a).inverse();
-  Eigen::MatrixXd cov = sigma2 * a_inv;
+  const double sigma2 = residualVariance(fit.residual_squares, n, p);
+  Eigen::MatrixXd cov;
   if (value_covariance && value_covariance->rows() == static_cast<Eigen::Index>(n)) {
-    Eigen::MatrixXd v = *value_covariance;
-    // Scatter beyond the model's prediction, as independent noise of variance lambda / w: only the
-    // part above the chance level of the scatter itself (3 sigma of its chi-square fluctuation), so
-    // that chance does not inflate the errors of the harmonics the correlated noise barely reaches.
-    double predicted = 0.0;
-    for (std::size_t i = 0; i < n; ++i) predicted += sw[i] * sw[i] * v(i, i);
-    predicted /= static_cast<double>(n);
-    const double significant = predicted * (1.0 + 3.0 * std::sqrt(2.0 / static_cast<double>(n - p)));
-    const double lambda = std::max(0.0, sigma2 - significant);  // continuous: no jump at the threshold
-    for (std::size_t i = 0; i < n; ++i) v(i, i) += lambda / (sw[i] * sw[i]);
-    const Eigen::MatrixXd xw = x.transpose() * (sw.array() * sw.array()).matrix().asDiagonal();
-    cov = a_inv * (xw * v * xw.transpose()) * a_inv;
+    const Eigen::VectorXd w = (sw.array() * sw.array()).matrix();
+    cov = sandwichCovariance(fit.normal_inverse, {{&x, &w, value_covariance}}, sigma2, p);
+  } else {
+    cov = residualCovariance(fit.normal_inverse, sigma2);
   }
   r.residual_rms = std::sqrt(residual.squaredNorm() / static_cast<double>(n));
   r.mean = c[0];

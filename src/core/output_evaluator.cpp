@@ -54,7 +54,7 @@ EvaluationResult OutputEvaluator::result() const {
   }
   const RateGroup& g1 = groups_.groups()[order[0]];
   const RateGroup& g2 = groups_.groups()[order[1]];
-  const DualRateEstimate e = estimateDualRate(g1.rates, g1.meanRate(), g2.rates, g2.meanRate(), settings_.orders,
+  const DualRateEstimate e = estimateDualRate(g1.rates(), g1.meanRate(), g2.rates(), g2.meanRate(), settings_.orders,
                                               settings_.orders, 0.25 * settings_.window);
   if (!e.ok) {
     r.reason = e.reason;

@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Dense>
+#include <Eigen/Core>
 
 #include "hrg_gyro/core/units.h"
+#include "hrg_gyro/core/weighted_least_squares.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -51,12 +52,12 @@ std::vector<int> usedBins(const ThetaBinnedRates& rates, double min_bin_time) {
   return used;
 }
 
-/// The node's coefficients of one model, restricted to `wanted` orders, with standard errors.
-HarmonicFitResult nodeFit(const Layout& layout, const std::vector<int>& orders, const std::vector<int>& wanted,
-                          int model, std::size_t node, const Eigen::VectorXd& c, const Eigen::MatrixXd& cov) {
+/// The node's coefficients of one model over all fitted orders, with standard errors.
+HarmonicFitResult nodeFit(const Layout& layout, const std::vector<int>& orders, int model, std::size_t node,
+                          const Eigen::VectorXd& c, const Eigen::MatrixXd& cov) {
   HarmonicFitResult r;
   r.ok = true;
-  r.orders = wanted;
+  r.orders = orders;
   auto value = [&](std::size_t term) { return c[layout.column(model, term, node)]; };
   auto sd = [&](std::size_t term) {
     const std::size_t i = layout.column(model, term, node);
@@ -64,8 +65,7 @@ HarmonicFitResult nodeFit(const Layout& layout, const std::vector<int>& orders, 
   };
   r.mean = value(0);
   r.mean_std = sd(0);
-  for (int k : wanted) {
-    const std::size_t q = static_cast<std::size_t>(std::find(orders.begin(), orders.end(), k) - orders.begin());
+  for (std::size_t q = 0; q < layout.harmonics; ++q) {
     r.cos.push_back(value(1 + q));
     r.sin.push_back(value(1 + layout.harmonics + q));
     r.cos_std.push_back(sd(1 + q));
@@ -74,70 +74,65 @@ HarmonicFitResult nodeFit(const Layout& layout, const std::vector<int>& orders, 
   return r;
 }
 
-}  // namespace
+/// The design rows of one (group, slice): its bins' noise is correlated within the block only.
+struct Block {
+  Eigen::MatrixXd x, v;
+  Eigen::VectorXd y, w;
+};
 
-ThermalEstimate estimateThermal(const SlicedRateGroup& group1, double rate1, const SlicedRateGroup& group2,
-                                double rate2, const FrequencyInterpolator& interpolator, int bins,
-                                const std::vector<int>& k_orders, const std::vector<int>& d_orders,
-                                double min_bin_time, double max_condition) {
-  ThermalEstimate e;
-  if (!(std::abs(rate1 - rate2) > 0.0)) {
-    e.reason = "the two plateau rates are equal";
-    return e;
-  }
-  if (interpolator.size() < 2) {
-    e.reason = "a frequency-dependent model needs at least 2 frequency nodes";
-    return e;
-  }
-  const std::vector<int> orders = mergeOrders(k_orders, d_orders);
-  const Layout layout{orders.size(), 1 + 2 * orders.size(), interpolator.size()};
-  const std::size_t p = layout.columns();
-  const SlicedRateGroup* groups[2] = {&group1, &group2};
-  const double rates[2] = {rate1, rate2};
-  std::vector<double> weights(layout.nodes), basis(layout.terms);
+/// What the joint fit works on: the two groups at their effective rates, the fitted orders and the
+/// column layout.
+struct JointProblem {
+  const RateGroup* groups[2];
+  double rates[2];
+  std::vector<int> orders;
+  Layout layout;
+  const FrequencyInterpolator& interpolator;
+  double min_bin_time;
+};
 
-  // Design blocks, one per (group, slice): the bins' noise is correlated within a block only.
-  struct Block {
-    Eigen::MatrixXd x, v;
-    Eigen::VectorXd y, w;
-  };
+/// Step 1: one design block per (group, slice) with used bins; the rows counted in e->rows and the
+/// smallest window attenuation in e->smoothing_factor.
+std::vector<Block> designBlocks(const JointProblem& jp, ThermalEstimate* e) {
+  const std::size_t p = jp.layout.columns();
+  std::vector<double> weights(jp.layout.nodes), basis(jp.layout.terms), row(p);
   std::vector<Block> blocks;
   std::size_t n = 0;
   for (int g = 0; g < 2; ++g) {
-    for (const auto& kv : groups[g]->slices) {
+    for (const auto& kv : jp.groups[g]->slices) {
       const ThetaBinnedRates& r = kv.second;
-      const std::vector<int> used = usedBins(r, min_bin_time);
+      const std::vector<int> used = usedBins(r, jp.min_bin_time);
       if (used.empty()) continue;
       Block blk;
       const Eigen::Index m = static_cast<Eigen::Index>(used.size());
       blk.x = Eigen::MatrixXd::Zero(m, static_cast<Eigen::Index>(p));
       blk.y.resize(m);
       blk.w.resize(m);
-      std::vector<double> row(p);
       for (Eigen::Index i = 0; i < m; ++i) {
-        designRow(layout, orders, r, used[i], rates[g], r.binTag(used[i]), interpolator, &weights, &basis, row.data());
+        designRow(jp.layout, jp.orders, r, used[i], jp.rates[g], r.binTag(used[i]), jp.interpolator, &weights, &basis,
+                  row.data());
         for (std::size_t c = 0; c < p; ++c) blk.x(i, static_cast<Eigen::Index>(c)) = row[c];
         blk.y[i] = r.binRate(used[i]);
         blk.w[i] = r.binTime(used[i]);
       }
       blk.v = r.rateCovariance(used);
-      for (int k : orders) {
+      for (int k : jp.orders) {
         const double s = sinc(0.5 * k * r.windowSpan());
-        e.smoothing_factor = std::min(e.smoothing_factor, s * s);
+        e->smoothing_factor = std::min(e->smoothing_factor, s * s);
       }
       n += used.size();
       blocks.push_back(std::move(blk));
     }
   }
-  e.rows = n;
-  if (n <= p) {
-    e.reason = "need more than " + std::to_string(p) + " binned rates for " + std::to_string(p) +
-               " node values, have " + std::to_string(n);
-    return e;
-  }
+  e->rows = n;
+  return blocks;
+}
 
-  // Normal equations, columns scaled to unit norm for the conditioning (K columns carry the
-  // table rate, D columns do not).
+/// Step 2: the normal equations over all blocks, solved with the columns scaled to unit norm (K
+/// columns carry the table rate, D columns do not). False with e->reason when refused.
+bool solveJoint(const JointProblem& jp, const std::vector<Block>& blocks, double max_condition,
+                LeastSquaresSolution* fit, ThermalEstimate* e) {
+  const std::size_t p = jp.layout.columns();
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(p, p);
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(p);
   for (const Block& blk : blocks) {
@@ -145,87 +140,72 @@ ThermalEstimate estimateThermal(const SlicedRateGroup& group1, double rate1, con
     a.noalias() += xw * blk.x;
     rhs.noalias() += xw * blk.y;
   }
-  Eigen::VectorXd scale(p);
   for (std::size_t c = 0; c < p; ++c) {
     if (!(a(c, c) > 0.0)) {
-      const std::size_t node = c % layout.nodes;
-      e.reason = "no data constrain frequency node " + std::to_string(node) + " (" +
-                 std::to_string(interpolator.nodes()[node]) + " Hz)";
-      return e;
+      const std::size_t node = c % jp.layout.nodes;
+      e->reason = "no data constrain frequency node " + std::to_string(node) + " (" +
+                  std::to_string(jp.interpolator.nodes()[node]) + " Hz)";
+      return false;
     }
-    scale[c] = 1.0 / std::sqrt(a(c, c));
   }
-  const Eigen::MatrixXd scaled = scale.asDiagonal() * a * scale.asDiagonal();
-  // The scaled normal matrix is symmetric positive (semi)definite: its singular values are its
-  // eigenvalues, the squares of the design matrix's singular values.
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::VectorXd sv = svd.singularValues();
-  e.condition_number = sv[p - 1] > 0.0 ? std::sqrt(sv[0] / sv[p - 1]) : INFINITY;
-  if (!(e.condition_number <= max_condition)) {
-    e.reason = "ill-conditioned frequency-dependent fit (condition number " + std::to_string(e.condition_number) +
-               "): the data do not separate the frequency nodes and harmonics";
-    return e;
+  *fit = solveNormalEquations(a, rhs, ColumnScaling::kUnitNorm, max_condition);
+  e->condition_number = fit->condition_number;
+  if (!fit->ok) {
+    e->reason = "ill-conditioned frequency-dependent fit (condition number " + std::to_string(e->condition_number) +
+                "): the data do not separate the frequency nodes and harmonics";
+    return false;
   }
-  const Eigen::MatrixXd scaled_inverse = svd.matrixV() * sv.cwiseInverse().asDiagonal() * svd.matrixU().transpose();
-  const Eigen::MatrixXd a_inverse = scale.asDiagonal() * scaled_inverse * scale.asDiagonal();
-  const Eigen::VectorXd c = a_inverse * rhs;
+  return true;
+}
 
-  // Standard errors: the sandwich with each block's telescoped-bin covariance, plus the scatter
-  // beyond it that is statistically significant, as independent noise of variance lambda / w.
-  double weighted_ss = 0.0, predicted = 0.0;
+/// Step 3: standard errors, the sandwich with each block's telescoped-bin covariance plus the
+/// significant scatter beyond it.
+Eigen::MatrixXd jointCovariance(const std::vector<Block>& blocks, const LeastSquaresSolution& fit, std::size_t n) {
+  double weighted_ss = 0.0;
+  std::vector<CorrelatedBlock> correlated;
   for (const Block& blk : blocks) {
-    const Eigen::VectorXd r = blk.y - blk.x * c;
+    const Eigen::VectorXd r = blk.y - blk.x * fit.coefficients;
     weighted_ss += (blk.w.array() * r.array().square()).sum();
-    predicted += (blk.w.array() * blk.v.diagonal().array()).sum();
+    correlated.push_back({&blk.x, &blk.w, &blk.v});
   }
-  const double dof = static_cast<double>(n - p);
-  const double sigma2 = weighted_ss / dof;
-  predicted /= static_cast<double>(n);
-  const double excess = std::max(0.0, sigma2 - predicted * (1.0 + 3.0 * std::sqrt(2.0 / dof)));
-  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(p, p);
-  for (const Block& blk : blocks) {
-    Eigen::MatrixXd v = blk.v;
-    for (Eigen::Index i = 0; i < v.rows(); ++i) v(i, i) += excess / blk.w[i];
-    const Eigen::MatrixXd xw = blk.x.transpose() * blk.w.asDiagonal();
-    meat.noalias() += xw * v * xw.transpose();
-  }
-  const Eigen::MatrixXd cov = a_inverse * meat * a_inverse;
-  if (!std::isfinite(c.sum()) || !std::isfinite(cov.sum())) {
-    e.reason = "non-finite frequency-dependent fit";
-    return e;
-  }
+  const std::size_t p = static_cast<std::size_t>(fit.coefficients.size());
+  return sandwichCovariance(fit.normal_inverse, correlated, residualVariance(weighted_ss, n, p), p);
+}
 
-  // Per-node results and the models.
-  auto model = [&](int which, const std::vector<int>& wanted) {
-    Eigen::MatrixXd values(1 + 2 * wanted.size(), layout.nodes);
-    for (std::size_t j = 0; j < layout.nodes; ++j) {
-      const HarmonicFitResult f = nodeFit(layout, orders, wanted, which, j, c, cov);
-      const std::vector<double> terms = f.terms();
-      for (std::size_t t = 0; t < terms.size(); ++t) values(static_cast<Eigen::Index>(t), j) = terms[t];
-      (which == 0 ? e.k : e.d).push_back(f);
-    }
-    return HarmonicModel(wanted, interpolator, values);
-  };
-  e.k_model = model(0, k_orders);
-  e.d_model = model(1, d_orders);
+/// Step 4: per-node results of one model at its own orders, and the model over the nodes.
+HarmonicModel nodeModel(const JointProblem& jp, int which, const std::vector<int>& wanted, const Eigen::VectorXd& c,
+                        const Eigen::MatrixXd& cov, std::vector<HarmonicFitResult>* fits) {
+  Eigen::MatrixXd values(1 + 2 * wanted.size(), jp.layout.nodes);
+  for (std::size_t j = 0; j < jp.layout.nodes; ++j) {
+    const HarmonicFitResult f = selectOrders(nodeFit(jp.layout, jp.orders, which, j, c, cov), wanted);
+    const std::vector<double> terms = f.terms();
+    for (std::size_t t = 0; t < terms.size(); ++t) values(static_cast<Eigen::Index>(t), j) = terms[t];
+    fits->push_back(f);
+  }
+  return HarmonicModel(wanted, jp.interpolator, values);
+}
 
-  // Dual-rate pairing by theta bin. On a ramp the two rates rarely share a slice, so each group's
-  // bins are first moved to the middle frequency of the nodes with the fitted frequency dependence
-  // (r - model(f_bin) + model(f_mid)) and summed over the slices; the paired K and D are then the
-  // data at f_mid, and their scatter about the model (seen the same way) is the fit's residual.
+/// Step 5: dual-rate pairing by theta bin. On a ramp the two rates rarely share a slice, so each
+/// group's bins are first moved to the middle frequency of the nodes with the fitted frequency
+/// dependence (r - model(f_bin) + model(f_mid)) and summed over the slices; the paired K and D are
+/// then the data at f_mid, and their scatter about the model (seen the same way) is the fit's
+/// residual (e->binned, e->k_residual_rms, e->d_residual_rms).
+void pairBins(const JointProblem& jp, int bins, const Eigen::VectorXd& c, ThermalEstimate* e) {
+  const std::size_t p = jp.layout.columns();
+  const double rate1 = jp.rates[0], rate2 = jp.rates[1];
   const double dr = rate1 - rate2;
-  const double f_mid = 0.5 * (interpolator.nodes().front() + interpolator.nodes().back());
+  const double f_mid = 0.5 * (jp.interpolator.nodes().front() + jp.interpolator.nodes().back());
   struct Sum {
     double time = 0.0, rate = 0.0, model = 0.0;  // sum t, sum t (r moved to f_mid), sum t model(f_mid)
   };
   std::vector<Sum> sums[2] = {std::vector<Sum>(bins), std::vector<Sum>(bins)};
-  std::vector<double> row(p), row_mid(p);
+  std::vector<double> weights(jp.layout.nodes), basis(jp.layout.terms), row(p), row_mid(p);
   for (int g = 0; g < 2; ++g) {
-    for (const auto& kv : groups[g]->slices) {
+    for (const auto& kv : jp.groups[g]->slices) {
       const ThetaBinnedRates& r = kv.second;
-      for (int b : usedBins(r, min_bin_time)) {
-        designRow(layout, orders, r, b, rates[g], r.binTag(b), interpolator, &weights, &basis, row.data());
-        designRow(layout, orders, r, b, rates[g], f_mid, interpolator, &weights, &basis, row_mid.data());
+      for (int b : usedBins(r, jp.min_bin_time)) {
+        designRow(jp.layout, jp.orders, r, b, jp.rates[g], r.binTag(b), jp.interpolator, &weights, &basis, row.data());
+        designRow(jp.layout, jp.orders, r, b, jp.rates[g], f_mid, jp.interpolator, &weights, &basis, row_mid.data());
         double m = 0.0, m_mid = 0.0;
         for (std::size_t col = 0; col < p; ++col) {
           m += row[col] * c[col];
@@ -253,11 +233,54 @@ ThermalEstimate estimateThermal(const SlicedRateGroup& group1, double rate1, con
     const double k_fit = (m1 - m2) / dr, d_fit = (m2 * rate1 - m1 * rate2) / dr;
     k_ss += (pt.k - k_fit) * (pt.k - k_fit);
     d_ss += (pt.d - d_fit) * (pt.d - d_fit);
-    e.binned.push_back(pt);
+    e->binned.push_back(pt);
   }
-  const double paired = static_cast<double>(e.binned.size());
-  e.k_residual_rms = paired > 0 ? std::sqrt(k_ss / paired) : 0.0;
-  e.d_residual_rms = paired > 0 ? std::sqrt(d_ss / paired) : 0.0;
+  const double paired = static_cast<double>(e->binned.size());
+  e->k_residual_rms = paired > 0 ? std::sqrt(k_ss / paired) : 0.0;
+  e->d_residual_rms = paired > 0 ? std::sqrt(d_ss / paired) : 0.0;
+}
+
+}  // namespace
+
+ThermalEstimate estimateThermal(const RateGroup& group1, double rate1, const RateGroup& group2,
+                                double rate2, const FrequencyInterpolator& interpolator, int bins,
+                                const std::vector<int>& k_orders, const std::vector<int>& d_orders,
+                                double min_bin_time, double max_condition) {
+  ThermalEstimate e;
+  if (!(std::abs(rate1 - rate2) > 0.0)) {
+    e.reason = "the two plateau rates are equal";
+    return e;
+  }
+  if (interpolator.size() < 2) {
+    e.reason = "a frequency-dependent model needs at least 2 frequency nodes";
+    return e;
+  }
+  const std::vector<int> orders = mergeOrders(k_orders, d_orders);
+  const JointProblem jp{{&group1, &group2},
+                        {rate1, rate2},
+                        orders,
+                        Layout{orders.size(), 1 + 2 * orders.size(), interpolator.size()},
+                        interpolator,
+                        min_bin_time};
+  const std::size_t p = jp.layout.columns();
+  const std::vector<Block> blocks = designBlocks(jp, &e);
+  const std::size_t n = e.rows;
+  if (n <= p) {
+    e.reason = "need more than " + std::to_string(p) + " binned rates for " + std::to_string(p) +
+               " node values, have " + std::to_string(n);
+    return e;
+  }
+  LeastSquaresSolution fit;
+  if (!solveJoint(jp, blocks, max_condition, &fit, &e)) return e;
+  const Eigen::VectorXd& c = fit.coefficients;
+  const Eigen::MatrixXd cov = jointCovariance(blocks, fit, n);
+  if (!std::isfinite(c.sum()) || !std::isfinite(cov.sum())) {
+    e.reason = "non-finite frequency-dependent fit";
+    return e;
+  }
+  e.k_model = nodeModel(jp, 0, k_orders, c, cov, &e.k);
+  e.d_model = nodeModel(jp, 1, d_orders, c, cov, &e.d);
+  pairBins(jp, bins, c, &e);
   for (auto* fits : {&e.k, &e.d}) {
     for (HarmonicFitResult& f : *fits) {
       f.residual_rms = fits == &e.k ? e.k_residual_rms : e.d_residual_rms;

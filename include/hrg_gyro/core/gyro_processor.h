@@ -108,6 +108,23 @@ class GyroProcessor {
 
  private:
   void countRejection(WaveStatus status);
+  // The phases of process(), in its order.
+  /// Counts a rejected sample toward the next output's rejected_before.
+  void reject(SampleVerdict verdict, ProcessorResult* r);
+  /// Zero, duplicate and out-of-order stamps are rejected (false); a large backward jump resets the
+  /// state. *dt_ns: the step from the previous sample (left at 0 without one).
+  bool admitStamp(Nanoseconds stamp, Nanoseconds* dt_ns, ProcessorResult* r);
+  /// The first sample (after a start or reset) anchors the unwrapped angle; no output.
+  void anchor(const ChannelSample& in, WaveState* wave, ProcessorResult* r);
+  /// Gap and glitch rules on the unwrapped angle step: false for a rejected jump; *integrate false
+  /// (and kFlagGap) for a gap or a persistent jump, which re-anchor the angle.
+  bool admitStep(double dt, double step, std::uint8_t* flags, bool* integrate);
+  /// kFlagFrequencyUnknown / kFlagFrequencyOutOfRange for a frequency-dependent model, counted.
+  std::uint8_t frequencyFlags(double f_mid);
+  /// The output across a re-anchor: dalpha = 0, K and D evaluated at the new angle.
+  AngleIncrement reanchorIncrement(double theta, double dt, double f_mid, const WaveState& wave);
+  /// The accepted sample becomes the previous one.
+  void remember(const ChannelSample& in, const WaveState& wave);
 
   ProcessorConfig config_;
   Compensator compensator_;

@@ -54,5 +54,9 @@ HarmonicFitResult fitHarmonics(const std::vector<FitPoint>& points, const std::v
                                const std::vector<double>& extra_attenuation = {}, double max_condition = 1e8,
                                const Eigen::MatrixXd* value_covariance = nullptr);
 
+/// The fit restricted to `orders`, in that order: their coefficients and standard errors (zeros for
+/// an order the fit lacks); the mean and the fit's statistics are kept.
+HarmonicFitResult selectOrders(const HarmonicFitResult& fit, const std::vector<int>& orders);
+
 }  // namespace core
 }  // namespace hrg_gyro

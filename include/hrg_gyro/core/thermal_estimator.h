@@ -28,7 +28,7 @@
 
 #include "hrg_gyro/core/dual_rate_estimator.h"
 #include "hrg_gyro/core/frequency_interpolator.h"
-#include "hrg_gyro/core/frequency_sliced_rates.h"
+#include "hrg_gyro/core/rate_groups.h"
 #include "hrg_gyro/core/harmonic_fit.h"
 #include "hrg_gyro/core/harmonic_model.h"
 
@@ -52,7 +52,7 @@ struct ThermalEstimate {
 
 /// rate1, rate2: effective rates (table + Earth) of the two groups; bins with less than
 /// min_bin_time s of data are left out. The fit refuses condition numbers above max_condition.
-ThermalEstimate estimateThermal(const SlicedRateGroup& group1, double rate1, const SlicedRateGroup& group2,
+ThermalEstimate estimateThermal(const RateGroup& group1, double rate1, const RateGroup& group2,
                                 double rate2, const FrequencyInterpolator& interpolator, int bins,
                                 const std::vector<int>& k_orders, const std::vector<int>& d_orders,
                                 double min_bin_time, double max_condition);

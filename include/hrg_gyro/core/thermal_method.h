@@ -3,7 +3,7 @@
 // Why: the resonator frequency f tracks temperature, and K and D drift with it; a model calibrated
 // at one temperature leaves ppm-level nonlinearity and scale-factor errors at another. This method
 // takes dual-rate plateaus recorded while the temperature moves (a ramp, or soaks at several
-// temperatures), bins theta per frequency slice (FrequencySlicedRates) and fits every coefficient
+// temperatures), bins theta per frequency slice (RateGroups with a slice width) and fits every coefficient
 // of K and D as a spline over f (ThermalEstimate). The written parameter file carries
 // frequency_nodes, and the processor evaluates K and D at each sample's frequency.
 //
@@ -20,7 +20,8 @@
 #include <vector>
 
 #include "hrg_gyro/core/calibration_method.h"
-#include "hrg_gyro/core/frequency_sliced_rates.h"
+#include "hrg_gyro/core/rate_groups.h"
+#include "hrg_gyro/core/thermal_estimator.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -40,12 +41,27 @@ class ThermalMethod : public CalibrationMethod {
   /// The explicit nodes, or node_count nodes evenly over the frequencies seen (empty if none).
   std::vector<double> nodes() const;
   /// Per node interval: fraction of theta bins the group swept for at least minBinTime().
-  std::vector<double> intervalCoverage(const SlicedRateGroup& group, const std::vector<double>& nodes) const;
+  std::vector<double> intervalCoverage(const RateGroup& group, const std::vector<double>& nodes) const;
   /// Smallest coverage over the intervals and the two main groups; `worst` gets the interval.
   double worstCoverage(const std::vector<double>& nodes, std::size_t* worst) const;
 
+  // The phases of finish(), in its order.
+  /// One summary per rate group, most data first.
+  void summarizeGroups(CalibrationOutcome* o) const;
+  /// Notes on the samples left out (no frequency, outside the nodes, beyond the slice limit).
+  void noteDroppedSamples(CalibrationOutcome* o) const;
+  /// Gates on the data of the two main groups g1, g2 at the nodes n: node spacing, coverage, rate
+  /// separation and noise.
+  void gateData(const std::vector<double>& n, const RateGroup& g1, const RateGroup& g2, CalibrationOutcome* o) const;
+  /// Gates on the fit at every node (K0 sign and change, residual, harmonic standard error) and the
+  /// peak nonlinearity; returns the steepest node's K slope for the error bound.
+  double gateNodes(const std::vector<double>& n, const ThermalEstimate& e, const GyroParameters& prior,
+                   CalibrationOutcome* o) const;
+  /// The paper-style error bound of the window method with the steepest node's model.
+  double errorBound(double slope, const RateGroup& g1, const RateGroup& g2) const;
+
   CalibrationSettings settings_;
-  FrequencySlicedRates rates_;
+  RateGroups rates_;
   std::uint64_t samples_ = 0, no_frequency_ = 0, out_of_range_ = 0, slice_limit_ = 0;
   double f_min_ = std::numeric_limits<double>::infinity(), f_max_ = -std::numeric_limits<double>::infinity();
 };
