@@ -13,9 +13,9 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "hrg_gyro/core/calibration_session.h"
-#include "hrg_gyro/core/gaussian_noise.h"
-#include "hrg_gyro/core/units.h"
+#include "hrg_gyro/core/calibration/calibration_session.h"
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
+#include "hrg_gyro/core/common/units.h"
 
 using namespace hrg_gyro::core;
 

@@ -8,16 +8,16 @@
 #include <string>
 #include <vector>
 
-#include "hrg_gyro/core/compensator.h"
-#include "hrg_gyro/core/correction_matrix.h"
-#include "hrg_gyro/core/gaussian_noise.h"
-#include "hrg_gyro/core/gyro_processor.h"
-#include "hrg_gyro/core/gyro_simulator.h"
-#include "hrg_gyro/core/harmonic_fit.h"
-#include "hrg_gyro/core/simulation_config.h"
-#include "hrg_gyro/core/synchronous_demodulator.h"
-#include "hrg_gyro/core/wave_estimator.h"
-#include "hrg_gyro/core/wave_parameters.h"
+#include "hrg_gyro/core/processing/compensator.h"
+#include "hrg_gyro/core/model/correction_matrix.h"
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
+#include "hrg_gyro/core/processing/gyro_processor.h"
+#include "hrg_gyro/core/simulation/gyro_simulator.h"
+#include "hrg_gyro/core/estimation/harmonic_fit.h"
+#include "hrg_gyro/core/simulation/simulation_config.h"
+#include "hrg_gyro/core/signal/synchronous_demodulator.h"
+#include "hrg_gyro/core/signal/wave_estimator.h"
+#include "hrg_gyro/core/model/wave_parameters.h"
 
 namespace hrg_gyro {
 namespace core {

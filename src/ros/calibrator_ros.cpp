@@ -6,9 +6,9 @@
 
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/ModelInfo.h"
-#include "hrg_gyro/core/atomic_file.h"
-#include "hrg_gyro/core/output_directory.h"
-#include "hrg_gyro/core/parameter_file.h"
+#include "hrg_gyro/core/common/atomic_file.h"
+#include "hrg_gyro/core/common/output_directory.h"
+#include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/diagnostics_timer.h"
 #include "hrg_gyro/ros/process_heap.h"

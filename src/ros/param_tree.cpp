@@ -2,7 +2,7 @@
 
 #include <sstream>
 
-#include "hrg_gyro/core/yaml_field.h"
+#include "hrg_gyro/core/common/yaml_field.h"
 
 namespace hrg_gyro {
 

@@ -8,10 +8,10 @@
 #include <std_msgs/String.h>
 #include <yaml-cpp/yaml.h>
 
-#include "hrg_gyro/core/calibration_method_kind.h"
-#include "hrg_gyro/core/effective_model.h"
-#include "hrg_gyro/core/parameter_file.h"
-#include "hrg_gyro/core/session_summary.h"
+#include "hrg_gyro/core/model/calibration_method_kind.h"
+#include "hrg_gyro/core/simulation/injected_model.h"
+#include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/evaluation/session_summary.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/param_tree.h"
 

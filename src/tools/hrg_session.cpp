@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "cli_checks.h"
-#include "hrg_gyro/core/atomic_file.h"
-#include "hrg_gyro/core/calibration_session.h"
-#include "hrg_gyro/core/offline_pipeline.h"
-#include "hrg_gyro/core/parameter_file.h"
-#include "hrg_gyro/core/session_summary.h"
+#include "hrg_gyro/core/common/atomic_file.h"
+#include "hrg_gyro/core/calibration/calibration_session.h"
+#include "hrg_gyro/core/evaluation/offline_pipeline.h"
+#include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/evaluation/session_summary.h"
 
 using namespace hrg_gyro::core;
 

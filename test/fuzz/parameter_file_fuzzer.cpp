@@ -5,7 +5,7 @@
 #include <string>
 
 #include "fuzz_check.h"
-#include "hrg_gyro/core/parameter_file.h"
+#include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
 namespace fuzz {

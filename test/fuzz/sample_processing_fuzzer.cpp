@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "fuzz_check.h"
-#include "hrg_gyro/core/gyro_processor.h"
-#include "hrg_gyro/core/parameter_file.h"
-#include "hrg_gyro/core/wave_parameters.h"
+#include "hrg_gyro/core/processing/gyro_processor.h"
+#include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/model/wave_parameters.h"
 
 namespace hrg_gyro {
 namespace fuzz {

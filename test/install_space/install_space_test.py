@@ -43,7 +43,7 @@ class InstallSpace(unittest.TestCase):
             self.assertTrue(os.access(path, os.X_OK), path)
         for lib in ("libhrg_gyro_core.so", "libhrg_gyro_ros.so", "libhrg_gyro_nodelets.so"):
             self.assertTrue(os.path.isfile(os.path.join(PREFIX, "lib", lib)), lib)
-        for rel in ("include/hrg_gyro/core/gyro_processor.h", "include/hrg_gyro/ros/processor_ros.h",
+        for rel in ("include/hrg_gyro/core/processing/gyro_processor.h", "include/hrg_gyro/ros/processor_ros.h",
                     "include/hrg_gyro/ChannelAmplitudes.h", "share/hrg_gyro/nodelet_plugins.xml",
                     "share/hrg_gyro/package.xml", "share/hrg_gyro/launch/processor.launch",
                     "share/hrg_gyro/launch/example_navigation_stack.launch", "share/hrg_gyro/config/processor.yaml",

@@ -29,8 +29,8 @@
 #include "hrg_gyro/StartCalibration.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
-#include "hrg_gyro/core/generator_pairing.h"
-#include "hrg_gyro/core/staged_calibration.h"
+#include "hrg_gyro/core/calibration/generator_pairing.h"
+#include "hrg_gyro/core/calibration/staged_calibration.h"
 #include "hrg_gyro/ros/input_thread.h"
 #include "hrg_gyro/ros/parameter_reader.h"
 

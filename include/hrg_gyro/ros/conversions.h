@@ -11,10 +11,10 @@
 #include "hrg_gyro/GyroOutput.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
-#include "hrg_gyro/core/calibration_outcome.h"
-#include "hrg_gyro/core/gyro_processor.h"
-#include "hrg_gyro/core/gyro_simulator.h"
-#include "hrg_gyro/core/units.h"
+#include "hrg_gyro/core/calibration/calibration_outcome.h"
+#include "hrg_gyro/core/processing/gyro_processor.h"
+#include "hrg_gyro/core/simulation/gyro_simulator.h"
+#include "hrg_gyro/core/common/units.h"
 
 namespace hrg_gyro {
 

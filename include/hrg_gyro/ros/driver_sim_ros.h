@@ -18,8 +18,8 @@
 
 #include <ros/ros.h>
 
-#include "hrg_gyro/core/gyro_simulator.h"
-#include "hrg_gyro/core/playback_schedule.h"
+#include "hrg_gyro/core/simulation/gyro_simulator.h"
+#include "hrg_gyro/core/simulation/playback_schedule.h"
 #include "hrg_gyro/ros/parameter_reader.h"
 
 namespace hrg_gyro {

@@ -21,8 +21,8 @@
 #include <std_srvs/Trigger.h>
 
 #include "hrg_gyro/ChannelAmplitudes.h"
-#include "hrg_gyro/core/bias_capture.h"
-#include "hrg_gyro/core/gyro_processor.h"
+#include "hrg_gyro/core/processing/bias_capture.h"
+#include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/ros/input_thread.h"
 #include "hrg_gyro/ros/parameter_reader.h"
 

@@ -23,8 +23,8 @@
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/GyroOutput.h"
 #include "hrg_gyro/ModelInfo.h"
-#include "hrg_gyro/core/output_evaluator.h"
-#include "hrg_gyro/core/simulation_config.h"
+#include "hrg_gyro/core/evaluation/output_evaluator.h"
+#include "hrg_gyro/core/simulation/simulation_config.h"
 #include "hrg_gyro/ros/parameter_reader.h"
 
 namespace hrg_gyro {

@@ -6,10 +6,10 @@
 
 #include <functional>
 
-#include "hrg_gyro/core/calibration_session.h"
-#include "hrg_gyro/core/gaussian_noise.h"
-#include "hrg_gyro/core/model_pair_evaluator.h"
-#include "hrg_gyro/core/turntable_profile.h"
+#include "hrg_gyro/core/calibration/calibration_session.h"
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
+#include "hrg_gyro/core/model/model_pair_evaluator.h"
+#include "hrg_gyro/core/simulation/turntable_profile.h"
 
 namespace hrg_gyro {
 namespace core {

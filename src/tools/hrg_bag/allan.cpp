@@ -8,8 +8,8 @@
 
 #include "../cli_checks.h"
 #include "bag_tools.h"
-#include "hrg_gyro/core/allan_deviation.h"
-#include "hrg_gyro/core/parameter_file.h"
+#include "hrg_gyro/core/estimation/allan_deviation.h"
+#include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
 

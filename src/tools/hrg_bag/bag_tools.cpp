@@ -18,8 +18,8 @@
 
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
-#include "hrg_gyro/core/output_directory.h"
-#include "hrg_gyro/core/yaml_field.h"
+#include "hrg_gyro/core/common/output_directory.h"
+#include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "../cli_checks.h"
 

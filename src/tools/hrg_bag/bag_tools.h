@@ -16,8 +16,8 @@
 #include <rosbag/view.h>
 
 #include "hrg_gyro/ChannelAmplitudes.h"
-#include "hrg_gyro/core/atomic_file.h"
-#include "hrg_gyro/core/gyro_processor.h"
+#include "hrg_gyro/core/common/atomic_file.h"
+#include "hrg_gyro/core/processing/gyro_processor.h"
 
 namespace hrg_gyro {
 namespace bag_tools {

@@ -8,9 +8,9 @@
 #include "bag_tools.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
-#include "hrg_gyro/core/calibration_session.h"
-#include "hrg_gyro/core/generator_pairing.h"
-#include "hrg_gyro/core/parameter_file.h"
+#include "hrg_gyro/core/calibration/calibration_session.h"
+#include "hrg_gyro/core/calibration/generator_pairing.h"
+#include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
 
 namespace hrg_gyro {

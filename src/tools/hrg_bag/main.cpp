@@ -6,7 +6,7 @@
 
 #include "../cli_checks.h"
 #include "bag_tools.h"
-#include "hrg_gyro/core/yaml_field.h"
+#include "hrg_gyro/core/common/yaml_field.h"
 
 int main(int argc, char** argv) {
   using namespace hrg_gyro::bag_tools;

@@ -7,7 +7,7 @@
 
 #include "../cli_checks.h"
 #include "bag_tools.h"
-#include "hrg_gyro/core/parameter_file.h"
+#include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
 
 namespace hrg_gyro {

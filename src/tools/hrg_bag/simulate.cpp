@@ -3,7 +3,7 @@
 
 #include "../cli_checks.h"
 #include "bag_tools.h"
-#include "hrg_gyro/core/gyro_simulator.h"
+#include "hrg_gyro/core/simulation/gyro_simulator.h"
 #include "hrg_gyro/ros/conversions.h"
 
 namespace hrg_gyro {

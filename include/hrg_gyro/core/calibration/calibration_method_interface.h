@@ -1,0 +1,52 @@
+// The interface every calibration method implements, and the samples it receives.
+//
+// The session (calibration_session.h) synchronises the wave and turntable streams and hands each
+// method only samples taken on a settled turntable plateau, labelled with that plateau. A method
+// accumulates in memory that does not grow with the session length, says when its data are
+// complete, and turns them into a CalibrationOutcome with its quality gates.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "hrg_gyro/core/calibration/calibration_outcome.h"
+#include "hrg_gyro/core/calibration/calibration_settings.h"
+#include "hrg_gyro/core/estimation/plateau_detector.h"
+#include "hrg_gyro/core/model/wave_parameters.h"
+
+namespace hrg_gyro {
+namespace core {
+
+struct PlateauSample {
+  Nanoseconds stamp = 0;
+  double theta = 0.0;        ///< measured electrical angle, rad (continuous)
+  double frequency = NAN;    ///< Hz
+  PlateauState plateau;      ///< settled plateau this sample belongs to
+  double table_angle = 0.0;  ///< rad, interpolated at the stamp
+  double table_rate = 0.0;   ///< rad/s, as reported
+};
+
+struct CalibrationProgress {
+  double fraction = 0.0;  ///< 0..1 towards complete()
+  std::string summary;    ///< one line for logs and diagnostics
+};
+
+class CalibrationMethod {
+ public:
+  virtual ~CalibrationMethod() = default;
+  virtual CalibrationMethodKind kind() const = 0;
+  virtual void addSample(const PlateauSample& sample) = 0;
+  /// Generator pairs: raw channel amplitudes and the known wave's ideal ones.
+  virtual void addGeneratorPair(const ChannelVector& /*raw*/, const ChannelVector& /*reference*/) {}
+  virtual bool complete() const = 0;
+  virtual CalibrationProgress progress() const = 0;
+  virtual CalibrationOutcome finish(const GyroParameters& prior) const = 0;
+};
+
+/// The method the settings choose; `prior` is the parameter set the data are measured with.
+std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettings& settings,
+                                                         const GyroParameters& prior);
+
+}  // namespace core
+}  // namespace hrg_gyro

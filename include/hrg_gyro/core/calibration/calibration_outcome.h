@@ -1,0 +1,79 @@
+// What a calibration run produced: the estimates with their uncertainties, the data summary, each
+// quality gate, and the parameter set to write when accepted. Also its YAML report form, read by
+// scripts/plot_calibration.py.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hrg_gyro/core/model/correction_matrix.h"
+#include "hrg_gyro/core/estimation/defect_diagnosis.h"
+#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
+#include "hrg_gyro/core/model/gyro_parameters.h"
+#include "hrg_gyro/core/estimation/harmonic_fit.h"
+
+namespace hrg_gyro {
+namespace core {
+
+struct GroupSummary {
+  double rate = 0.0;      ///< mean table rate, rad/s
+  double rate_std = 0.0;  ///< rad/s
+  double duration = 0.0;  ///< s of wave data
+  std::uint64_t samples = 0;
+  double coverage = 0.0;  ///< fraction of theta bins
+  double turns = 0.0;     ///< electrical angle swept / pi
+};
+
+struct GateResult {
+  std::string name;
+  bool passed = false;
+  double value = 0.0;
+  double limit = 0.0;
+  std::string message;
+};
+
+struct CalibrationOutcome {
+  CalibrationMethodKind method = CalibrationMethodKind::kDualRate;
+  bool accepted = false;
+  std::string reason;               ///< first failed gate, or why no estimate exists
+  GyroParameters parameters;        ///< prior with the new estimates (meaningful when accepted)
+  std::vector<HarmonicFitResult> scale_factor;  ///< one entry (or one per frequency node)
+  std::vector<HarmonicFitResult> drift;
+  std::vector<double> frequency_nodes;          ///< Hz; empty when frequency independent
+  bool has_correction = false;
+  CorrectionMatrixEstimator::Result correction;
+  double coverage = 0.0;
+  double smoothing_factor = 1.0;
+  double error_bound = 0.0;         ///< the paper's bound for K (dimensionless)
+  double nonlinearity_ppm = 0.0;    ///< peak |K(theta) - K0| / |K0| of the fitted model
+  double duration = 0.0;            ///< s of data used
+  std::uint64_t samples = 0;
+  std::vector<GroupSummary> plateaus;
+  std::vector<GateResult> gates;
+  std::vector<BinnedCurvePoint> binned;  ///< binned K and D (dual-rate) or step points
+  std::vector<std::string> notes;
+  double quadrature_ratio = 0.0;          ///< mean |B/A| of the wave samples (F of the diagnosis)
+  std::vector<DefectDiagnosis> diagnosis;  ///< one per scale_factor fit with 2 and 4 theta terms
+
+  /// Appends a gate; the first failing one becomes the reason.
+  void gate(const std::string& name, bool passed, double value, double limit, const std::string& message);
+  /// accepted = every gate passed (and at least one exists).
+  void decide();
+};
+
+/// ISO 8601 UTC time of now, for CalibrationProvenance::time.
+std::string utcNow();
+/// A number with `precision` significant digits, for gate messages.
+std::string formatShort(double value, int precision = 4);
+/// Highest harmonic order fitted for K or D (2 if none): what the window smoothing is sized for.
+int maxFittedOrder(const std::vector<int>& scale_factor_orders, const std::vector<int>& drift_orders);
+
+/// Fills outcome->diagnosis from its scale-factor fits, read against the P in force during the run.
+void diagnose(CalibrationOutcome* outcome, const CorrectionMatrix& correction_in_force);
+
+/// Human- and machine-readable YAML of the outcome (report files, plots).
+std::string emitCalibrationReport(const CalibrationOutcome& outcome);
+
+}  // namespace core
+}  // namespace hrg_gyro

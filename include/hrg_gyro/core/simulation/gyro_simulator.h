@@ -1,0 +1,103 @@
+// The simulated gyro on its turntable: the resonator dynamics, the signal-level pickoff and
+// demodulation, and the ground truth, one output sample at a time.
+//
+// Dynamics (docs/math.md, 'Dynamics and compensation'):
+//   d theta/dt = K(theta) (Omega_table(t) + Omega_E) + D(theta) with the
+// resonator's intrinsic K and D, integrated by RK4 over each resonator period. The table rate is
+// piecewise linear, so the RK4 stages see it exactly. Each period is then sampled N times through
+// the eight pickoffs and demodulated (SignalSynthesizer); `periods_per_output` periods are averaged
+// into one output sample stamped at the centre of its window. With the generator enabled the
+// session starts with a known sweep of (theta, B, tau) at rest (for the correction-matrix fit), and
+// the turntable profile, if any, follows it.
+//
+// With a thermal section (thermal_model.h) the temperature is evaluated at the centre of each
+// output window and held over it: the pickoff defects, the amplitude and the intrinsic K and D are
+// those of that temperature, and the sample reports T and f(T). Without one every sample reports
+// the nominal frequency and an unknown (NaN) temperature, exactly as before thermal support existed.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
+#include "hrg_gyro/core/model/model_pair_evaluator.h"
+#include "hrg_gyro/core/simulation/signal_synthesizer.h"
+#include "hrg_gyro/core/simulation/simulation_config.h"
+#include "hrg_gyro/core/common/units.h"
+
+namespace hrg_gyro {
+namespace core {
+
+struct TruthState {
+  double table_angle = 0.0;     ///< rad, Earth-fixed
+  double table_rate = 0.0;      ///< rad/s
+  double inertial_angle = 0.0;  ///< rad, table angle + vertical Earth rate x time
+  double inertial_rate = 0.0;   ///< rad/s
+  double theta = 0.0;           ///< true electrical angle, rad (continuous)
+  double amplitude = 0.0;
+  double quadrature = 0.0;
+  double phase = 0.0;
+  double frequency = 0.0;       ///< Hz
+  double temperature = NAN;     ///< degC
+  bool generator = false;
+  const std::string* segment = nullptr;  ///< profile label (owned by the simulator)
+};
+
+struct SimulationSample {
+  std::uint64_t index = 0;
+  Nanoseconds stamp = 0;          ///< centre of the demodulation window
+  ChannelVector z = ChannelVector::Zero();
+  double frequency = 0.0;         ///< Hz
+  double temperature = NAN;       ///< degC
+  std::uint32_t periods = 0;
+  TruthState truth;
+};
+
+class GyroSimulator {
+ public:
+  explicit GyroSimulator(const SimulationConfig& config);
+  // The dynamics evaluator points into config_: the simulator stays where it was built.
+  GyroSimulator(const GyroSimulator&) = delete;
+  GyroSimulator& operator=(const GyroSimulator&) = delete;
+
+  const SimulationConfig& config() const { return config_; }
+  /// Simulated duration of the whole scenario, s.
+  double duration() const;
+  /// Simulated time reached, s from the start.
+  double elapsed() const { return t_; }
+  bool done() const;
+
+  /// The next output sample; false once the scenario is complete.
+  bool next(SimulationSample* out);
+
+ private:
+  double thetaRate(double t, double theta);
+  void nextDynamic(SimulationSample* out);
+  void nextGenerator(SimulationSample* out);
+  double generatorDuration() const;
+  std::uint64_t generatorOutputsPerState() const;
+  void stamp(double t_center, SimulationSample* out) const;
+  /// Thermal scenarios: moves the gyro to the temperature at time t (s from the start).
+  void updateTemperature(double t);
+
+  SimulationConfig config_;
+  SignalSynthesizer synth_;
+  GaussianNoise rate_noise_;  // separate stream: switching it on leaves the pickoff noise unchanged
+  // Intrinsic K and D: the resonator's own models, or (thermal) those of the current temperature.
+  HarmonicModel thermal_k_{0.0}, thermal_d_{0.0};
+  ModelPairEvaluator intrinsic_;
+  double temperature_ = NAN;  // degC; NaN without a thermal section
+  double frequency_;          // reported resonance frequency, Hz
+  double amplitude_;          // wave amplitude A at the current temperature
+  double earth_rate_;
+  double t_ = 0.0;            // s since start, Kahan-compensated
+  double t_compensation_ = 0.0;
+  double theta_;              // true electrical angle at t_
+  std::uint64_t index_ = 0;
+  std::uint64_t generator_state_ = 0;
+  std::uint64_t generator_outputs_in_state_ = 0;
+  std::string generator_label_ = "generator";
+};
+
+}  // namespace core
+}  // namespace hrg_gyro

@@ -1,0 +1,29 @@
+// The K(theta) and D(theta) a perfect calibration should find for a simulated gyro.
+//
+// The processor measures theta~ = g(theta) through the pickoffs (and the correction P it applies),
+// so what it sees is d theta~ = g'(theta) [K(theta) (d alpha + Omega_E dt) + D(theta) dt]: the
+// effective models are K_eff(theta~) = g' K and D_eff(theta~) = g' D. g is measured noise free at
+// signal level on a fine grid of true angles, g' by central differences, and both effective models
+// are fitted with harmonics of theta~. This is the "injected" reference of the summaries and tests.
+#pragma once
+
+#include <vector>
+
+#include "hrg_gyro/core/model/correction_matrix.h"
+#include "hrg_gyro/core/estimation/harmonic_fit.h"
+#include "hrg_gyro/core/simulation/simulation_config.h"
+
+namespace hrg_gyro {
+namespace core {
+
+struct EffectiveModel {
+  HarmonicFitResult scale_factor;  ///< K_eff over the requested orders
+  HarmonicFitResult drift;         ///< D_eff, rad/s
+  double nonlinearity_ppm = 0.0;   ///< peak |K_eff - K0| / |K0| including every order up to 16
+};
+
+EffectiveModel computeEffectiveModel(const SimulationConfig& config, const CorrectionMatrix& correction,
+                                     const std::vector<int>& k_orders, const std::vector<int>& d_orders);
+
+}  // namespace core
+}  // namespace hrg_gyro

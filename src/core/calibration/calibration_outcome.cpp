@@ -1,0 +1,197 @@
+#include "hrg_gyro/core/calibration/calibration_outcome.h"
+
+#include <cmath>
+#include <ctime>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/common/yaml_field.h"
+
+namespace hrg_gyro {
+namespace core {
+
+void CalibrationOutcome::gate(const std::string& name, bool passed, double value, double limit,
+                              const std::string& message) {
+  gates.push_back({name, passed, value, limit, message});
+  if (!passed && reason.empty()) reason = name + ": " + message;
+}
+
+void CalibrationOutcome::decide() {
+  accepted = !gates.empty();
+  for (const GateResult& g : gates) accepted = accepted && g.passed;
+  if (gates.empty() && reason.empty()) reason = "no quality gate was evaluated";
+}
+
+namespace {
+
+void emitNumbers(YAML::Emitter& out, const std::vector<double>& v) {
+  out << YAML::Flow << YAML::BeginSeq;
+  for (double x : v) out << formatDouble(x);
+  out << YAML::EndSeq;
+}
+
+void emitFit(YAML::Emitter& out, const HarmonicFitResult& f, double frequency) {
+  out << YAML::BeginMap;
+  out << YAML::Key << "orders" << YAML::Value << YAML::Flow << f.orders;
+  if (frequency == frequency) out << YAML::Key << "frequency" << YAML::Value << formatDouble(frequency);
+  out << YAML::Key << "mean" << YAML::Value << formatDouble(f.mean);
+  out << YAML::Key << "mean_std" << YAML::Value << formatDouble(f.mean_std);
+  out << YAML::Key << "cos" << YAML::Value;
+  emitNumbers(out, f.cos);
+  out << YAML::Key << "cos_std" << YAML::Value;
+  emitNumbers(out, f.cos_std);
+  out << YAML::Key << "sin" << YAML::Value;
+  emitNumbers(out, f.sin);
+  out << YAML::Key << "sin_std" << YAML::Value;
+  emitNumbers(out, f.sin_std);
+  out << YAML::Key << "residual_rms" << YAML::Value << formatDouble(f.residual_rms);
+  out << YAML::Key << "points" << YAML::Value << f.points;
+  out << YAML::EndMap;
+}
+
+}  // namespace
+
+std::string utcNow() {
+  char buf[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  return buf;
+}
+
+std::string formatShort(double value, int precision) {
+  std::ostringstream s;
+  s.precision(precision);
+  s << value;
+  return s.str();
+}
+
+int maxFittedOrder(const std::vector<int>& scale_factor_orders, const std::vector<int>& drift_orders) {
+  const std::vector<int> all = mergeOrders(scale_factor_orders, drift_orders);
+  return all.empty() ? 2 : all.back();
+}
+
+void diagnose(CalibrationOutcome* o, const CorrectionMatrix& correction_in_force) {
+  o->diagnosis.clear();
+  for (std::size_t i = 0; i < o->scale_factor.size(); ++i) {
+    const HarmonicFitResult& k = o->scale_factor[i];
+    if (!k.ok) continue;
+    const double f = i < o->frequency_nodes.size() ? o->frequency_nodes[i] : NAN;
+    o->diagnosis.push_back(diagnoseDefects(k, o->quadrature_ratio, correction_in_force, f));
+  }
+}
+
+std::string emitCalibrationReport(const CalibrationOutcome& o) {
+  YAML::Emitter out;
+  out << YAML::Comment("hrg_gyro calibration report. K dimensionless, D in rad/s, angles in rad.");
+  out << YAML::BeginMap;
+  out << YAML::Key << "method" << YAML::Value << nameOf(o.method);
+  out << YAML::Key << "accepted" << YAML::Value << o.accepted;
+  out << YAML::Key << "reason" << YAML::Value << YAML::DoubleQuoted << o.reason;
+  out << YAML::Key << "coverage" << YAML::Value << formatDouble(o.coverage);
+  out << YAML::Key << "smoothing_factor" << YAML::Value << formatDouble(o.smoothing_factor);
+  out << YAML::Key << "error_bound" << YAML::Value << formatDouble(o.error_bound);
+  out << YAML::Key << "nonlinearity_ppm" << YAML::Value << formatDouble(o.nonlinearity_ppm);
+  out << YAML::Key << "duration" << YAML::Value << formatDouble(o.duration);
+  out << YAML::Key << "samples" << YAML::Value << o.samples;
+  if (!o.frequency_nodes.empty()) {
+    out << YAML::Key << "frequency_nodes" << YAML::Value;
+    emitNumbers(out, o.frequency_nodes);
+  }
+  for (const char* part : {"scale_factor", "drift"}) {
+    const auto& fits = std::string(part) == "scale_factor" ? o.scale_factor : o.drift;
+    out << YAML::Key << part << YAML::Value << YAML::BeginSeq;
+    for (std::size_t i = 0; i < fits.size(); ++i) {
+      emitFit(out, fits[i], i < o.frequency_nodes.size() ? o.frequency_nodes[i] : NAN);
+    }
+    out << YAML::EndSeq;
+  }
+  if (o.has_correction) {
+    out << YAML::Key << "correction" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "p" << YAML::Value;
+    emitNumbers(out, {o.correction.correction.p.begin(), o.correction.correction.p.end()});
+    out << YAML::Key << "p_std" << YAML::Value;
+    emitNumbers(out, {o.correction.standard_error.begin(), o.correction.standard_error.end()});
+    out << YAML::Key << "residual_rms" << YAML::Value << formatDouble(o.correction.residual_rms);
+    out << YAML::Key << "condition_number" << YAML::Value << formatDouble(o.correction.condition_number);
+    out << YAML::Key << "pairs" << YAML::Value << o.correction.pairs;
+    out << YAML::EndMap;
+  }
+  out << YAML::Key << "quadrature_ratio" << YAML::Value << formatDouble(o.quadrature_ratio);
+  // Root causes read from the K harmonics (first order, docs/math.md 'Pickoff defects to first
+  // order'); see defect_diagnosis.h.
+  out << YAML::Key << "diagnosis" << YAML::Value << YAML::BeginSeq;
+  for (const DefectDiagnosis& d : o.diagnosis) {
+    out << YAML::BeginMap;
+    if (std::isfinite(d.frequency)) out << YAML::Key << "frequency" << YAML::Value << formatDouble(d.frequency);
+    out << YAML::Key << "valid" << YAML::Value << d.valid;
+    out << YAML::Key << "note" << YAML::Value << YAML::DoubleQuoted << d.note;
+    out << YAML::Key << "gain_mismatch" << YAML::Value << formatDouble(d.gain_mismatch)
+        << YAML::Comment("gc - gs, relative");
+    out << YAML::Key << "gain_mismatch_std" << YAML::Value << formatDouble(d.gain_mismatch_std);
+    out << YAML::Key << "misplacement_difference" << YAML::Value << formatDouble(d.misplacement_difference)
+        << YAML::Comment("dc - ds, rad");
+    out << YAML::Key << "misplacement_difference_std" << YAML::Value << formatDouble(d.misplacement_difference_std);
+    out << YAML::Key << "pickoff_ratio" << YAML::Value << formatDouble(d.pickoff_ratio) << YAML::Comment("A/d0");
+    out << YAML::Key << "pickoff_ratio_std" << YAML::Value << formatDouble(d.pickoff_ratio_std);
+    out << YAML::Key << "quadrature_factor" << YAML::Value << formatDouble(d.quadrature_factor);
+    out << YAML::Key << "current_p" << YAML::Value;
+    emitNumbers(out, {d.current_correction.p.begin(), d.current_correction.p.end()});
+    out << YAML::Key << "recommended_p" << YAML::Value;
+    emitNumbers(out, {d.recommended_correction.p.begin(), d.recommended_correction.p.end()});
+    out << YAML::Key << "recommended_p_std" << YAML::Value;
+    emitNumbers(out, {d.recommended_correction_std.begin(), d.recommended_correction_std.end()});
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::Key << "plateaus" << YAML::Value << YAML::BeginSeq;
+  for (const GroupSummary& g : o.plateaus) {
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "rate" << YAML::Value << formatDouble(g.rate);
+    out << YAML::Key << "rate_std" << YAML::Value << formatDouble(g.rate_std);
+    out << YAML::Key << "duration" << YAML::Value << formatDouble(g.duration);
+    out << YAML::Key << "samples" << YAML::Value << g.samples;
+    out << YAML::Key << "coverage" << YAML::Value << formatDouble(g.coverage);
+    out << YAML::Key << "turns" << YAML::Value << formatDouble(g.turns);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::Key << "gates" << YAML::Value << YAML::BeginSeq;
+  for (const GateResult& g : o.gates) {
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << g.name;
+    out << YAML::Key << "passed" << YAML::Value << g.passed;
+    out << YAML::Key << "value" << YAML::Value << formatDouble(g.value);
+    out << YAML::Key << "limit" << YAML::Value << formatDouble(g.limit);
+    out << YAML::Key << "message" << YAML::Value << YAML::DoubleQuoted << g.message;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::Key << "notes" << YAML::Value << YAML::BeginSeq;
+  for (const std::string& n : o.notes) out << YAML::DoubleQuoted << n;
+  out << YAML::EndSeq;
+  out << YAML::Key << "binned" << YAML::Value << YAML::BeginMap;
+  std::vector<double> th, k, d, w;
+  for (const BinnedCurvePoint& p : o.binned) {
+    th.push_back(p.theta);
+    k.push_back(p.k);
+    d.push_back(p.d);
+    w.push_back(p.weight);
+  }
+  out << YAML::Key << "theta" << YAML::Value;
+  emitNumbers(out, th);
+  out << YAML::Key << "k" << YAML::Value;
+  emitNumbers(out, k);
+  out << YAML::Key << "d" << YAML::Value;
+  emitNumbers(out, d);
+  out << YAML::Key << "weight" << YAML::Value;
+  emitNumbers(out, w);
+  out << YAML::EndMap;
+  out << YAML::Key << "parameters" << YAML::Value << YAML::Literal << (o.accepted ? emitParameters(o.parameters) : std::string("not accepted"));
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace core
+}  // namespace hrg_gyro

@@ -1,0 +1,130 @@
+#include "hrg_gyro/core/calibration/calibration_settings.h"
+
+#include <stdexcept>
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+std::vector<int> parseEvenOrders(const YamlField& f) {
+  std::vector<int> out;
+  const auto raw = f.asIntegers();
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    if (raw[i] < 2 || raw[i] > 64 || raw[i] % 2 != 0) f.at(i).fail("orders must be even, in [2, 64]");
+    if (!out.empty() && raw[i] <= out.back()) f.at(i).fail("orders must be strictly increasing");
+    out.push_back(static_cast<int>(raw[i]));
+  }
+  return out;
+}
+
+// The keys, listed once: parse() refuses any other, keyPaths() lists them for the node's template check.
+const std::vector<std::string> kPlateauKeys = {"rate_tolerance", "relative_tolerance", "settle_time", "static_rate",
+                                               "max_gap"};
+const std::vector<std::string> kGateKeys = {"min_coverage",     "min_rate_separation",   "max_rate_noise",
+                                            "min_samples",      "max_condition",         "max_relative_residual",
+                                            "max_k0_change",    "max_harmonic_std",      "min_steps",
+                                            "min_dwell_time",   "min_pairs",             "max_p_condition"};
+const std::vector<std::string> kThermalKeys = {"frequency_nodes", "node_count", "interpolation", "slice_width",
+                                               "max_slices"};
+const std::vector<std::string> kScalarKeys = {"method", "scale_factor_orders", "drift_orders", "bins", "window",
+                                              "window_span", "group_tolerance", "auto_finish_idle"};
+
+double positive(const YamlField& parent, const char* key, double fallback) {
+  const double v = parent.getDouble(key, fallback);
+  if (!(v > 0.0)) parent[key].fail("must be positive");
+  return v;
+}
+
+}  // namespace
+
+std::vector<std::string> CalibrationSettings::keyPaths() {
+  std::vector<std::string> keys = kScalarKeys;
+  for (const std::string& k : kPlateauKeys) keys.push_back("plateau/" + k);
+  for (const std::string& k : kGateKeys) keys.push_back("gates/" + k);
+  for (const std::string& k : kThermalKeys) keys.push_back("thermal/" + k);
+  return keys;
+}
+
+CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
+  CalibrationSettings s;
+  root.requireMap();
+  std::vector<std::string> allowed = kScalarKeys;
+  allowed.insert(allowed.end(), {"plateau", "gates", "thermal"});
+  allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
+  root.rejectUnknownKeys(allowed);
+  if (root.has("method")) {
+    try {
+      s.method = parseCalibrationMethod(root["method"].asString());
+    } catch (const std::invalid_argument& e) {
+      root["method"].fail(e.what());
+    }
+  }
+  if (root.has("scale_factor_orders")) s.scale_factor_orders = parseEvenOrders(root["scale_factor_orders"]);
+  if (root.has("drift_orders")) s.drift_orders = parseEvenOrders(root["drift_orders"]);
+  s.bins = static_cast<int>(root.getInteger("bins", s.bins));
+  if (s.bins < 8 || s.bins > 4096) root["bins"].fail("must be in [8, 4096]");
+  s.window = positive(root, "window", s.window);
+  s.window_span = positive(root, "window_span", s.window_span);
+  s.group_tolerance = positive(root, "group_tolerance", s.group_tolerance);
+  s.auto_finish_idle = root.getDouble("auto_finish_idle", s.auto_finish_idle);
+  if (root.has("plateau")) {
+    const YamlField p = root["plateau"];
+    p.rejectUnknownKeys(kPlateauKeys);
+    s.plateau.rate_tolerance = positive(p, "rate_tolerance", s.plateau.rate_tolerance);
+    s.plateau.relative_tolerance = p.getDouble("relative_tolerance", s.plateau.relative_tolerance);
+    if (s.plateau.relative_tolerance < 0.0) p["relative_tolerance"].fail("must be >= 0");
+    s.plateau.settle_time = p.getDouble("settle_time", s.plateau.settle_time);
+    if (s.plateau.settle_time < 0.0) p["settle_time"].fail("must be >= 0");
+    s.plateau.static_rate = positive(p, "static_rate", s.plateau.static_rate);
+    s.plateau.max_gap = positive(p, "max_gap", s.plateau.max_gap);
+  }
+  if (root.has("gates")) {
+    const YamlField g = root["gates"];
+    g.rejectUnknownKeys(kGateKeys);
+    QualityLimits& q = s.gates;
+    q.min_coverage = g.getDouble("min_coverage", q.min_coverage);
+    if (q.min_coverage < 0.0 || q.min_coverage > 1.0) g["min_coverage"].fail("must be in [0, 1]");
+    q.min_rate_separation = positive(g, "min_rate_separation", q.min_rate_separation);
+    q.max_rate_noise = positive(g, "max_rate_noise", q.max_rate_noise);
+    const long min_samples = g.getInteger("min_samples", static_cast<long>(q.min_samples));
+    if (min_samples < 0) g["min_samples"].fail("must be >= 0");
+    q.min_samples = static_cast<std::uint64_t>(min_samples);
+    q.max_condition = positive(g, "max_condition", q.max_condition);
+    q.max_relative_residual = positive(g, "max_relative_residual", q.max_relative_residual);
+    q.max_k0_change = positive(g, "max_k0_change", q.max_k0_change);
+    q.max_harmonic_std = positive(g, "max_harmonic_std", q.max_harmonic_std);
+    q.min_steps = static_cast<int>(g.getInteger("min_steps", q.min_steps));
+    if (q.min_steps < 2) g["min_steps"].fail("must be >= 2");
+    q.min_dwell_time = g.getDouble("min_dwell_time", q.min_dwell_time);
+    const long min_pairs = g.getInteger("min_pairs", static_cast<long>(q.min_pairs));
+    if (min_pairs < 2) g["min_pairs"].fail("must be >= 2");
+    q.min_pairs = static_cast<std::uint64_t>(min_pairs);
+    q.max_p_condition = positive(g, "max_p_condition", q.max_p_condition);
+  }
+  if (root.has("thermal")) {
+    const YamlField t = root["thermal"];
+    t.rejectUnknownKeys(kThermalKeys);
+    ThermalSettings& ts = s.thermal;
+    if (t.has("frequency_nodes")) {
+      const YamlField nf = t["frequency_nodes"];
+      ts.frequency_nodes = nf.asDoubles();
+      if (ts.frequency_nodes.size() == 1) nf.fail("give at least 2 nodes, or none for automatic nodes (node_count)");
+      for (std::size_t j = 0; j < ts.frequency_nodes.size(); ++j) {
+        if (!(ts.frequency_nodes[j] > 0.0)) nf.at(j).fail("frequency must be positive (Hz)");
+        if (j > 0 && !(ts.frequency_nodes[j] > ts.frequency_nodes[j - 1])) nf.at(j).fail("nodes must be strictly increasing");
+      }
+    }
+    ts.node_count = static_cast<int>(t.getInteger("node_count", ts.node_count));
+    if (ts.node_count < 2 || ts.node_count > 32) t["node_count"].fail("must be in [2, 32]");
+    if (t.has("interpolation") && !parseInterpolation(t["interpolation"].asString(), &ts.interpolation)) {
+      t["interpolation"].fail("expected natural_cubic_spline or piecewise_linear");
+    }
+    ts.slice_width = positive(t, "slice_width", ts.slice_width);
+    ts.max_slices = static_cast<int>(t.getInteger("max_slices", ts.max_slices));
+    if (ts.max_slices < 1 || ts.max_slices > 100000) t["max_slices"].fail("must be in [1, 100000]");
+  }
+  return s;
+}
+
+}  // namespace core
+}  // namespace hrg_gyro

@@ -1,0 +1,103 @@
+// The core's layout is its design: every file sits in one concept folder, and the folders depend on
+// each other one way only, in the order below (a folder's library code includes only its own folder
+// and those before it; tests may use any folder, the simulator above all, to make their data).
+// Each folder says in its README.md what it holds and what it may include, and every unit test in a
+// folder is named after a module of that folder (foo.cpp / foo.h -> foo_test.cpp).
+#include <dirent.h>
+
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace {
+
+const std::vector<std::string> kFolders = {"common",     "model",       "signal",     "estimation",
+                                           "processing", "calibration", "simulation", "evaluation"};
+
+std::vector<std::string> entries(const std::string& dir, bool directories) {
+  std::vector<std::string> out;
+  DIR* d = opendir(dir.c_str());
+  if (!d) return out;
+  while (dirent* e = readdir(d)) {
+    const std::string name = e->d_name;
+    if (name == "." || name == "..") continue;
+    if ((e->d_type == DT_DIR) == directories) out.push_back(name);
+  }
+  closedir(d);
+  return out;
+}
+
+bool endsWith(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+class CoreLayoutTest : public ::testing::Test {
+ protected:
+  const std::string root_ = HRG_GYRO_SOURCE_DIR;
+  const std::string include_ = root_ + "/include/hrg_gyro/core";
+  const std::string src_ = root_ + "/src/core";
+};
+
+TEST_F(CoreLayoutTest, EveryFileSitsInAConceptFolder) {
+  EXPECT_TRUE(entries(include_, false).empty()) << "headers directly in include/hrg_gyro/core";
+  EXPECT_TRUE(entries(src_, false).empty()) << "files directly in src/core";
+  std::set<std::string> allowed(kFolders.begin(), kFolders.end());
+  for (const std::string& d : entries(include_, true)) EXPECT_TRUE(allowed.count(d)) << "include/hrg_gyro/core/" << d;
+  allowed.insert({"integration", "testing"});  // cross-module tests and their helpers
+  for (const std::string& d : entries(src_, true)) EXPECT_TRUE(allowed.count(d)) << "src/core/" << d;
+  for (const std::string& f : kFolders) {
+    EXPECT_FALSE(read(src_ + "/" + f + "/README.md").empty()) << "src/core/" << f << "/README.md";
+  }
+}
+
+TEST_F(CoreLayoutTest, FoldersDependOneWay) {
+  std::map<std::string, int> rank;
+  for (std::size_t i = 0; i < kFolders.size(); ++i) rank[kFolders[i]] = static_cast<int>(i);
+  const std::regex include(R"(#\s*include\s*"hrg_gyro/core/([a-z_]+)/([a-z_0-9]+\.h)\")");
+  int checked = 0;
+  for (const std::string& folder : kFolders) {
+    std::vector<std::string> files;
+    for (const std::string& h : entries(include_ + "/" + folder, false)) files.push_back(include_ + "/" + folder + "/" + h);
+    for (const std::string& c : entries(src_ + "/" + folder, false)) {
+      if (endsWith(c, ".cpp") && !endsWith(c, "_test.cpp")) files.push_back(src_ + "/" + folder + "/" + c);
+    }
+    for (const std::string& path : files) {
+      const std::string text = read(path);
+      for (std::sregex_iterator it(text.begin(), text.end(), include), end; it != end; ++it) {
+        const std::string used = (*it)[1];
+        ASSERT_TRUE(rank.count(used)) << path << " includes an unknown folder " << used;
+        EXPECT_LE(rank[used], rank[folder]) << path << " (" << folder << ") includes " << used << "/" << (*it)[2]
+                                            << ": folders may only use those before them";
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 60);
+}
+
+TEST_F(CoreLayoutTest, UnitTestsAreNamedAfterTheirModule) {
+  for (const std::string& folder : kFolders) {
+    std::set<std::string> modules;
+    for (const std::string& h : entries(include_ + "/" + folder, false)) modules.insert(h.substr(0, h.rfind('.')));
+    for (const std::string& c : entries(src_ + "/" + folder, false)) {
+      if (!endsWith(c, "_test.cpp")) continue;
+      const std::string module = c.substr(0, c.size() - std::string("_test.cpp").size());
+      EXPECT_TRUE(modules.count(module)) << "src/core/" << folder << "/" << c << " names no module of " << folder;
+    }
+  }
+}
+
+}  // namespace

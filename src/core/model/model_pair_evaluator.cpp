@@ -1,0 +1,36 @@
+#include "hrg_gyro/core/model/model_pair_evaluator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+HarmonicBasis basisFor(const HarmonicModel& k, const HarmonicModel& d) {
+  const int step = std::gcd(k.orderStep(), d.orderStep());
+  return step == 0 ? HarmonicBasis(1, 0) : HarmonicBasis(step, std::max(k.maxOrder(), d.maxOrder()));
+}
+
+}  // namespace
+
+ModelPairEvaluator::ModelPairEvaluator(const HarmonicModel& k, const HarmonicModel& d)
+    : k_(&k),
+      d_(&d),
+      basis_(basisFor(k, d)),
+      k_coefficients_(k.termCount()),
+      d_coefficients_(d.termCount()),
+      frequency_dependent_(k.frequencyDependent() || d.frequencyDependent()) {
+  refresh(NAN);
+}
+
+void ModelPairEvaluator::refresh(double frequency) {
+  k_->coefficientsAt(frequency, k_coefficients_.data());
+  d_->coefficientsAt(frequency, d_coefficients_.data());
+  cached_frequency_ = frequency;
+  cached_is_nan_ = std::isnan(frequency);
+}
+
+}  // namespace core
+}  // namespace hrg_gyro

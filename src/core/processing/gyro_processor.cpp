@@ -1,0 +1,236 @@
+#include "hrg_gyro/core/processing/gyro_processor.h"
+
+#include <cmath>
+#include <string>
+
+#include "hrg_gyro/core/common/yaml_field.h"
+
+namespace hrg_gyro {
+namespace core {
+
+namespace {
+
+double largestMean(const HarmonicModel& k) { return k.nodeValues().row(0).cwiseAbs().maxCoeff(); }
+
+void requirePositive(const char* key, double value, const char* unit) {
+  if (!(std::isfinite(value) && value > 0.0)) {
+    throw ConfigError(key, std::string("must be a positive number of ") + unit + ", got " + formatDouble(value));
+  }
+}
+
+}  // namespace
+
+void validate(const ProcessorConfig& c) {
+  requirePositive("max_gap", c.max_gap, "seconds");
+  requirePositive("backward_reset", c.backward_reset, "seconds");
+  requirePositive("max_rate", c.max_rate, "rad/s");
+  if (c.max_consecutive_jumps < 0) {
+    throw ConfigError("max_consecutive_jumps", "must be >= 0, got " + std::to_string(c.max_consecutive_jumps));
+  }
+  const WaveLimits& l = c.limits;
+  if (!(l.min_anisotropy > 0.0 && l.min_anisotropy < 1.0)) {
+    throw ConfigError("min_anisotropy", "must be strictly between 0 and 1, got " + formatDouble(l.min_anisotropy));
+  }
+  if (!(std::isfinite(l.min_amplitude) && l.min_amplitude >= 0.0)) {
+    throw ConfigError("min_amplitude", "must be a finite amplitude >= 0, got " + formatDouble(l.min_amplitude));
+  }
+  if (!(std::isfinite(l.max_amplitude) && l.max_amplitude > l.min_amplitude)) {
+    throw ConfigError("max_amplitude", "must be finite and above min_amplitude (" + formatDouble(l.min_amplitude) +
+                                           "), got " + formatDouble(l.max_amplitude));
+  }
+}
+
+GyroProcessor::GyroProcessor(const ProcessorConfig& config, std::shared_ptr<const GyroParameters> parameters)
+    : config_(config), compensator_(std::move(parameters)), max_abs_k0_(largestMean(compensator_.parameters().scale_factor)) {}
+
+void GyroProcessor::setParameters(std::shared_ptr<const GyroParameters> parameters) {
+  const CorrectionMatrix old_p = compensator_.parameters().correction;
+  compensator_ = Compensator(std::move(parameters));
+  max_abs_k0_ = largestMean(compensator_.parameters().scale_factor);
+  if (has_previous_ && !(compensator_.parameters().correction == old_p)) {
+    WaveState w;
+    if (estimateWave(compensator_.parameters().correction.apply(previous_z_), config_.limits, &w) == WaveStatus::kOk) {
+      ThetaUnwrapper rebased;
+      rebased.unwrap(unwrapper_.last());
+      const double theta = rebased.unwrap(w.theta);
+      w.rebase(theta);
+      unwrapper_ = ThetaUnwrapper();
+      unwrapper_.unwrap(theta);
+      previous_cos_ = w.cos_theta;
+      previous_sin_ = w.sin_theta;
+    }
+  }
+}
+
+void GyroProcessor::reset() {
+  unwrapper_.reset();
+  has_previous_ = false;
+  alpha_ = 0.0;
+  consecutive_jumps_ = 0;
+}
+
+void GyroProcessor::countRejection(WaveStatus status) {
+  switch (status) {
+    case WaveStatus::kNonFinite: ++counters_.non_finite; break;
+    case WaveStatus::kNoSignal: ++counters_.no_signal; break;
+    case WaveStatus::kDegenerate: ++counters_.degenerate; break;
+    case WaveStatus::kAmplitudeOutOfRange: ++counters_.amplitude_out_of_range; break;
+    case WaveStatus::kOk: break;
+  }
+}
+
+// The phases of process(), inline: process() is the per-sample hot path.
+
+inline void GyroProcessor::reject(SampleVerdict verdict, ProcessorResult* r) {
+  ++rejected_since_output_;
+  r->verdict = verdict;
+}
+
+inline bool GyroProcessor::admitStamp(Nanoseconds stamp, Nanoseconds* dt_ns, ProcessorResult* r) {
+  if (stamp <= 0) {
+    ++counters_.zero_stamp;
+    reject(SampleVerdict::kRejectedStamp, r);
+    return false;
+  }
+  if (!has_previous_) return true;
+  *dt_ns = stamp - previous_stamp_;
+  if (*dt_ns == 0) {
+    ++counters_.duplicate;
+    reject(SampleVerdict::kDuplicate, r);
+    return false;
+  }
+  if (*dt_ns < 0) {
+    if (toSeconds(-*dt_ns) <= config_.backward_reset) {
+      ++counters_.out_of_order;
+      reject(SampleVerdict::kOutOfOrder, r);
+      return false;
+    }
+    ++counters_.resets;  // time jumped back (bag loop): start over
+    reset();
+    pending_flags_ |= kFlagReset;
+  }
+  return true;
+}
+
+inline void GyroProcessor::remember(const ChannelSample& in, const WaveState& wave) {
+  has_previous_ = true;
+  previous_stamp_ = in.stamp;
+  previous_frequency_ = in.frequency;
+  previous_z_ = in.z;
+  previous_cos_ = wave.cos_theta;
+  previous_sin_ = wave.sin_theta;
+  ++counters_.accepted;
+}
+
+inline void GyroProcessor::anchor(const ChannelSample& in, WaveState* wave, ProcessorResult* r) {
+  wave->rebase(unwrapper_.unwrap(wave->theta));
+  remember(in, *wave);
+  r->verdict = SampleVerdict::kFirst;
+  r->has_wave = true;
+  r->wave = *wave;
+  r->alpha = alpha_;
+}
+
+inline bool GyroProcessor::admitStep(double dt, double step, std::uint8_t* flags, bool* integrate) {
+  if (dt > config_.max_gap) {
+    ++counters_.gaps;
+    if (dt > counters_.largest_gap) counters_.largest_gap = dt;
+    *flags |= kFlagGap;
+    *integrate = false;
+  } else {
+    const double limit = max_abs_k0_ * config_.max_rate * dt;
+    if (std::abs(step) > limit) {
+      if (++consecutive_jumps_ <= config_.max_consecutive_jumps) {
+        ++counters_.jumps;
+        return false;
+      }
+      *flags |= kFlagGap;  // the jump persists: take the new angle as a re-anchor
+      *integrate = false;
+    }
+  }
+  consecutive_jumps_ = 0;
+  return true;
+}
+
+inline std::uint8_t GyroProcessor::frequencyFlags(double f_mid) {
+  const GyroParameters& p = compensator_.parameters();
+  if (p.scale_factor.frequencyDependent() || p.drift.frequencyDependent()) {
+    if (std::isnan(f_mid)) {
+      ++counters_.frequency_unknown;
+      return kFlagFrequencyUnknown;
+    }
+    if (!p.scale_factor.interpolator().inRange(f_mid) || !p.drift.interpolator().inRange(f_mid)) {
+      ++counters_.frequency_out_of_range;
+      return kFlagFrequencyOutOfRange;
+    }
+  }
+  return 0;
+}
+
+inline AngleIncrement GyroProcessor::reanchorIncrement(double theta, double dt, double f_mid, const WaveState& wave) {
+  AngleIncrement increment;
+  increment.dt = dt;
+  increment.theta_mid = theta;
+  increment.frequency = f_mid;
+  const AngleIncrement at =
+      compensator_.step(theta, theta, 0.0, f_mid, wave.cos_theta, wave.sin_theta, wave.cos_theta, wave.sin_theta);
+  increment.scale_factor = at.scale_factor;
+  increment.drift = at.drift;
+  return increment;
+}
+
+ProcessorResult GyroProcessor::process(const ChannelSample& in) {
+  ProcessorResult r;
+  ++counters_.received;
+  Nanoseconds dt_ns = 0;
+  if (!admitStamp(in.stamp, &dt_ns, &r)) return r;
+
+  WaveState wave;
+  r.wave_status = estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &wave);
+  if (r.wave_status != WaveStatus::kOk) {
+    countRejection(r.wave_status);
+    reject(SampleVerdict::kRejectedValue, &r);
+    return r;
+  }
+  if (!has_previous_) {
+    anchor(in, &wave, &r);
+    return r;
+  }
+
+  const double dt = toSeconds(dt_ns);
+  const double previous_theta = unwrapper_.last();
+  const double theta = wave.theta + kPi * std::round((previous_theta - wave.theta) / kPi);
+  std::uint8_t flags = pending_flags_;
+  bool integrate = true;
+  if (!admitStep(dt, theta - previous_theta, &flags, &integrate)) {
+    reject(SampleVerdict::kRejectedJump, &r);
+    return r;
+  }
+  unwrapper_.unwrap(theta);
+  wave.rebase(theta);
+
+  const double f_mid = 0.5 * (in.frequency + previous_frequency_);
+  flags |= frequencyFlags(f_mid);
+  if (integrate) {
+    r.increment = compensator_.step(previous_theta, theta, dt, f_mid, previous_cos_, previous_sin_, wave.cos_theta,
+                                    wave.sin_theta);
+    alpha_ += r.increment.dalpha;
+  } else {
+    r.increment = reanchorIncrement(theta, dt, f_mid, wave);
+  }
+  remember(in, wave);
+  ++counters_.outputs;
+  r.verdict = SampleVerdict::kAccepted;
+  r.has_wave = true;
+  r.wave = wave;
+  r.has_output = true;
+  r.alpha = alpha_;
+  r.flags = flags;
+  r.rejected_before = rejected_since_output_;
+  rejected_since_output_ = 0;
+  pending_flags_ = 0;
+  return r;
+}
+
+}  // namespace core
+}  // namespace hrg_gyro

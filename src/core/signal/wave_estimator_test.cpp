@@ -1,0 +1,110 @@
+// Wave state from Z (docs/math.md, 'Wave angle') and unwrapping.
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <random>
+
+#include "hrg_gyro/core/signal/theta_unwrapper.h"
+#include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/signal/wave_estimator.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+TEST(WaveEstimatorTest, RecoversRandomWaves) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 500; ++trial) {
+    WaveParameters w;
+    w.amplitude = 0.2 + std::abs(u(rng));
+    w.quadrature = 0.3 * w.amplitude * u(rng);
+    w.theta = 0.499 * kPi * u(rng);  // principal range of atan2(S, R)/2
+    w.phase = 0.999 * kPi * u(rng);
+    WaveState s;
+    ASSERT_EQ(estimateWave(idealChannels(w), WaveLimits{}, &s), WaveStatus::kOk);
+    EXPECT_NEAR(s.theta, w.theta, 1e-12);
+    EXPECT_NEAR(s.amplitude, w.amplitude, 1e-12);
+    EXPECT_NEAR(s.quadrature, w.quadrature, 1e-12);
+    EXPECT_NEAR(wrapToPi(s.phase - w.phase), 0.0, 1e-11);
+    const double a2 = w.amplitude * w.amplitude, b2 = w.quadrature * w.quadrature;
+    EXPECT_NEAR(s.energy, a2 + b2, 1e-12);
+    EXPECT_NEAR(s.quadrature_product, 2.0 * w.amplitude * w.quadrature, 1e-12);  // Q = +2AB
+    EXPECT_NEAR(s.cos_component, (a2 - b2) * std::cos(2 * w.theta), 1e-12);
+    EXPECT_NEAR(s.sin_component, (a2 - b2) * std::sin(2 * w.theta), 1e-12);
+    EXPECT_NEAR(s.phase_error, -(a2 - b2) * std::sin(2 * w.phase), 1e-12);
+  }
+}
+
+TEST(WaveEstimatorTest, ThetaIsDefinedModuloPi) {
+  // (A, theta + pi, tau + pi) is the same wave; rebase keeps the phase consistent.
+  const WaveParameters w{1.0, 0.05, 0.4, 0.3};
+  const WaveParameters flipped{1.0, 0.05, 0.4 + kPi, 0.3 + kPi};
+  EXPECT_LT((idealChannels(w) - idealChannels(flipped)).norm(), 1e-14);
+  WaveState s;
+  ASSERT_EQ(estimateWave(idealChannels(w), WaveLimits{}, &s), WaveStatus::kOk);
+  s.rebase(s.theta + 3 * kPi);
+  EXPECT_NEAR(s.theta, 0.4 + 3 * kPi, 1e-12);
+  EXPECT_NEAR(wrapToPi(s.phase - (0.3 + kPi)), 0.0, 1e-12);
+  const WaveParameters back{s.amplitude, s.quadrature, s.theta, s.phase};
+  EXPECT_LT((idealChannels(back) - idealChannels(w)).norm(), 1e-12);
+}
+
+TEST(WaveEstimatorTest, DegenerateAndBadInputNeverGiveNaN) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  WaveState s;
+  s.theta = 123.0;  // must stay untouched on rejection
+  EXPECT_EQ(estimateWave(ChannelVector(nan, 0, 1, 0), WaveLimits{}, &s), WaveStatus::kNonFinite);
+  EXPECT_EQ(estimateWave(ChannelVector(inf, 0, 1, 0), WaveLimits{}, &s), WaveStatus::kNonFinite);
+  // Finite but so large that the energy overflows: out of range, not "non-finite".
+  EXPECT_EQ(estimateWave(ChannelVector(1e200, 1e200, 0, 0), WaveLimits{}, &s), WaveStatus::kAmplitudeOutOfRange);
+  EXPECT_EQ(estimateWave(idealChannels({1e300, 1e298, 0.3, 0.1}), WaveLimits{}, &s), WaveStatus::kAmplitudeOutOfRange);
+  EXPECT_EQ(estimateWave(ChannelVector(-1e300, 0, 1e300, 0), WaveLimits{}, &s), WaveStatus::kAmplitudeOutOfRange);
+  EXPECT_EQ(estimateWave(ChannelVector(1e300, inf, 0, 0), WaveLimits{}, &s), WaveStatus::kNonFinite);
+  EXPECT_EQ(estimateWave(ChannelVector::Zero(), WaveLimits{}, &s), WaveStatus::kNoSignal);
+  // A = B: a travelling wave, theta undefined.
+  EXPECT_EQ(estimateWave(idealChannels({1.0, 1.0, 0.3, 0.1}), WaveLimits{}, &s), WaveStatus::kDegenerate);
+  EXPECT_EQ(estimateWave(idealChannels({1.0, 0.9, 0.3, 0.1}), WaveLimits{}, &s), WaveStatus::kDegenerate);
+  WaveLimits tight;
+  tight.max_amplitude = 2.0;
+  EXPECT_EQ(estimateWave(idealChannels({5.0, 0.0, 0.3, 0.1}), tight, &s), WaveStatus::kAmplitudeOutOfRange);
+  EXPECT_EQ(s.theta, 123.0);
+  // Sign flip of every channel is tau + pi: same angle.
+  ASSERT_EQ(estimateWave(-idealChannels({1.0, 0.0, 0.3, 0.1}), WaveLimits{}, &s), WaveStatus::kOk);
+  EXPECT_NEAR(s.theta, 0.3, 1e-12);
+}
+
+TEST(ThetaUnwrapperTest, FollowsSeveralRevolutionsBothWays) {
+  ThetaUnwrapper unwrapper;
+  double truth = 0.2;
+  for (int i = 0; i < 4000; ++i) {
+    truth += (i < 2000 ? 0.01 : -0.013);
+    WaveState s;
+    ASSERT_EQ(estimateWave(idealChannels({1.0, 0.02, truth, 0.5}), WaveLimits{}, &s), WaveStatus::kOk);
+    EXPECT_NEAR(unwrapper.unwrap(s.theta), truth, 1e-10) << i;
+  }
+  EXPECT_GT(std::abs(truth - 0.2), 5.0);  // many half-turns crossed
+  unwrapper.reset();
+  EXPECT_FALSE(unwrapper.initialized());
+}
+
+TEST(WaveEstimatorTest, CarriesTheUnitVectorOfThetaThroughRebase) {
+  // cos/sin of theta come from half-angle identities (no trigonometry) and follow the unwrapping.
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> angle(-kPi, kPi), turns(-40.0, 40.0);
+  for (int i = 0; i < 500; ++i) {
+    const double theta = angle(rng);
+    WaveState w;
+    ASSERT_EQ(estimateWave(idealChannels({1.0, 0.02, theta, 0.3}), WaveLimits(), &w), WaveStatus::kOk);
+    EXPECT_NEAR(w.cos_theta, std::cos(w.theta), 1e-14);
+    EXPECT_NEAR(w.sin_theta, std::sin(w.theta), 1e-14);
+    const double continuous = w.theta + kPi * std::round(turns(rng));
+    w.rebase(continuous);
+    EXPECT_NEAR(w.cos_theta, std::cos(continuous), 1e-12);
+    EXPECT_NEAR(w.sin_theta, std::sin(continuous), 1e-12);
+  }
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro

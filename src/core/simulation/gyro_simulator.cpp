@@ -1,0 +1,173 @@
+#include "hrg_gyro/core/simulation/gyro_simulator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace hrg_gyro {
+namespace core {
+
+GyroSimulator::GyroSimulator(const SimulationConfig& config)
+    : config_(config),
+      synth_(config_.pickoff, config_.resonator.samples_per_period, config_.seed),
+      rate_noise_(config_.seed ^ 0x5deece66dULL),
+      intrinsic_(config_.resonator.scale_factor, config_.resonator.drift),
+      frequency_(config_.resonator.frequency),
+      amplitude_(config_.resonator.amplitude),
+      earth_rate_(verticalEarthRate(config_.latitude)),
+      theta_(config_.resonator.initial_theta) {
+  if (config_.thermal.enabled) updateTemperature(0.0);
+}
+
+void GyroSimulator::updateTemperature(double t) {
+  const double temperature = config_.thermal.profile.evaluate(t);
+  if (temperature == temperature_) return;  // a hold: nothing to rebuild
+  const ResonatorConfig& rc = config_.resonator;
+  GyroAtTemperature g = gyroAtTemperature(config_.thermal, temperature, rc.frequency, rc.amplitude, config_.pickoff,
+                                          rc.scale_factor, rc.drift);
+  temperature_ = temperature;
+  frequency_ = g.frequency;
+  amplitude_ = g.amplitude;
+  synth_.setDefects(g.pickoff);
+  thermal_k_ = std::move(g.scale_factor);
+  thermal_d_ = std::move(g.drift);
+  intrinsic_ = ModelPairEvaluator(thermal_k_, thermal_d_);
+}
+
+std::uint64_t GyroSimulator::generatorOutputsPerState() const {
+  return static_cast<std::uint64_t>(std::max(1.0, std::round(config_.generator.dwell / config_.outputPeriod())));
+}
+
+double GyroSimulator::generatorDuration() const {
+  if (!config_.generator.enabled) return 0.0;
+  const GeneratorConfig& g = config_.generator;
+  const double states = static_cast<double>(g.angles) * g.quadratures.size() * g.phases.size();
+  return states * generatorOutputsPerState() * config_.outputPeriod();
+}
+
+double GyroSimulator::duration() const { return generatorDuration() + config_.profile.duration(); }
+
+bool GyroSimulator::done() const { return t_ >= duration() - 1e-9; }
+
+double GyroSimulator::thetaRate(double t, double theta) {
+  double angle, rate, k, d;
+  config_.profile.evaluate(t - generatorDuration(), &angle, &rate);
+  intrinsic_.evaluate(theta, config_.resonator.frequency, &k, &d);
+  return k * (rate + earth_rate_) + d;
+}
+
+void GyroSimulator::stamp(double t_center, SimulationSample* out) const {
+  out->stamp = toNanoseconds(config_.start_time + t_center);
+}
+
+bool GyroSimulator::next(SimulationSample* out) {
+  if (done()) return false;
+  if (config_.generator.enabled && t_ < generatorDuration() - 1e-9) {
+    nextGenerator(out);
+  } else {
+    nextDynamic(out);
+  }
+  out->index = index_++;
+  return true;
+}
+
+void GyroSimulator::nextDynamic(SimulationSample* out) {
+  const ResonatorConfig& rc = config_.resonator;
+  const int m = rc.periods_per_output;
+  const double period = 1.0 / rc.frequency;
+  std::vector<double> boundary_theta(m + 1);
+  boundary_theta[0] = theta_;
+  const double t_start = t_;
+  if (config_.thermal.enabled) updateTemperature(t_start + 0.5 * m * period);
+  ChannelVector sum = ChannelVector::Zero();
+  WaveParameters wave{amplitude_, rc.quadrature, theta_, rc.phase};
+  for (int p = 0; p < m; ++p) {
+    // RK4 over one period: the rate changes by < 1e-5 relative within it.
+    const double h = period, t = t_;
+    const double k1 = thetaRate(t, theta_);
+    const double k2 = thetaRate(t + h / 2, theta_ + h / 2 * k1);
+    const double k3 = thetaRate(t + h / 2, theta_ + h / 2 * k2);
+    const double k4 = thetaRate(t + h, theta_ + h * k3);
+    double theta_end = theta_ + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    if (rc.rate_noise > 0.0) {
+      // A white body-rate noise, seen through the scale factor like any rotation.
+      double k, d;
+      intrinsic_.evaluate(theta_, rc.frequency, &k, &d);
+      theta_end += k * rc.rate_noise * std::sqrt(h) * rate_noise_.next();
+    }
+    wave.theta = theta_;
+    sum += synth_.period(wave, theta_end);
+    theta_ = theta_end;
+    boundary_theta[p + 1] = theta_;
+    // Kahan summation keeps 24 h of 200 us steps exact to the nanosecond.
+    const double y = h - t_compensation_;
+    const double sum_t = t_ + y;
+    t_compensation_ = (sum_t - t_) - y;
+    t_ = sum_t;
+  }
+  out->z = sum / m;
+  out->frequency = frequency_;
+  out->temperature = temperature_;
+  out->periods = static_cast<std::uint32_t>(m);
+  const double t_center = 0.5 * (t_start + t_);
+  stamp(t_center, out);
+  // Truth at the window centre, theta interpolated between the period boundaries around it.
+  const double pos = 0.5 * m;
+  const int lo = std::min(static_cast<int>(pos), m - 1);
+  const double frac = pos - lo;
+  TruthState& truth = out->truth;
+  truth.theta = boundary_theta[lo] + frac * (boundary_theta[lo + 1] - boundary_theta[lo]);
+  config_.profile.evaluate(t_center - generatorDuration(), &truth.table_angle, &truth.table_rate, &truth.segment);
+  truth.inertial_rate = truth.table_rate + earth_rate_;
+  truth.inertial_angle = truth.table_angle + earth_rate_ * t_center;
+  truth.amplitude = amplitude_;
+  truth.quadrature = rc.quadrature;
+  truth.phase = rc.phase;
+  truth.frequency = frequency_;
+  truth.temperature = temperature_;
+  truth.generator = false;
+}
+
+void GyroSimulator::nextGenerator(SimulationSample* out) {
+  const GeneratorConfig& g = config_.generator;
+  const ResonatorConfig& rc = config_.resonator;
+  const std::uint64_t per_state = generatorOutputsPerState();
+  // State order: phase fastest, then quadrature, then angle.
+  const std::uint64_t np = g.phases.size(), nq = g.quadratures.size();
+  const std::uint64_t s = generator_state_;
+  if (config_.thermal.enabled) updateTemperature((index_ + 0.5) * config_.outputPeriod());
+  WaveParameters wave;
+  wave.amplitude = amplitude_;
+  wave.phase = g.phases[s % np];
+  wave.quadrature = g.quadratures[(s / np) % nq];
+  wave.theta = kPi * static_cast<double>(s / (np * nq)) / g.angles;
+  const int m = rc.periods_per_output;
+  ChannelVector sum = ChannelVector::Zero();
+  for (int p = 0; p < m; ++p) sum += synth_.period(wave, wave.theta);
+  const double t_start = t_;
+  t_ = (index_ + 1) * config_.outputPeriod();
+  out->z = sum / m;
+  out->frequency = frequency_;
+  out->temperature = temperature_;
+  out->periods = static_cast<std::uint32_t>(m);
+  stamp(0.5 * (t_start + t_), out);
+  TruthState& truth = out->truth;
+  truth = TruthState();
+  truth.theta = wave.theta;
+  truth.amplitude = wave.amplitude;
+  truth.quadrature = wave.quadrature;
+  truth.phase = wave.phase;
+  truth.frequency = frequency_;
+  truth.temperature = temperature_;
+  truth.inertial_rate = earth_rate_;
+  truth.inertial_angle = earth_rate_ * 0.5 * (t_start + t_);
+  truth.generator = true;
+  truth.segment = &generator_label_;
+  if (++generator_outputs_in_state_ >= per_state) {
+    generator_outputs_in_state_ = 0;
+    ++generator_state_;
+  }
+}
+
+}  // namespace core
+}  // namespace hrg_gyro

@@ -1,0 +1,58 @@
+#include "hrg_gyro/core/simulation/injected_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
+#include "hrg_gyro/core/simulation/signal_synthesizer.h"
+#include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/signal/wave_estimator.h"
+
+namespace hrg_gyro {
+namespace core {
+EffectiveModel computeEffectiveModel(const SimulationConfig& config, const CorrectionMatrix& correction,
+                                     const std::vector<int>& k_orders, const std::vector<int>& d_orders) {
+  PickoffDefects noiseless = config.pickoff;
+  noiseless.noise = 0.0;
+  SignalSynthesizer synth(noiseless, config.resonator.samples_per_period, 1);
+  const ResonatorConfig& rc = config.resonator;
+  const int m = 4096;
+  const double h = kPi / m;
+  // g(theta) on the grid, one extra point at each end for the central differences.
+  std::vector<double> measured(m + 2);
+  for (int j = -1; j <= m; ++j) {
+    const double theta = j * h;
+    WaveState w;
+    estimateWave(correction.apply(synth.period({rc.amplitude, rc.quadrature, theta, rc.phase}, theta)), WaveLimits{}, &w);
+    measured[j + 1] = theta + wrapToPi(2.0 * (w.theta - theta)) / 2.0;
+  }
+  std::vector<FitPoint> kp, dp;
+  for (int j = 0; j < m; ++j) {
+    const double theta = j * h;
+    const double slope = (measured[j + 2] - measured[j]) / (2.0 * h);
+    const double at = measured[j + 1];
+    FitPoint k_point, d_point;
+    k_point.theta = d_point.theta = at;
+    k_point.value = rc.scale_factor(theta, rc.frequency) * slope;
+    d_point.value = rc.drift(theta, rc.frequency) * slope;
+    kp.push_back(k_point);
+    dp.push_back(d_point);
+  }
+  std::vector<int> all;
+  for (int k = 2; k <= 16; k += 2) all.push_back(k);
+  const HarmonicFitResult k_all = fitHarmonics(kp, all, {}, INFINITY);
+  const HarmonicFitResult d_all = fitHarmonics(dp, all, {}, INFINITY);
+  EffectiveModel e;
+  // The reference is exact: the harmonics carry no standard errors.
+  e.scale_factor = selectOrders(k_all, k_orders);
+  e.drift = selectOrders(d_all, d_orders);
+  for (HarmonicFitResult* f : {&e.scale_factor, &e.drift}) {
+    std::fill(f->cos_std.begin(), f->cos_std.end(), 0.0);
+    std::fill(f->sin_std.begin(), f->sin_std.end(), 0.0);
+  }
+  e.nonlinearity_ppm = 1e6 * toModel(k_all).peakDeviation() / std::abs(k_all.mean);
+  return e;
+}
+
+}  // namespace core
+}  // namespace hrg_gyro

@@ -1,0 +1,40 @@
+#include "hrg_gyro/core/simulation/signal_synthesizer.h"
+
+#include <cmath>
+
+namespace hrg_gyro {
+namespace core {
+
+SignalSynthesizer::SignalSynthesizer(const PickoffDefects& defects, int samples_per_period, std::uint64_t seed)
+    : pickoffs_(defects), demodulator_(samples_per_period), noise_(seed) {}
+
+ChannelVector SignalSynthesizer::period(const WaveParameters& wave, double theta_end) {
+  const int n = demodulator_.samplesPerPeriod();
+  const double sigma = pickoffs_.channelNoiseSigma();
+  // Carrier: cos(2 pi j/N + tau) and sin(...) by rotating the reference table by tau.
+  const double ctau = std::cos(wave.phase), stau = std::sin(wave.phase);
+  // Wave angle at the sample instants (j + 1/2) T / N: rotate (cos theta, sin theta) by a constant
+  // step per sample, starting half a step into the period.
+  const double step = (theta_end - wave.theta) / n;
+  double ct = std::cos(wave.theta + 0.5 * step), st = std::sin(wave.theta + 0.5 * step);
+  const double cstep = std::cos(step), sstep = std::sin(step);
+  for (int j = 0; j < n; ++j) {
+    const double rc = demodulator_.referenceCos(j), rs = demodulator_.referenceSin(j);
+    const double u = wave.amplitude * (rc * ctau - rs * stau);   // A cos(wt + tau)
+    const double v = wave.quadrature * (rs * ctau + rc * stau);  // B sin(wt + tau)
+    double c, s;
+    pickoffs_.channels(u * ct - v * st, u * st + v * ct, &c, &s);
+    if (sigma > 0.0) {
+      c += sigma * noise_.next();
+      s += sigma * noise_.next();
+    }
+    demodulator_.push(c, s);
+    const double ct_next = ct * cstep - st * sstep;
+    st = st * cstep + ct * sstep;
+    ct = ct_next;
+  }
+  return demodulator_.result();  // the N-th push completed the period
+}
+
+}  // namespace core
+}  // namespace hrg_gyro

@@ -1,0 +1,158 @@
+#include "hrg_gyro/core/simulation/turntable_profile.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hrg_gyro {
+namespace core {
+
+void TurntableProfile::append(double duration, double rate0, double accel, const std::string& label) {
+  if (duration <= 0.0) return;
+  Piece p;
+  if (!pieces_.empty()) {
+    const Piece& last = pieces_.back();
+    p.start = last.start + last.duration;
+    p.angle0 = last.angle0 + last.rate0 * last.duration + 0.5 * last.accel * last.duration * last.duration;
+  }
+  p.duration = duration;
+  p.rate0 = rate0;
+  p.accel = accel;
+  p.label = label;
+  pieces_.push_back(p);
+}
+
+double TurntableProfile::finalRate() const {
+  if (pieces_.empty()) return 0.0;
+  const Piece& last = pieces_.back();
+  return last.rate0 + last.accel * last.duration;
+}
+
+void TurntableProfile::rampTo(double target, double acceleration, const std::string& label) {
+  const double from = finalRate();
+  if (from == target) return;
+  const double a = std::copysign(acceleration, target - from);
+  append((target - from) / a, from, a, label + "/ramp");
+}
+
+void TurntableProfile::moveBy(double angle, double cruise, double acceleration, const std::string& label) {
+  // Trapezoidal (or triangular when the move is too short to reach the cruise rate) from rest to rest.
+  const double dir = angle >= 0.0 ? 1.0 : -1.0;
+  const double dist = std::abs(angle);
+  double peak = std::abs(cruise);
+  double t_acc = peak / acceleration;
+  double d_acc = 0.5 * acceleration * t_acc * t_acc;
+  if (2.0 * d_acc > dist) {
+    peak = std::sqrt(dist * acceleration);
+    t_acc = peak / acceleration;
+    d_acc = 0.5 * dist;
+  }
+  const double t_cruise = (dist - 2.0 * d_acc) / peak;
+  append(t_acc, 0.0, dir * acceleration, label + "/move");
+  append(t_cruise, dir * peak, 0.0, label + "/move");
+  append(t_acc, dir * peak, -dir * acceleration, label + "/move");
+}
+
+TurntableProfile TurntableProfile::parse(const YamlField& profile, double acceleration) {
+  if (!(acceleration > 0.0)) throw ConfigError("turntable.acceleration", "must be positive (rad/s^2)");
+  profile.requireSequence();
+  if (profile.size() == 0) profile.fail("the profile needs at least one segment");
+  TurntableProfile tp;
+  for (std::size_t i = 0; i < profile.size(); ++i) {
+    const YamlField seg = profile.at(i);
+    seg.requireMap();
+    const std::string type = seg["type"].asString();
+    const std::string label = seg.getString("label", type + "_" + std::to_string(i));
+    auto positive = [&](const char* key) {
+      const double v = seg[key].asDouble();
+      if (!(v > 0.0)) seg[key].fail("must be positive");
+      return v;
+    };
+    if (type == "dwell") {
+      seg.rejectUnknownKeys({"type", "label", "duration"});
+      tp.rampTo(0.0, acceleration, label);
+      tp.append(positive("duration"), 0.0, 0.0, label);
+    } else if (type == "rate") {
+      seg.rejectUnknownKeys({"type", "label", "rate", "duration", "settle"});
+      const double rate = seg["rate"].asDouble();
+      tp.rampTo(rate, acceleration, label);
+      tp.append(seg.getDouble("settle", 0.0), rate, 0.0, label + "/settle");
+      tp.append(positive("duration"), rate, 0.0, label);
+    } else if (type == "dual_rate") {
+      seg.rejectUnknownKeys({"type", "label", "rates", "duration", "settle", "repeat"});
+      const std::vector<double> rates = seg["rates"].asDoubles(2);
+      if (rates[0] == rates[1]) seg["rates"].fail("the two plateau rates must differ");
+      const long repeat = seg.getInteger("repeat", 1);
+      if (repeat < 1) seg["repeat"].fail("must be >= 1");
+      const double duration = positive("duration"), settle = seg.getDouble("settle", 0.0);
+      for (long r = 0; r < repeat; ++r) {
+        for (int k = 0; k < 2; ++k) {
+          const std::string sub = label + "/rate" + std::to_string(k + 1);
+          tp.rampTo(rates[k], acceleration, sub);
+          tp.append(settle, rates[k], 0.0, sub + "/settle");
+          tp.append(duration, rates[k], 0.0, sub);
+        }
+      }
+    } else if (type == "steps") {
+      seg.rejectUnknownKeys({"type", "label", "angle", "rate", "dwell", "count"});
+      const double angle = seg["angle"].asDouble();
+      if (angle == 0.0) seg["angle"].fail("must be non-zero");
+      const double cruise = positive("rate"), dwell = positive("dwell");
+      const long count = seg["count"].asInteger();
+      if (count < 1) seg["count"].fail("must be >= 1");
+      tp.rampTo(0.0, acceleration, label);
+      tp.append(dwell, 0.0, 0.0, label + "/dwell");
+      for (long k = 0; k < count; ++k) {
+        tp.moveBy(angle, cruise, acceleration, label);
+        tp.append(dwell, 0.0, 0.0, label + "/dwell");
+      }
+    } else if (type == "piecewise") {
+      seg.rejectUnknownKeys({"type", "label", "points"});
+      const YamlField pts = seg["points"];
+      pts.requireSequence();
+      if (pts.size() < 2) pts.fail("need at least two [time, rate] points");
+      std::vector<double> t(pts.size()), w(pts.size());
+      for (std::size_t k = 0; k < pts.size(); ++k) {
+        const std::vector<double> p = pts.at(k).asDoubles(2);
+        t[k] = p[0];
+        w[k] = p[1];
+        if (k == 0 && t[0] != 0.0) pts.at(0).fail("the first point must be at time 0");
+        if (k > 0 && !(t[k] > t[k - 1])) pts.at(k).fail("times must be strictly increasing");
+      }
+      tp.rampTo(w[0], acceleration, label);
+      for (std::size_t k = 1; k < t.size(); ++k) {
+        const double dt = t[k] - t[k - 1];
+        tp.append(dt, w[k - 1], (w[k] - w[k - 1]) / dt, label);
+      }
+    } else {
+      seg["type"].fail("unknown segment type '" + type + "' (dwell, rate, dual_rate, steps, piecewise)");
+    }
+  }
+  tp.rampTo(0.0, acceleration, "end");
+  return tp;
+}
+
+const TurntableProfile::Piece& TurntableProfile::pieceAt(double t) const {
+  if (cursor_ >= pieces_.size()) cursor_ = 0;
+  if (t < pieces_[cursor_].start) cursor_ = 0;
+  while (cursor_ + 1 < pieces_.size() && t >= pieces_[cursor_ + 1].start) ++cursor_;
+  return pieces_[cursor_];
+}
+
+void TurntableProfile::evaluate(double t, double* angle, double* rate, const std::string** label) const {
+  static const std::string kNone = "none";
+  if (pieces_.empty()) {
+    *angle = 0.0;
+    *rate = 0.0;
+    if (label) *label = &kNone;
+    return;
+  }
+  const Piece& p = pieceAt(t);
+  const double tau = std::clamp(t - p.start, 0.0, p.duration);
+  *angle = p.angle0 + p.rate0 * tau + 0.5 * p.accel * tau * tau;
+  *rate = p.rate0 + p.accel * tau;
+  if (t > p.start + p.duration) *angle += *rate * (t - p.start - p.duration);  // hold after the end
+  if (label) *label = &p.label;
+}
+
+}  // namespace core
+}  // namespace hrg_gyro
