@@ -36,6 +36,8 @@ test: build
 	cd $(WS) && source devel/setup.bash && catkin_make $(CATKIN_ARGS) -j1 run_tests
 	@# The package as a user installs it (fresh prefix, only the install space sourced) and catkin_lint.
 	bash $(ROOT)/test/install_space/run.sh $(WS)
+	@# Every C++ file formatted as .clang-format says.
+	ROS_TEST_RESULTS_DIR=$(WS)/build/test_results /usr/bin/python3 $(ROOT)/test/source_format_test.py
 	cd $(WS) && catkin_test_results build/test_results
 
 run: build

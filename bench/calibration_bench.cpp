@@ -14,8 +14,8 @@
 #include <cstdlib>
 
 #include "hrg_gyro/core/calibration/calibration_session.h"
-#include "hrg_gyro/core/simulation/gaussian_noise.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
 
 using namespace hrg_gyro::core;
 

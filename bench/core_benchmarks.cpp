@@ -8,16 +8,16 @@
 #include <string>
 #include <vector>
 
-#include "hrg_gyro/core/processing/compensator.h"
-#include "hrg_gyro/core/model/correction_matrix.h"
-#include "hrg_gyro/core/simulation/gaussian_noise.h"
-#include "hrg_gyro/core/processing/gyro_processor.h"
-#include "hrg_gyro/core/simulation/gyro_simulator.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
-#include "hrg_gyro/core/simulation/simulation_config.h"
+#include "hrg_gyro/core/model/correction_matrix.h"
+#include "hrg_gyro/core/model/wave_parameters.h"
+#include "hrg_gyro/core/processing/compensator.h"
+#include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/signal/synchronous_demodulator.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
-#include "hrg_gyro/core/model/wave_parameters.h"
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
+#include "hrg_gyro/core/simulation/gyro_simulator.h"
+#include "hrg_gyro/core/simulation/simulation_config.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -213,8 +213,8 @@ void BM_SimulatorRealTimeFactor(benchmark::State& state) {
   }
   state.counters["rtf"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);
   state.SetItemsProcessed(200 * state.iterations());
-  state.SetLabel("5 kHz, 32 samples/period, 8 defective sensors, " +
-                 std::to_string(5000 / state.range(0)) + " Hz output");
+  state.SetLabel("5 kHz, 32 samples/period, 8 defective sensors, " + std::to_string(5000 / state.range(0)) +
+                 " Hz output");
 }
 BENCHMARK(BM_SimulatorRealTimeFactor)->Arg(5)->Arg(25)->Unit(benchmark::kMillisecond);
 

@@ -1,19 +1,18 @@
 // Bench-only node: measures the live pipeline from the outside. Subscribes `output` (and the
-// processor's /diagnostics for the samples it saw lost on its input), and for ~duration wall seconds after the first output records the end-to-end
-// latency (wall time of arrival minus the driver's stamp, which driver_sim takes from the wall clock
-// when not under sim time) and the outputs missing from the stamp sequence. Then writes
-// ~result_file (YAML) and exits, which ends a launch that marks it required.
+// processor's /diagnostics for the samples it saw lost on its input), and for ~duration wall seconds after the first
+// output records the end-to-end latency (wall time of arrival minus the driver's stamp, which driver_sim takes from the
+// wall clock when not under sim time) and the outputs missing from the stamp sequence. Then writes ~result_file (YAML)
+// and exits, which ends a launch that marks it required.
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <ros/callback_queue.h>
+#include <ros/ros.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <vector>
-
-#include <ros/callback_queue.h>
-#include <ros/ros.h>
-
-#include <diagnostic_msgs/DiagnosticArray.h>
 
 #include "hrg_gyro/GyroOutput.h"
 

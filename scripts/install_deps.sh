@@ -13,14 +13,14 @@ PACKAGES=(
   python3-std-srvs python3-sensor-msgs python3-diagnostic-msgs python3-yaml
   python3-numpy python3-matplotlib
   libcli11-dev
-  tf2-tools libtf2-ros-dev python3-rosunit catkin-lint python3-nodelet
+  tf2-tools libtf2-ros-dev python3-rosunit catkin-lint python3-nodelet clang-format
 )
 # libcli11-dev: the command-line parser of hrg_bag and hrg_session (header only). Its rosdep key,
 # cli11, is recent in rosdistro and absent from older rosdep databases (Debian's python3-rosdep2
 # file among them), so CMakeLists.txt finds the header itself and this list installs it.
 # tf2-tools and libtf2-ros-dev: static_transform_publisher and the tf2_ros package of the example
 # stack launch; python3-rosunit and catkin-lint: the install-space and package checks of make test;
-# python3-nodelet: the nodelet manager's list service in two_gyros.test.
+# python3-nodelet: the nodelet manager's list service in two_gyros.test; clang-format: the format check.
 # Extra packages for one target, e.g. `install_deps.sh clang-14 libclang-rt-14-dev` for `make fuzz`.
 PACKAGES+=("$@")
 

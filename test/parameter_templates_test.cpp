@@ -41,8 +41,8 @@ TEST(ParameterTemplateTest, TyposAreUnknownKeys) {
 TEST(ParameterTemplateTest, MistypedValuesAreRefused) {
   // YAML reads 1.0e6 (no exponent sign) as text: it must not fall back to the default silently.
   ros::NodeHandle("mistyped/processor").setParam("max_amplitude", std::string("1.0e6"));
-  ros::NodeHandle("mistyped/processor").setParam("parameter_file", std::string(HRG_GYRO_SOURCE_DIR) +
-                                                                        "/config/params_uncalibrated.yaml");
+  ros::NodeHandle("mistyped/processor")
+      .setParam("parameter_file", std::string(HRG_GYRO_SOURCE_DIR) + "/config/params_uncalibrated.yaml");
   try {
     ProcessorRos node(ros::NodeHandle("mistyped"), ros::NodeHandle("mistyped/processor"));
     FAIL() << "a text value for ~max_amplitude was accepted";

@@ -1,12 +1,12 @@
 // The four wrappers as nodelets, for zero-copy pipelines in one manager. Each owns the same wrapper
 // class as its node. The driver never shuts the manager down when its scenario ends; the session
 // monitor does when ~shutdown_when_done asks for it (demos and tests).
+#include <nodelet/nodelet.h>
+
 #include <exception>
 #include <memory>
-#include <utility>
-
-#include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
+#include <utility>
 
 #include "hrg_gyro/ros/calibrator_ros.h"
 #include "hrg_gyro/ros/driver_sim_ros.h"

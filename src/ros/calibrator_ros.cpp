@@ -11,8 +11,8 @@
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/diagnostics_timer.h"
-#include "hrg_gyro/ros/process_heap.h"
 #include "hrg_gyro/ros/param_tree.h"
+#include "hrg_gyro/ros/process_heap.h"
 
 namespace hrg_gyro {
 namespace {
@@ -23,12 +23,11 @@ constexpr double kSweepChannelsWait = 30.0;
 using diagnostic_msgs::DiagnosticStatus;
 
 const std::vector<std::string>& nodeOnlyKeys() {
-  static const std::vector<std::string> keys = {"parameter_file", "report_file", "output_directory", "reload_service",
-                                                "write", "autostart", "stages", "queue_size", "diagnostic_period",
-                                                "backward_reset", "heap_trim_period"};
+  static const std::vector<std::string> keys = {
+      "parameter_file", "report_file", "output_directory",  "reload_service", "write",           "autostart",
+      "stages",         "queue_size",  "diagnostic_period", "backward_reset", "heap_trim_period"};
   return keys;
 }
-
 
 }  // namespace
 
@@ -44,7 +43,8 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   params_.claim(core::CalibrationSettings::keyPaths());
   params_.claim({"diagnostic_period"});  // read by diagnostic_updater itself
   parameter_file_ = params_.get<std::string>("parameter_file", "");
-  if (parameter_file_.empty()) throw std::invalid_argument("calibrator: ~parameter_file is required (the file to refresh)");
+  if (parameter_file_.empty())
+    throw std::invalid_argument("calibrator: ~parameter_file is required (the file to refresh)");
   // Empty report file and output directory: derived from the parameter file.
   report_file_ = params_.get<std::string>("report_file", "");
   if (report_file_.empty()) report_file_ = core::StagedCalibration::defaultReportPath(parameter_file_);
@@ -92,8 +92,8 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
                                 ros::TransportHints().tcpNoDelay());
   wave_sub_ = in.subscribe("wave", queue_size, &CalibratorRos::onWave, this, ros::TransportHints().tcpNoDelay());
   if (calibration_->usesGeneratorPairs()) {
-    channels_sub_ = in.subscribe("channels", queue_size, &CalibratorRos::onChannels, this,
-                                 ros::TransportHints().tcpNoDelay());
+    channels_sub_ =
+        in.subscribe("channels", queue_size, &CalibratorRos::onChannels, this, ros::TransportHints().tcpNoDelay());
     truth_sub_ = in.subscribe("truth", queue_size, &CalibratorRos::onTruth, this, ros::TransportHints().tcpNoDelay());
   }
   if (!reload_service_.empty()) {
@@ -182,8 +182,9 @@ void CalibratorRos::reloadLoop() {
         since = model_since_;
       }
       if (!known) {
-        ROS_WARN("calibrator: no ModelInfo from the processor for the new file: the next stage may see waves "
-                 "still queued from the previous model");
+        ROS_WARN(
+            "calibrator: no ModelInfo from the processor for the new file: the next stage may see waves "
+            "still queued from the previous model");
       }
       std::lock_guard<std::mutex> lock(mutex_);
       std::string reason;
@@ -236,9 +237,10 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
   restartIfTimeWentBack(msg->header.stamp, &last_turntable_stamp_);
   if (!session()) return;
   if (!sweep_end_.isZero() && (msg->header.stamp - sweep_end_).toSec() > kSweepChannelsWait) {
-    ROS_WARN("calibrator: the raw channels did not reach the end of the generator sweep within %.0f s; "
-             "fitting P with the %llu pairs received", kSweepChannelsWait,
-             static_cast<unsigned long long>(session()->counters().used));
+    ROS_WARN(
+        "calibrator: the raw channels did not reach the end of the generator sweep within %.0f s; "
+        "fitting P with the %llu pairs received",
+        kSweepChannelsWait, static_cast<unsigned long long>(session()->counters().used));
     endGeneratorSweep();
     if (!session()) return;
   }
@@ -267,7 +269,8 @@ void CalibratorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!session() || !core::traitsOf(session()->settings().method).uses_generator_pairs) return;
   last_channels_stamp_ = msg->header.stamp;
-  pairing_.addRaw(toNanoseconds(msg->header.stamp), core::ChannelVector(msg->c_in, msg->c_quad, msg->s_in, msg->s_quad));
+  pairing_.addRaw(toNanoseconds(msg->header.stamp),
+                  core::ChannelVector(msg->c_in, msg->c_quad, msg->s_in, msg->s_quad));
   if (!sweep_end_.isZero() && msg->header.stamp >= sweep_end_) endGeneratorSweep();
 }
 
@@ -324,8 +327,8 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
   last_accepted_ = o.accepted && *written;
   last_result_ = *message;
   if (*written) {
-    ROS_INFO("calibrator: %s %s (peak nonlinearity of the new K: %.1f ppm, coverage %.1f %%)", core::nameOf(o.method).c_str(),
-             message->c_str(), o.nonlinearity_ppm, 100 * o.coverage);
+    ROS_INFO("calibrator: %s %s (peak nonlinearity of the new K: %.1f ppm, coverage %.1f %%)",
+             core::nameOf(o.method).c_str(), message->c_str(), o.nonlinearity_ppm, 100 * o.coverage);
   } else {
     ROS_WARN("calibrator: %s %s", core::nameOf(o.method).c_str(), message->c_str());
   }
@@ -349,8 +352,8 @@ bool CalibratorRos::onStart(StartCalibration::Request& req, StartCalibration::Re
   if (session()) {
     // Starting over would silently throw away the data gathered so far.
     res.success = false;
-    res.message = "a run is in progress (" + core::nameOf(session()->settings().method) +
-                  "): ~finish or ~abort it first";
+    res.message =
+        "a run is in progress (" + core::nameOf(session()->settings().method) + "): ~finish or ~abort it first";
     return true;
   }
   if (req.method.empty()) {
@@ -388,7 +391,8 @@ bool CalibratorRos::onFinish(std_srvs::Trigger::Request&, std_srvs::Trigger::Res
 bool CalibratorRos::onAbort(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   std::lock_guard<std::mutex> lock(mutex_);
   res.success = session() != nullptr;
-  res.message = session() ? "aborted " + core::nameOf(session()->settings().method) + ": nothing written" : "no run in progress";
+  res.message =
+      session() ? "aborted " + core::nameOf(session()->settings().method) + ": nothing written" : "no run in progress";
   calibration_->abort();
   return true;
 }

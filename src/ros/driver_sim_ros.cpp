@@ -1,10 +1,10 @@
 #include "hrg_gyro/ros/driver_sim_ros.h"
 
-#include <cmath>
-#include <cstdio>
-
 #include <rosgraph_msgs/Clock.h>
 #include <std_msgs/Bool.h>
+
+#include <cmath>
+#include <cstdio>
 
 #include "hrg_gyro/ChannelAmplitudes.h"
 #include "hrg_gyro/GroundTruth.h"
@@ -82,10 +82,11 @@ bool DriverSimRos::waitForSubscribers() {
       return true;
     }
     if (ros::WallTime::now() > until) {
-      ROS_WARN("driver_sim: starting after %.1f s without all expected subscribers (channels %u/%d, "
-               "turntable %u/%d, truth %u/%d)",
-               wait_timeout_, channels_pub_.getNumSubscribers(), wait_channels_, turntable_pub_.getNumSubscribers(),
-               wait_turntable_, truth_pub_.getNumSubscribers(), wait_truth_);
+      ROS_WARN(
+          "driver_sim: starting after %.1f s without all expected subscribers (channels %u/%d, "
+          "turntable %u/%d, truth %u/%d)",
+          wait_timeout_, channels_pub_.getNumSubscribers(), wait_channels_, turntable_pub_.getNumSubscribers(),
+          wait_turntable_, truth_pub_.getNumSubscribers(), wait_truth_);
       return true;
     }
     ros::WallDuration(0.01).sleep();
@@ -123,8 +124,10 @@ void DriverSimRos::run() {
       ROS_WARN_THROTTLE(10.0, "driver_sim: %.3f s behind schedule (this thread was not run in time); catching up",
                         late);
     } else if (late > max_lag_ && use_sim_time_) {
-      ROS_INFO_THROTTLE(30.0, "driver_sim: %.3f s behind schedule: the simulated clock runs slower than "
-                              "~time_scale (%.1f s let go so far)", late, schedule.slid());
+      ROS_INFO_THROTTLE(30.0,
+                        "driver_sim: %.3f s behind schedule: the simulated clock runs slower than "
+                        "~time_scale (%.1f s let go so far)",
+                        late, schedule.slid());
     }
     if (!clock_pub_.getTopic().empty() && sim.elapsed() >= next_clock) {
       rosgraph_msgs::Clock c;

@@ -1,8 +1,8 @@
 #include "hrg_gyro/ros/parameter_reader.h"
 
-#include <stdexcept>
-
 #include <ros/console.h>
+
+#include <stdexcept>
 
 namespace hrg_gyro {
 namespace {

@@ -1,11 +1,11 @@
 #include "hrg_gyro/ros/processor_ros.h"
 
+#include <sensor_msgs/Imu.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-
-#include <sensor_msgs/Imu.h>
 
 #include "hrg_gyro/GyroOutput.h"
 #include "hrg_gyro/ModelInfo.h"
@@ -123,7 +123,8 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   input_.start();
   diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
   ROS_INFO("processor: %s (K0 %.6f, %zu K harmonics, calibration %s)", parameter_file_.c_str(),
-           params->scale_factor.meanAt(NAN), params->scale_factor.orders().size(), params->calibration.method.name().c_str());
+           params->scale_factor.meanAt(NAN), params->scale_factor.orders().size(),
+           params->calibration.method.name().c_str());
 }
 
 ProcessorRos::~ProcessorRos() {
@@ -172,7 +173,7 @@ void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
     ROS_WARN_THROTTLE(5.0, "processor: dropped a sample with a bad stamp (%s)",
                       r.verdict == core::SampleVerdict::kRejectedStamp ? "zero"
                       : r.verdict == core::SampleVerdict::kDuplicate   ? "duplicate"
-                                                                        : "out of order");
+                                                                       : "out of order");
   } else if (r.verdict == core::SampleVerdict::kRejectedValue) {
     ROS_WARN_THROTTLE(5.0, "processor: rejected a sample: %s", core::toString(r.wave_status));
   } else if (r.verdict == core::SampleVerdict::kRejectedJump) {
@@ -255,7 +256,8 @@ bool ProcessorRos::onReload(std_srvs::Trigger::Request&, std_srvs::Trigger::Resp
   char buf[256];
   std::snprintf(buf, sizeof buf, "loaded %s: K0 %.9f, %zu K harmonics, %zu D harmonics, calibration %s %s",
                 parameter_file_.c_str(), params->scale_factor.meanAt(NAN), params->scale_factor.orders().size(),
-                params->drift.orders().size(), params->calibration.method.name().c_str(), params->calibration.time.c_str());
+                params->drift.orders().size(), params->calibration.method.name().c_str(),
+                params->calibration.time.c_str());
   res.message = buf;
   ROS_INFO("processor: %s", buf);
   return true;
@@ -302,8 +304,8 @@ bool ProcessorRos::onCaptureBias(std_srvs::Trigger::Request&, std_srvs::Trigger:
       saved = "; written to " + parameter_file_ + " (previous file kept as .bak)";
     } catch (const std::exception& e) {
       res.success = false;
-      res.message = "bias captured but the parameter file could not be written, model unchanged: " +
-                    std::string(e.what());
+      res.message =
+          "bias captured but the parameter file could not be written, model unchanged: " + std::string(e.what());
       ROS_ERROR("processor: %s", res.message.c_str());
       return true;
     }
@@ -334,7 +336,8 @@ void ProcessorRos::diagnoseInput(diagnostic_updater::DiagnosticStatusWrapper& st
   } else if (lost > 0) {
     stat.summaryf(DiagnosticStatus::WARN, "%lu messages lost (sequence gaps) since the last report",
                   static_cast<unsigned long>(lost));
-  } else if (c.zero_stamp + c.duplicate + c.out_of_order > reported_.zero_stamp + reported_.duplicate + reported_.out_of_order) {
+  } else if (c.zero_stamp + c.duplicate + c.out_of_order >
+             reported_.zero_stamp + reported_.duplicate + reported_.out_of_order) {
     stat.summary(DiagnosticStatus::WARN, "samples with zero, duplicate or out-of-order stamps dropped");
   } else if (c.gaps > reported_.gaps || c.resets > reported_.resets) {
     stat.summary(DiagnosticStatus::WARN, c.resets > reported_.resets ? "time went backwards: state reset"
@@ -359,9 +362,9 @@ void ProcessorRos::diagnoseWave(diagnostic_updater::DiagnosticStatusWrapper& sta
   const std::uint64_t received = c.received - reported_.received;
   const std::uint64_t bad = (c.non_finite - reported_.non_finite) + (c.no_signal - reported_.no_signal) +
                             (c.degenerate - reported_.degenerate) +
-                            (c.amplitude_out_of_range - reported_.amplitude_out_of_range) +
-                            (c.jumps - reported_.jumps);
-  const double ratio = has_wave_ && last_wave_.amplitude > 0.0 ? std::abs(last_wave_.quadrature) / last_wave_.amplitude : 0.0;
+                            (c.amplitude_out_of_range - reported_.amplitude_out_of_range) + (c.jumps - reported_.jumps);
+  const double ratio =
+      has_wave_ && last_wave_.amplitude > 0.0 ? std::abs(last_wave_.quadrature) / last_wave_.amplitude : 0.0;
   if (received > 0 && bad == received) {
     std::string why = c.non_finite > reported_.non_finite   ? "non-finite channel amplitudes"
                       : c.degenerate > reported_.degenerate ? "degenerate wave (A close to B)"

@@ -1,17 +1,17 @@
 #include "hrg_gyro/ros/session_monitor_ros.h"
 
+#include <std_msgs/String.h>
+#include <yaml-cpp/yaml.h>
+
 #include <cstdint>
 #include <fstream>
 #include <optional>
 #include <sstream>
 
-#include <std_msgs/String.h>
-#include <yaml-cpp/yaml.h>
-
-#include "hrg_gyro/core/model/calibration_method_kind.h"
-#include "hrg_gyro/core/simulation/injected_model.h"
-#include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/evaluation/session_summary.h"
+#include "hrg_gyro/core/model/calibration_method_kind.h"
+#include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/simulation/injected_model.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/param_tree.h"
 
@@ -25,9 +25,9 @@ SessionMonitorRos::SessionMonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   shutdown_when_done_ = params_.get("shutdown_when_done", shutdown_when_done_);
   const std::string scenario_ns = params_.get<std::string>("scenario_namespace", "driver_sim");
   params_.warnAboutUnknownKeys();
-  scenario_ = std::make_unique<core::SimulationConfig>(core::SimulationConfig::parse(
-      core::YamlField(privateParameters(ros::NodeHandle(nh_, scenario_ns)), scenario_ns),
-      core::nodeOnlyScenarioKeys()));
+  scenario_ = std::make_unique<core::SimulationConfig>(
+      core::SimulationConfig::parse(core::YamlField(privateParameters(ros::NodeHandle(nh_, scenario_ns)), scenario_ns),
+                                    core::nodeOnlyScenarioKeys()));
   after_ = std::make_unique<Track>(evaluation_);
   before_ = std::make_unique<Track>(evaluation_);
   const int q = 20000;
@@ -137,7 +137,8 @@ void SessionMonitorRos::finish() {
   std::vector<int> k_orders{2, 4, 6, 8}, d_orders{2, 4};
   if (result_) {
     s.calibration = fromMessage(*result_);
-    if (!result_->scale_factor.empty()) k_orders.assign(result_->scale_factor[0].orders.begin(), result_->scale_factor[0].orders.end());
+    if (!result_->scale_factor.empty())
+      k_orders.assign(result_->scale_factor[0].orders.begin(), result_->scale_factor[0].orders.end());
     if (!result_->drift.empty()) d_orders.assign(result_->drift[0].orders.begin(), result_->drift[0].orders.end());
   } else {
     s.has_calibration = false;

@@ -8,14 +8,13 @@
 // says why; runCommandLine turns it into exit code 2.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <iostream>
 #include <limits>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 namespace hrg_gyro {
 namespace tools {
@@ -45,8 +44,8 @@ inline CLI::Validator wholeNumber(long long low, long long high) {
         const char* end = text.data() + text.size();
         const auto r = std::from_chars(text.data(), end, value);
         if (text.empty() || r.ec != std::errc() || r.ptr != end || value < low || value > high) {
-          return "expects a whole number in [" + std::to_string(low) + ", " + std::to_string(high) + "], got '" +
-                 text + "'";
+          return "expects a whole number in [" + std::to_string(low) + ", " + std::to_string(high) + "], got '" + text +
+                 "'";
         }
         text = std::to_string(value);
         return "";

@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "cli_checks.h"
-#include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/calibration/calibration_session.h"
+#include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
-#include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/evaluation/session_summary.h"
+#include "hrg_gyro/core/model/parameter_file.h"
 
 using namespace hrg_gyro::core;
 
@@ -43,11 +43,14 @@ CalibrationSettings checkedSettings(const std::string& method, const std::vector
   try {
     return CalibrationSettings::parse(YamlField(n, ""));
   } catch (const ConfigError& e) {
-    static const std::pair<const char*, const char*> kOptions[] = {
-        {"method", "--method"}, {"scale_factor_orders", "--orders"}, {"drift_orders", "--drift-orders"},
-        {"bins", "--bins"},     {"window", "--window"}};
+    static const std::pair<const char*, const char*> kOptions[] = {{"method", "--method"},
+                                                                   {"scale_factor_orders", "--orders"},
+                                                                   {"drift_orders", "--drift-orders"},
+                                                                   {"bins", "--bins"},
+                                                                   {"window", "--window"}};
     for (const auto& ko : kOptions) {
-      if (e.key().rfind(ko.first, 0) == 0) throw ArgumentError(ko.second + e.key().substr(std::strlen(ko.first)) + ": " + e.problem());
+      if (e.key().rfind(ko.first, 0) == 0)
+        throw ArgumentError(ko.second + e.key().substr(std::strlen(ko.first)) + ": " + e.problem());
     }
     throw ArgumentError(e.what());
   }
@@ -60,7 +63,8 @@ std::vector<int> checkedEvaluationOrders(const std::vector<int>& orders) {
   try {
     return CalibrationSettings::parse(YamlField(n, "")).scale_factor_orders;
   } catch (const ConfigError& e) {
-    throw ArgumentError("--evaluation-orders" + e.key().substr(std::strlen("scale_factor_orders")) + ": " + e.problem());
+    throw ArgumentError("--evaluation-orders" + e.key().substr(std::strlen("scale_factor_orders")) + ": " +
+                        e.problem());
   }
 }
 

@@ -7,12 +7,12 @@
 #include <cstdio>
 #include <cstdlib>
 
-#define HRG_FUZZ_CHECK(condition)                                                            \
-  do {                                                                                       \
-    if (!(condition)) {                                                                      \
+#define HRG_FUZZ_CHECK(condition)                                                                   \
+  do {                                                                                              \
+    if (!(condition)) {                                                                             \
       std::fprintf(stderr, "%s:%d: fuzz invariant violated: %s\n", __FILE__, __LINE__, #condition); \
-      std::abort();                                                                          \
-    }                                                                                        \
+      std::abort();                                                                                 \
+    }                                                                                               \
   } while (0)
 
 #define HRG_FUZZ_CHECK_FINITE(value) HRG_FUZZ_CHECK(std::isfinite(value))

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "fuzz_check.h"
-#include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/model/wave_parameters.h"
+#include "hrg_gyro/core/processing/gyro_processor.h"
 
 namespace hrg_gyro {
 namespace fuzz {
@@ -48,7 +48,8 @@ constexpr std::size_t kModelCount = sizeof(kModels) / sizeof(kModels[0]);
 std::shared_ptr<const core::GyroParameters> model(std::size_t index) {
   static const std::vector<std::shared_ptr<const core::GyroParameters>> models = [] {
     std::vector<std::shared_ptr<const core::GyroParameters>> m;
-    for (const char* text : kModels) m.push_back(std::make_shared<core::GyroParameters>(core::parseParameterText(text)));
+    for (const char* text : kModels)
+      m.push_back(std::make_shared<core::GyroParameters>(core::parseParameterText(text)));
     return m;
   }();
   return models[index % kModelCount];
@@ -135,12 +136,24 @@ int sampleProcessingTarget(const std::uint8_t* data, std::size_t size) {
         const std::uint8_t what = in.take<std::uint8_t>();
         const int channel = what & 3;
         switch ((what >> 2) % 6) {
-          case 0: sample.z[channel] = -sample.z[channel]; break;
-          case 1: sample.z[channel] = 0.0; break;
-          case 2: sample.z *= in.take<double>(); break;
-          case 3: sample.stamp = shifted(sample.stamp, -static_cast<std::int64_t>(in.take<std::uint32_t>())); break;
-          case 4: sample.stamp = shifted(sample.stamp, static_cast<std::int64_t>(in.take<std::uint32_t>()) * 1000); break;
-          default: sample.frequency = in.take<double>(); break;
+          case 0:
+            sample.z[channel] = -sample.z[channel];
+            break;
+          case 1:
+            sample.z[channel] = 0.0;
+            break;
+          case 2:
+            sample.z *= in.take<double>();
+            break;
+          case 3:
+            sample.stamp = shifted(sample.stamp, -static_cast<std::int64_t>(in.take<std::uint32_t>()));
+            break;
+          case 4:
+            sample.stamp = shifted(sample.stamp, static_cast<std::int64_t>(in.take<std::uint32_t>()) * 1000);
+            break;
+          default:
+            sample.frequency = in.take<double>();
+            break;
         }
         break;
       }

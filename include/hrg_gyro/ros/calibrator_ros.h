@@ -11,6 +11,10 @@
 // itself (stages, generator pairing, reports' names) is the core's: this class wires it to ROS.
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+#include <std_srvs/Trigger.h>
+
 #include <condition_variable>
 #include <deque>
 #include <map>
@@ -19,10 +23,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <diagnostic_updater/diagnostic_updater.h>
-#include <ros/ros.h>
-#include <std_srvs/Trigger.h>
 
 #include "hrg_gyro/ChannelAmplitudes.h"
 #include "hrg_gyro/GroundTruth.h"

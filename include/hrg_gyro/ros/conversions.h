@@ -1,9 +1,9 @@
 // Conversions between the core's types and ROS time and messages.
 #pragma once
 
-#include <string>
-
 #include <ros/time.h>
+
+#include <string>
 
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/ChannelAmplitudes.h"
@@ -12,9 +12,9 @@
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
 #include "hrg_gyro/core/calibration/calibration_outcome.h"
+#include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/simulation/gyro_simulator.h"
-#include "hrg_gyro/core/common/units.h"
 
 namespace hrg_gyro {
 

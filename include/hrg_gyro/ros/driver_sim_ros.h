@@ -10,13 +10,13 @@
 // turns true when the scenario is over.
 #pragma once
 
+#include <ros/ros.h>
+
 #include <atomic>
 #include <memory>
 #include <optional>
 #include <string>
 #include <thread>
-
-#include <ros/ros.h>
 
 #include "hrg_gyro/core/simulation/gyro_simulator.h"
 #include "hrg_gyro/core/simulation/playback_schedule.h"
@@ -43,7 +43,7 @@ class DriverSimRos {
   std::unique_ptr<core::SimulationConfig> config_;
   ros::Publisher channels_pub_, turntable_pub_, truth_pub_, clock_pub_, done_pub_;
   double time_scale_ = 1.0;
-  double max_lag_ = 0.25;  // s, sim time only
+  double max_lag_ = 0.25;                           // s, sim time only
   std::optional<core::PlaybackSchedule> schedule_;  // built (and validated) with the parameters
   double clock_period_ = 0.05;  // every subscriber of /clock (every node under sim time) pays for it
   std::string frame_id_ = "gyro_link";

@@ -3,10 +3,10 @@
 // of keys, one set of checks, errors that name the key.
 #pragma once
 
-#include <string>
-
 #include <ros/node_handle.h>
 #include <yaml-cpp/yaml.h>
+
+#include <string>
 
 namespace hrg_gyro {
 

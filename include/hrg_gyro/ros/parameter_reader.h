@@ -8,11 +8,11 @@
 // itself; the reader only accounts for them.
 #pragma once
 
+#include <ros/node_handle.h>
+
 #include <set>
 #include <string>
 #include <vector>
-
-#include <ros/node_handle.h>
 
 namespace hrg_gyro {
 

@@ -10,15 +10,15 @@
 // about unknown ones.
 #pragma once
 
-#include <condition_variable>
-#include <memory>
-#include <mutex>
-#include <string>
-
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
+
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <string>
 
 #include "hrg_gyro/ChannelAmplitudes.h"
 #include "hrg_gyro/core/processing/bias_capture.h"
@@ -96,8 +96,8 @@ class ProcessorRos {
   std::uint8_t last_flags_ = 0;
   // Angle-noise estimate from second differences of alpha, for the IMU covariance.
   double alpha1_ = 0.0, alpha2_ = 0.0, dt_last_ = 0.0, d2_variance_ = 0.0;
-  int history_ = 0;                        // continuous alphas held (0..2)
-  std::uint64_t second_differences_ = 0;   // in the noise estimate
+  int history_ = 0;                       // continuous alphas held (0..2)
+  std::uint64_t second_differences_ = 0;  // in the noise estimate
 };
 
 }  // namespace hrg_gyro

@@ -6,18 +6,18 @@
 // angle error). A second processor fed the uncalibrated model (`before/output`) gives the "before"
 // figures. It collects the calibrator's latched `~result`, checks on the processor's latched
 // `processor/model` that the calibrated model was in force before the verification began, and
-// computes the exact injected model from the driver's scenario parameters. When the driver reports `done`, it writes the summary (the same
-// text as hrg_session) to `~summary_file`, publishes the key figures as YAML on `~summary`
+// computes the exact injected model from the driver's scenario parameters. When the driver reports `done`, it writes
+// the summary (the same text as hrg_session) to `~summary_file`, publishes the key figures as YAML on `~summary`
 // (latched) and, with `~shutdown_when_done`, ends its process (as a nodelet: the manager).
 #pragma once
+
+#include <ros/ros.h>
+#include <std_msgs/Bool.h>
 
 #include <deque>
 #include <memory>
 #include <mutex>
 #include <string>
-
-#include <ros/ros.h>
-#include <std_msgs/Bool.h>
 
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/GroundTruth.h"
@@ -48,8 +48,8 @@ class SessionMonitorRos {
     core::OutputEvaluator evaluator;
     std::deque<OutputSample> pending;  // outputs whose truth has not arrived yet
     std::uint64_t samples = 0;
-    std::uint64_t unmatched = 0;       // verification-span outputs without a truth
-    core::Nanoseconds passed = 0;      // every truth up to here has been looked at
+    std::uint64_t unmatched = 0;   // verification-span outputs without a truth
+    core::Nanoseconds passed = 0;  // every truth up to here has been looked at
   };
   void onTruth(const GroundTruth::ConstPtr& msg);
   void onOutput(const GyroOutput::ConstPtr& msg, Track* track);

@@ -84,11 +84,12 @@ std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettin
 }
 
 // ------------------------------------------------------------------------------------------------
-namespace {
-}  // namespace
+namespace {}  // namespace
 
 DualRateMethod::DualRateMethod(const CalibrationSettings& s, double k0)
-    : settings_(s), groups_(s.bins, s.window, s.window_span, k0, maxFittedOrder(s.scale_factor_orders, s.drift_orders), s.group_tolerance, s.plateau.max_gap) {}
+    : settings_(s),
+      groups_(s.bins, s.window, s.window_span, k0, maxFittedOrder(s.scale_factor_orders, s.drift_orders),
+              s.group_tolerance, s.plateau.max_gap) {}
 
 void DualRateMethod::addSample(const PlateauSample& s) {
   if (s.plateau.is_static) return;
@@ -164,7 +165,9 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
 
 // ------------------------------------------------------------------------------------------------
 ConstantRateMethod::ConstantRateMethod(const CalibrationSettings& s, double k0)
-    : settings_(s), groups_(s.bins, s.window, s.window_span, k0, maxFittedOrder(s.scale_factor_orders, s.drift_orders), s.group_tolerance, s.plateau.max_gap) {}
+    : settings_(s),
+      groups_(s.bins, s.window, s.window_span, k0, maxFittedOrder(s.scale_factor_orders, s.drift_orders),
+              s.group_tolerance, s.plateau.max_gap) {}
 
 void ConstantRateMethod::closeDwell() {
   if (dwell_.samples() >= 3 && dwell_.duration() > 0.0) {
@@ -199,8 +202,9 @@ CalibrationProgress ConstantRateMethod::progress() const {
   const auto order = groups_.byDuration();
   const double cov = order.empty() ? 0.0 : groups_.groups()[order[0]].rates().coverage(minBinTime());
   const double dwell = dwellTime();
-  p.fraction = std::min(std::min(1.0, cov / settings_.gates.min_coverage),
-                        settings_.gates.min_dwell_time > 0 ? std::min(1.0, dwell / settings_.gates.min_dwell_time) : 1.0);
+  p.fraction =
+      std::min(std::min(1.0, cov / settings_.gates.min_coverage),
+               settings_.gates.min_dwell_time > 0 ? std::min(1.0, dwell / settings_.gates.min_dwell_time) : 1.0);
   p.summary = "constant_rate: coverage " + formatShort(100 * cov) + " %, rest data " + formatShort(dwell) + " s";
   return p;
 }
@@ -264,15 +268,16 @@ CalibrationOutcome ConstantRateMethod::finish(const GyroParameters& prior) const
   k.residual_rms = fit.residual_rms / std::abs(w + earth);
   for (int b = 0; b < g.rates().binCount(); ++b) {
     if (g.rates().binTime(b) < minBinTime()) continue;
-    o.binned.push_back({g.rates().binCenter(b), k.mean + (g.rates().binRate(b) - fit.mean) / (w + earth), 0.0,
-                        g.rates().binTime(b)});
+    o.binned.push_back(
+        {g.rates().binCenter(b), k.mean + (g.rates().binRate(b) - fit.mean) / (w + earth), 0.0, g.rates().binTime(b)});
   }
   HarmonicFitResult d;
   d.ok = true;
   d.mean = rest - k.mean * earth;
   d.points = 1;
-  o.notes.push_back("constant_rate measures D only at the dwell angle: D(theta) harmonics are not separable from "
-                    "K(theta) and leak into it by D_k / Omega; the drift model written is the constant D0");
+  o.notes.push_back(
+      "constant_rate measures D only at the dwell angle: D(theta) harmonics are not separable from "
+      "K(theta) and leak into it by D_k / Omega; the drift model written is the constant D0");
   const double tau = g.rates().effectiveWindow();
   o.error_bound = slopeBound(k) * std::abs(k.mean) * std::abs(w) * tau + std::abs(d.mean) / std::abs(w) +
                   2.0 * g.rates().windowNoise() / (std::abs(w) * tau);
@@ -434,8 +439,7 @@ bool CorrectionMatrixMethod::complete() const {
 
 CalibrationProgress CorrectionMatrixMethod::progress() const {
   CalibrationProgress p;
-  p.fraction = complete() ? 1.0
-                          : std::min(0.99, static_cast<double>(estimator_.pairs()) / settings_.gates.min_pairs);
+  p.fraction = complete() ? 1.0 : std::min(0.99, static_cast<double>(estimator_.pairs()) / settings_.gates.min_pairs);
   p.summary = "correction_matrix: " + std::to_string(estimator_.pairs()) + " generator pairs";
   return p;
 }
@@ -450,10 +454,10 @@ CalibrationOutcome CorrectionMatrixMethod::finish(const GyroParameters& prior) c
   o.gate("pairs", estimator_.pairs() >= q.min_pairs, static_cast<double>(estimator_.pairs()),
          static_cast<double>(q.min_pairs), std::to_string(estimator_.pairs()) + " generator samples");
   o.gate("condition", o.correction.condition_number <= q.max_p_condition, o.correction.condition_number,
-         q.max_p_condition, "generator sweep condition number " + formatShort(o.correction.condition_number) +
-                                (o.correction.ok ? "" : " (" + o.correction.reason + ")"));
-  const double rms_amplitude =
-      estimator_.pairs() ? std::sqrt(reference_energy_ / (4.0 * estimator_.pairs())) : 1.0;
+         q.max_p_condition,
+         "generator sweep condition number " + formatShort(o.correction.condition_number) +
+             (o.correction.ok ? "" : " (" + o.correction.reason + ")"));
+  const double rms_amplitude = estimator_.pairs() ? std::sqrt(reference_energy_ / (4.0 * estimator_.pairs())) : 1.0;
   const double relative = o.correction.residual_rms / rms_amplitude;
   o.gate("residual", o.correction.ok && relative <= 1e-2, relative, 1e-2,
          "channel residual after correction is " + formatShort(relative) + " of the amplitude");

@@ -1,8 +1,8 @@
 // The calibration methods on fast angle-level sessions (docs/math.md, 'Calibration methods'), the
 // session's stream synchronisation, and the quality gates.
-#include <deque>
-
 #include <gtest/gtest.h>
+
+#include <deque>
 
 #include "core/testing/angle_level_session.h"
 
@@ -83,7 +83,8 @@ TEST(DualRateTest, StandardErrorsDescribeTheActualErrors) {
     const HarmonicFitResult& k = o.scale_factor[0];
     const double truth_cos[] = {-6e-4, 2e-3}, truth_sin[] = {4e-4, 0.0};
     for (int j = 0; j < 2; ++j) {
-      z2 += std::pow((k.cos[j] - truth_cos[j]) / k.cos_std[j], 2) + std::pow((k.sin[j] - truth_sin[j]) / k.sin_std[j], 2);
+      z2 +=
+          std::pow((k.cos[j] - truth_cos[j]) / k.cos_std[j], 2) + std::pow((k.sin[j] - truth_sin[j]) / k.sin_std[j], 2);
       n += 2;
     }
   }
@@ -119,7 +120,8 @@ TEST(ConstantRateTest, DriftHarmonicsLeakIntoKByDkOverOmega) {
 TEST(StepTest, RecoversKFromStepsAndDFromDwells) {
   AngleLevelGyro g = referenceGyro();
   g.noise = 1.1e-5;
-  YAML::Node n = YAML::Load("[{type: steps, angle: 0.3490658503988659, rate: 0.17453292519943295, dwell: 15.0, count: 18}]");
+  YAML::Node n =
+      YAML::Load("[{type: steps, angle: 0.3490658503988659, rate: 0.17453292519943295, dwell: 15.0, count: 18}]");
   const TurntableProfile p = TurntableProfile::parse(YamlField(n, "profile"), 0.5);
   CalibrationSettings s = settings("step");
   s.bins = 64;

@@ -1,13 +1,13 @@
 #include "hrg_gyro/core/calibration/calibration_outcome.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <cmath>
 #include <ctime>
 #include <sstream>
 
-#include <yaml-cpp/yaml.h>
-
-#include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -188,7 +188,8 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
   out << YAML::Key << "weight" << YAML::Value;
   emitNumbers(out, w);
   out << YAML::EndMap;
-  out << YAML::Key << "parameters" << YAML::Value << YAML::Literal << (o.accepted ? emitParameters(o.parameters) : std::string("not accepted"));
+  out << YAML::Key << "parameters" << YAML::Value << YAML::Literal
+      << (o.accepted ? emitParameters(o.parameters) : std::string("not accepted"));
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

@@ -54,8 +54,7 @@ void CalibrationSession::addWave(Nanoseconds stamp, double theta, double frequen
   last_wave_stamp_ = stamp;
   pending_.push_back({stamp, theta, frequency});
   // A turntable stream that stopped (or never started) must not make the queue grow without bound.
-  while (!pending_.empty() && (pending_.size() > kMaxPending ||
-                               toSeconds(stamp - pending_.front().stamp) > kMaxWait)) {
+  while (!pending_.empty() && (pending_.size() > kMaxPending || toSeconds(stamp - pending_.front().stamp) > kMaxWait)) {
     ++counters_.unsynchronized;
     pending_.pop_front();
   }

@@ -20,14 +20,14 @@ std::vector<int> parseEvenOrders(const YamlField& f) {
 // The keys, listed once: parse() refuses any other, keyPaths() lists them for the node's template check.
 const std::vector<std::string> kPlateauKeys = {"rate_tolerance", "relative_tolerance", "settle_time", "static_rate",
                                                "max_gap"};
-const std::vector<std::string> kGateKeys = {"min_coverage",     "min_rate_separation",   "max_rate_noise",
-                                            "min_samples",      "max_condition",         "max_relative_residual",
-                                            "max_k0_change",    "max_harmonic_std",      "min_steps",
-                                            "min_dwell_time",   "min_pairs",             "max_p_condition"};
+const std::vector<std::string> kGateKeys = {"min_coverage",   "min_rate_separation", "max_rate_noise",
+                                            "min_samples",    "max_condition",       "max_relative_residual",
+                                            "max_k0_change",  "max_harmonic_std",    "min_steps",
+                                            "min_dwell_time", "min_pairs",           "max_p_condition"};
 const std::vector<std::string> kThermalKeys = {"frequency_nodes", "node_count", "interpolation", "slice_width",
                                                "max_slices"};
-const std::vector<std::string> kScalarKeys = {"method", "scale_factor_orders", "drift_orders", "bins", "window",
-                                              "window_span", "group_tolerance", "auto_finish_idle"};
+const std::vector<std::string> kScalarKeys = {"method", "scale_factor_orders", "drift_orders",    "bins",
+                                              "window", "window_span",         "group_tolerance", "auto_finish_idle"};
 
 double positive(const YamlField& parent, const char* key, double fallback) {
   const double v = parent.getDouble(key, fallback);
@@ -111,7 +111,8 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
       if (ts.frequency_nodes.size() == 1) nf.fail("give at least 2 nodes, or none for automatic nodes (node_count)");
       for (std::size_t j = 0; j < ts.frequency_nodes.size(); ++j) {
         if (!(ts.frequency_nodes[j] > 0.0)) nf.at(j).fail("frequency must be positive (Hz)");
-        if (j > 0 && !(ts.frequency_nodes[j] > ts.frequency_nodes[j - 1])) nf.at(j).fail("nodes must be strictly increasing");
+        if (j > 0 && !(ts.frequency_nodes[j] > ts.frequency_nodes[j - 1]))
+          nf.at(j).fail("nodes must be strictly increasing");
       }
     }
     ts.node_count = static_cast<int>(t.getInteger("node_count", ts.node_count));

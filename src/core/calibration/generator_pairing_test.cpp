@@ -1,12 +1,12 @@
 // Generator pairing: raw channels and generator references paired by stamp, whichever comes first,
 // with bounded waiting lists.
+#include "hrg_gyro/core/calibration/generator_pairing.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
 #include <vector>
-
-#include "hrg_gyro/core/calibration/generator_pairing.h"
 
 namespace hrg_gyro {
 namespace core {

@@ -1,5 +1,7 @@
 // Staged calibration: the stages run in order, each on the prior the previous one wrote, one report
 // per stage.
+#include "hrg_gyro/core/calibration/staged_calibration.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,7 +9,6 @@
 #include <vector>
 
 #include "hrg_gyro/core/calibration/calibration_settings.h"
-#include "hrg_gyro/core/calibration/staged_calibration.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {

@@ -5,8 +5,8 @@
 #include <ctime>
 #include <sstream>
 
-#include "hrg_gyro/core/estimation/thermal_estimator.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/estimation/thermal_estimator.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -23,8 +23,8 @@ double coverageOf(const std::vector<double>& swept, double min_time) {
 
 ThermalMethod::ThermalMethod(const CalibrationSettings& s, double k0)
     : settings_(s),
-      rates_(s.bins, s.window, s.window_span, k0, maxFittedOrder(s.scale_factor_orders, s.drift_orders), s.group_tolerance, s.plateau.max_gap,
-             s.thermal.slice_width, s.thermal.max_slices) {}
+      rates_(s.bins, s.window, s.window_span, k0, maxFittedOrder(s.scale_factor_orders, s.drift_orders),
+             s.group_tolerance, s.plateau.max_gap, s.thermal.slice_width, s.thermal.max_slices) {}
 
 void ThermalMethod::addSample(const PlateauSample& s) {
   if (s.plateau.is_static) return;
@@ -56,8 +56,7 @@ std::vector<double> ThermalMethod::nodes() const {
   return n;
 }
 
-std::vector<double> ThermalMethod::intervalCoverage(const RateGroup& group,
-                                                    const std::vector<double>& nodes) const {
+std::vector<double> ThermalMethod::intervalCoverage(const RateGroup& group, const std::vector<double>& nodes) const {
   const std::size_t intervals = nodes.size() - 1;
   std::vector<std::vector<double>> swept(intervals, std::vector<double>(rates_.binCount(), 0.0));
   for (const auto& kv : group.slices) {
@@ -129,7 +128,8 @@ void ThermalMethod::noteDroppedSamples(CalibrationOutcome* o) const {
   }
   if (out_of_range_ > 0) {
     o->notes.push_back(std::to_string(out_of_range_) + " samples lay outside the frequency nodes [" +
-                       formatShort(ts.frequency_nodes.front(), 8) + ", " + formatShort(ts.frequency_nodes.back(), 8) + "] Hz");
+                       formatShort(ts.frequency_nodes.front(), 8) + ", " + formatShort(ts.frequency_nodes.back(), 8) +
+                       "] Hz");
   }
   if (slice_limit_ > 0) {
     o->notes.push_back(std::to_string(slice_limit_) + " samples fell beyond thermal/max_slices (" +
@@ -145,15 +145,16 @@ void ThermalMethod::gateData(const std::vector<double>& n, const RateGroup& g1, 
   for (std::size_t j = 1; j < n.size(); ++j) narrowest = std::min(narrowest, n[j] - n[j - 1]);
   o->frequency_nodes = n;
   o->gate("node_spacing", narrowest >= ts.slice_width, narrowest, ts.slice_width,
-          "narrowest node interval " + formatShort(narrowest) + " Hz against frequency slices of " + formatShort(ts.slice_width) +
+          "narrowest node interval " + formatShort(narrowest) + " Hz against frequency slices of " +
+              formatShort(ts.slice_width) +
               " Hz (use fewer nodes, a finer thermal/slice_width, or the dual_rate method)");
   const double w1 = g1.meanRate(), w2 = g2.meanRate();
   o->duration = g1.totalTime() + g2.totalTime();
   std::size_t worst = 0;
   o->coverage = worstCoverage(n, &worst);
   o->gate("coverage", o->coverage >= q.min_coverage, o->coverage, q.min_coverage,
-          "theta bins covered at both rates in every node interval: worst " + formatShort(100 * o->coverage) + " % in [" +
-              formatShort(n[worst], 8) + ", " + formatShort(n[worst + 1], 8) + "] Hz");
+          "theta bins covered at both rates in every node interval: worst " + formatShort(100 * o->coverage) +
+              " % in [" + formatShort(n[worst], 8) + ", " + formatShort(n[worst + 1], 8) + "] Hz");
   o->gate("rate_separation", std::abs(w1 - w2) >= q.min_rate_separation, std::abs(w1 - w2), q.min_rate_separation,
           "plateau rates " + formatShort(w1) + " and " + formatShort(w2) + " rad/s");
   const double noise = std::max(g1.rateStd() / std::abs(w1), g2.rateStd() / std::abs(w2));
@@ -179,7 +180,8 @@ double ThermalMethod::gateNodes(const std::vector<double>& n, const ThermalEstim
     k0_abs_mean += std::abs(k.mean) / static_cast<double>(n.size());
     o->nonlinearity_ppm = std::max(o->nonlinearity_ppm, 1e6 * e.k_model.peakDeviation(n[j]) / std::abs(k.mean));
   }
-  o->gate("k0_sign", k0_max < 0.0, k0_max, 0.0, "largest K0 over the nodes = " + formatShort(k0_max) + " must be negative");
+  o->gate("k0_sign", k0_max < 0.0, k0_max, 0.0,
+          "largest K0 over the nodes = " + formatShort(k0_max) + " must be negative");
   o->gate("k0_change", change <= q.max_k0_change, change, q.max_k0_change,
           "K0 moved by up to " + formatShort(100 * change) + " % from the prior");
   const double residual = e.k_residual_rms / k0_abs_mean;
@@ -225,7 +227,8 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   const std::vector<double> n = nodes();
   if (n.size() < 2) {
     o.gate("frequency_nodes", false, 0.0, static_cast<double>(ts.nodeCount()),
-           "the data span no frequency range (" + (samples_ ? formatShort(f_min_, 8) + " Hz only" : std::string("none")) +
+           "the data span no frequency range (" +
+               (samples_ ? formatShort(f_min_, 8) + " Hz only" : std::string("none")) +
                "): a frequency-dependent model cannot be fitted; use dual_rate");
     o.decide();
     return o;
@@ -236,9 +239,9 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
 
   const double earth = prior.earth_rate.verticalRate();
   const FrequencyInterpolator interpolator(n, ts.interpolation);
-  const ThermalEstimate e = estimateThermal(g1, g1.meanRate() + earth, g2, g2.meanRate() + earth, interpolator,
-                                            rates_.binCount(), settings_.scale_factor_orders, settings_.drift_orders,
-                                            minBinTime(), INFINITY);
+  const ThermalEstimate e =
+      estimateThermal(g1, g1.meanRate() + earth, g2, g2.meanRate() + earth, interpolator, rates_.binCount(),
+                      settings_.scale_factor_orders, settings_.drift_orders, minBinTime(), INFINITY);
   if (!e.ok) {
     o.gate("fit", false, 0.0, 0.0, e.reason);
     o.decide();
@@ -260,7 +263,8 @@ CalibrationOutcome ThermalMethod::finish(const GyroParameters& prior) const {
   o.parameters.calibration.method = ParameterOrigin::calibratedBy(o.method);
   o.parameters.calibration.time = utcNow();
   o.notes.push_back("K and D are splines (" + std::string(toString(ts.interpolation)) + ") over " +
-                    std::to_string(n.size()) + " frequency nodes " + formatShort(n.front(), 8) + ".." + formatShort(n.back(), 8) +
+                    std::to_string(n.size()) + " frequency nodes " + formatShort(n.front(), 8) + ".." +
+                    formatShort(n.back(), 8) +
                     " Hz; outside them the processor holds the end values and flags the samples");
   o.decide();
   return o;

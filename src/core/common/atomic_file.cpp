@@ -43,9 +43,7 @@ int injectedFault(OutputFileStep step, const std::string& target) {
 
 std::string errnoText(int error) { return std::strerror(error); }
 
-[[noreturn]] void fail(const std::string& what, int error) {
-  throw std::runtime_error(what + ": " + errnoText(error));
-}
+[[noreturn]] void fail(const std::string& what, int error) { throw std::runtime_error(what + ": " + errnoText(error)); }
 
 constexpr int kMaxLinkHops = 40;
 /// A temporary whose writer is gone is removed once it is older than the current write. One whose
@@ -178,7 +176,8 @@ std::string prepareBackup(const std::string& target) {
   struct stat st {};
   if (::lstat(target.c_str(), &st) != 0) return "";  // nothing to back up yet
   const std::string backup = target + ".bak";
-  if (const int injected = injectedFault(OutputFileStep::kBackup, target)) fail("cannot keep backup '" + backup + "'", injected);
+  if (const int injected = injectedFault(OutputFileStep::kBackup, target))
+    fail("cannot keep backup '" + backup + "'", injected);
   std::string temporary;
   // mkstemp reserves a unique name; the hard link then takes its place (link never overwrites).
   ::close(createTemporary(target, ".bak.tmp", &temporary));
@@ -217,7 +216,7 @@ void finishBackup(const std::string& target, const std::string& temporary) {
 }
 
 timespec now() {
-  timespec t {};
+  timespec t{};
   ::clock_gettime(CLOCK_REALTIME, &t);
   return t;
 }
@@ -274,7 +273,8 @@ AtomicOutputFile::AtomicOutputFile(const std::string& path, const OutputFileOpti
     : requested_path_(path), options_(options) {
   if (path.empty()) throw std::runtime_error("empty output file name");
   if (!isTemporarySuffix(options.temporary_suffix)) {
-    throw std::invalid_argument("temporary suffix '" + options.temporary_suffix + "' is not a dot and letters or digits");
+    throw std::invalid_argument("temporary suffix '" + options.temporary_suffix +
+                                "' is not a dot and letters or digits");
   }
   target_path_ = resolveOutputTarget(path);
   struct stat st {};
@@ -299,11 +299,14 @@ AtomicOutputFile::AtomicOutputFile(const std::string& path, const OutputFileOpti
 AtomicOutputFile::~AtomicOutputFile() { discard(); }
 
 std::ostream& AtomicOutputFile::stream() {
-  if (finished_) throw std::logic_error("AtomicOutputFile for '" + target_path_ + "' is already committed or discarded");
+  if (finished_)
+    throw std::logic_error("AtomicOutputFile for '" + target_path_ + "' is already committed or discarded");
   return *stream_;
 }
 
-void AtomicOutputFile::write(const std::string& text) { stream().write(text.data(), static_cast<std::streamsize>(text.size())); }
+void AtomicOutputFile::write(const std::string& text) {
+  stream().write(text.data(), static_cast<std::streamsize>(text.size()));
+}
 
 void AtomicOutputFile::discard() noexcept {
   if (finished_) return;
@@ -314,16 +317,16 @@ void AtomicOutputFile::discard() noexcept {
 }
 
 void AtomicOutputFile::commit(const Verifier& verify) {
-  if (finished_) throw std::logic_error("AtomicOutputFile for '" + target_path_ + "' is already committed or discarded");
+  if (finished_)
+    throw std::logic_error("AtomicOutputFile for '" + target_path_ + "' is already committed or discarded");
   const std::string unchanged = target_existed_ ? " (the existing file is unchanged)" : "";
   std::string backup_temporary;
   try {
     if (!buffer_->flushAll() || !*stream_) {
       fail("cannot write '" + target_path_ + "'" + unchanged, buffer_->error() != 0 ? buffer_->error() : EIO);
     }
-    const int metadata_error = target_existed_
-                                   ? copyMetadata(fd_, target_uid_, target_gid_, target_mode_)
-                                   : (::fchmod(fd_, kNewOutputFileMode & ~processUmask()) == 0 ? 0 : errno);
+    const int metadata_error = target_existed_ ? copyMetadata(fd_, target_uid_, target_gid_, target_mode_)
+                                               : (::fchmod(fd_, kNewOutputFileMode & ~processUmask()) == 0 ? 0 : errno);
     if (metadata_error != 0) fail("cannot set the mode of '" + temporary_path_ + "'" + unchanged, metadata_error);
     int sync_error = injectedFault(OutputFileStep::kSync, target_path_);
     if (sync_error == 0 && ::fsync(fd_) != 0) sync_error = errno;
@@ -332,7 +335,8 @@ void AtomicOutputFile::commit(const Verifier& verify) {
     if (options_.keep_backup) backup_temporary = prepareBackup(target_path_);
     int rename_error = injectedFault(OutputFileStep::kRename, target_path_);
     if (rename_error == 0 && ::rename(temporary_path_.c_str(), target_path_.c_str()) != 0) rename_error = errno;
-    if (rename_error != 0) fail("cannot rename '" + temporary_path_ + "' over '" + target_path_ + "'" + unchanged, rename_error);
+    if (rename_error != 0)
+      fail("cannot rename '" + temporary_path_ + "' over '" + target_path_ + "'" + unchanged, rename_error);
   } catch (...) {
     if (!backup_temporary.empty()) ::unlink(backup_temporary.c_str());
     discard();
@@ -429,7 +433,9 @@ std::string readBoundedRegularFile(const std::string& path, std::size_t max_byte
   if (::stat(path.c_str(), &st) != 0) fail("cannot read " + what + " '" + path + "'", errno);
   auto refuseKind = [&](mode_t mode) {
     if (S_ISDIR(mode)) throw std::runtime_error("'" + path + "' is a directory, not a " + what);
-    if (!S_ISREG(mode)) throw std::runtime_error("'" + path + "' is " + kindOf(mode) + ", not a regular file: refusing to read it as a " + what);
+    if (!S_ISREG(mode))
+      throw std::runtime_error("'" + path + "' is " + kindOf(mode) + ", not a regular file: refusing to read it as a " +
+                               what);
   };
   auto refuseSize = [&](const std::string& size) {
     throw std::runtime_error("'" + path + "' is " + size + ", above the limit of " + std::to_string(max_bytes) +

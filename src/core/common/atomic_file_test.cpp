@@ -3,9 +3,8 @@
 // failures at every step leaving the old file intact; checkDistinct; the bounded reader.
 #include "hrg_gyro/core/common/atomic_file.h"
 
-#include <gtest/gtest.h>
-
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/types.h>
@@ -249,8 +248,10 @@ TEST_F(AtomicFileTest, StaleTemporariesOfKilledWritersAreRemovedAtTheNextWrite) 
   }
   for (const auto& name : kept) {
     writeText(at(name), "keep");
-    if (name.find("recent") == std::string::npos) fs::last_write_time(at(name), old_enough);
-    else fs::last_write_time(at(name), fs::file_time_type::clock::now() + std::chrono::seconds(30));
+    if (name.find("recent") == std::string::npos)
+      fs::last_write_time(at(name), old_enough);
+    else
+      fs::last_write_time(at(name), fs::file_time_type::clock::now() + std::chrono::seconds(30));
   }
   writeFileAtomically(at("params.yaml"), "new\n");
   std::set<std::string> expected = kept;
@@ -303,11 +304,12 @@ TEST_F(AtomicFileTest, FailureAtAnyStepLeavesTheOldFileIntact) {
     int error;
     const char* message;
   };
-  for (const Case& c : {Case{OutputFileStep::kWrite, ENOSPC, "No space left on device"},
-                        Case{OutputFileStep::kSync, EIO, "Input/output error"},
-                        Case{OutputFileStep::kBackup, EDQUOT, "quota"},
-                        Case{OutputFileStep::kRename, EXDEV, "cross-device"}}) {
-    fault_injection::setOutputFileFault([&](OutputFileStep step, const std::string&) { return step == c.step ? c.error : 0; });
+  for (const Case& c :
+       {Case{OutputFileStep::kWrite, ENOSPC, "No space left on device"},
+        Case{OutputFileStep::kSync, EIO, "Input/output error"}, Case{OutputFileStep::kBackup, EDQUOT, "quota"},
+        Case{OutputFileStep::kRename, EXDEV, "cross-device"}}) {
+    fault_injection::setOutputFileFault(
+        [&](OutputFileStep step, const std::string&) { return step == c.step ? c.error : 0; });
     try {
       writeFileAtomically(path, std::string(200000, 'n'), OutputFileOptions{true});
       ADD_FAILURE() << "no failure reported for step " << static_cast<int>(c.step);

@@ -14,7 +14,8 @@ namespace fs = std::filesystem;
 class OutputDirectoryTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    root_ = fs::temp_directory_path() / ("hrg_gyro_outdir_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+    root_ = fs::temp_directory_path() /
+            ("hrg_gyro_outdir_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
     fs::remove_all(root_);
     fs::create_directories(root_ / "out" / "sub");
     fs::create_directories(root_ / "outside");

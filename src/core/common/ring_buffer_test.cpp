@@ -1,9 +1,9 @@
 #include "hrg_gyro/core/common/ring_buffer.h"
 
+#include <gtest/gtest.h>
+
 #include <deque>
 #include <random>
-
-#include <gtest/gtest.h>
 
 namespace hrg_gyro {
 namespace core {
@@ -39,7 +39,7 @@ TEST(RingBufferTest, StopsAllocatingOnceItHasGrown) {
   RingBuffer<int> ring(100000);
   for (int i = 0; i < 5000; ++i) ring.push_back(i);
   const std::size_t capacity = ring.capacity();
-  const int* storage = &ring[0];  // the block's start: nothing was popped yet
+  const int* storage = &ring[0];       // the block's start: nothing was popped yet
   for (int i = 0; i < 1000000; ++i) {  // a steady FIFO of 5000 elements
     ring.pop_front();
     ring.push_back(i);
@@ -57,8 +57,8 @@ TEST(RingBufferTest, StopsAllocatingOnceItHasGrown) {
 
 TEST(RingBufferTest, LowerBoundOnSortedContentAcrossTheWrap) {
   RingBuffer<int> ring(8);
-  for (int i = 0; i < 6; ++i) ring.push_back(10 * i);  // 0..50
-  for (int i = 0; i < 4; ++i) ring.pop_front();        // 40, 50
+  for (int i = 0; i < 6; ++i) ring.push_back(10 * i);   // 0..50
+  for (int i = 0; i < 4; ++i) ring.pop_front();         // 40, 50
   for (int i = 6; i < 11; ++i) ring.push_back(10 * i);  // 40..100, wrapped
   const auto less = [](int v, int key) { return v < key; };
   EXPECT_EQ(ring.lowerBound(40, less), 0u);

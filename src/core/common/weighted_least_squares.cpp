@@ -1,9 +1,8 @@
 #include "hrg_gyro/core/common/weighted_least_squares.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/Dense>
 
 namespace hrg_gyro {
 namespace core {

@@ -1,13 +1,12 @@
 // The weighted least-squares solver: a line through three weighted points worked out by hand, a
 // larger problem against Eigen's direct solve of the normal equations, refusals, and the sandwich
 // covariance in the two cases it can be written down in closed form.
+#include "hrg_gyro/core/common/weighted_least_squares.h"
+
 #include <gtest/gtest.h>
 
-#include <cmath>
-
 #include <Eigen/Dense>
-
-#include "hrg_gyro/core/common/weighted_least_squares.h"
+#include <cmath>
 
 namespace hrg_gyro {
 namespace core {

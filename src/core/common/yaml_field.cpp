@@ -54,8 +54,9 @@ void YamlField::rejectUnknownKeys(const std::vector<std::string>& allowed) const
     // A key that is itself a list or a map ({a: 1}: 2) has no name to check: refuse it here rather
     // than let yaml-cpp's conversion error escape as something other than a ConfigError.
     if (!kv.first.IsScalar()) {
-      fail(std::string("keys must be plain names, got ") +
-           (kv.first.IsMap() ? "a map" : kv.first.IsSequence() ? "a list" : "an empty key"));
+      fail(std::string("keys must be plain names, got ") + (kv.first.IsMap()        ? "a map"
+                                                            : kv.first.IsSequence() ? "a list"
+                                                                                    : "an empty key"));
     }
     const std::string key = kv.first.as<std::string>();
     if (!ok.count(key)) {
@@ -111,11 +112,24 @@ bool isValidUtf8(const std::string& s) {
     const unsigned char c = static_cast<unsigned char>(s[i]);
     std::size_t n = 0;
     std::uint32_t cp = 0, min = 0;
-    if (c < 0x80) { ++i; continue; }
-    if ((c & 0xE0) == 0xC0) { n = 1; cp = c & 0x1F; min = 0x80; }
-    else if ((c & 0xF0) == 0xE0) { n = 2; cp = c & 0x0F; min = 0x800; }
-    else if ((c & 0xF8) == 0xF0) { n = 3; cp = c & 0x07; min = 0x10000; }
-    else return false;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    if ((c & 0xE0) == 0xC0) {
+      n = 1;
+      cp = c & 0x1F;
+      min = 0x80;
+    } else if ((c & 0xF0) == 0xE0) {
+      n = 2;
+      cp = c & 0x0F;
+      min = 0x800;
+    } else if ((c & 0xF8) == 0xF0) {
+      n = 3;
+      cp = c & 0x07;
+      min = 0x10000;
+    } else
+      return false;
     for (std::size_t k = 1; k <= n; ++k) {
       if (i + k >= s.size()) return false;
       const unsigned char cc = static_cast<unsigned char>(s[i + k]);

@@ -1,7 +1,8 @@
 // Overlapping Allan deviation: the textbook slopes and the readings taken from them.
+#include "hrg_gyro/core/estimation/allan_deviation.h"
+
 #include <gtest/gtest.h>
 
-#include "hrg_gyro/core/estimation/allan_deviation.h"
 #include "hrg_gyro/core/simulation/gaussian_noise.h"
 
 namespace hrg_gyro {
@@ -65,7 +66,8 @@ TEST(AllanDeviationTest, FlickerLikeBiasGivesAFlatBottomAndB) {
   EXPECT_GE(r.bias_instability.tau_max, 100.0);
   double lowest = INFINITY;
   for (const AllanPoint& p : r.curve) {
-    if (p.tau >= r.bias_instability.tau_min && p.tau <= r.bias_instability.tau_max) lowest = std::min(lowest, p.deviation);
+    if (p.tau >= r.bias_instability.tau_min && p.tau <= r.bias_instability.tau_max)
+      lowest = std::min(lowest, p.deviation);
   }
   EXPECT_DOUBLE_EQ(r.bias_instability.value, lowest / 0.664);
   EXPECT_NEAR(r.bias_instability.value, 1.04e-6 / 0.664, 0.06 * 1.04e-6 / 0.664);

@@ -56,8 +56,8 @@ DefectDiagnosis diagnoseDefects(const HarmonicFitResult& k, double quadrature_ra
     d.recommended_correction.p[1] -= half_gain;
     d.recommended_correction.p[2] += half_place;
     d.recommended_correction.p[3] -= half_place;
-    d.recommended_correction_std = {d.gain_mismatch_std / 2, d.gain_mismatch_std / 2,
-                                    d.misplacement_difference_std / 2, d.misplacement_difference_std / 2};
+    d.recommended_correction_std = {d.gain_mismatch_std / 2, d.gain_mismatch_std / 2, d.misplacement_difference_std / 2,
+                                    d.misplacement_difference_std / 2};
   }
   if (has4) {
     // K cos4 coefficient = -K0 (3/4) a^2.
@@ -70,8 +70,10 @@ DefectDiagnosis diagnoseDefects(const HarmonicFitResult& k, double quadrature_ra
                               : std::sqrt(d.pickoff_ratio_squared_std);
   }
   d.valid = has2 && has4;
-  if (!has2) d.note = "scale-factor fit without the 2 theta harmonic: gain and misplacement not diagnosed";
-  else if (!has4) d.note = "scale-factor fit without the 4 theta harmonic: A/d0 not diagnosed";
+  if (!has2)
+    d.note = "scale-factor fit without the 2 theta harmonic: gain and misplacement not diagnosed";
+  else if (!has4)
+    d.note = "scale-factor fit without the 4 theta harmonic: A/d0 not diagnosed";
   else if (d.pickoff_ratio_squared < 0.0)
     d.note = "negative cos 4theta reading: not a capacitive pickoff nonlinearity (A/d0 set to 0)";
   return d;

@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include "hrg_gyro/core/simulation/injected_model.h"
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/signal/pickoff_array.h"
+#include "hrg_gyro/core/simulation/injected_model.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -69,8 +69,8 @@ TEST(DefectDiagnosisTest, ReadsTheInjectedDefectsFromADualRateCalibration) {
       loadParameterFile(std::string(HRG_GYRO_SOURCE_DIR) + "/config/params_uncalibrated.yaml"));
   const OfflineCalibration run = calibrateOnSimulation(c, params, CalibrationSettings());
   ASSERT_TRUE(run.outcome.accepted) << run.outcome.reason;
-  const DefectDiagnosis d = diagnoseDefects(run.outcome.scale_factor[0], run.outcome.quadrature_ratio,
-                                            params->correction);
+  const DefectDiagnosis d =
+      diagnoseDefects(run.outcome.scale_factor[0], run.outcome.quadrature_ratio, params->correction);
   expectRecovers(d, c, 3.0);
 }
 

@@ -78,8 +78,7 @@ DualRateEstimate estimateDualRate(const ThetaBinnedRates& g1, double r1, const T
     assign(&k, t, (c1[t] - c2[t]) / dr, std::hypot(s1[t], s2[t]) / std::abs(dr));
     assign(&d, t, (c2[t] * r1 - c1[t] * r2) / dr, std::hypot(s2[t] * r1, s1[t] * r2) / std::abs(dr));
   }
-  k.condition_number = d.condition_number =
-      std::max(e.group_fit[0].condition_number, e.group_fit[1].condition_number);
+  k.condition_number = d.condition_number = std::max(e.group_fit[0].condition_number, e.group_fit[1].condition_number);
 
   // Binned K and D where both groups have data; residuals against the (equally smoothed) fit.
   double k_ss = 0.0, d_ss = 0.0;

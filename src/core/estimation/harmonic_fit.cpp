@@ -1,9 +1,8 @@
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/Dense>
 
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/common/weighted_least_squares.h"

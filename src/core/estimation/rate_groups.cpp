@@ -101,9 +101,8 @@ bool RateGroups::add(Nanoseconds stamp, double theta, double y, std::uint64_t pl
 std::vector<std::size_t> RateGroups::byDuration() const {
   std::vector<std::size_t> idx(groups_.size());
   std::iota(idx.begin(), idx.end(), 0);
-  std::stable_sort(idx.begin(), idx.end(), [this](std::size_t a, std::size_t b) {
-    return groups_[a].totalTime() > groups_[b].totalTime();
-  });
+  std::stable_sort(idx.begin(), idx.end(),
+                   [this](std::size_t a, std::size_t b) { return groups_[a].totalTime() > groups_[b].totalTime(); });
   return idx;
 }
 

@@ -1,9 +1,8 @@
 #include "hrg_gyro/core/estimation/thermal_estimator.h"
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/Core>
 
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/common/weighted_least_squares.h"
@@ -23,8 +22,8 @@ struct Layout {
 
 /// One design row: the bin b of one group's slice, with the model taken at `frequency` (the bin's
 /// own mean frequency for the fit).
-void designRow(const Layout& layout, const std::vector<int>& orders, const ThetaBinnedRates& rates, int b,
-               double rate, double frequency, const FrequencyInterpolator& interpolator, std::vector<double>* weights,
+void designRow(const Layout& layout, const std::vector<int>& orders, const ThetaBinnedRates& rates, int b, double rate,
+               double frequency, const FrequencyInterpolator& interpolator, std::vector<double>* weights,
                std::vector<double>* basis, double* row) {
   interpolator.weights(frequency, weights->data());
   const double span = rates.windowSpan();
@@ -242,10 +241,9 @@ void pairBins(const JointProblem& jp, int bins, const Eigen::VectorXd& c, Therma
 
 }  // namespace
 
-ThermalEstimate estimateThermal(const RateGroup& group1, double rate1, const RateGroup& group2,
-                                double rate2, const FrequencyInterpolator& interpolator, int bins,
-                                const std::vector<int>& k_orders, const std::vector<int>& d_orders,
-                                double min_bin_time, double max_condition) {
+ThermalEstimate estimateThermal(const RateGroup& group1, double rate1, const RateGroup& group2, double rate2,
+                                const FrequencyInterpolator& interpolator, int bins, const std::vector<int>& k_orders,
+                                const std::vector<int>& d_orders, double min_bin_time, double max_condition) {
   ThermalEstimate e;
   if (!(std::abs(rate1 - rate2) > 0.0)) {
     e.reason = "the two plateau rates are equal";
@@ -256,12 +254,9 @@ ThermalEstimate estimateThermal(const RateGroup& group1, double rate1, const Rat
     return e;
   }
   const std::vector<int> orders = mergeOrders(k_orders, d_orders);
-  const JointProblem jp{{&group1, &group2},
-                        {rate1, rate2},
-                        orders,
-                        Layout{orders.size(), 1 + 2 * orders.size(), interpolator.size()},
-                        interpolator,
-                        min_bin_time};
+  const JointProblem jp{
+      {&group1, &group2}, {rate1, rate2}, orders, Layout{orders.size(), 1 + 2 * orders.size(), interpolator.size()},
+      interpolator,       min_bin_time};
   const std::size_t p = jp.layout.columns();
   const std::vector<Block> blocks = designBlocks(jp, &e);
   const std::size_t n = e.rows;

@@ -23,7 +23,8 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
     }
     session.addTurntable(s.stamp, s.truth.table_angle, s.truth.table_rate);
     const ProcessorResult r = proc.process({s.stamp, s.z, s.frequency, s.temperature});
-    if (r.has_wave) session.addWave(s.stamp, r.wave.theta, s.frequency, quadratureRatio(r.wave.quadrature, r.wave.amplitude));
+    if (r.has_wave)
+      session.addWave(s.stamp, r.wave.theta, s.frequency, quadratureRatio(r.wave.quadrature, r.wave.amplitude));
   }
   OfflineCalibration out;
   out.outcome = session.finish();
@@ -35,7 +36,8 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
 
 std::vector<EvaluationResult> verifyOnSimulation(const SimulationConfig& scenario,
                                                  const std::vector<std::shared_ptr<const GyroParameters>>& parameters,
-                                                 const EvaluationSettings& evaluation, const ProcessorConfig& processor) {
+                                                 const EvaluationSettings& evaluation,
+                                                 const ProcessorConfig& processor) {
   GyroSimulator sim(scenario);
   std::vector<GyroProcessor> processors;
   std::vector<OutputEvaluator> evaluators;

@@ -47,8 +47,8 @@ void printSessionSummary(std::ostream& out, const SessionSummary& s) {
   out << "calibration: method " << (s.has_calibration ? nameOf(c.method) : ParameterOrigin::none().name()) << ", "
       << (c.accepted ? "ACCEPTED" : "REFUSED");
   if (!c.accepted) out << " (" << c.reason << ")";
-  out << line(", %.0f s of data, coverage %.1f %%, smoothing factor %.6f (corrected)\n", c.duration,
-              100 * c.coverage, c.smoothing_factor, 0.0);
+  out << line(", %.0f s of data, coverage %.1f %%, smoothing factor %.6f (corrected)\n", c.duration, 100 * c.coverage,
+              c.smoothing_factor, 0.0);
   for (const GroupSummary& g : c.plateaus) {
     out << line("  plateau %+.5f rad/s: %.1f s, %.2f half-turns of theta, coverage %.1f %%\n", g.rate, g.duration,
                 g.turns, 100 * g.coverage);
@@ -69,8 +69,8 @@ void printSessionSummary(std::ostream& out, const SessionSummary& s) {
       ds[j] = e.sin[j] - (j < i.sin.size() ? i.sin[j] : 0.0);
     }
     const double err = HarmonicModel(e.orders, 0.0, dc, ds).peakDeviation() / std::abs(i.mean);
-    out << line("model error against the injected model (exact, no verification noise): peak %.3f ppm\n", 1e6 * err,
-                0, 0, 0);
+    out << line("model error against the injected model (exact, no verification noise): peak %.3f ppm\n", 1e6 * err, 0,
+                0, 0);
   }
   out << "verification (processor output against ground truth, dual-rate on the output):\n";
   out << "                           before (uncalibrated)   after (calibrated)\n";

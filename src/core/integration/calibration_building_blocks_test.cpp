@@ -2,10 +2,10 @@
 #include <gtest/gtest.h>
 
 #include "hrg_gyro/core/estimation/dual_rate_estimator.h"
-#include "hrg_gyro/core/simulation/gaussian_noise.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/estimation/plateau_detector.h"
 #include "hrg_gyro/core/estimation/theta_binned_rates.h"
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
 
 namespace hrg_gyro {
 namespace core {

@@ -1,8 +1,7 @@
 // The core library must build and run without ROS: no file under a core/ folder may include a ROS
 // header (roscpp, messages, nodelet, rosbag, diagnostics, pluginlib, or this package's messages).
-#include <gtest/gtest.h>
-
 #include <dirent.h>
+#include <gtest/gtest.h>
 
 #include <fstream>
 #include <regex>

@@ -4,6 +4,7 @@
 // Each folder says in its README.md what it holds and what it may include, and every unit test in a
 // folder is named after a module of that folder (foo.cpp / foo.h -> foo_test.cpp).
 #include <dirent.h>
+#include <gtest/gtest.h>
 
 #include <fstream>
 #include <map>
@@ -12,8 +13,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 namespace {
 
@@ -70,7 +69,8 @@ TEST_F(CoreLayoutTest, FoldersDependOneWay) {
   int checked = 0;
   for (const std::string& folder : kFolders) {
     std::vector<std::string> files;
-    for (const std::string& h : entries(include_ + "/" + folder, false)) files.push_back(include_ + "/" + folder + "/" + h);
+    for (const std::string& h : entries(include_ + "/" + folder, false))
+      files.push_back(include_ + "/" + folder + "/" + h);
     for (const std::string& c : entries(src_ + "/" + folder, false)) {
       if (endsWith(c, ".cpp") && !endsWith(c, "_test.cpp")) files.push_back(src_ + "/" + folder + "/" + c);
     }

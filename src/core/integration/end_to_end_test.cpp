@@ -3,9 +3,9 @@
 // "injected" model it is compared with and the correction-matrix stage.
 #include <gtest/gtest.h>
 
-#include "hrg_gyro/core/simulation/injected_model.h"
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
 #include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/simulation/injected_model.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -54,8 +54,8 @@ TEST(EndToEnd, DualRateCalibrationRemovesTheNonlinearity) {
   EXPECT_EQ(run.processor.rejected(), 0u);
 
   // Estimated harmonics within a few standard errors of the exact injected ones.
-  const EffectiveModel injected = computeEffectiveModel(cal, before->correction, settings.scale_factor_orders,
-                                                        settings.drift_orders);
+  const EffectiveModel injected =
+      computeEffectiveModel(cal, before->correction, settings.scale_factor_orders, settings.drift_orders);
   const HarmonicFitResult& k = run.outcome.scale_factor[0];
   EXPECT_NEAR(k.mean, injected.scale_factor.mean, 4 * k.mean_std);
   for (std::size_t j = 0; j < k.orders.size(); ++j) {

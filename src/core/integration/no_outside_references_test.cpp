@@ -3,9 +3,8 @@
 // project's own words; a citation of the old files would send a reader to something they cannot
 // open. The test walks the whole checkout (not the workspace, git's data or run outputs) and lists
 // every offending file:line.
-#include <gtest/gtest.h>
-
 #include <dirent.h>
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 
 #include <cctype>

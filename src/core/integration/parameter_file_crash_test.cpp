@@ -2,7 +2,6 @@
 // random points while it rewrites the file over and over, and after every kill the file (and its
 // backup) must load and equal one of the two parameter sets written, never a mixture or a fragment.
 #include <gtest/gtest.h>
-
 #include <signal.h>
 #include <sys/types.h>
 #include <sys/wait.h>

@@ -4,8 +4,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "hrg_gyro/core/simulation/simulation_config.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/simulation/simulation_config.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -87,9 +87,8 @@ std::string readFile(const std::string& path) {
 TEST(Scenarios, ShippedScenariosParseAndDescribeTheSameGyro) {
   const std::string dir = std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/";
   std::string reference_gyro;
-  for (const char* name :
-       {"dual_rate.yaml", "constant_rate.yaml", "steps.yaml", "verification.yaml", "generator.yaml", "demo.yaml",
-        "two_stage.yaml", "thermal_ramp.yaml"}) {
+  for (const char* name : {"dual_rate.yaml", "constant_rate.yaml", "steps.yaml", "verification.yaml", "generator.yaml",
+                           "demo.yaml", "two_stage.yaml", "thermal_ramp.yaml"}) {
     SCOPED_TRACE(name);
     const SimulationConfig c = SimulationConfig::load(dir + name, nodeOnlyScenarioKeys());
     EXPECT_EQ(c.resonator.samples_per_period, 32);

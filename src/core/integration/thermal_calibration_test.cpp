@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "core/testing/angle_level_session.h"
-#include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/calibration/thermal_method.h"
+#include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -34,8 +34,8 @@ AngleLevelGyro thermalGyro(double f_start, double f_end, double duration) {
   AngleLevelGyro g;
   const FrequencyInterpolator linear({4990.0, 5010.0}, Interpolation::kPiecewiseLinear);
   // Terms: mean, cos 2, cos 4, sin 2, sin 4.
-  g.k = HarmonicModel({2, 4}, linear,
-                      linearNodes({-0.56, -6e-4, 2e-3, 4e-4, 0.0}, {-2e-6, 1e-6, 1.5e-6, -0.5e-6, 0.0}));
+  g.k =
+      HarmonicModel({2, 4}, linear, linearNodes({-0.56, -6e-4, 2e-3, 4e-4, 0.0}, {-2e-6, 1e-6, 1.5e-6, -0.5e-6, 0.0}));
   g.d = HarmonicModel({2}, linear, linearNodes({1e-5, 2e-5, -1e-5}, {5e-7, -3e-7, 0.0}));
   g.earth_rate = verticalEarthRate(0.9);
   g.rate_hz = 200.0;
@@ -97,8 +97,10 @@ TEST(Thermal, RecoversFrequencyDependentKAndDAcrossARamp) {
     g.k.coefficientsAt(f, truth_k.data());
     g.d.coefficientsAt(f, truth_d.data());
     const std::vector<double> est_k = o.scale_factor[j].terms(), est_d = o.drift[j].terms();
-    for (std::size_t t = 0; t < est_k.size(); ++t) EXPECT_NEAR(est_k[t], truth_k[t], 1e-7) << "K term " << t << " node " << j;
-    for (std::size_t t = 0; t < est_d.size(); ++t) EXPECT_NEAR(est_d[t], truth_d[t], 1e-9) << "D term " << t << " node " << j;
+    for (std::size_t t = 0; t < est_k.size(); ++t)
+      EXPECT_NEAR(est_k[t], truth_k[t], 1e-7) << "K term " << t << " node " << j;
+    for (std::size_t t = 0; t < est_d.size(); ++t)
+      EXPECT_NEAR(est_d[t], truth_d[t], 1e-9) << "D term " << t << " node " << j;
   }
   // Across the calibrated range the frequency-dependent model leaves < 0.2 ppm (no noise here; the
   // dual-rate method itself errs by ~5e-8 in K0 on this profile). Outside the nodes the processor
@@ -140,9 +142,10 @@ TEST(Thermal, AFrequencyIndependentModelLeavesPpmThatTheSplineRemoves) {
     worst_thermal_scale =
         std::max(worst_thermal_scale, std::abs(scaleErrorPpm(thermal.parameters.scale_factor, g.k, f)));
   }
-  std::printf("[ measured ] over %.2f..%.2f Hz, worst residual nonlinearity and scale error: frequency-independent "
-              "%.2f ppm, %.2f ppm; thermal %.3f ppm, %.3f ppm\n",
-              nodes.front(), nodes.back(), worst_fixed, worst_fixed_scale, worst_thermal, worst_thermal_scale);
+  std::printf(
+      "[ measured ] over %.2f..%.2f Hz, worst residual nonlinearity and scale error: frequency-independent "
+      "%.2f ppm, %.2f ppm; thermal %.3f ppm, %.3f ppm\n",
+      nodes.front(), nodes.back(), worst_fixed, worst_fixed_scale, worst_thermal, worst_thermal_scale);
   EXPECT_GT(worst_fixed, 5.0);
   EXPECT_GT(worst_fixed_scale, 5.0);
   EXPECT_LT(worst_thermal, 1.0);
@@ -193,7 +196,8 @@ TEST(Thermal, ExplicitNodesAndTheirRange) {
   EXPECT_EQ(o.parameters.scale_factor.interpolator().kind(), Interpolation::kPiecewiseLinear);
   // The quarter of the ramp outside [4997, 5003] Hz is left out, and said so.
   bool noted = false;
-  for (const std::string& note : o.notes) noted = noted || note.find("outside the frequency nodes") != std::string::npos;
+  for (const std::string& note : o.notes)
+    noted = noted || note.find("outside the frequency nodes") != std::string::npos;
   EXPECT_TRUE(noted);
   std::vector<double> truth(g.k.termCount());
   g.k.coefficientsAt(5000.0, truth.data());

@@ -7,9 +7,9 @@
 #include <chrono>
 
 #include "core/testing/angle_level_session.h"
-#include "hrg_gyro/core/simulation/injected_model.h"
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
 #include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/simulation/injected_model.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -70,15 +70,17 @@ TEST(ThermalEndToEnd, RampCalibrationBringsTheResidualBelowOnePpmAcrossTheRange)
   // temperature (T from the node frequency).
   for (std::size_t j = 0; j < thermal.frequency_nodes.size(); ++j) {
     const double temperature = t.reference_temperature + (thermal.frequency_nodes[j] - f0) / t.frequency_coefficient;
-    const EffectiveModel exact = computeEffectiveModel(atTemperature(cal, temperature), prior->correction,
-                                                       thermal_settings.scale_factor_orders,
-                                                       thermal_settings.drift_orders);
+    const EffectiveModel exact =
+        computeEffectiveModel(atTemperature(cal, temperature), prior->correction, thermal_settings.scale_factor_orders,
+                              thermal_settings.drift_orders);
     const std::vector<double> k = thermal.scale_factor[j].terms(), k_sd = thermal.scale_factor[j].termStds();
     const std::vector<double> k_true = exact.scale_factor.terms();
-    for (std::size_t i = 0; i < k.size(); ++i) EXPECT_NEAR(k[i], k_true[i], 4 * k_sd[i]) << "K term " << i << " node " << j;
+    for (std::size_t i = 0; i < k.size(); ++i)
+      EXPECT_NEAR(k[i], k_true[i], 4 * k_sd[i]) << "K term " << i << " node " << j;
     const std::vector<double> d = thermal.drift[j].terms(), d_sd = thermal.drift[j].termStds();
     const std::vector<double> d_true = exact.drift.terms();
-    for (std::size_t i = 0; i < d.size(); ++i) EXPECT_NEAR(d[i], d_true[i], 4 * d_sd[i]) << "D term " << i << " node " << j;
+    for (std::size_t i = 0; i < d.size(); ++i)
+      EXPECT_NEAR(d[i], d_true[i], 4 * d_sd[i]) << "D term " << i << " node " << j;
   }
 
   // Across 15..35 degC: the frequency-independent model leaves several ppm, the spline < 1 ppm.
@@ -91,9 +93,10 @@ TEST(ThermalEndToEnd, RampCalibrationBringsTheResidualBelowOnePpmAcrossTheRange)
     const HarmonicModel truth = toModel(exact.scale_factor);
     const Residual a = residualAgainst(thermal.parameters.scale_factor, truth, f);
     const Residual b = residualAgainst(dual.parameters.scale_factor, truth, f);
-    std::printf("[ measured ] %4.1f degC %.1f Hz: frequency-independent %6.2f ppm (scale %+6.2f), thermal %.3f ppm "
-                "(scale %+.3f)\n",
-                temperature, f, b.nonlinearity_ppm, b.scale_ppm, a.nonlinearity_ppm, a.scale_ppm);
+    std::printf(
+        "[ measured ] %4.1f degC %.1f Hz: frequency-independent %6.2f ppm (scale %+6.2f), thermal %.3f ppm "
+        "(scale %+.3f)\n",
+        temperature, f, b.nonlinearity_ppm, b.scale_ppm, a.nonlinearity_ppm, a.scale_ppm);
     thermal_worst = std::max(thermal_worst, a.nonlinearity_ppm);
     dual_worst = std::max(dual_worst, b.nonlinearity_ppm);
     thermal_scale = std::max(thermal_scale, std::abs(a.scale_ppm));
@@ -113,11 +116,12 @@ TEST(ThermalEndToEnd, RampCalibrationBringsTheResidualBelowOnePpmAcrossTheRange)
   const auto results = verifyOnSimulation(ver, {std::make_shared<const GyroParameters>(dual.parameters),
                                                 std::make_shared<const GyroParameters>(thermal.parameters)});
   ASSERT_TRUE(results[0].ok && results[1].ok) << results[0].reason << results[1].reason;
-  std::printf("[ measured ] verification at 35 degC: frequency-independent %.2f +- %.2f ppm, thermal %.2f +- %.2f "
-              "ppm; %.1f s wall for the whole test\n",
-              results[0].nonlinearity_ppm, results[0].nonlinearity_sigma_ppm, results[1].nonlinearity_ppm,
-              results[1].nonlinearity_sigma_ppm,
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  std::printf(
+      "[ measured ] verification at 35 degC: frequency-independent %.2f +- %.2f ppm, thermal %.2f +- %.2f "
+      "ppm; %.1f s wall for the whole test\n",
+      results[0].nonlinearity_ppm, results[0].nonlinearity_sigma_ppm, results[1].nonlinearity_ppm,
+      results[1].nonlinearity_sigma_ppm,
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   EXPECT_GT(results[0].nonlinearity_ppm, 10.0);
   EXPECT_LT(results[1].nonlinearity_ppm, 3.5 * results[1].nonlinearity_sigma_ppm + 0.5);
 }

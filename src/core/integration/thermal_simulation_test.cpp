@@ -31,12 +31,12 @@ TEST(TemperatureProfile, HoldRampAndLaggedStep) {
       20.0);
   EXPECT_EQ(p.evaluate(-1.0), 20.0);
   EXPECT_EQ(p.evaluate(5.0), 20.0);
-  EXPECT_NEAR(p.evaluate(60.0), 25.0, 1e-12);   // half way up the ramp
-  EXPECT_NEAR(p.evaluate(110.0), 30.0, 1e-12);  // its end
-  EXPECT_NEAR(p.evaluate(115.0), 27.5, 1e-12);  // 0.5 degC/s down: 10 s to 25
+  EXPECT_NEAR(p.evaluate(60.0), 25.0, 1e-12);                                  // half way up the ramp
+  EXPECT_NEAR(p.evaluate(110.0), 30.0, 1e-12);                                 // its end
+  EXPECT_NEAR(p.evaluate(115.0), 27.5, 1e-12);                                 // 0.5 degC/s down: 10 s to 25
   EXPECT_NEAR(p.evaluate(120.0 + 10.0), 15.0 + 10.0 * std::exp(-1.0), 1e-12);  // one time constant
-  EXPECT_NEAR(p.evaluate(170.0 + 1e-9), 40.0, 1e-12);  // an instant step
-  EXPECT_EQ(p.evaluate(1e6), 40.0);                    // held after the end
+  EXPECT_NEAR(p.evaluate(170.0 + 1e-9), 40.0, 1e-12);                          // an instant step
+  EXPECT_EQ(p.evaluate(1e6), 40.0);                                            // held after the end
   EXPECT_NEAR(p.duration(), 175.0, 1e-12);
   EXPECT_EQ(p.minimum(), 15.0 + 10.0 * std::exp(-5.0));
   EXPECT_EQ(p.maximum(), 40.0);
@@ -78,13 +78,15 @@ TEST(ThermalScenario, BadKeysAreNamed) {
         "thermal.frequency_coefficient");
   check("thermal: {coefficients: {amplitude: -0.006}, profile: [{type: ramp, to: 190, duration: 10}]}\n",
         "thermal.coefficients.amplitude");
-  check("pickoff: {gain_error: [0, 0, 0, 0, 0, 0.45, 0, 0]}\n"
-        "thermal: {coefficients: {gain_error: [0, 0, 0, 0, 0, 0.0009, 0, 0]}, "
-        "profile: [{type: ramp, to: 150, duration: 10}]}\n",
-        "thermal.coefficients.gain_error[5]");
-  check("thermal: {coefficients: {scale_factor: {orders: [], mean: 0.01, cos: [], sin: []}},"
-        " profile: [{type: ramp, to: 90, duration: 10}]}\n",
-        "thermal.coefficients.scale_factor");
+  check(
+      "pickoff: {gain_error: [0, 0, 0, 0, 0, 0.45, 0, 0]}\n"
+      "thermal: {coefficients: {gain_error: [0, 0, 0, 0, 0, 0.0009, 0, 0]}, "
+      "profile: [{type: ramp, to: 150, duration: 10}]}\n",
+      "thermal.coefficients.gain_error[5]");
+  check(
+      "thermal: {coefficients: {scale_factor: {orders: [], mean: 0.01, cos: [], sin: []}},"
+      " profile: [{type: ramp, to: 90, duration: 10}]}\n",
+      "thermal.coefficients.scale_factor");
 }
 
 TEST(ThermalScenario, ShippedRampReportsTemperatureAndFrequency) {

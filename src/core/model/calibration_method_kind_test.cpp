@@ -1,5 +1,7 @@
 // The calibration method as a type (its one list, names, traits, the parameter file's provenance),
 // and the texts users read the method list from, checked against that one list.
+#include "hrg_gyro/core/model/calibration_method_kind.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,7 +12,6 @@
 #include <stdexcept>
 #include <vector>
 
-#include "hrg_gyro/core/model/calibration_method_kind.h"
 #include "hrg_gyro/core/calibration/calibration_settings.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
@@ -156,8 +157,8 @@ TEST(CalibrationMethodKindTest, ParameterTemplateAndDocsListEveryMethod) {
   // docs/calibration.md: one row of the method table per method.
   const std::string doc = readSourceFile("docs/calibration.md");
   for (CalibrationMethodKind k : allCalibrationMethods()) {
-    EXPECT_NE(doc.find("\n| `" + nameOf(k) + "`"), std::string::npos) << "docs/calibration.md: no table row for "
-                                                                        << nameOf(k);
+    EXPECT_NE(doc.find("\n| `" + nameOf(k) + "`"), std::string::npos)
+        << "docs/calibration.md: no table row for " << nameOf(k);
   }
 }
 

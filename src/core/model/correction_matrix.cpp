@@ -10,20 +10,21 @@ namespace core {
 
 Eigen::Matrix4d CorrectionMatrix::matrix() const {
   Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
-  m(kAc, kAc) = p[0];  m(kAc, kAs) = p[2];
-  m(kBc, kBc) = p[0];  m(kBc, kBs) = p[2];
-  m(kAs, kAc) = -p[3]; m(kAs, kAs) = p[1];
-  m(kBs, kBc) = -p[3]; m(kBs, kBs) = p[1];
+  m(kAc, kAc) = p[0];
+  m(kAc, kAs) = p[2];
+  m(kBc, kBc) = p[0];
+  m(kBc, kBs) = p[2];
+  m(kAs, kAc) = -p[3];
+  m(kAs, kAs) = p[1];
+  m(kBs, kBc) = -p[3];
+  m(kBs, kBs) = p[1];
   return m;
 }
 
 void CorrectionMatrixEstimator::add(const ChannelVector& z, const ChannelVector& zm) {
   // (E - P) z - zm = 0  <=>  P z = z - zm; P z is linear in p with these rows (one per channel).
   Eigen::Matrix4d j;
-  j << z[kAc], 0.0, z[kAs], 0.0,
-       z[kBc], 0.0, z[kBs], 0.0,
-       0.0, z[kAs], 0.0, -z[kAc],
-       0.0, z[kBs], 0.0, -z[kBc];
+  j << z[kAc], 0.0, z[kAs], 0.0, z[kBc], 0.0, z[kBs], 0.0, 0.0, z[kAs], 0.0, -z[kAc], 0.0, z[kBs], 0.0, -z[kBc];
   const Eigen::Vector4d y = z - zm;
   jtj_.noalias() += j.transpose() * j;
   jty_.noalias() += j.transpose() * y;
@@ -41,8 +42,8 @@ CorrectionMatrixEstimator::Result CorrectionMatrixEstimator::solve(double max_co
   const LeastSquaresSolution fit = solveNormalEquations(jtj_, jty_, ColumnScaling::kNone, max_condition);
   r.condition_number = fit.condition_number;
   if (!fit.ok) {
-    r.reason = "generator sweep does not determine p1..p4 (condition number " +
-               std::to_string(r.condition_number) + "): spread theta over [0, pi)";
+    r.reason = "generator sweep does not determine p1..p4 (condition number " + std::to_string(r.condition_number) +
+               "): spread theta over [0, pi)";
     return r;
   }
   const Eigen::VectorXd& p = fit.coefficients;

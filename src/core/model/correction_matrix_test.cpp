@@ -80,18 +80,20 @@ TEST(CorrectionMatrixTest, PaperZmTypoMakesThe2ThetaErrorWorse) {
   // (measured: 2.2x at B = 0.1, 8.5x at B = 0.2) where the right Z_m removes it completely.
   const PickoffDefects d = linearDefects();
   const double b = 0.2;
-  const auto typo = fitFromGenerator(
-      d,
-      [](const WaveParameters& w) {
-        ChannelVector z = idealChannels(w);
-        z[kBs] = -w.amplitude * std::sin(w.theta) * std::sin(w.phase) +
-                 w.quadrature * std::sin(w.theta) * std::cos(w.phase);
-        return z;
-      },
-      {b, -b});
+  const auto typo = fitFromGenerator(d,
+                                     [](const WaveParameters& w) {
+                                       ChannelVector z = idealChannels(w);
+                                       z[kBs] = -w.amplitude * std::sin(w.theta) * std::sin(w.phase) +
+                                                w.quadrature * std::sin(w.theta) * std::cos(w.phase);
+                                       return z;
+                                     },
+                                     {b, -b});
   const auto right = fitFromGenerator(d, [](const WaveParameters& w) { return idealChannels(w); }, {b, -b});
   const WaveParameters wave{1.0, b, 0.0, 0.4};
-  const double raw = [&] { const auto h = testing::sweepAngleError(d, wave); return std::hypot(h.c[2], h.s[2]); }();
+  const double raw = [&] {
+    const auto h = testing::sweepAngleError(d, wave);
+    return std::hypot(h.c[2], h.s[2]);
+  }();
   const auto with_typo = testing::sweepAngleError(d, wave, typo.correction);
   const auto with_right = testing::sweepAngleError(d, wave, right.correction);
   EXPECT_GT(std::hypot(with_typo.c[2], with_typo.s[2]), 5.0 * raw);

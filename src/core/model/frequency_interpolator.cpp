@@ -1,10 +1,9 @@
 #include "hrg_gyro/core/model/frequency_interpolator.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-#include <Eigen/LU>
 
 namespace hrg_gyro {
 namespace core {
@@ -28,7 +27,8 @@ FrequencyInterpolator::FrequencyInterpolator(std::vector<double> nodes, Interpol
     : nodes_(std::move(nodes)), kind_(kind) {
   if (nodes_.empty()) throw std::invalid_argument("at least one frequency node is required");
   for (std::size_t j = 0; j < nodes_.size(); ++j) {
-    if (!std::isfinite(nodes_[j])) throw std::invalid_argument("frequency node " + std::to_string(j) + " is not finite");
+    if (!std::isfinite(nodes_[j]))
+      throw std::invalid_argument("frequency node " + std::to_string(j) + " is not finite");
     if (j > 0 && !(nodes_[j] > nodes_[j - 1])) {
       throw std::invalid_argument("frequency nodes must be strictly increasing (node " + std::to_string(j) + ")");
     }

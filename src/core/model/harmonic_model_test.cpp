@@ -1,11 +1,12 @@
 // The unified harmonic model, its recurrence basis and the frequency interpolation.
+#include "hrg_gyro/core/model/harmonic_model.h"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "hrg_gyro/core/model/harmonic_basis.h"
-#include "hrg_gyro/core/model/harmonic_model.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/harmonic_basis.h"
 
 namespace hrg_gyro {
 namespace core {

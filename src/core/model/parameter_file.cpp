@@ -72,7 +72,8 @@ HarmonicModel parseModel(const YamlField& f, ModelKind kind) {
     const YamlField list = f[part];
     list.requireSequence();
     if (list.size() != n) {
-      list.fail("expected " + std::to_string(n) + " entries (one per harmonic order), got " + std::to_string(list.size()));
+      list.fail("expected " + std::to_string(n) + " entries (one per harmonic order), got " +
+                std::to_string(list.size()));
     }
     const std::size_t row0 = std::strcmp(part, "cos") == 0 ? 1 : 1 + n;
     for (std::size_t i = 0; i < n; ++i) {
@@ -95,16 +96,19 @@ HarmonicModel parseModel(const YamlField& f, ModelKind kind) {
       }
       if (std::abs(m0) < kMinScaleFactorMagnitude || std::abs(m0) > kMaxScaleFactorMagnitude) {
         f["mean"].fail("|K0| must be in [" + formatDouble(kMinScaleFactorMagnitude) + ", " +
-                       formatDouble(kMaxScaleFactorMagnitude) + "] (K0 = -2k, Bryan factor k below 1; -0.56 for a "
-                       "hemisphere); got " + formatDouble(m0) + where);
+                       formatDouble(kMaxScaleFactorMagnitude) +
+                       "] (K0 = -2k, Bryan factor k below 1; -0.56 for a "
+                       "hemisphere); got " +
+                       formatDouble(m0) + where);
       }
       if (harmonics >= 0.5 * std::abs(m0)) {
         f.fail("harmonics too large: sum of |cos| + |sin| = " + formatDouble(harmonics) +
                " must stay below |K0|/2 so that K(theta) keeps its sign" + where);
       }
     } else if (std::abs(m0) + harmonics > kMaxDriftMagnitude) {
-      f.fail("drift coefficients add up to " + formatDouble(std::abs(m0) + harmonics) + " rad/s, above the plausible limit of " +
-             formatDouble(kMaxDriftMagnitude) + " rad/s (units are rad/s of electrical angle)" + where);
+      f.fail("drift coefficients add up to " + formatDouble(std::abs(m0) + harmonics) +
+             " rad/s, above the plausible limit of " + formatDouble(kMaxDriftMagnitude) +
+             " rad/s (units are rad/s of electrical angle)" + where);
     }
   };
   for (std::size_t j = 0; j < nodes; ++j) {
@@ -149,8 +153,7 @@ void emitModel(YAML::Emitter& out, const HarmonicModel& m) {
     out << YAML::EndSeq;
   };
   out << YAML::BeginMap;
-  out << YAML::Key << "orders" << YAML::Value << YAML::Flow << m.orders()
-      << YAML::Comment("harmonic orders k (even)");
+  out << YAML::Key << "orders" << YAML::Value << YAML::Flow << m.orders() << YAML::Comment("harmonic orders k (even)");
   if (fdep) {
     out << YAML::Key << "frequency_nodes" << YAML::Value << YAML::Flow << YAML::BeginSeq;
     for (double f : m.interpolator().nodes()) out << formatDouble(f);
@@ -192,7 +195,8 @@ GyroParameters parseParameters(const YAML::Node& root) {
   cm.rejectUnknownKeys({"p"});
   const std::vector<double> pv = cm["p"].asDoubles(4);
   for (int i = 0; i < 4; ++i) {
-    if (std::abs(pv[i]) >= 0.5) cm["p"].at(i).fail("|p" + std::to_string(i + 1) + "| must be below 0.5 (a small correction)");
+    if (std::abs(pv[i]) >= 0.5)
+      cm["p"].at(i).fail("|p" + std::to_string(i + 1) + "| must be below 0.5 (a small correction)");
     p.correction.p[i] = pv[i];
   }
 
@@ -303,7 +307,8 @@ void saveParameterFile(const std::string& path, const GyroParameters& parameters
   file.write(text);
   // What is on disk, read back through the same bounded reader the processor uses.
   file.commit([&](const std::string& temporary) {
-    if (loadParameterFile(temporary) != parameters) throw std::runtime_error("written file reads back differently: " + temporary);
+    if (loadParameterFile(temporary) != parameters)
+      throw std::runtime_error("written file reads back differently: " + temporary);
   });
 }
 

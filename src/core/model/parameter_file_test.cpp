@@ -1,6 +1,7 @@
 // Parameter file: round trips, key-by-key rejections with the key named, atomic save with backup.
-#include <gtest/gtest.h>
+#include "hrg_gyro/core/model/parameter_file.h"
 
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -8,15 +9,12 @@
 #include <unistd.h>
 
 #include <chrono>
-
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <set>
 #include <sstream>
-
-#include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -28,7 +26,6 @@ std::string readText(const std::string& path) {
   ss << in.rdbuf();
   return ss.str();
 }
-
 
 class TempDir {
  public:
@@ -165,7 +162,8 @@ TEST(ParameterFileTest, RejectsBadKeysNamingThem) {
   // Found by the fuzzer: text that is not UTF-8 would not read back as written.
   expectRejected(std::string(kValid) + "calibration:\n  notes: \"a\xff\"\n", "calibration.notes", "UTF-8");
   expectRejected(std::string(kValid) + "calibration:\n  time: \"\xc0\xaf\"\n", "calibration.time", "UTF-8");
-  EXPECT_NO_THROW(parseParameterText(std::string(kValid) + "calibration:\n  notes: \"d\xc3\xa9j\xc3\xa0 vu \xe2\x9c\x93\"\n"));
+  EXPECT_NO_THROW(
+      parseParameterText(std::string(kValid) + "calibration:\n  notes: \"d\xc3\xa9j\xc3\xa0 vu \xe2\x9c\x93\"\n"));
   // Found by the fuzzer: a map or a list used as a key escaped as a yaml-cpp conversion error.
   expectRejected(replaced("earth_rate:", "{e: 0}: 1\nearth_rate:"), "", "plain names");
   expectRejected(replaced("  enabled: true", "  [a, b]: 1\n  enabled: true"), "earth_rate", "plain names");
@@ -176,11 +174,13 @@ TEST(ParameterFileTest, RejectsBadKeysNamingThem) {
 // values at two nodes bulges to 0.32 between them (|K0|/2 = 0.28). Piecewise-linear interpolation
 // of the same nodes cannot overshoot and is accepted.
 TEST(ParameterFileTest, SplineOvershootBetweenNodesIsRejected) {
-  const std::string sf = "scale_factor:\n  orders: [2]\n  frequency_nodes: [4990.0, 5000.0, 5010.0, 5020.0]\n"
-                         "  mean: [-0.56, -0.56, -0.56, -0.56]\n  cos: [[0.0, 0.279, 0.279, 0.0]]\n"
-                         "  sin: [[0.0, 0.0, 0.0, 0.0]]\n";
-  const std::string old_sf = "scale_factor:\n  orders: [2, 4]\n  mean: -0.56\n  cos: [1.0e-3, 2.0e-4]\n"
-                             "  sin: [0.0, -1.0e-4]\n";
+  const std::string sf =
+      "scale_factor:\n  orders: [2]\n  frequency_nodes: [4990.0, 5000.0, 5010.0, 5020.0]\n"
+      "  mean: [-0.56, -0.56, -0.56, -0.56]\n  cos: [[0.0, 0.279, 0.279, 0.0]]\n"
+      "  sin: [[0.0, 0.0, 0.0, 0.0]]\n";
+  const std::string old_sf =
+      "scale_factor:\n  orders: [2, 4]\n  mean: -0.56\n  cos: [1.0e-3, 2.0e-4]\n"
+      "  sin: [0.0, -1.0e-4]\n";
   ASSERT_NE(std::string(kValid).find(old_sf), std::string::npos);
   const std::string spline = replaced(old_sf, sf);
   expectRejected(spline, "scale_factor", "between frequency nodes 1 and 2");
@@ -262,14 +262,17 @@ std::string withFrequencyNodes(std::size_t nodes) {
 
 TEST(ParameterFileTest, DuplicateKeysAreRefusedWithTheirPath) {
   // yaml-cpp keeps the first of two equal keys; the second must not be dropped without a word.
-  expectRejected(std::string(kValid) + "earth_rate:\n  enabled: false\n  latitude: 0.1\n", "earth_rate", "more than once");
+  expectRejected(std::string(kValid) + "earth_rate:\n  enabled: false\n  latitude: 0.1\n", "earth_rate",
+                 "more than once");
   expectRejected(replaced("  mean: -0.56", "  mean: -0.56\n  mean: -0.57"), "scale_factor.mean", "more than once");
-  expectRejected(replaced("  latitude: 0.9", "  latitude: 0.9\n  enabled: false"), "earth_rate.enabled", "more than once");
+  expectRejected(replaced("  latitude: 0.9", "  latitude: 0.9\n  enabled: false"), "earth_rate.enabled",
+                 "more than once");
 }
 
 TEST(ParameterFileTest, FrequencyNodeCountIsLimitedBeforeAnyWork) {
   EXPECT_NO_THROW(parseParameterText(withFrequencyNodes(kMaxFrequencyNodes)));
-  expectRejected(withFrequencyNodes(kMaxFrequencyNodes + 1), "scale_factor.frequency_nodes", "at most 64 frequency nodes");
+  expectRejected(withFrequencyNodes(kMaxFrequencyNodes + 1), "scale_factor.frequency_nodes",
+                 "at most 64 frequency nodes");
   // 20000 nodes used to end in bad_alloc after minutes of cubic work: now refused at once.
   const std::string huge = withFrequencyNodes(20000);
   const auto start = std::chrono::steady_clock::now();
@@ -280,16 +283,17 @@ TEST(ParameterFileTest, FrequencyNodeCountIsLimitedBeforeAnyWork) {
 TEST(ParameterFileTest, ScaleFactorMeanMustBePhysical) {
   // -1e308 made the output stop integrating, -1e-300 made the processor reject most samples.
   for (const char* k0 : {"-1.0e308", "-1.0e-300", "-2.5", "-0.005"}) {
-    expectRejected(replaced("  mean: -0.56", std::string("  mean: ") + k0), "scale_factor.mean", "|K0| must be in [0.01, 2.0]");
+    expectRejected(replaced("  mean: -0.56", std::string("  mean: ") + k0), "scale_factor.mean",
+                   "|K0| must be in [0.01, 2.0]");
   }
   for (const char* k0 : {"-0.01", "-2.0", "-0.3", "-1.12"}) {
     EXPECT_NO_THROW(parseParameterText(replaced("  mean: -0.56", std::string("  mean: ") + k0))) << k0;
   }
   // The same bound at every frequency node.
-  const std::string nodes = replaced(
-      "  orders: [2, 4]\n  mean: -0.56\n  cos: [1.0e-3, 2.0e-4]\n  sin: [0.0, -1.0e-4]\n",
-      "  orders: [2]\n  frequency_nodes: [4990.0, 5010.0]\n  interpolation: piecewise_linear\n"
-      "  mean: [-0.56, -1.0e-300]\n  cos: [[0.0, 0.0]]\n  sin: [[0.0, 0.0]]\n");
+  const std::string nodes =
+      replaced("  orders: [2, 4]\n  mean: -0.56\n  cos: [1.0e-3, 2.0e-4]\n  sin: [0.0, -1.0e-4]\n",
+               "  orders: [2]\n  frequency_nodes: [4990.0, 5010.0]\n  interpolation: piecewise_linear\n"
+               "  mean: [-0.56, -1.0e-300]\n  cos: [[0.0, 0.0]]\n  sin: [[0.0, 0.0]]\n");
   expectRejected(nodes, "scale_factor.mean", "at frequency node 1");
 }
 

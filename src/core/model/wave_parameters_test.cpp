@@ -1,11 +1,11 @@
 // The wave parameters' guarded quadrature ratio B/A.
+#include "hrg_gyro/core/model/wave_parameters.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
 #include <vector>
-
-#include "hrg_gyro/core/model/wave_parameters.h"
 
 namespace hrg_gyro {
 namespace core {

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/processing/gyro_processor.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -24,8 +24,10 @@ void BiasCaptureSettings::validate() const {
   if (!(block > 0.0) || !(block <= duration)) {
     throw ConfigError("bias_capture/block", "must be positive and at most bias_capture/duration (s)");
   }
-  if (!(max_motion > 0.0) || !std::isfinite(max_motion)) throw ConfigError("bias_capture/max_motion", "must be positive (rad/s)");
-  if (!(max_bias > 0.0) || !std::isfinite(max_bias)) throw ConfigError("bias_capture/max_bias", "must be positive (rad/s)");
+  if (!(max_motion > 0.0) || !std::isfinite(max_motion))
+    throw ConfigError("bias_capture/max_motion", "must be positive (rad/s)");
+  if (!(max_bias > 0.0) || !std::isfinite(max_bias))
+    throw ConfigError("bias_capture/max_bias", "must be positive (rad/s)");
 }
 
 BiasCapture::BiasCapture(const BiasCaptureSettings& settings, const GyroParameters& in_force)

@@ -1,13 +1,14 @@
 // Turn-on bias capture against a wave integrated from a known gyro at rest: the captured D0 is the
 // true one (harmonics of D and K and the Earth rate accounted for), and motion, constant rotation,
 // gaps and bad settings are refused with a reason.
+#include "hrg_gyro/core/processing/bias_capture.h"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "hrg_gyro/core/processing/bias_capture.h"
-#include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/processing/gyro_processor.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -53,7 +54,8 @@ TEST(BiasCaptureTest, RecoversTheTrueDriftAtRest) {
   BiasCaptureSettings settings;
   settings.duration = 20.0;
   BiasCapture capture(settings, in_force);
-  run(&capture, real, in_force, [](double) { return 0.0; }, 30.0);
+  run(
+      &capture, real, in_force, [](double) { return 0.0; }, 30.0);
   ASSERT_TRUE(capture.finished());
   const BiasCaptureResult r = capture.result();
   ASSERT_TRUE(r.accepted) << r.reason;
@@ -67,7 +69,8 @@ TEST(BiasCaptureTest, RecoversTheTrueDriftAtRest) {
   EXPECT_EQ(r.parameters.scale_factor, in_force.scale_factor);
   // Through the refreshed model the output at rest is the Earth rate.
   BiasCapture check(settings, r.parameters);
-  run(&check, real, r.parameters, [](double) { return 0.0; }, 30.0);
+  run(
+      &check, real, r.parameters, [](double) { return 0.0; }, 30.0);
   EXPECT_NEAR(check.result().mean_rate, real.earth_rate.verticalRate(), 2e-9);
 }
 
@@ -79,7 +82,8 @@ TEST(BiasCaptureTest, AngleNoiseAveragesOut) {
   settings.duration = 10.0;
   BiasCapture capture(settings, in_force);
   const double sigma = 2e-6;  // rad of angle noise per sample
-  run(&capture, real, in_force, [](double) { return 0.0; }, 20.0, sigma);
+  run(
+      &capture, real, in_force, [](double) { return 0.0; }, 20.0, sigma);
   const BiasCaptureResult r = capture.result();
   ASSERT_TRUE(r.accepted) << r.reason;
   // White angle noise leaves sqrt(2) sigma / T on the mean rate (first and last samples only).
@@ -92,7 +96,8 @@ TEST(BiasCaptureTest, RefusesMotion) {
   settings.duration = 10.0;
   BiasCapture capture(settings, real);
   // Someone turns the table by 0.01 rad/s for a second in the middle.
-  run(&capture, real, real, [](double t) { return t > 4.0 && t < 5.0 ? 0.01 : 0.0; }, 20.0);
+  run(
+      &capture, real, real, [](double t) { return t > 4.0 && t < 5.0 ? 0.01 : 0.0; }, 20.0);
   ASSERT_TRUE(capture.finished());
   const BiasCaptureResult r = capture.result();
   EXPECT_FALSE(r.accepted);
@@ -105,7 +110,8 @@ TEST(BiasCaptureTest, RefusesConstantRotation) {
   BiasCaptureSettings settings;
   settings.duration = 5.0;
   BiasCapture capture(settings, real);
-  run(&capture, real, real, [](double) { return 0.02; }, 10.0);
+  run(
+      &capture, real, real, [](double) { return 0.02; }, 10.0);
   const BiasCaptureResult r = capture.result();
   EXPECT_FALSE(r.accepted);
   EXPECT_NE(r.reason.find("turning"), std::string::npos) << r.reason;

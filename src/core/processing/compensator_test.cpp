@@ -1,9 +1,9 @@
 // The compensation step recovers the body rotation from a wave angle that obeys
 // d theta = K(theta) (d alpha + Omega_E dt) + D(theta) dt (docs/math.md, 'Dynamics and
 // compensation').
-#include <gtest/gtest.h>
-
 #include "hrg_gyro/core/processing/compensator.h"
+
+#include <gtest/gtest.h>
 
 namespace hrg_gyro {
 namespace core {

@@ -41,7 +41,9 @@ void validate(const ProcessorConfig& c) {
 }
 
 GyroProcessor::GyroProcessor(const ProcessorConfig& config, std::shared_ptr<const GyroParameters> parameters)
-    : config_(config), compensator_(std::move(parameters)), max_abs_k0_(largestMean(compensator_.parameters().scale_factor)) {}
+    : config_(config),
+      compensator_(std::move(parameters)),
+      max_abs_k0_(largestMean(compensator_.parameters().scale_factor)) {}
 
 void GyroProcessor::setParameters(std::shared_ptr<const GyroParameters> parameters) {
   const CorrectionMatrix old_p = compensator_.parameters().correction;
@@ -71,11 +73,20 @@ void GyroProcessor::reset() {
 
 void GyroProcessor::countRejection(WaveStatus status) {
   switch (status) {
-    case WaveStatus::kNonFinite: ++counters_.non_finite; break;
-    case WaveStatus::kNoSignal: ++counters_.no_signal; break;
-    case WaveStatus::kDegenerate: ++counters_.degenerate; break;
-    case WaveStatus::kAmplitudeOutOfRange: ++counters_.amplitude_out_of_range; break;
-    case WaveStatus::kOk: break;
+    case WaveStatus::kNonFinite:
+      ++counters_.non_finite;
+      break;
+    case WaveStatus::kNoSignal:
+      ++counters_.no_signal;
+      break;
+    case WaveStatus::kDegenerate:
+      ++counters_.degenerate;
+      break;
+    case WaveStatus::kAmplitudeOutOfRange:
+      ++counters_.amplitude_out_of_range;
+      break;
+    case WaveStatus::kOk:
+      break;
   }
 }
 

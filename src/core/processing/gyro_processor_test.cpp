@@ -1,9 +1,10 @@
 // The processor's handling of bad input and time: reject, count, flag, recover, never NaN.
+#include "hrg_gyro/core/processing/gyro_processor.h"
+
 #include <gtest/gtest.h>
 
 #include <limits>
 
-#include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 
 namespace hrg_gyro {
@@ -64,7 +65,7 @@ TEST_F(GyroProcessorTest, RejectsBadValuesCountsThemAndRecovers) {
   ASSERT_TRUE(r.has_output);
   expectFinite(r);
   EXPECT_EQ(r.rejected_before, 4u);
-  EXPECT_NEAR(r.increment.dt, 0.005, 1e-15);  // the increment spans the rejected samples
+  EXPECT_NEAR(r.increment.dt, 0.005, 1e-15);            // the increment spans the rejected samples
   EXPECT_NEAR(r.alpha, -0.028 * 0.006 / -0.56, 1e-12);  // nothing lost
   EXPECT_EQ(proc_.counters().non_finite, 1u);
   EXPECT_EQ(proc_.counters().amplitude_out_of_range, 1u);
@@ -229,7 +230,6 @@ TEST(GyroProcessorModelSwapTest, ANewCorrectionMatrixDoesNotStepTheAngle) {
   EXPECT_FALSE(r.flags & kFlagGap);
 }
 
-
 // The limits' one rule set (the node and hrg_bag both apply it): each refusal names its key.
 TEST(ProcessorConfigTest, AcceptsTheDefaultsAndNamesTheKeyOfEachRefusal) {
   EXPECT_NO_THROW(validate(ProcessorConfig{}));
@@ -248,7 +248,8 @@ TEST(ProcessorConfigTest, AcceptsTheDefaultsAndNamesTheKeyOfEachRefusal) {
       {"min_anisotropy", [](ProcessorConfig& c) { c.limits.min_anisotropy = 0.0; }},
       {"min_amplitude", [](ProcessorConfig& c) { c.limits.min_amplitude = -1.0; }},
       {"max_amplitude", [](ProcessorConfig& c) { c.limits.max_amplitude = 0.0; }},
-      {"max_amplitude", [](ProcessorConfig& c) {
+      {"max_amplitude",
+       [](ProcessorConfig& c) {
          c.limits.min_amplitude = 5.0;
          c.limits.max_amplitude = 1.0;
        }},

@@ -38,8 +38,7 @@ PickoffSignature PickoffArray::signature() const {
   return sig;
 }
 
-std::array<double, kPickoffCount> PickoffArray::sensorOutputs(const WaveParameters& wave,
-                                                              double carrier_phase) const {
+std::array<double, kPickoffCount> PickoffArray::sensorOutputs(const WaveParameters& wave, double carrier_phase) const {
   const double u = wave.amplitude * std::cos(carrier_phase + wave.phase);
   const double v = wave.quadrature * std::sin(carrier_phase + wave.phase);
   std::array<double, kPickoffCount> d{};
@@ -73,10 +72,14 @@ Eigen::Matrix4d PickoffArray::linearChannelMap() const {
     a22 += g * sin2psi_[i] * ((i / 2) % 2 == 0 ? 1.0 : -1.0);
   }
   Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
-  m(kAc, kAc) = a11;  m(kAc, kAs) = a12;
-  m(kBc, kBc) = a11;  m(kBc, kBs) = a12;
-  m(kAs, kAc) = -a21; m(kAs, kAs) = a22;
-  m(kBs, kBc) = -a21; m(kBs, kBs) = a22;
+  m(kAc, kAc) = a11;
+  m(kAc, kAs) = a12;
+  m(kBc, kBc) = a11;
+  m(kBc, kBs) = a12;
+  m(kAs, kAc) = -a21;
+  m(kAs, kAs) = a22;
+  m(kBs, kBc) = -a21;
+  m(kBs, kBs) = a22;
   return m;
 }
 

@@ -1,14 +1,15 @@
 // Demodulation of the eight-pickoff channels: the exact closed form (docs/math.md, 'Channel amplitudes').
+#include "hrg_gyro/core/signal/synchronous_demodulator.h"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "hrg_gyro/core/signal/pickoff_array.h"
-#include "hrg_gyro/core/simulation/signal_synthesizer.h"
-#include "hrg_gyro/core/signal/synchronous_demodulator.h"
 #include "hrg_gyro/core/common/units.h"
-#include "hrg_gyro/core/signal/wave_estimator.h"
 #include "hrg_gyro/core/model/wave_parameters.h"
+#include "hrg_gyro/core/signal/pickoff_array.h"
+#include "hrg_gyro/core/signal/wave_estimator.h"
+#include "hrg_gyro/core/simulation/signal_synthesizer.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -29,7 +30,8 @@ WaveParameters randomWave(std::mt19937_64& rng) {
 ChannelVector demodulateFromSensors(const PickoffArray& pickoffs, const WaveParameters& w, int n) {
   SynchronousDemodulator demod(n);
   std::vector<double> c(n), s(n);
-  for (int j = 0; j < n; ++j) PickoffArray::formChannels(pickoffs.sensorOutputs(w, demod.carrierPhase(j)), &c[j], &s[j]);
+  for (int j = 0; j < n; ++j)
+    PickoffArray::formChannels(pickoffs.sensorOutputs(w, demod.carrierPhase(j)), &c[j], &s[j]);
   return demod.demodulate(c.data(), s.data());
 }
 
@@ -70,7 +72,8 @@ TEST(SynchronousDemodulatorTest, FastChannelPathEqualsSensorFormula) {
     double c_ref, s_ref, c, s;
     PickoffArray::formChannels(pickoffs.sensorOutputs(w, phase), &c_ref, &s_ref);
     const double u = w.amplitude * std::cos(phase + w.phase), v = w.quadrature * std::sin(phase + w.phase);
-    pickoffs.channels(u * std::cos(w.theta) - v * std::sin(w.theta), u * std::sin(w.theta) + v * std::cos(w.theta), &c, &s);
+    pickoffs.channels(u * std::cos(w.theta) - v * std::sin(w.theta), u * std::sin(w.theta) + v * std::cos(w.theta), &c,
+                      &s);
     EXPECT_NEAR(c, c_ref, 1e-15);
     EXPECT_NEAR(s, s_ref, 1e-15);
   }

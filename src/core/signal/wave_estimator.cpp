@@ -10,11 +10,16 @@ namespace core {
 
 const char* toString(WaveStatus status) {
   switch (status) {
-    case WaveStatus::kOk: return "ok";
-    case WaveStatus::kNonFinite: return "non-finite channel amplitude";
-    case WaveStatus::kNoSignal: return "no signal (energy below floor)";
-    case WaveStatus::kDegenerate: return "degenerate wave (A close to B, theta undefined)";
-    case WaveStatus::kAmplitudeOutOfRange: return "amplitude out of range";
+    case WaveStatus::kOk:
+      return "ok";
+    case WaveStatus::kNonFinite:
+      return "non-finite channel amplitude";
+    case WaveStatus::kNoSignal:
+      return "no signal (energy below floor)";
+    case WaveStatus::kDegenerate:
+      return "degenerate wave (A close to B, theta undefined)";
+    case WaveStatus::kAmplitudeOutOfRange:
+      return "amplitude out of range";
   }
   return "unknown";
 }

@@ -1,12 +1,13 @@
 // Wave state from Z (docs/math.md, 'Wave angle') and unwrapping.
+#include "hrg_gyro/core/signal/wave_estimator.h"
+
 #include <gtest/gtest.h>
 
 #include <limits>
 #include <random>
 
-#include "hrg_gyro/core/signal/theta_unwrapper.h"
 #include "hrg_gyro/core/common/units.h"
-#include "hrg_gyro/core/signal/wave_estimator.h"
+#include "hrg_gyro/core/signal/theta_unwrapper.h"
 
 namespace hrg_gyro {
 namespace core {

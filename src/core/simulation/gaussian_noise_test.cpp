@@ -1,6 +1,6 @@
-#include <gtest/gtest.h>
-
 #include "hrg_gyro/core/simulation/gaussian_noise.h"
+
+#include <gtest/gtest.h>
 
 namespace hrg_gyro {
 namespace core {
@@ -22,8 +22,8 @@ TEST(GaussianNoiseTest, HasUnitNormalMoments) {
   m4 /= n;
   EXPECT_NEAR(m1, 0.0, 5 / std::sqrt(n));
   EXPECT_NEAR(m2, 1.0, 5 * std::sqrt(2.0 / n));
-  EXPECT_NEAR(m4, 3.0, 0.03);                  // kurtosis of a normal
-  EXPECT_NEAR(tail / n, 0.0026998, 0.0003);    // P(|x| > 3)
+  EXPECT_NEAR(m4, 3.0, 0.03);                // kurtosis of a normal
+  EXPECT_NEAR(tail / n, 0.0026998, 0.0003);  // P(|x| > 3)
 }
 
 TEST(GaussianNoiseTest, IsReproducibleBySeed) {

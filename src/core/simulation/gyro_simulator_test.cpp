@@ -1,8 +1,9 @@
 // The simulator against its own ground truth, and its determinism.
+#include "hrg_gyro/core/simulation/gyro_simulator.h"
+
 #include <gtest/gtest.h>
 
 #include "hrg_gyro/core/processing/gyro_processor.h"
-#include "hrg_gyro/core/simulation/gyro_simulator.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -124,7 +125,8 @@ TEST(GyroSimulatorTest, GeneratorSweepsKnownWaves) {
   std::vector<double> thetas;
   while (sim.next(&s)) {
     EXPECT_TRUE(s.truth.generator);
-    EXPECT_LT((s.z - idealChannels({s.truth.amplitude, s.truth.quadrature, s.truth.theta, s.truth.phase})).norm(), 1e-12);
+    EXPECT_LT((s.z - idealChannels({s.truth.amplitude, s.truth.quadrature, s.truth.theta, s.truth.phase})).norm(),
+              1e-12);
     thetas.push_back(s.truth.theta);
   }
   ASSERT_EQ(thetas.size(), 4u * 2u * 2u);

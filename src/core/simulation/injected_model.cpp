@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
-#include "hrg_gyro/core/simulation/signal_synthesizer.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
+#include "hrg_gyro/core/simulation/signal_synthesizer.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -23,7 +23,8 @@ EffectiveModel computeEffectiveModel(const SimulationConfig& config, const Corre
   for (int j = -1; j <= m; ++j) {
     const double theta = j * h;
     WaveState w;
-    estimateWave(correction.apply(synth.period({rc.amplitude, rc.quadrature, theta, rc.phase}, theta)), WaveLimits{}, &w);
+    estimateWave(correction.apply(synth.period({rc.amplitude, rc.quadrature, theta, rc.phase}, theta)), WaveLimits{},
+                 &w);
     measured[j + 1] = theta + wrapToPi(2.0 * (w.theta - theta)) / 2.0;
   }
   std::vector<FitPoint> kp, dp;

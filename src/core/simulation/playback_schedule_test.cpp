@@ -1,9 +1,9 @@
 #include "hrg_gyro/core/simulation/playback_schedule.h"
 
+#include <gtest/gtest.h>
+
 #include <limits>
 #include <stdexcept>
-
-#include <gtest/gtest.h>
 
 namespace hrg_gyro {
 namespace core {

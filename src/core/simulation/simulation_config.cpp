@@ -8,10 +8,9 @@ namespace hrg_gyro {
 namespace core {
 
 const std::vector<std::string>& nodeOnlyScenarioKeys() {
-  static const std::vector<std::string> keys = {"time_scale",         "clock_period", "frame_id",
-                                                "publish_clock",      "wait_for_subscribers",
-                                                "wait_timeout",       "shutdown_when_done", "queue_size",
-                                                "max_lag"};
+  static const std::vector<std::string> keys = {"time_scale",         "clock_period",         "frame_id",
+                                                "publish_clock",      "wait_for_subscribers", "wait_timeout",
+                                                "shutdown_when_done", "queue_size",           "max_lag"};
   return keys;
 }
 
@@ -174,7 +173,8 @@ SimulationConfig SimulationConfig::load(const std::string& path, const std::vect
   } catch (const YAML::BadFile&) {
     throw ConfigError("", "cannot read scenario file '" + path + "'");
   } catch (const YAML::ParserException& e) {
-    throw ConfigError("", "YAML syntax error in '" + path + "' at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    throw ConfigError("",
+                      "YAML syntax error in '" + path + "' at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   return parse(YamlField(root, ""), extra_keys);
 }

@@ -7,8 +7,8 @@
 #include <functional>
 
 #include "hrg_gyro/core/calibration/calibration_session.h"
-#include "hrg_gyro/core/simulation/gaussian_noise.h"
 #include "hrg_gyro/core/model/model_pair_evaluator.h"
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
 #include "hrg_gyro/core/simulation/turntable_profile.h"
 
 namespace hrg_gyro {
@@ -18,9 +18,9 @@ namespace testing {
 struct AngleLevelGyro {
   HarmonicModel k{-0.56};
   HarmonicModel d{0.0};
-  double earth_rate = 0.0;   ///< rad/s
-  double noise = 0.0;        ///< white angle noise per sample, rad
-  double rate_noise = 0.0;   ///< noise on the reported table rate, rad/s
+  double earth_rate = 0.0;  ///< rad/s
+  double noise = 0.0;       ///< white angle noise per sample, rad
+  double rate_noise = 0.0;  ///< noise on the reported table rate, rad/s
   double rate_hz = 1000.0;
   double theta0 = 0.2;
   std::uint64_t seed = 7;
@@ -59,9 +59,8 @@ inline void runAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profi
 /// The same without the frequency: sink(stamp, table_angle, table_rate_reported, theta_measured).
 inline void runAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profile,
                           const std::function<void(Nanoseconds, double, double, double)>& sink) {
-  runAngleLevel(g, profile, [&](Nanoseconds t, double angle, double rate, double theta, double) {
-    sink(t, angle, rate, theta);
-  });
+  runAngleLevel(g, profile,
+                [&](Nanoseconds t, double angle, double rate, double theta, double) { sink(t, angle, rate, theta); });
 }
 
 inline CalibrationOutcome calibrateAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profile,

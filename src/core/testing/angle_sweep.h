@@ -5,10 +5,10 @@
 #include <cmath>
 #include <vector>
 
-#include "hrg_gyro/core/model/correction_matrix.h"
-#include "hrg_gyro/core/simulation/signal_synthesizer.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/correction_matrix.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
+#include "hrg_gyro/core/simulation/signal_synthesizer.h"
 
 namespace hrg_gyro {
 namespace core {

@@ -32,23 +32,26 @@ int runAllan(const AllanOptions& o) {
   core::GyroProcessor processor(o.processor, params);
   // Continuous stretches of the integrated angle; the longest one is analysed.
   std::vector<double> current, best, dts;
-  replayChannels(*bag, topics.channels, processor, [&](const ChannelAmplitudes&, const core::ProcessorResult& r) {
-    if (!r.has_output) return;
-    if (r.flags & (core::kFlagGap | core::kFlagReset)) {
-      if (current.size() > best.size()) best.swap(current);
-      current.clear();
-    }
-    current.push_back(r.alpha);
-    dts.push_back(r.increment.dt);
-  }, "allan");
+  replayChannels(
+      *bag, topics.channels, processor,
+      [&](const ChannelAmplitudes&, const core::ProcessorResult& r) {
+        if (!r.has_output) return;
+        if (r.flags & (core::kFlagGap | core::kFlagReset)) {
+          if (current.size() > best.size()) best.swap(current);
+          current.clear();
+        }
+        current.push_back(r.alpha);
+        dts.push_back(r.increment.dt);
+      },
+      "allan");
   if (current.size() > best.size()) best.swap(current);
   if (best.size() < 100) throw UsageError("fewer than 100 continuous samples: nothing to analyse");
   std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
   const double tau0 = dts[dts.size() / 2];
   const core::AllanResult a = core::allanDeviation(best, tau0);
   constexpr double kDegPerHour = 180.0 / M_PI * 3600.0;
-  std::printf("allan: %zu samples, tau0 %.6f s, %zu points from %.3g s to %.3g s\n", best.size(), tau0,
-              a.curve.size(), a.curve.front().tau, a.curve.back().tau);
+  std::printf("allan: %zu samples, tau0 %.6f s, %zu points from %.3g s to %.3g s\n", best.size(), tau0, a.curve.size(),
+              a.curve.front().tau, a.curve.back().tau);
   auto reading = [](const char* name, const core::NoiseReading& r, double scale, const char* unit, double si_scale,
                     const char* si_unit) {
     if (!r.identified) {
@@ -87,7 +90,7 @@ Command addAllanCommand(CLI::App& root) {
   cmd->add_option("BAG", o->bag, "input bag with the gyro's channels (a static session)")->required();
   cmd->add_option("--params", o->params, "parameter file (default: the nominal model)")->check(tools::notEmpty());
   CLI::Option* csv = cmd->add_option("--csv", o->csv, "output CSV: tau (s), deviation and its error (rad/s), clusters")
-      ->check(tools::notEmpty());
+                         ->check(tools::notEmpty());
   cmd->add_option("--plot", o->plot, "PNG drawn from the CSV")->needs(csv)->check(tools::notEmpty());
   addTopicOptions(*cmd, &o->topics, false);
   addProcessorOptions(*cmd, &o->processor);

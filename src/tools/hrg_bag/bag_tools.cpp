@@ -1,5 +1,7 @@
 #include "bag_tools.h"
 
+#include <ros/package.h>
+#include <rosbag/exceptions.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <sys/wait.h>
@@ -13,23 +15,18 @@
 #include <cstring>
 #include <fstream>
 
-#include <ros/package.h>
-#include <rosbag/exceptions.h>
-
+#include "../cli_checks.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/core/common/output_directory.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/ros/conversions.h"
-#include "../cli_checks.h"
 
 namespace hrg_gyro {
 namespace bag_tools {
 namespace {
 
-double now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 }  // namespace
 
@@ -159,8 +156,9 @@ std::unique_ptr<rosbag::Bag> openBag(const std::string& path) {
     throw UsageError("bag '" + path + "' is truncated or corrupt: " + e.what());
   } catch (const rosbag::BagIOException& e) {
     // The header points at an index past the end of the file: cut short after it was closed.
-    throw UsageError("bag '" + path + "' is truncated or unindexed (copy cut short?): run `rosbag reindex` on a copy (" +
-                     e.what() + ")");
+    throw UsageError("bag '" + path +
+                     "' is truncated or unindexed (copy cut short?): run `rosbag reindex` on a copy (" + e.what() +
+                     ")");
   } catch (const rosbag::BagException& e) {
     throw UsageError("cannot open bag '" + path + "': " + e.what());
   }
@@ -168,12 +166,14 @@ std::unique_ptr<rosbag::Bag> openBag(const std::string& path) {
 }
 
 void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_truth) {
-  command.add_option("--channels-topic", chosen->channels,
-                     "hrg_gyro/ChannelAmplitudes topic (default: the only one in the bag)")
+  command
+      .add_option("--channels-topic", chosen->channels,
+                  "hrg_gyro/ChannelAmplitudes topic (default: the only one in the bag)")
       ->check(tools::notEmpty());
   if (!turntable_and_truth) return;
-  command.add_option("--turntable-topic", chosen->turntable,
-                     "hrg_gyro/TurntableState topic (default: the only one in the bag)")
+  command
+      .add_option("--turntable-topic", chosen->turntable,
+                  "hrg_gyro/TurntableState topic (default: the only one in the bag)")
       ->check(tools::notEmpty());
   command.add_option("--truth-topic", chosen->truth, "hrg_gyro/GroundTruth topic (default: the only one in the bag)")
       ->check(tools::notEmpty());
@@ -208,8 +208,10 @@ GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool nee
     return found.front();
   };
   GyroTopics t;
-  t.channels = pick(chosen.channels, "channels-topic", ros::message_traits::datatype<ChannelAmplitudes>(), need_channels);
-  t.turntable = pick(chosen.turntable, "turntable-topic", ros::message_traits::datatype<TurntableState>(), need_turntable);
+  t.channels =
+      pick(chosen.channels, "channels-topic", ros::message_traits::datatype<ChannelAmplitudes>(), need_channels);
+  t.turntable =
+      pick(chosen.turntable, "turntable-topic", ros::message_traits::datatype<TurntableState>(), need_turntable);
   t.truth = pick(chosen.truth, "truth-topic", ros::message_traits::datatype<GroundTruth>(), false);
   return t;
 }
@@ -226,8 +228,8 @@ void Progress::update(double done, std::uint64_t items) {
   last_ = t;
   last_percent_ = percent;
   const double rate = items / std::max(1e-9, t - start_);
-  std::fprintf(stderr, tty_ ? "\r%s: %5.1f %% (%.0f samples/s)   " : "%s: %5.1f %% (%.0f samples/s)\n",
-               what_.c_str(), percent, rate);
+  std::fprintf(stderr, tty_ ? "\r%s: %5.1f %% (%.0f samples/s)   " : "%s: %5.1f %% (%.0f samples/s)\n", what_.c_str(),
+               percent, rate);
   std::fflush(stderr);
 }
 
@@ -335,8 +337,9 @@ std::string imageExtension(const std::string& path) {
   const std::size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return ".png";
   const std::string extension = path.substr(dot);
-  const bool plain = extension.size() >= 2 && extension.size() <= 8 &&
-                     std::all_of(extension.begin() + 1, extension.end(), [](unsigned char c) { return std::isalnum(c) != 0; });
+  const bool plain =
+      extension.size() >= 2 && extension.size() <= 8 &&
+      std::all_of(extension.begin() + 1, extension.end(), [](unsigned char c) { return std::isalnum(c) != 0; });
   return plain ? extension : ".png";
 }
 

@@ -3,6 +3,10 @@
 // same core::GyroProcessor the processor node runs.
 #pragma once
 
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+
+#include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstdint>
 #include <functional>
@@ -10,10 +14,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
 
 #include "hrg_gyro/ChannelAmplitudes.h"
 #include "hrg_gyro/core/common/atomic_file.h"

@@ -44,8 +44,8 @@ int runCalibrate(const CalibrateOptions& o) {
   if (!o.method.empty()) settings.method = core::parseCalibrationMethod(o.method);  // checked by --method's validator
   const core::CalibrationMethodTraits& method = core::traitsOf(settings.method);
   const std::string& out_path = o.out;
-  const auto prior = std::make_shared<const core::GyroParameters>(
-      o.params.empty() ? core::GyroParameters() : core::loadParameterFile(o.params));
+  const auto prior = std::make_shared<const core::GyroParameters>(o.params.empty() ? core::GyroParameters()
+                                                                                   : core::loadParameterFile(o.params));
   const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
   const GyroTopics topics = findTopics(*bag, o.topics, true, method.needs_turntable);
   if (method.uses_generator_pairs && topics.truth.empty()) {
@@ -78,7 +78,8 @@ int runCalibrate(const CalibrateOptions& o) {
         }
         const core::ProcessorResult r = processor.process(in);
         if (r.has_wave) {
-          session.addWave(in.stamp, r.wave.theta, in.frequency, core::quadratureRatio(r.wave.quadrature, r.wave.amplitude));
+          session.addWave(in.stamp, r.wave.theta, in.frequency,
+                          core::quadratureRatio(r.wave.quadrature, r.wave.amplitude));
         }
       } else if (m.getTopic() == topics.turntable) {
         const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
@@ -156,10 +157,11 @@ Command addCalibrateCommand(CLI::App& root) {
       ->check(tools::notEmpty());
   cmd->add_option("--params", o->params, "prior parameter file (default: the nominal model at latitude 0)")
       ->check(tools::notEmpty());
-  cmd->add_option("--config", o->config, "calibrator settings (YAML: bins, window, gates/..., thermal/..., as the node's)")
+  cmd->add_option("--config", o->config,
+                  "calibrator settings (YAML: bins, window, gates/..., thermal/..., as the node's)")
       ->check(tools::notEmpty());
-  CLI::Option* report = cmd->add_option("--report", o->report, "calibration report (YAML), written either way")
-      ->check(tools::notEmpty());
+  CLI::Option* report =
+      cmd->add_option("--report", o->report, "calibration report (YAML), written either way")->check(tools::notEmpty());
   cmd->add_option("--plot", o->plot, "PNG drawn from the report")->needs(report)->check(tools::notEmpty());
   addTopicOptions(*cmd, &o->topics, true);
   addProcessorOptions(*cmd, &o->processor);

@@ -32,9 +32,12 @@ struct StampStats {
     }
     max_record_lag = std::max(max_record_lag, std::abs(record.toSec() - t));
     if (has_prev) {
-      if (t == prev) ++duplicate;
-      else if (t < prev) ++backwards;
-      else dts.push_back(t - prev);
+      if (t == prev)
+        ++duplicate;
+      else if (t < prev)
+        ++backwards;
+      else
+        dts.push_back(t - prev);
       if (h.seq > prev_seq + 1) seq_lost += h.seq - prev_seq - 1;
     } else {
       first = t;
@@ -70,10 +73,11 @@ int runInfo(const InfoOptions& o) {
   std::map<std::string, std::pair<std::string, std::uint64_t>> topics;
   for (const rosbag::ConnectionInfo* c : all.getConnections()) topics[c->topic].first = c->datatype;
   for (const auto& kv : topics) topics[kv.first].second = rosbag::View(*bag, rosbag::TopicQuery(kv.first)).size();
-  std::printf("bag %s: %.3f s, %u messages\n", o.bag.c_str(),
-              (all.getEndTime() - all.getBeginTime()).toSec(), all.size());
-  for (const auto& kv : topics) std::printf("  %-28s %-34s %10lu\n", kv.first.c_str(), kv.second.first.c_str(),
-                                            static_cast<unsigned long>(kv.second.second));
+  std::printf("bag %s: %.3f s, %u messages\n", o.bag.c_str(), (all.getEndTime() - all.getBeginTime()).toSec(),
+              all.size());
+  for (const auto& kv : topics)
+    std::printf("  %-28s %-34s %10lu\n", kv.first.c_str(), kv.second.first.c_str(),
+                static_cast<unsigned long>(kv.second.second));
   int errors = 0, warnings = 0;
   GyroTopics t;
   try {
@@ -120,8 +124,10 @@ int runInfo(const InfoOptions& o) {
     if (s.zero || s.duplicate || s.backwards) {
       std::printf("  ERROR: %lu zero, %lu duplicate, %lu backward stamps\n", static_cast<unsigned long>(s.zero),
                   static_cast<unsigned long>(s.duplicate), static_cast<unsigned long>(s.backwards));
-      if (required) ++errors;
-      else ++warnings;
+      if (required)
+        ++errors;
+      else
+        ++warnings;
     }
   };
   report(t.channels, scan<ChannelAmplitudes>(*bag, t.channels), true);

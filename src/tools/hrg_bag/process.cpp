@@ -15,13 +15,20 @@ namespace {
 
 const char* verdictName(const core::ProcessorResult& r) {
   switch (r.verdict) {
-    case core::SampleVerdict::kAccepted: return "accepted";
-    case core::SampleVerdict::kFirst: return "first";
-    case core::SampleVerdict::kRejectedValue: return "rejected_value";
-    case core::SampleVerdict::kRejectedStamp: return "rejected_stamp";
-    case core::SampleVerdict::kDuplicate: return "duplicate";
-    case core::SampleVerdict::kOutOfOrder: return "out_of_order";
-    case core::SampleVerdict::kRejectedJump: return "rejected_jump";
+    case core::SampleVerdict::kAccepted:
+      return "accepted";
+    case core::SampleVerdict::kFirst:
+      return "first";
+    case core::SampleVerdict::kRejectedValue:
+      return "rejected_value";
+    case core::SampleVerdict::kRejectedStamp:
+      return "rejected_stamp";
+    case core::SampleVerdict::kDuplicate:
+      return "duplicate";
+    case core::SampleVerdict::kOutOfOrder:
+      return "out_of_order";
+    case core::SampleVerdict::kRejectedJump:
+      return "rejected_jump";
   }
   return "unknown";
 }
@@ -94,61 +101,64 @@ int runProcess(const ProcessOptions& o) {
   std::uint64_t outputs = 0;
   CsvRow row;
   std::string csv_buffer;
-  replayChannels(*in, topics.channels, processor, [&](const ChannelAmplitudes& msg, const core::ProcessorResult& r) {
-    const WaveState wave = toWaveMessage(msg, r.wave, o.frame_id);
-    const GyroOutput output = toOutputMessage(wave.header, r);
-    if (out && r.has_wave) out->write("/wave", msg.header.stamp, wave);
-    if (out && r.has_output) out->write("/output", msg.header.stamp, output);
-    outputs += r.has_output ? 1 : 0;
-    if (csv_file) {
-      row.clear();
-      row.stamp(msg.header.stamp.sec, msg.header.stamp.nsec);
-      row.integer(msg.header.seq);
-      row.text(verdictName(r));
-      const bool o = r.has_output, w = r.has_wave;
-      row.number(output.dt, o);
-      row.number(output.dtheta, o);
-      row.number(output.dalpha, o);
-      row.number(output.dalpha_earth_fixed, o);
-      row.number(r.alpha, w);
-      row.number(output.rate, o);
-      row.number(output.theta_mid, o);
-      row.number(output.frequency, o);
-      row.number(output.scale_factor, o);
-      row.number(output.drift, o);
-      if (o) {
-        row.integer(output.rejected_before);
-        row.integer(output.flags);
-      } else {
-        row.text("");
-        row.text("");
-      }
-      row.number(wave.theta, w);
-      row.number(wave.amplitude, w);
-      row.number(wave.quadrature, w);
-      row.number(wave.phase, w);
-      row.end();
-      csv_buffer += row.line();
-      if (csv_buffer.size() > (1u << 20)) {
-        csv_file->stream() << csv_buffer;
-        csv_buffer.clear();
-      }
-    }
-  }, "process");
+  replayChannels(
+      *in, topics.channels, processor,
+      [&](const ChannelAmplitudes& msg, const core::ProcessorResult& r) {
+        const WaveState wave = toWaveMessage(msg, r.wave, o.frame_id);
+        const GyroOutput output = toOutputMessage(wave.header, r);
+        if (out && r.has_wave) out->write("/wave", msg.header.stamp, wave);
+        if (out && r.has_output) out->write("/output", msg.header.stamp, output);
+        outputs += r.has_output ? 1 : 0;
+        if (csv_file) {
+          row.clear();
+          row.stamp(msg.header.stamp.sec, msg.header.stamp.nsec);
+          row.integer(msg.header.seq);
+          row.text(verdictName(r));
+          const bool o = r.has_output, w = r.has_wave;
+          row.number(output.dt, o);
+          row.number(output.dtheta, o);
+          row.number(output.dalpha, o);
+          row.number(output.dalpha_earth_fixed, o);
+          row.number(r.alpha, w);
+          row.number(output.rate, o);
+          row.number(output.theta_mid, o);
+          row.number(output.frequency, o);
+          row.number(output.scale_factor, o);
+          row.number(output.drift, o);
+          if (o) {
+            row.integer(output.rejected_before);
+            row.integer(output.flags);
+          } else {
+            row.text("");
+            row.text("");
+          }
+          row.number(wave.theta, w);
+          row.number(wave.amplitude, w);
+          row.number(wave.quadrature, w);
+          row.number(wave.phase, w);
+          row.end();
+          csv_buffer += row.line();
+          if (csv_buffer.size() > (1u << 20)) {
+            csv_file->stream() << csv_buffer;
+            csv_buffer.clear();
+          }
+        }
+      },
+      "process");
   if (csv_file) {
     csv_file->stream() << csv_buffer;
     csv_file->commit();
   }
   if (out) out->commit();
   const core::ProcessorCounters& c = processor.counters();
-  std::cerr << "process: " << c.received << " samples, " << outputs << " outputs, " << c.rejected()
-            << " rejected, " << c.gaps << " gaps, " << c.resets << " resets\n";
+  std::cerr << "process: " << c.received << " samples, " << outputs << " outputs, " << c.rejected() << " rejected, "
+            << c.gaps << " gaps, " << c.resets << " resets\n";
   if (c.accepted == 0) {
     // Nothing usable: an output file of rejections only is not a successful run.
     std::cerr << "process: no sample accepted (" << c.non_finite << " non-finite, " << c.no_signal << " no signal, "
               << c.degenerate << " degenerate, " << c.amplitude_out_of_range << " amplitude out of range, "
-              << c.zero_stamp << " zero stamp, " << c.duplicate << " duplicate, " << c.out_of_order
-              << " out of order, " << c.jumps << " jumps)\n";
+              << c.zero_stamp << " zero stamp, " << c.duplicate << " duplicate, " << c.out_of_order << " out of order, "
+              << c.jumps << " jumps)\n";
     return 1;
   }
   return 0;

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "hrg_gyro/core/calibration/calibration_method_interface.h"
-#include "hrg_gyro/core/model/correction_matrix.h"
 #include "hrg_gyro/core/estimation/dwell_fit.h"
 #include "hrg_gyro/core/estimation/rate_groups.h"
+#include "hrg_gyro/core/model/correction_matrix.h"
 
 namespace hrg_gyro {
 namespace core {

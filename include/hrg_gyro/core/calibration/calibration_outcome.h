@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "hrg_gyro/core/model/correction_matrix.h"
 #include "hrg_gyro/core/estimation/defect_diagnosis.h"
 #include "hrg_gyro/core/estimation/dual_rate_estimator.h"
-#include "hrg_gyro/core/model/gyro_parameters.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
+#include "hrg_gyro/core/model/correction_matrix.h"
+#include "hrg_gyro/core/model/gyro_parameters.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -36,24 +36,24 @@ struct GateResult {
 struct CalibrationOutcome {
   CalibrationMethodKind method = CalibrationMethodKind::kDualRate;
   bool accepted = false;
-  std::string reason;               ///< first failed gate, or why no estimate exists
-  GyroParameters parameters;        ///< prior with the new estimates (meaningful when accepted)
+  std::string reason;                           ///< first failed gate, or why no estimate exists
+  GyroParameters parameters;                    ///< prior with the new estimates (meaningful when accepted)
   std::vector<HarmonicFitResult> scale_factor;  ///< one entry (or one per frequency node)
   std::vector<HarmonicFitResult> drift;
-  std::vector<double> frequency_nodes;          ///< Hz; empty when frequency independent
+  std::vector<double> frequency_nodes;  ///< Hz; empty when frequency independent
   bool has_correction = false;
   CorrectionMatrixEstimator::Result correction;
   double coverage = 0.0;
   double smoothing_factor = 1.0;
-  double error_bound = 0.0;         ///< the paper's bound for K (dimensionless)
-  double nonlinearity_ppm = 0.0;    ///< peak |K(theta) - K0| / |K0| of the fitted model
-  double duration = 0.0;            ///< s of data used
+  double error_bound = 0.0;       ///< the paper's bound for K (dimensionless)
+  double nonlinearity_ppm = 0.0;  ///< peak |K(theta) - K0| / |K0| of the fitted model
+  double duration = 0.0;          ///< s of data used
   std::uint64_t samples = 0;
   std::vector<GroupSummary> plateaus;
   std::vector<GateResult> gates;
   std::vector<BinnedCurvePoint> binned;  ///< binned K and D (dual-rate) or step points
   std::vector<std::string> notes;
-  double quadrature_ratio = 0.0;          ///< mean |B/A| of the wave samples (F of the diagnosis)
+  double quadrature_ratio = 0.0;           ///< mean |B/A| of the wave samples (F of the diagnosis)
   std::vector<DefectDiagnosis> diagnosis;  ///< one per scale_factor fit with 2 and 4 theta terms
 
   /// Appends a gate; the first failing one becomes the reason.

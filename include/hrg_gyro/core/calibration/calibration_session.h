@@ -12,8 +12,8 @@
 #include <memory>
 
 #include "hrg_gyro/core/calibration/calibration_method_interface.h"
-#include "hrg_gyro/core/model/gyro_parameters.h"
 #include "hrg_gyro/core/common/ring_buffer.h"
+#include "hrg_gyro/core/model/gyro_parameters.h"
 
 namespace hrg_gyro {
 namespace core {

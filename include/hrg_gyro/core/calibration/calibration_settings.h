@@ -6,28 +6,28 @@
 #include <string>
 #include <vector>
 
+#include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/estimation/plateau_detector.h"
 #include "hrg_gyro/core/model/calibration_method_kind.h"
 #include "hrg_gyro/core/model/frequency_interpolator.h"
-#include "hrg_gyro/core/estimation/plateau_detector.h"
-#include "hrg_gyro/core/common/yaml_field.h"
 
 namespace hrg_gyro {
 namespace core {
 
 /// Acceptance thresholds. A result that fails any is refused and nothing is written.
 struct QualityLimits {
-  double min_coverage = 0.95;          ///< fraction of theta bins with data, per plateau group
-  double min_rate_separation = 0.01;   ///< rad/s between the two dual-rate groups
-  double max_rate_noise = 1e-3;        ///< std of the reported table rate / |rate| within a group
-  std::uint64_t min_samples = 1000;    ///< wave samples used
-  double max_condition = 1e4;          ///< of the harmonic design matrix
-  double max_relative_residual = 1e-3; ///< rms of binned K about the fit / |K0|
-  double max_k0_change = 0.2;          ///< |K0 - K0 prior| / |K0 prior|
-  double max_harmonic_std = 1e-5;      ///< largest standard error of a K harmonic / |K0|
-  int min_steps = 8;                   ///< step method: steps used
-  double min_dwell_time = 5.0;         ///< s of static data (step and constant-rate methods)
-  std::uint64_t min_pairs = 24;        ///< correction-matrix method: generator samples
-  double max_p_condition = 1e3;        ///< correction-matrix method
+  double min_coverage = 0.95;           ///< fraction of theta bins with data, per plateau group
+  double min_rate_separation = 0.01;    ///< rad/s between the two dual-rate groups
+  double max_rate_noise = 1e-3;         ///< std of the reported table rate / |rate| within a group
+  std::uint64_t min_samples = 1000;     ///< wave samples used
+  double max_condition = 1e4;           ///< of the harmonic design matrix
+  double max_relative_residual = 1e-3;  ///< rms of binned K about the fit / |K0|
+  double max_k0_change = 0.2;           ///< |K0 - K0 prior| / |K0 prior|
+  double max_harmonic_std = 1e-5;       ///< largest standard error of a K harmonic / |K0|
+  int min_steps = 8;                    ///< step method: steps used
+  double min_dwell_time = 5.0;          ///< s of static data (step and constant-rate methods)
+  std::uint64_t min_pairs = 24;         ///< correction-matrix method: generator samples
+  double max_p_condition = 1e3;         ///< correction-matrix method
 };
 
 /// The thermal method (K and D as splines over the resonator frequency, thermal_method.h).
@@ -45,11 +45,11 @@ struct CalibrationSettings {
   CalibrationMethodKind method = CalibrationMethodKind::kDualRate;
   std::vector<int> scale_factor_orders{2, 4, 6, 8};
   std::vector<int> drift_orders{2, 4};
-  int bins = 128;            ///< theta bins over [0, pi)
-  double window = 2.0;       ///< s, longest averaging window tau
-  double window_span = 0.06; ///< rad, most wave angle a window may sweep (shortens tau at high rates)
-  double group_tolerance = 1e-3;  ///< rad/s: plateaus closer than this in rate form one group
-  double auto_finish_idle = 20.0; ///< s at rest after the data are complete -> finish (<= 0: never)
+  int bins = 128;                  ///< theta bins over [0, pi)
+  double window = 2.0;             ///< s, longest averaging window tau
+  double window_span = 0.06;       ///< rad, most wave angle a window may sweep (shortens tau at high rates)
+  double group_tolerance = 1e-3;   ///< rad/s: plateaus closer than this in rate form one group
+  double auto_finish_idle = 20.0;  ///< s at rest after the data are complete -> finish (<= 0: never)
   PlateauSettings plateau;
   QualityLimits gates;
   ThermalSettings thermal;

@@ -20,10 +20,9 @@
 // chance does not inflate the errors of coefficients the correlated noise barely reaches.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace hrg_gyro {
 namespace core {
@@ -33,8 +32,8 @@ namespace core {
 double conditionNumber(double largest, double smallest);
 
 struct LeastSquaresSolution {
-  bool ok = false;                 ///< false: condition number above the limit, nothing solved
-  double condition_number = 0.0;   ///< of the weighted design matrix (unit-norm columns if asked)
+  bool ok = false;                ///< false: condition number above the limit, nothing solved
+  double condition_number = 0.0;  ///< of the weighted design matrix (unit-norm columns if asked)
   Eigen::VectorXd coefficients;
   Eigen::MatrixXd normal_inverse;  ///< (X^T W X)^-1, the covariance per unit residual variance
   /// Weighted residual sum of squares, sum w (y - X c)^2 (design form only).

@@ -4,12 +4,12 @@
 // goes through this one accessor: "scale_factor.cos[2]: expected a finite number, got 'abc'".
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <yaml-cpp/yaml.h>
 
 namespace hrg_gyro {
 namespace core {
@@ -60,8 +60,12 @@ class YamlField {
   std::vector<long> asIntegers() const;
 
   // Optional forms: the default when the key is absent (or null), the checked value otherwise.
-  double getDouble(const std::string& key, double fallback) const { return has(key) ? (*this)[key].asDouble() : fallback; }
-  long getInteger(const std::string& key, long fallback) const { return has(key) ? (*this)[key].asInteger() : fallback; }
+  double getDouble(const std::string& key, double fallback) const {
+    return has(key) ? (*this)[key].asDouble() : fallback;
+  }
+  long getInteger(const std::string& key, long fallback) const {
+    return has(key) ? (*this)[key].asInteger() : fallback;
+  }
   bool getBool(const std::string& key, bool fallback) const { return has(key) ? (*this)[key].asBool() : fallback; }
   std::string getString(const std::string& key, const std::string& fallback) const {
     return has(key) ? (*this)[key].asString() : fallback;

@@ -26,15 +26,15 @@ struct AllanPoint {
 
 struct NoiseReading {
   bool identified = false;
-  double value = 0.0;               ///< Q (rad), N (rad/sqrt(s)) or B (rad/s)
+  double value = 0.0;                   ///< Q (rad), N (rad/sqrt(s)) or B (rad/s)
   double tau_min = 0.0, tau_max = 0.0;  ///< s, range of the curve it was read from
 };
 
 struct AllanResult {
   std::vector<AllanPoint> curve;
-  NoiseReading angle_white_noise;   ///< Q
-  NoiseReading angle_random_walk;   ///< N
-  NoiseReading bias_instability;    ///< B
+  NoiseReading angle_white_noise;  ///< Q
+  NoiseReading angle_random_walk;  ///< N
+  NoiseReading bias_instability;   ///< B
 };
 
 /// `angle` sampled every `tau0` seconds; `points_per_decade` of the tau grid.

@@ -19,25 +19,25 @@
 #include <string>
 #include <vector>
 
-#include "hrg_gyro/core/model/correction_matrix.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
+#include "hrg_gyro/core/model/correction_matrix.h"
 
 namespace hrg_gyro {
 namespace core {
 
 struct DefectDiagnosis {
   bool valid = false;
-  std::string note;                     ///< why not valid, or what limits it
-  double frequency = 0.0;               ///< Hz of the fit it was read from (NaN: frequency independent)
-  double gain_mismatch = 0.0;           ///< gc - gs (relative)
+  std::string note;            ///< why not valid, or what limits it
+  double frequency = 0.0;      ///< Hz of the fit it was read from (NaN: frequency independent)
+  double gain_mismatch = 0.0;  ///< gc - gs (relative)
   double gain_mismatch_std = 0.0;
   double misplacement_difference = 0.0;  ///< dc - ds, rad
   double misplacement_difference_std = 0.0;
-  double pickoff_ratio_squared = 0.0;   ///< (A/d0)^2; may come out negative within its error
+  double pickoff_ratio_squared = 0.0;  ///< (A/d0)^2; may come out negative within its error
   double pickoff_ratio_squared_std = 0.0;
-  double pickoff_ratio = 0.0;           ///< A/d0 = sqrt(max(0, ratio^2))
-  double pickoff_ratio_std = 0.0;       ///< from the ratio^2 error (one-sided near 0)
-  double quadrature_factor = 1.0;       ///< F used
+  double pickoff_ratio = 0.0;      ///< A/d0 = sqrt(max(0, ratio^2))
+  double pickoff_ratio_std = 0.0;  ///< from the ratio^2 error (one-sided near 0)
+  double quadrature_factor = 1.0;  ///< F used
   CorrectionMatrix current_correction;
   CorrectionMatrix recommended_correction;
   std::array<double, 4> recommended_correction_std{};

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
-#include "hrg_gyro/core/model/harmonic_model.h"
 #include "hrg_gyro/core/estimation/theta_binned_rates.h"
+#include "hrg_gyro/core/model/harmonic_model.h"
 
 namespace hrg_gyro {
 namespace core {

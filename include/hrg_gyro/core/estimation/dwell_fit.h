@@ -27,7 +27,7 @@ class DwellFit {
   double valueAt(Nanoseconds t) const;  ///< fitted theta, rad
   double meanTheta() const { return n_ ? theta0_ + th_ / n_ : 0.0; }
   double meanTableAngle() const { return n_ ? angle_ / n_ : 0.0; }
-  double residualStd() const;           ///< rad
+  double residualStd() const;  ///< rad
 
  private:
   Nanoseconds start_ = 0, end_ = 0, rest_since_ = 0;

@@ -13,17 +13,16 @@
 // independent noise (proportional to 1/w), so the errors never understate the data.
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace hrg_gyro {
 namespace core {
 
 struct FitPoint {
-  double theta = 0.0;   ///< rad, centre of the span
+  double theta = 0.0;  ///< rad, centre of the span
   double value = 0.0;
   double weight = 1.0;  ///< relative, > 0
   double span = 0.0;    ///< rad over which the value is an average

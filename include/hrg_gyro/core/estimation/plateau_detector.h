@@ -23,11 +23,11 @@ struct PlateauSettings {
 };
 
 struct PlateauState {
-  std::uint64_t id = 0;      ///< changes whenever a new plateau starts
+  std::uint64_t id = 0;  ///< changes whenever a new plateau starts
   bool settled = false;
   bool is_static = false;
-  double rate = 0.0;         ///< running mean rate of the plateau, rad/s
-  Nanoseconds start = 0;     ///< first state of the plateau
+  double rate = 0.0;      ///< running mean rate of the plateau, rad/s
+  Nanoseconds start = 0;  ///< first state of the plateau
 };
 
 class PlateauDetector {

@@ -27,9 +27,9 @@
 #include <vector>
 
 #include "hrg_gyro/core/estimation/dual_rate_estimator.h"
-#include "hrg_gyro/core/model/frequency_interpolator.h"
-#include "hrg_gyro/core/estimation/rate_groups.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
+#include "hrg_gyro/core/estimation/rate_groups.h"
+#include "hrg_gyro/core/model/frequency_interpolator.h"
 #include "hrg_gyro/core/model/harmonic_model.h"
 
 namespace hrg_gyro {
@@ -38,24 +38,23 @@ namespace core {
 struct ThermalEstimate {
   bool ok = false;
   std::string reason;
-  std::vector<HarmonicFitResult> k;  ///< one per node: K coefficients at the node, with standard errors
-  std::vector<HarmonicFitResult> d;  ///< one per node, rad/s
-  HarmonicModel k_model{0.0};        ///< K(theta, f) over the nodes
-  HarmonicModel d_model{0.0};        ///< D(theta, f)
-  double condition_number = 0.0;     ///< of the weighted design matrix with unit-norm columns
-  double k_residual_rms = 0.0;       ///< rms of the binned K (at the middle frequency) about the fit
-  double d_residual_rms = 0.0;       ///< rad/s
-  std::size_t rows = 0;              ///< bins used (all groups and slices)
-  double smoothing_factor = 1.0;     ///< smallest window attenuation corrected for
+  std::vector<HarmonicFitResult> k;      ///< one per node: K coefficients at the node, with standard errors
+  std::vector<HarmonicFitResult> d;      ///< one per node, rad/s
+  HarmonicModel k_model{0.0};            ///< K(theta, f) over the nodes
+  HarmonicModel d_model{0.0};            ///< D(theta, f)
+  double condition_number = 0.0;         ///< of the weighted design matrix with unit-norm columns
+  double k_residual_rms = 0.0;           ///< rms of the binned K (at the middle frequency) about the fit
+  double d_residual_rms = 0.0;           ///< rad/s
+  std::size_t rows = 0;                  ///< bins used (all groups and slices)
+  double smoothing_factor = 1.0;         ///< smallest window attenuation corrected for
   std::vector<BinnedCurvePoint> binned;  ///< per theta bin, moved to the middle frequency of the nodes
 };
 
 /// rate1, rate2: effective rates (table + Earth) of the two groups; bins with less than
 /// min_bin_time s of data are left out. The fit refuses condition numbers above max_condition.
-ThermalEstimate estimateThermal(const RateGroup& group1, double rate1, const RateGroup& group2,
-                                double rate2, const FrequencyInterpolator& interpolator, int bins,
-                                const std::vector<int>& k_orders, const std::vector<int>& d_orders,
-                                double min_bin_time, double max_condition);
+ThermalEstimate estimateThermal(const RateGroup& group1, double rate1, const RateGroup& group2, double rate2,
+                                const FrequencyInterpolator& interpolator, int bins, const std::vector<int>& k_orders,
+                                const std::vector<int>& d_orders, double min_bin_time, double max_condition);
 
 }  // namespace core
 }  // namespace hrg_gyro

@@ -20,15 +20,14 @@
 // where the bin's data really were.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <map>
 #include <utility>
 #include <vector>
 
-#include <Eigen/Core>
-
-#include "hrg_gyro/core/model/harmonic_basis.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/harmonic_basis.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -111,7 +110,7 @@ class ThetaBinnedRates {
   Block block_;
   bool has_previous_mean_ = false;
   double previous_t_ = 0.0, previous_theta_ = 0.0, previous_y_ = 0.0, previous_tag_ = 0.0;
-  int previous_bin_ = -1;  // bin of the last increment of the chain
+  int previous_bin_ = -1;                                    // bin of the last increment of the chain
   std::map<std::pair<int, int>, std::uint32_t> shared_far_;  // rare: boundaries between non-adjacent bins
   std::uint64_t samples_ = 0, increments_ = 0, window_samples_ = 0;
   double total_time_ = 0.0, theta_swept_ = 0.0;

@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "hrg_gyro/core/calibration/calibration_session.h"
+#include "hrg_gyro/core/evaluation/output_evaluator.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/simulation/gyro_simulator.h"
-#include "hrg_gyro/core/evaluation/output_evaluator.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -24,8 +24,7 @@ struct OfflineCalibration {
 /// Runs a scenario through a processor with `parameters` into a calibration session, then finishes it.
 OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
                                          std::shared_ptr<const GyroParameters> parameters,
-                                         const CalibrationSettings& calibration,
-                                         const ProcessorConfig& processor = {});
+                                         const CalibrationSettings& calibration, const ProcessorConfig& processor = {});
 
 /// Runs a scenario through one processor per parameter set and evaluates each output.
 std::vector<EvaluationResult> verifyOnSimulation(const SimulationConfig& scenario,

@@ -35,15 +35,15 @@ struct EvaluationSettings {
 struct EvaluationResult {
   bool ok = false;
   std::string reason;
-  HarmonicFitResult relative_scale;    ///< K_rel(theta): output angle per true angle
-  double nonlinearity_ppm = 0.0;       ///< peak |K_rel - mean| / mean
-  double nonlinearity_sigma_ppm = 0.0; ///< 1-sigma of the fitted deviation at the peak
-  double scale_error_ppm = 0.0;        ///< mean K_rel - 1
-  HarmonicFitResult residual_drift;    ///< rad/s of body rate
-  double angle_error_max = 0.0;        ///< rad, largest block mean
-  double angle_error_rms = 0.0;        ///< rad, rms of the block means
-  double angle_error_final = 0.0;      ///< rad, last complete block
-  double duration = 0.0;               ///< s
+  HarmonicFitResult relative_scale;     ///< K_rel(theta): output angle per true angle
+  double nonlinearity_ppm = 0.0;        ///< peak |K_rel - mean| / mean
+  double nonlinearity_sigma_ppm = 0.0;  ///< 1-sigma of the fitted deviation at the peak
+  double scale_error_ppm = 0.0;         ///< mean K_rel - 1
+  HarmonicFitResult residual_drift;     ///< rad/s of body rate
+  double angle_error_max = 0.0;         ///< rad, largest block mean
+  double angle_error_rms = 0.0;         ///< rad, rms of the block means
+  double angle_error_final = 0.0;       ///< rad, last complete block
+  double duration = 0.0;                ///< s
   std::uint64_t samples = 0;
 };
 

@@ -9,17 +9,17 @@
 #include <vector>
 
 #include "hrg_gyro/core/calibration/calibration_outcome.h"
-#include "hrg_gyro/core/simulation/injected_model.h"
 #include "hrg_gyro/core/evaluation/output_evaluator.h"
+#include "hrg_gyro/core/simulation/injected_model.h"
 
 namespace hrg_gyro {
 namespace core {
 
 struct SessionSummary {
-  EffectiveModel injected;          ///< what a perfect calibration would find
+  EffectiveModel injected;  ///< what a perfect calibration would find
   CalibrationOutcome calibration;
-  bool has_calibration = true;      ///< false: no calibration result arrived (printed as method none)
-  EvaluationResult before, after;   ///< measured on the verification profile
+  bool has_calibration = true;        ///< false: no calibration result arrived (printed as method none)
+  EvaluationResult before, after;     ///< measured on the verification profile
   std::vector<std::string> warnings;  ///< printed before the machine-readable last line
 };
 

@@ -28,14 +28,14 @@ enum class CalibrationMethodKind {
 
 /// What a method needs from a session and what it estimates.
 struct CalibrationMethodTraits {
-  const char* name;               ///< the name in files, parameters and command lines
-  const char* description;        ///< one line for help texts
-  bool uses_generator_pairs;      ///< fed raw channels paired with the generator reference (the truth
-                                  ///< stream), finishes when the sweep ends; else fed the wave on plateaus
-  bool needs_turntable;           ///< needs the turntable state stream
-  bool estimates_k_and_d;         ///< writes K(theta) and D(theta)
-  bool estimates_correction;      ///< writes the correction matrix P
-  bool frequency_dependent;       ///< K and D over the resonator frequency (the input must carry it)
+  const char* name;           ///< the name in files, parameters and command lines
+  const char* description;    ///< one line for help texts
+  bool uses_generator_pairs;  ///< fed raw channels paired with the generator reference (the truth
+                              ///< stream), finishes when the sweep ends; else fed the wave on plateaus
+  bool needs_turntable;       ///< needs the turntable state stream
+  bool estimates_k_and_d;     ///< writes K(theta) and D(theta)
+  bool estimates_correction;  ///< writes the correction matrix P
+  bool frequency_dependent;   ///< K and D over the resonator frequency (the input must carry it)
 };
 
 /// Every method, in the order help texts list them; the first is the default.

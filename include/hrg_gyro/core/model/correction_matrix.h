@@ -8,11 +8,10 @@
 // belongs in the K(theta) model.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <cstddef>
 #include <string>
-
-#include <Eigen/Core>
 
 #include "hrg_gyro/core/model/wave_parameters.h"
 
@@ -42,11 +41,11 @@ class CorrectionMatrixEstimator {
  public:
   struct Result {
     bool ok = false;
-    std::string reason;                  ///< why not ok
+    std::string reason;  ///< why not ok
     CorrectionMatrix correction;
     std::array<double, 4> standard_error{};
-    double residual_rms = 0.0;           ///< per channel amplitude, amplitude units
-    double condition_number = 0.0;       ///< of the normal matrix, sqrt(lambda_max / lambda_min)
+    double residual_rms = 0.0;      ///< per channel amplitude, amplitude units
+    double condition_number = 0.0;  ///< of the normal matrix, sqrt(lambda_max / lambda_min)
     std::size_t pairs = 0;
   };
 

@@ -9,11 +9,10 @@
 // not extrapolated beyond the temperatures it was calibrated at); inRange() tells the caller.
 #pragma once
 
+#include <Eigen/Core>
 #include <cmath>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace hrg_gyro {
 namespace core {
@@ -28,8 +27,7 @@ class FrequencyInterpolator {
   /// A single node: the constant interpolator (frequency independent).
   FrequencyInterpolator() : nodes_{0.0} {}
   /// Nodes must be finite and strictly increasing (throws std::invalid_argument otherwise).
-  explicit FrequencyInterpolator(std::vector<double> nodes,
-                                 Interpolation kind = Interpolation::kNaturalCubicSpline);
+  explicit FrequencyInterpolator(std::vector<double> nodes, Interpolation kind = Interpolation::kNaturalCubicSpline);
 
   const std::vector<double>& nodes() const { return nodes_; }
   std::size_t size() const { return nodes_.size(); }

@@ -5,10 +5,10 @@
 
 #include <string>
 
+#include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/calibration_method_kind.h"
 #include "hrg_gyro/core/model/correction_matrix.h"
 #include "hrg_gyro/core/model/harmonic_model.h"
-#include "hrg_gyro/core/common/units.h"
 
 namespace hrg_gyro {
 namespace core {

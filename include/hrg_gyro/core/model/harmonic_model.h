@@ -10,10 +10,9 @@
 // evaluate(basis, coefficients) per model.
 #pragma once
 
+#include <Eigen/Core>
 #include <cmath>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "hrg_gyro/core/model/frequency_interpolator.h"
 #include "hrg_gyro/core/model/harmonic_basis.h"

@@ -12,13 +12,13 @@
 // A reader therefore always finds either the complete old file or the complete new one.
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
 #include <cstddef>
 #include <string>
 
-#include <yaml-cpp/yaml.h>
-
-#include "hrg_gyro/core/model/gyro_parameters.h"
 #include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/model/gyro_parameters.h"
 
 namespace hrg_gyro {
 namespace core {

@@ -18,32 +18,32 @@
 #include <cstdint>
 #include <string>
 
-#include "hrg_gyro/core/processing/compensator.h"
 #include "hrg_gyro/core/model/gyro_parameters.h"
+#include "hrg_gyro/core/processing/compensator.h"
 
 namespace hrg_gyro {
 namespace core {
 
 struct BiasCaptureSettings {
-  double duration = 10.0;   ///< s of sample time averaged
-  double block = 0.5;       ///< s, length of the blocks whose mean rates judge stillness
-  double max_motion = 2e-3; ///< rad/s, largest departure of a block's mean rate from the capture's mean
-  double max_bias = 5e-3;   ///< rad/s, largest |mean compensated rate - Earth rate| taken as a bias
+  double duration = 10.0;    ///< s of sample time averaged
+  double block = 0.5;        ///< s, length of the blocks whose mean rates judge stillness
+  double max_motion = 2e-3;  ///< rad/s, largest departure of a block's mean rate from the capture's mean
+  double max_bias = 5e-3;    ///< rad/s, largest |mean compensated rate - Earth rate| taken as a bias
   /// Throws ConfigError naming the setting when a value is out of range.
   void validate() const;
 };
 
 struct BiasCaptureResult {
   bool accepted = false;
-  std::string reason;          ///< why it was refused, or a one-line summary when accepted
-  double seconds = 0.0;        ///< sample time averaged
+  std::string reason;    ///< why it was refused, or a one-line summary when accepted
+  double seconds = 0.0;  ///< sample time averaged
   std::uint64_t samples = 0;
-  double mean_rate = 0.0;      ///< rad/s, compensated body rate through the model in force
-  double earth_rate = 0.0;     ///< rad/s, vertical Earth rate of the model
-  double worst_motion = 0.0;   ///< rad/s, largest block departure seen
-  double previous_d0 = 0.0;    ///< rad/s, D0 of the model in force (at the capture's mean frequency)
-  double new_d0 = 0.0;         ///< rad/s
-  GyroParameters parameters;   ///< the refreshed model (when accepted)
+  double mean_rate = 0.0;     ///< rad/s, compensated body rate through the model in force
+  double earth_rate = 0.0;    ///< rad/s, vertical Earth rate of the model
+  double worst_motion = 0.0;  ///< rad/s, largest block departure seen
+  double previous_d0 = 0.0;   ///< rad/s, D0 of the model in force (at the capture's mean frequency)
+  double new_d0 = 0.0;        ///< rad/s
+  GyroParameters parameters;  ///< the refreshed model (when accepted)
 };
 
 class BiasCapture {

@@ -18,9 +18,9 @@
 #include <cstdint>
 #include <memory>
 
+#include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/processing/compensator.h"
 #include "hrg_gyro/core/signal/theta_unwrapper.h"
-#include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
 
 namespace hrg_gyro {
@@ -28,9 +28,9 @@ namespace core {
 
 struct ProcessorConfig {
   WaveLimits limits;
-  double max_gap = 0.1;           ///< s
-  double backward_reset = 0.5;    ///< s
-  double max_rate = 20.0;         ///< rad/s of body rate
+  double max_gap = 0.1;         ///< s
+  double backward_reset = 0.5;  ///< s
+  double max_rate = 20.0;       ///< rad/s of body rate
   int max_consecutive_jumps = 5;
 };
 
@@ -56,10 +56,10 @@ enum OutputFlags : std::uint8_t {
 };
 
 enum class SampleVerdict : std::uint8_t {
-  kAccepted,         ///< wave state and (except for the first sample) an output
-  kFirst,            ///< wave state, no increment yet
-  kRejectedValue,    ///< see wave_status
-  kRejectedStamp,    ///< zero or negative stamp
+  kAccepted,       ///< wave state and (except for the first sample) an output
+  kFirst,          ///< wave state, no increment yet
+  kRejectedValue,  ///< see wave_status
+  kRejectedStamp,  ///< zero or negative stamp
   kDuplicate,
   kOutOfOrder,
   kRejectedJump,
@@ -69,10 +69,10 @@ struct ProcessorResult {
   SampleVerdict verdict = SampleVerdict::kRejectedValue;
   WaveStatus wave_status = WaveStatus::kOk;
   bool has_wave = false;
-  WaveState wave;                ///< corrected, theta continuous
+  WaveState wave;  ///< corrected, theta continuous
   bool has_output = false;
   AngleIncrement increment;
-  double alpha = 0.0;            ///< integrated inertial angle after this sample, rad
+  double alpha = 0.0;  ///< integrated inertial angle after this sample, rad
   std::uint8_t flags = 0;
   std::uint32_t rejected_before = 0;
 };
@@ -135,7 +135,7 @@ class GyroProcessor {
   Nanoseconds previous_stamp_ = 0;
   double previous_frequency_ = NAN;
   ChannelVector previous_z_ = ChannelVector::Zero();  // raw, for re-reading under a new P
-  double previous_cos_ = 1.0, previous_sin_ = 0.0;  // of the previous (unwrapped) theta
+  double previous_cos_ = 1.0, previous_sin_ = 0.0;    // of the previous (unwrapped) theta
   double alpha_ = 0.0;
   std::uint8_t pending_flags_ = 0;
   std::uint32_t rejected_since_output_ = 0;

@@ -14,10 +14,9 @@
 #include <emmintrin.h>
 #endif
 
+#include <Eigen/Core>
 #include <array>
 #include <limits>
-
-#include <Eigen/Core>
 
 #include "hrg_gyro/core/model/wave_parameters.h"
 
@@ -69,8 +68,8 @@ class PickoffArray {
     for (int q = 0; q < 8; q += 2) {
       const __m128d r =
           _mm_add_pd(_mm_mul_pd(_mm_load_pd(channel_cos_ + q), xv), _mm_mul_pd(_mm_load_pd(channel_sin_ + q), yv));
-      _mm_store_pd(t + q, _mm_div_pd(_mm_mul_pd(_mm_load_pd(channel_weight_ + q), r),
-                                     _mm_sub_pd(one, _mm_mul_pd(r, g))));
+      _mm_store_pd(t + q,
+                   _mm_div_pd(_mm_mul_pd(_mm_load_pd(channel_weight_ + q), r), _mm_sub_pd(one, _mm_mul_pd(r, g))));
     }
 #else
     for (int q = 0; q < 8; ++q) {

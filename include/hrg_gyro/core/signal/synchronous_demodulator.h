@@ -3,11 +3,10 @@
 // Ac = (2/T) int c cos(wt), Bc = (2/T) int c sin(wt), and likewise As, Bs from s (docs/math.md,
 // 'Channel amplitudes'),
 // as sums over N samples per period taken at carrier phases 2 pi (j + 1/2) / N (the reference is
-// locked to the resonator, so the sample grid always spans exactly one period, centred on it). The sum is exact for every
-// carrier harmonic m with m != +-1 mod N; the capacitive nonlinearity puts energy at the odd
-// harmonics, so N = 4 aliases the third harmonic onto the fundamental and N >= 8 is required for
-// that reason (the class itself accepts N >= 3, where the discrete orthogonality holds, so that tests
-// can show the aliasing).
+// locked to the resonator, so the sample grid always spans exactly one period, centred on it). The sum is exact for
+// every carrier harmonic m with m != +-1 mod N; the capacitive nonlinearity puts energy at the odd harmonics, so N = 4
+// aliases the third harmonic onto the fundamental and N >= 8 is required for that reason (the class itself accepts N >=
+// 3, where the discrete orthogonality holds, so that tests can show the aliasing).
 #pragma once
 
 #include <vector>

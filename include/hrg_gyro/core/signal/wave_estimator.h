@@ -17,18 +17,18 @@ namespace core {
 
 enum class WaveStatus : std::uint8_t {
   kOk = 0,
-  kNonFinite,             ///< a channel amplitude is NaN or infinite (or E overflowed)
-  kNoSignal,              ///< energy below the floor: nothing vibrates
-  kDegenerate,            ///< (A^2 - B^2)/(A^2 + B^2) below the floor: theta undefined
-  kAmplitudeOutOfRange,   ///< A outside the configured plausible range
+  kNonFinite,            ///< a channel amplitude is NaN or infinite (or E overflowed)
+  kNoSignal,             ///< energy below the floor: nothing vibrates
+  kDegenerate,           ///< (A^2 - B^2)/(A^2 + B^2) below the floor: theta undefined
+  kAmplitudeOutOfRange,  ///< A outside the configured plausible range
 };
 const char* toString(WaveStatus status);
 
 struct WaveLimits {
-  double min_energy = 1e-12;      ///< amplitude units squared
-  double min_anisotropy = 0.2;    ///< floor of (A^2 - B^2)/(A^2 + B^2); 0.2 means B/A < 0.82
-  double min_amplitude = 1e-6;    ///< amplitude units
-  double max_amplitude = 1e6;     ///< amplitude units
+  double min_energy = 1e-12;    ///< amplitude units squared
+  double min_anisotropy = 0.2;  ///< floor of (A^2 - B^2)/(A^2 + B^2); 0.2 means B/A < 0.82
+  double min_amplitude = 1e-6;  ///< amplitude units
+  double max_amplitude = 1e6;   ///< amplitude units
 };
 
 struct WaveState {

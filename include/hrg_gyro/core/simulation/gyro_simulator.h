@@ -19,11 +19,11 @@
 #include <cstdint>
 #include <string>
 
-#include "hrg_gyro/core/simulation/gaussian_noise.h"
+#include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/model_pair_evaluator.h"
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
 #include "hrg_gyro/core/simulation/signal_synthesizer.h"
 #include "hrg_gyro/core/simulation/simulation_config.h"
-#include "hrg_gyro/core/common/units.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -37,18 +37,18 @@ struct TruthState {
   double amplitude = 0.0;
   double quadrature = 0.0;
   double phase = 0.0;
-  double frequency = 0.0;       ///< Hz
-  double temperature = NAN;     ///< degC
+  double frequency = 0.0;    ///< Hz
+  double temperature = NAN;  ///< degC
   bool generator = false;
   const std::string* segment = nullptr;  ///< profile label (owned by the simulator)
 };
 
 struct SimulationSample {
   std::uint64_t index = 0;
-  Nanoseconds stamp = 0;          ///< centre of the demodulation window
+  Nanoseconds stamp = 0;  ///< centre of the demodulation window
   ChannelVector z = ChannelVector::Zero();
-  double frequency = 0.0;         ///< Hz
-  double temperature = NAN;       ///< degC
+  double frequency = 0.0;    ///< Hz
+  double temperature = NAN;  ///< degC
   std::uint32_t periods = 0;
   TruthState truth;
 };
@@ -90,9 +90,9 @@ class GyroSimulator {
   double frequency_;          // reported resonance frequency, Hz
   double amplitude_;          // wave amplitude A at the current temperature
   double earth_rate_;
-  double t_ = 0.0;            // s since start, Kahan-compensated
+  double t_ = 0.0;  // s since start, Kahan-compensated
   double t_compensation_ = 0.0;
-  double theta_;              // true electrical angle at t_
+  double theta_;  // true electrical angle at t_
   std::uint64_t index_ = 0;
   std::uint64_t generator_state_ = 0;
   std::uint64_t generator_outputs_in_state_ = 0;

@@ -9,8 +9,8 @@
 
 #include <vector>
 
-#include "hrg_gyro/core/model/correction_matrix.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
+#include "hrg_gyro/core/model/correction_matrix.h"
 #include "hrg_gyro/core/simulation/simulation_config.h"
 
 namespace hrg_gyro {

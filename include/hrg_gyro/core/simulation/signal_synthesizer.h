@@ -10,10 +10,10 @@
 
 #include <cstdint>
 
-#include "hrg_gyro/core/simulation/gaussian_noise.h"
+#include "hrg_gyro/core/model/wave_parameters.h"
 #include "hrg_gyro/core/signal/pickoff_array.h"
 #include "hrg_gyro/core/signal/synchronous_demodulator.h"
-#include "hrg_gyro/core/model/wave_parameters.h"
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
 
 namespace hrg_gyro {
 namespace core {

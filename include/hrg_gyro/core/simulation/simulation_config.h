@@ -1,30 +1,30 @@
 // A simulation scenario: the gyro (resonator, pickoffs), the turntable profile, the generator
-// sweep and, optionally, the temperature (thermal_model.h). The keys are those of the driver_sim node's private parameters, so one YAML file serves
-// `roslaunch` (rosparam load into ~) and `hrg_bag simulate` alike. Defaults: the shipped simulated
-// gyro (docs/simulation.md).
+// sweep and, optionally, the temperature (thermal_model.h). The keys are those of the driver_sim node's private
+// parameters, so one YAML file serves `roslaunch` (rosparam load into ~) and `hrg_bag simulate` alike. Defaults: the
+// shipped simulated gyro (docs/simulation.md).
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/model/harmonic_model.h"
 #include "hrg_gyro/core/signal/pickoff_array.h"
 #include "hrg_gyro/core/simulation/temperature_dependence.h"
 #include "hrg_gyro/core/simulation/turntable_profile.h"
-#include "hrg_gyro/core/common/yaml_field.h"
 
 namespace hrg_gyro {
 namespace core {
 
 struct ResonatorConfig {
-  double frequency = 5000.0;       ///< Hz
-  int samples_per_period = 32;     ///< N >= 8
-  int periods_per_output = 5;      ///< periods demodulated into one output sample (5 -> 1 kHz)
-  double amplitude = 1.0;          ///< A, amplitude units
-  double quadrature = 0.02;        ///< B, held by the quadrature loop
-  double phase = 0.3;              ///< tau, rad
-  double initial_theta = 0.0;      ///< electrical rad
+  double frequency = 5000.0;          ///< Hz
+  int samples_per_period = 32;        ///< N >= 8
+  int periods_per_output = 5;         ///< periods demodulated into one output sample (5 -> 1 kHz)
+  double amplitude = 1.0;             ///< A, amplitude units
+  double quadrature = 0.02;           ///< B, held by the quadrature loop
+  double phase = 0.3;                 ///< tau, rad
+  double initial_theta = 0.0;         ///< electrical rad
   HarmonicModel scale_factor{-0.56};  ///< intrinsic K(theta) of the resonator (Bryan factor and its anisotropy)
   HarmonicModel drift{0.0};           ///< intrinsic D(theta), rad/s
   /// White noise of the body rate the resonator senses (angle random walk), rad/sqrt(s); the
@@ -33,11 +33,11 @@ struct ResonatorConfig {
 };
 
 struct GeneratorConfig {
-  bool enabled = false;                        ///< sweep known waves instead of running the dynamics
-  int angles = 24;                             ///< theta evenly over [0, pi)
+  bool enabled = false;  ///< sweep known waves instead of running the dynamics
+  int angles = 24;       ///< theta evenly over [0, pi)
   std::vector<double> quadratures{0.0, 0.05, -0.05};
-  std::vector<double> phases{0.0, 1.0};        ///< rad
-  double dwell = 0.05;                         ///< s per generator state
+  std::vector<double> phases{0.0, 1.0};  ///< rad
+  double dwell = 0.05;                   ///< s per generator state
 };
 
 struct SimulationConfig {
@@ -49,7 +49,7 @@ struct SimulationConfig {
   double acceleration = 0.5;  ///< rad/s^2 of the turntable
   TurntableProfile profile;
   GeneratorConfig generator;
-  ThermalConfig thermal;      ///< disabled unless the scenario has a thermal section
+  ThermalConfig thermal;  ///< disabled unless the scenario has a thermal section
 
   double outputPeriod() const { return resonator.periods_per_output / resonator.frequency; }
 

@@ -21,10 +21,10 @@
 
 #include <array>
 
+#include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/model/harmonic_model.h"
 #include "hrg_gyro/core/signal/pickoff_array.h"
 #include "hrg_gyro/core/simulation/temperature_profile.h"
-#include "hrg_gyro/core/common/yaml_field.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -39,10 +39,10 @@ struct ThermalCoefficients {
 };
 
 struct ThermalConfig {
-  bool enabled = false;                ///< false: no thermal section, the gyro has no temperature
-  double reference_temperature = 25.0; ///< degC at which the resonator and pickoff sections hold
-  double frequency_coefficient = 0.0;  ///< df/dT, Hz/degC
-  TemperatureProfile profile;          ///< T over the session (t from the session start)
+  bool enabled = false;                 ///< false: no thermal section, the gyro has no temperature
+  double reference_temperature = 25.0;  ///< degC at which the resonator and pickoff sections hold
+  double frequency_coefficient = 0.0;   ///< df/dT, Hz/degC
+  TemperatureProfile profile;           ///< T over the session (t from the session start)
   ThermalCoefficients coefficients;
 
   double frequencyAt(double temperature, double nominal_frequency) const {
