@@ -31,6 +31,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import yaml  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import plot_calibration  # noqa: E402  (the report plots: one reader of each tool output)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DPI = 100
 
@@ -222,16 +225,7 @@ def figure_allan(hrg_bag, params, seconds, path):
         bag, csv = os.path.join(tmp, "rest.bag"), os.path.join(tmp, "allan.csv")
         run([hrg_bag, "simulate", "--scenario", rest_scenario(seconds, tmp), "--out", bag])
         readings = run([hrg_bag, "allan", bag, "--params", params, "--csv", csv])
-        taus, devs, errs = [], [], []
-        with open(csv) as f:
-            header = f.readline().strip().split(",")
-            if header[:3] != ["tau", "deviation", "error"]:
-                fail("%s is not an hrg_bag allan CSV" % csv)
-            for line in f:
-                tau, dev, err = (float(x) for x in line.split(",")[:3])
-                taus.append(tau)
-                devs.append(dev)
-                errs.append(err)
+        taus, devs, errs = plot_calibration.read_allan_csv(csv)
     to_deg_h = 180.0 / math.pi * 3600.0
     fig, ax = plt.subplots(figsize=(7, 4.5))
     ax.loglog(taus, [d * to_deg_h for d in devs], "o-", ms=3, color="C0", label="overlapping Allan deviation")

@@ -157,7 +157,8 @@ def plot_calibration(report_path, out_path):
     fig.savefig(out_path, dpi=110)
 
 
-def plot_allan(csv_path, out_path):
+def read_allan_csv(csv_path):
+    """(taus, deviations, errors) of an `hrg_bag allan --csv` file; SystemExit on another file."""
     taus, devs, errs = [], [], []
     with open(csv_path) as f:
         header = f.readline().strip().split(",")
@@ -168,6 +169,11 @@ def plot_allan(csv_path, out_path):
             taus.append(tau)
             devs.append(dev)
             errs.append(err)
+    return taus, devs, errs
+
+
+def plot_allan(csv_path, out_path):
+    taus, devs, errs = read_allan_csv(csv_path)
     to_deg_h = 180.0 / math.pi * 3600.0
     fig, ax = plt.subplots(figsize=(8, 6))
     ax.loglog(taus, [d * to_deg_h for d in devs], "o-", ms=3, label="overlapping Allan deviation")
