@@ -24,8 +24,8 @@ using diagnostic_msgs::DiagnosticStatus;
 
 const std::vector<std::string>& nodeOnlyKeys() {
   static const std::vector<std::string> keys = {
-      "parameter_file", "report_file", "output_directory",  "reload_service", "write",           "autostart",
-      "stages",         "queue_size",  "diagnostic_period", "backward_reset", "heap_trim_period"};
+      "parameter_file", "report_file", "output_directory", "reload_service",    "write",
+      "autostart",      "stages",      "queue_size",       "diagnostic_period", "heap_trim_period"};
   return keys;
 }
 
@@ -53,8 +53,6 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   if (output_directory_.empty()) output_directory_ = core::directoryOf(parameter_file_);
   reload_service_ = params_.get<std::string>("reload_service", "processor/reload");
   write_ = params_.get("write", write_);
-  backward_reset_ = params_.get("backward_reset", backward_reset_);
-  if (!(backward_reset_ > 0.0)) throw std::invalid_argument("calibrator: ~backward_reset must be positive (s)");
   for (const std::string& f : {parameter_file_, report_file_}) {
     // Links followed, also a link at the file itself: the writer replaces the file it points to.
     if (!core::isInsideDirectory(f, output_directory_)) {
@@ -217,24 +215,20 @@ bool CalibratorRos::startRun(bool restart, std::string* reason) {
   }
 }
 
-bool CalibratorRos::restartIfTimeWentBack(const ros::Time& stamp, ros::Time* last) {
-  const bool back = !last->isZero() && (*last - stamp).toSec() > backward_reset_;
-  *last = stamp;
-  if (!back || !session()) return false;
-  // A looping bag (or a restarted driver): the bins hold the previous pass, and the new data would
-  // all be dropped as out of order. Start the same method again from the prior.
+void CalibratorRos::noteRestart(std::uint64_t restarts_before) {
+  if (!session() || session()->counters().restarts == restarts_before) return;
+  // The session saw a stream go back for good (a looping bag, a restarted driver) and started the
+  // run over from its prior; what the node keeps about the run starts over too.
   ++resets_;
-  ROS_WARN("calibrator: time went backwards by more than %.1f s (bag loop?): %s run restarted", backward_reset_,
-           core::nameOf(session()->settings().method).c_str());
-  std::string reason;
-  startRun(true, &reason);
-  last_turntable_stamp_ = last_wave_stamp_ = stamp;
-  return true;
+  ROS_WARN("calibrator: time went back for %d records in a row (bag loop?): %s run restarted",
+           base_settings_.backward_persist, core::nameOf(session()->settings().method).c_str());
+  skip_waves_until_ = ros::Time();
+  sweep_end_ = last_channels_stamp_ = ros::Time();
+  pairing_.clear();
 }
 
 void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  restartIfTimeWentBack(msg->header.stamp, &last_turntable_stamp_);
   if (!session()) return;
   if (!sweep_end_.isZero() && (msg->header.stamp - sweep_end_).toSec() > kSweepChannelsWait) {
     ROS_WARN(
@@ -244,7 +238,9 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
     endGeneratorSweep();
     if (!session()) return;
   }
+  const std::uint64_t restarts = session()->counters().restarts;
   session()->addTurntable(toNanoseconds(msg->header.stamp), msg->angle, msg->rate);
+  noteRestart(restarts);
   if (session()->shouldFinish()) {
     bool written = false;
     std::string message;
@@ -254,14 +250,15 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
 
 void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  restartIfTimeWentBack(msg->header.stamp, &last_wave_stamp_);
   if (session() && !skip_waves_until_.isZero() && msg->header.stamp <= skip_waves_until_) {
     ++skipped_old_model_;
     return;
   }
   if (session()) {
+    const std::uint64_t restarts = session()->counters().restarts;
     session()->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency,
                        core::quadratureRatio(msg->quadrature, msg->amplitude));
+    noteRestart(restarts);
   }
 }
 
@@ -418,6 +415,12 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
     stat.add("not on a settled plateau", c.unsettled);
     stat.add("without turntable state", c.unsynchronized);
     stat.add("dropped (out-of-order stamps)", c.out_of_order);
+    // Glitched turntable records, dropped before the plateau detector (all runs of this session).
+    stat.add("turntable dropped (bad rate)", c.rejected.bad_rate);
+    stat.add("turntable dropped (bad angle)", c.rejected.bad_angle);
+    stat.add("turntable dropped (zero stamp)", c.rejected.bad_stamp);
+    stat.add("turntable dropped (duplicate stamp)", c.rejected.duplicate);
+    stat.add("turntable dropped (out-of-order stamp)", c.rejected.out_of_order);
   } else if (runs_ > 0 && !last_accepted_) {
     stat.summary(DiagnosticStatus::WARN, "idle; last run " + last_result_);
   } else {

@@ -55,8 +55,9 @@ class CalibratorRos {
   bool onAbort(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
-  /// Restarts the current run when `stamp` is more than ~backward_reset s before `*last`; updates `*last`.
-  bool restartIfTimeWentBack(const ros::Time& stamp, ros::Time* last);
+  /// After a record was fed: when the session restarted its run (a stream went back for good,
+  /// settings backward_reset and backward_persist), counts it and resets the node's run state.
+  void noteRestart(std::uint64_t restarts_before);
   /// Starts the next stage (or, with `restart`, the stage in progress again) with the current
   /// parameter file as prior; false + reason on failure (then no stage is left).
   bool startRun(bool restart, std::string* reason);
@@ -78,9 +79,7 @@ class CalibratorRos {
   bool write_ = true;
   std::uint64_t runs_ = 0;
   std::string last_result_;
-  // Bag loops: a stream going back by more than backward_reset_ s restarts the run.
-  double backward_reset_ = 1.0;
-  ros::Time last_turntable_stamp_, last_wave_stamp_;
+  // Bag loops: counted here, detected by the session.
   std::uint64_t resets_ = 0, reported_resets_ = 0;
   bool last_accepted_ = false;
 

@@ -119,6 +119,16 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
     out << YAML::EndMap;
   }
   out << YAML::Key << "quadrature_ratio" << YAML::Value << formatDouble(o.quadrature_ratio);
+  // Glitched turntable records dropped before the plateau detector, and bag-loop restarts.
+  out << YAML::Key << "turntable_records" << YAML::Value << o.turntable_records;
+  out << YAML::Key << "turntable_rejected" << YAML::Value << YAML::Flow << YAML::BeginMap;
+  out << YAML::Key << "bad_rate" << YAML::Value << o.turntable_rejected.bad_rate;
+  out << YAML::Key << "bad_angle" << YAML::Value << o.turntable_rejected.bad_angle;
+  out << YAML::Key << "bad_stamp" << YAML::Value << o.turntable_rejected.bad_stamp;
+  out << YAML::Key << "duplicate" << YAML::Value << o.turntable_rejected.duplicate;
+  out << YAML::Key << "out_of_order" << YAML::Value << o.turntable_rejected.out_of_order;
+  out << YAML::EndMap;
+  out << YAML::Key << "restarts" << YAML::Value << o.restarts;
   // Root causes read from the K harmonics (first order, docs/math.md 'Pickoff defects to first
   // order'); see defect_diagnosis.h.
   out << YAML::Key << "diagnosis" << YAML::Value << YAML::BeginSeq;

@@ -13,6 +13,9 @@ namespace {
 constexpr double kMaxWait = 60.0;  // s of stamps
 constexpr std::size_t kMaxPending = 200000;
 constexpr std::size_t kMaxHistory = 400000;
+// rad: the angle a good record may differ from the last good one beyond max_rate * dt (reporting
+// jitter between the angle and the stamp).
+constexpr double kAngleSlack = 0.01;
 
 }  // namespace
 
@@ -22,13 +25,55 @@ CalibrationSession::CalibrationSession(const CalibrationSettings& settings, cons
       method_(makeCalibrationMethod(settings, prior)),
       detector_(settings.plateau),
       turntable_(kMaxHistory + 1),
-      pending_(kMaxPending + 1) {}
+      pending_(kMaxPending + 1),
+      turntable_timeline_(settings.backward_reset, settings.backward_persist),
+      wave_timeline_(settings.backward_reset, settings.backward_persist) {}
 
-void CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double rate) {
+bool CalibrationSession::plausible(Nanoseconds stamp, double angle, double rate) {
+  if (!std::isfinite(rate) || std::abs(rate) > settings_.plateau.max_rate) {
+    ++counters_.rejected.bad_rate;
+    return false;
+  }
+  if (!std::isfinite(angle)) {
+    ++counters_.rejected.bad_angle;
+    return false;
+  }
+  if (!turntable_.empty() && stamp > turntable_.back().stamp) {
+    const TurntableRecord& last = turntable_.back();
+    const double reach = settings_.plateau.max_rate * toSeconds(stamp - last.stamp) + kAngleSlack;
+    // A few in a row: a glitch. More than backward_persist: the table's angle really is elsewhere
+    // (the good record kept last was the glitch, or the encoder was re-zeroed); take the new one.
+    if (std::abs(angle - last.angle) > reach && ++bad_angle_run_ <= settings_.backward_persist) {
+      ++counters_.rejected.bad_angle;
+      return false;
+    }
+  }
+  bad_angle_run_ = 0;
+  return true;
+}
+
+bool CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double rate) {
   ++counters_.turntable;
-  if (!turntable_.empty() && stamp <= turntable_.back().stamp) {
-    ++counters_.out_of_order;
-    return;
+  ++counters_.turntable_total;
+  // Values first: a glitched record must not move the stamp reference either.
+  if (stamp > 0 && !plausible(stamp, angle, rate)) return false;
+  switch (turntable_timeline_.check(stamp)) {
+    case StampVerdict::kNext:
+      break;
+    case StampVerdict::kNewTimeline:
+      restart();
+      wave_timeline_.expectJumpBack(kMaxWait);
+      counters_.turntable = 1;
+      break;
+    case StampVerdict::kNonPositive:
+      ++counters_.rejected.bad_stamp;
+      return false;
+    case StampVerdict::kDuplicate:
+      ++counters_.rejected.duplicate;
+      return false;
+    case StampVerdict::kBehind:
+      ++counters_.rejected.out_of_order;
+      return false;
   }
   turntable_.push_back({stamp, angle, rate, detector_.update(stamp, rate)});
   drain();
@@ -39,17 +84,48 @@ void CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double ra
   while (turntable_.size() > 2 && (turntable_[1].stamp < keep_from || turntable_.size() > kMaxHistory)) {
     turntable_.pop_front();
   }
+  return true;
+}
+
+void CalibrationSession::restart() {
+  const TurntableRejects rejected = counters_.rejected;
+  const std::uint64_t restarts = counters_.restarts + 1;
+  const std::uint64_t out_of_order = counters_.out_of_order;
+  const std::uint64_t turntable_total = counters_.turntable_total;
+  method_ = makeCalibrationMethod(settings_, prior_);
+  detector_ = PlateauDetector(settings_.plateau);
+  turntable_.clear();
+  pending_.clear();
+  counters_ = SessionCounters();
+  counters_.rejected = rejected;
+  counters_.restarts = restarts;
+  counters_.out_of_order = out_of_order;
+  counters_.turntable_total = turntable_total;
+  bad_angle_run_ = 0;
+  last_wave_stamp_ = 0;
+  last_generator_stamp_ = 0;
+  generator_ended_ = false;
+  quadrature_sum_ = 0.0;
+  quadrature_count_ = 0;
 }
 
 void CalibrationSession::addWave(Nanoseconds stamp, double theta, double frequency, double quadrature_ratio) {
   ++counters_.wave;
+  switch (wave_timeline_.check(stamp)) {
+    case StampVerdict::kNext:
+      break;
+    case StampVerdict::kNewTimeline:
+      restart();
+      turntable_timeline_.expectJumpBack(kMaxWait);
+      counters_.wave = 1;
+      break;
+    default:
+      ++counters_.out_of_order;
+      return;
+  }
   if (std::isfinite(quadrature_ratio)) {
     quadrature_sum_ += std::abs(quadrature_ratio);
     ++quadrature_count_;
-  }
-  if (stamp <= last_wave_stamp_) {
-    ++counters_.out_of_order;
-    return;
   }
   last_wave_stamp_ = stamp;
   pending_.push_back({stamp, theta, frequency});
@@ -119,6 +195,20 @@ CalibrationOutcome CalibrationSession::finish() const {
   CalibrationOutcome o = method_->finish(prior_);
   o.quadrature_ratio = quadrature_count_ > 0 ? quadrature_sum_ / quadrature_count_ : 0.0;
   diagnose(&o, prior_.correction);
+  o.turntable_records = counters_.turntable_total;
+  o.turntable_rejected = counters_.rejected;
+  o.restarts = counters_.restarts;
+  if (counters_.rejected.total() > 0) {
+    const TurntableRejects& r = counters_.rejected;
+    o.notes.push_back(std::to_string(r.total()) + " glitched turntable records dropped (" + std::to_string(r.bad_rate) +
+                      " bad rate, " + std::to_string(r.bad_angle) + " bad angle, " + std::to_string(r.bad_stamp) +
+                      " zero stamp, " + std::to_string(r.duplicate) + " duplicate, " + std::to_string(r.out_of_order) +
+                      " out of order)");
+  }
+  if (counters_.restarts > 0) {
+    o.notes.push_back("the stamps went back for good " + std::to_string(counters_.restarts) +
+                      " time(s) (bag loop): the run restarted from the prior");
+  }
   if (counters_.unsynchronized > 0) {
     o.notes.push_back(std::to_string(counters_.unsynchronized) +
                       " wave samples had no turntable state around them and were not used");

@@ -18,16 +18,17 @@ std::vector<int> parseEvenOrders(const YamlField& f) {
 }
 
 // The keys, listed once: parse() refuses any other, keyPaths() lists them for the node's template check.
-const std::vector<std::string> kPlateauKeys = {"rate_tolerance", "relative_tolerance", "settle_time", "static_rate",
-                                               "max_gap"};
+const std::vector<std::string> kPlateauKeys = {
+    "rate_tolerance", "relative_tolerance", "settle_time", "static_rate", "max_gap", "max_rate"};
 const std::vector<std::string> kGateKeys = {"min_coverage",   "min_rate_separation", "max_rate_noise",
                                             "min_samples",    "max_condition",       "max_relative_residual",
                                             "max_k0_change",  "max_harmonic_std",    "min_steps",
                                             "min_dwell_time", "min_pairs",           "max_p_condition"};
 const std::vector<std::string> kThermalKeys = {"frequency_nodes", "node_count", "interpolation", "slice_width",
                                                "max_slices"};
-const std::vector<std::string> kScalarKeys = {"method", "scale_factor_orders", "drift_orders",    "bins",
-                                              "window", "window_span",         "group_tolerance", "auto_finish_idle"};
+const std::vector<std::string> kScalarKeys = {
+    "method",      "scale_factor_orders", "drift_orders",     "bins",           "window",
+    "window_span", "group_tolerance",     "auto_finish_idle", "backward_reset", "backward_persist"};
 
 double positive(const YamlField& parent, const char* key, double fallback) {
   const double v = parent.getDouble(key, fallback);
@@ -67,6 +68,9 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   s.window_span = positive(root, "window_span", s.window_span);
   s.group_tolerance = positive(root, "group_tolerance", s.group_tolerance);
   s.auto_finish_idle = root.getDouble("auto_finish_idle", s.auto_finish_idle);
+  s.backward_reset = positive(root, "backward_reset", s.backward_reset);
+  s.backward_persist = static_cast<int>(root.getInteger("backward_persist", s.backward_persist));
+  if (s.backward_persist < 1 || s.backward_persist > 1000) root["backward_persist"].fail("must be in [1, 1000]");
   if (root.has("plateau")) {
     const YamlField p = root["plateau"];
     p.rejectUnknownKeys(kPlateauKeys);
@@ -77,6 +81,7 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
     if (s.plateau.settle_time < 0.0) p["settle_time"].fail("must be >= 0");
     s.plateau.static_rate = positive(p, "static_rate", s.plateau.static_rate);
     s.plateau.max_gap = positive(p, "max_gap", s.plateau.max_gap);
+    s.plateau.max_rate = positive(p, "max_rate", s.plateau.max_rate);
   }
   if (root.has("gates")) {
     const YamlField g = root["gates"];

@@ -16,6 +16,16 @@
 namespace hrg_gyro {
 namespace core {
 
+/// Turntable records dropped before the plateau detector, by reason.
+struct TurntableRejects {
+  std::uint64_t bad_rate = 0;      ///< non-finite, or |rate| above plateau/max_rate
+  std::uint64_t bad_angle = 0;     ///< non-finite, or a step from the last good angle beyond max_rate
+  std::uint64_t bad_stamp = 0;     ///< zero or negative stamp
+  std::uint64_t duplicate = 0;     ///< the stamp of the last good record
+  std::uint64_t out_of_order = 0;  ///< behind the last good stamp (not, or not yet, a new timeline)
+  std::uint64_t total() const { return bad_rate + bad_angle + bad_stamp + duplicate + out_of_order; }
+};
+
 struct GroupSummary {
   double rate = 0.0;      ///< mean table rate, rad/s
   double rate_std = 0.0;  ///< rad/s
@@ -54,6 +64,9 @@ struct CalibrationOutcome {
   std::vector<BinnedCurvePoint> binned;  ///< binned K and D (dual-rate) or step points
   std::vector<std::string> notes;
   double quadrature_ratio = 0.0;           ///< mean |B/A| of the wave samples (F of the diagnosis)
+  std::uint64_t turntable_records = 0;     ///< turntable records received (all runs of the session)
+  TurntableRejects turntable_rejected;     ///< of them, dropped as glitches
+  std::uint64_t restarts = 0;              ///< times a stream went back for good and the run started over
   std::vector<DefectDiagnosis> diagnosis;  ///< one per scale_factor fit with 2 and 4 theta terms
 
   /// Appends a gate; the first failing one becomes the reason.

@@ -5,6 +5,12 @@
 // to the same settled plateau (a sample at a plateau boundary is skipped), and it is handed to the
 // method with that plateau, the interpolated table angle and the reported rate. Memory is bounded:
 // the wave queue and the turntable history are trimmed by age, the methods keep bins.
+//
+// A glitched turntable record (a non-finite or impossible rate, a non-finite angle or one the rate
+// bound cannot reach, a zero, duplicate or backward stamp) is dropped and counted by reason before
+// the plateau detector sees it, so it cannot end a plateau. A stream whose stamps go back for good
+// (settings backward_reset and backward_persist, a looping bag) restarts the run from the prior: the
+// bins hold the previous pass. The live calibrator and hrg_bag calibrate both rely on this.
 #pragma once
 
 #include <cmath>
@@ -13,25 +19,30 @@
 
 #include "hrg_gyro/core/calibration/calibration_method_interface.h"
 #include "hrg_gyro/core/common/ring_buffer.h"
+#include "hrg_gyro/core/common/stamp_timeline.h"
 #include "hrg_gyro/core/model/gyro_parameters.h"
 
 namespace hrg_gyro {
 namespace core {
 
 struct SessionCounters {
-  std::uint64_t turntable = 0;       ///< turntable states received
-  std::uint64_t wave = 0;            ///< wave samples received
-  std::uint64_t used = 0;            ///< handed to the method
-  std::uint64_t unsettled = 0;       ///< not on a settled plateau (ramps, settling, boundaries)
-  std::uint64_t unsynchronized = 0;  ///< no turntable state around the stamp (or too far away)
-  std::uint64_t out_of_order = 0;    ///< stamps going backwards within a stream
+  std::uint64_t turntable = 0;        ///< turntable states received
+  std::uint64_t wave = 0;             ///< wave samples received
+  std::uint64_t used = 0;             ///< handed to the method
+  std::uint64_t unsettled = 0;        ///< not on a settled plateau (ramps, settling, boundaries)
+  std::uint64_t unsynchronized = 0;   ///< no turntable state around the stamp (or too far away)
+  std::uint64_t out_of_order = 0;     ///< wave samples dropped: zero, duplicate or backward stamps
+  TurntableRejects rejected;          ///< turntable records dropped (glitches), all runs of the session
+  std::uint64_t restarts = 0;         ///< a stream went back for good: the run started over
+  std::uint64_t turntable_total = 0;  ///< turntable records received, all runs of the session
 };
 
 class CalibrationSession {
  public:
   CalibrationSession(const CalibrationSettings& settings, const GyroParameters& prior);
 
-  void addTurntable(Nanoseconds stamp, double angle, double rate);
+  /// Returns false when the record was dropped (counted in counters().rejected).
+  bool addTurntable(Nanoseconds stamp, double angle, double rate);
   /// quadrature_ratio: B/A of the wave (NaN if unknown), averaged for the defect diagnosis.
   void addWave(Nanoseconds stamp, double theta, double frequency, double quadrature_ratio = NAN);
   void addGeneratorPair(Nanoseconds stamp, const ChannelVector& raw, const ChannelVector& reference);
@@ -61,6 +72,10 @@ class CalibrationSession {
     double theta, frequency;
   };
   void drain();
+  /// Whether the values of a turntable record are possible; counts the reason when not.
+  bool plausible(Nanoseconds stamp, double angle, double rate);
+  /// The stream went back for good: drop what the run gathered, start over from the prior.
+  void restart();
   void classify(const WaveRecord& w);
 
   CalibrationSettings settings_;
@@ -70,7 +85,10 @@ class CalibrationSession {
   RingBuffer<TurntableRecord> turntable_;
   RingBuffer<WaveRecord> pending_;
   SessionCounters counters_;
+  StampTimeline turntable_timeline_;
+  StampTimeline wave_timeline_;
   Nanoseconds last_wave_stamp_ = 0;
+  int bad_angle_run_ = 0;  // turntable records in a row whose angle the rate bound cannot reach
   Nanoseconds last_generator_stamp_ = 0;
   bool generator_ended_ = false;
   double quadrature_sum_ = 0.0;  // of |B/A|, for the diagnosis's F factor

@@ -50,6 +50,10 @@ struct CalibrationSettings {
   double window_span = 0.06;       ///< rad, most wave angle a window may sweep (shortens tau at high rates)
   double group_tolerance = 1e-3;   ///< rad/s: plateaus closer than this in rate form one group
   double auto_finish_idle = 20.0;  ///< s at rest after the data are complete -> finish (<= 0: never)
+  /// A stream whose stamps go back by more than backward_reset s for backward_persist records in a
+  /// row has moved to a new timeline (bag loop): the run restarts. Fewer are dropped as glitches.
+  double backward_reset = 0.5;  ///< s
+  int backward_persist = 5;     ///< records
   PlateauSettings plateau;
   QualityLimits gates;
   ThermalSettings thermal;

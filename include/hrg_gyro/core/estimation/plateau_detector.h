@@ -20,6 +20,9 @@ struct PlateauSettings {
   double settle_time = 2.0;          ///< s
   double static_rate = 2e-4;         ///< rad/s
   double max_gap = 0.5;              ///< s between turntable states
+  /// rad/s: a reported |rate| above this is no table's (a glitched record) and is dropped before
+  /// the detector sees it, as is a non-finite rate.
+  double max_rate = 20.0;
 };
 
 struct PlateauState {
@@ -34,7 +37,8 @@ class PlateauDetector {
  public:
   explicit PlateauDetector(const PlateauSettings& settings = {}) : settings_(settings) {}
 
-  /// Feeds one state (stamps increasing) and returns the plateau status at it.
+  /// Feeds one state (stamps increasing, rate finite) and returns the plateau status at it. The
+  /// calibration session drops glitched records before they get here.
   PlateauState update(Nanoseconds stamp, double rate);
   const PlateauState& current() const { return state_; }
   const PlateauSettings& settings() const { return settings_; }
