@@ -315,9 +315,11 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
   }
   {
     const std::string path = core::StagedCalibration::stageReportPath(report_file_, o.method);
-    std::ofstream report(path);
-    report << core::emitCalibrationReport(o);
-    if (!report) ROS_WARN("calibrator: cannot write the report %s", path.c_str());
+    try {
+      core::writeFileAtomically(path, core::emitCalibrationReport(o));  // whole or not at all
+    } catch (const std::exception& e) {
+      ROS_WARN("calibrator: cannot write the report %s: %s", path.c_str(), e.what());
+    }
   }
   result_pub_.publish(toMessage(o, *written, parameter_file_, ros::Time::now()));
   ++runs_;

@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/evaluation/session_summary.h"
 #include "hrg_gyro/core/model/calibration_method_kind.h"
 #include "hrg_gyro/core/model/parameter_file.h"
@@ -16,6 +17,18 @@
 #include "hrg_gyro/ros/param_tree.h"
 
 namespace hrg_gyro {
+namespace {
+
+/// A summary file appears whole or not at all (scripts wait for it to exist).
+void writeSummary(const std::string& path, const std::string& text) {
+  try {
+    core::writeFileAtomically(path, text);
+  } catch (const std::exception& e) {
+    ROS_ERROR("session_monitor: cannot write %s: %s", path.c_str(), e.what());
+  }
+}
+
+}  // namespace
 
 SessionMonitorRos::SessionMonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), params_(pnh, "session_monitor") {
@@ -164,10 +177,7 @@ void SessionMonitorRos::finish() {
   }
   std::ostringstream text;
   core::printSessionSummary(text, s);
-  if (!summary_file_.empty()) {
-    std::ofstream f(summary_file_);
-    f << text.str();
-  }
+  if (!summary_file_.empty()) writeSummary(summary_file_, text.str());
   ROS_INFO_STREAM("session_monitor:" << text.str());
 
   YAML::Emitter y;
@@ -201,10 +211,7 @@ void SessionMonitorRos::finish() {
   }
   y << YAML::Key << "worst_z" << YAML::Value << worst_z;
   y << YAML::EndMap;
-  if (!summary_file_.empty()) {
-    std::ofstream f(summary_file_ + ".yaml");
-    f << y.c_str() << "\n";
-  }
+  if (!summary_file_.empty()) writeSummary(summary_file_ + ".yaml", std::string(y.c_str()) + "\n");
   std_msgs::String summary;
   summary.data = y.c_str();
   summary_pub_.publish(summary);
