@@ -25,5 +25,5 @@ if [ ! -s "$out/summary.txt" ]; then
   exit 1
 fi
 echo "make run: done in $(( $(date +%s) - start )) s; calibrated parameters in $out/params.yaml," \
-     "calibration report in $out/params.report.yaml, logs in $out/roslaunch.log" >&2
+     "calibration report in $out/params.dual_rate.report.yaml, logs in $out/roslaunch.log" >&2
 cat "$out/summary.txt"
