@@ -13,16 +13,7 @@ namespace {
 using testing::AngleLevelGyro;
 using testing::calibrateAngleLevel;
 using testing::dualRateProfile;
-
-// Reference magnitudes for the methods (K0 = -0.56, our electrical convention): harmonics of a
-// few 1e-4 in K, a drift with a 2theta term, so that drift leaking into K would show.
-AngleLevelGyro referenceGyro() {
-  AngleLevelGyro g;
-  g.k = HarmonicModel({2, 4}, -0.56, {-6e-4, 2e-3}, {4e-4, 0.0});
-  g.d = HarmonicModel({2}, 1e-5, {2e-5}, {-1e-5});
-  g.earth_rate = verticalEarthRate(0.9);
-  return g;
-}
+using testing::referenceGyro;
 
 GyroParameters priorFor(const AngleLevelGyro& g) {
   GyroParameters p;

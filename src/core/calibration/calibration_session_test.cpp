@@ -18,11 +18,8 @@ namespace {
 
 using testing::AngleLevelGyro;
 
-AngleLevelGyro referenceGyro() {
-  AngleLevelGyro g;
-  g.k = HarmonicModel({2, 4}, -0.56, {-6e-4, 2e-3}, {4e-4, 0.0});
-  g.d = HarmonicModel({2}, 1e-5, {2e-5}, {-1e-5});
-  g.earth_rate = verticalEarthRate(0.9);
+AngleLevelGyro noisyReferenceGyro() {
+  AngleLevelGyro g = testing::referenceGyro();
   g.noise = 1e-6;
   return g;
 }
@@ -66,7 +63,7 @@ CalibrationOutcome run(const TurntableProfile& profile, CalibrationMethodKind me
   std::uniform_int_distribution<int> pick(0, one_in - 1);
   int next_kind = 0;
   Nanoseconds previous = 0;
-  testing::runAngleLevel(referenceGyro(), profile, [&](Nanoseconds t, double angle, double rate, double theta) {
+  testing::runAngleLevel(noisyReferenceGyro(), profile, [&](Nanoseconds t, double angle, double rate, double theta) {
     if (one_in > 0 && pick(random) == 0) {
       const Glitch kind = static_cast<Glitch>(next_kind++ % kGlitchKinds);
       ++injected->count[kind];
@@ -176,7 +173,7 @@ TEST(CalibrationSessionTest, ZeroStampsAndLoneBackwardStampsDoNotRestartTheRun) 
 TEST(CalibrationSessionTest, APersistingBackwardTimelineRestartsTheRun) {
   // A bag loop: the first 100 s of the session, then the whole session from its start again. The
   // run restarts once and ends as the single pass does.
-  const AngleLevelGyro g = referenceGyro();
+  const AngleLevelGyro g = noisyReferenceGyro();
   const TurntableProfile p = testing::dualRateProfile(0.05, -0.05, 120.0);
   const CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
   const CalibrationOutcome single = testing::calibrateAngleLevel(g, p, s, prior());

@@ -21,6 +21,8 @@
 #include <string>
 #include <thread>
 
+#include "core/testing/concurrent_writers.h"
+
 namespace hrg_gyro {
 namespace core {
 namespace {
@@ -200,25 +202,10 @@ TEST_F(AtomicFileTest, BackupTemporariesAreUniqueToo) {
 TEST_F(AtomicFileTest, TwoProcessesWritingOneFileBothSucceed) {
   const std::string path = at("params.yaml");
   writeText(path, "a\n");
-  pid_t children[2];
-  for (int c = 0; c < 2; ++c) {
-    children[c] = ::fork();
-    ASSERT_GE(children[c], 0);
-    if (children[c] == 0) {
-      try {
-        for (int i = 0; i < 300; ++i) writeFileAtomically(path, c == 0 ? "a\n" : "b\n", OutputFileOptions{true});
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "writer %d: %s\n", c, e.what());
-        ::_exit(1);
-      }
-      ::_exit(0);
-    }
-  }
-  for (pid_t child : children) {
-    int status = 0;
-    ASSERT_EQ(::waitpid(child, &status, 0), child);
-    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "a writer failed (see its message above)";
-  }
+  const std::vector<bool> ok = testing::runConcurrentWriters(2, [&](int c) {
+    for (int i = 0; i < 300; ++i) writeFileAtomically(path, c == 0 ? "a\n" : "b\n", OutputFileOptions{true});
+  });
+  EXPECT_EQ(ok, std::vector<bool>(2, true)) << "a writer failed (see its message above)";
   const std::string now = readText(path), backup = readText(path + ".bak");
   EXPECT_TRUE(now == "a\n" || now == "b\n") << now;
   EXPECT_TRUE(backup == "a\n" || backup == "b\n") << backup;

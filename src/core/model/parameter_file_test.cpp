@@ -16,6 +16,8 @@
 #include <set>
 #include <sstream>
 
+#include "core/testing/concurrent_writers.h"
+
 namespace hrg_gyro {
 namespace core {
 namespace {
@@ -380,25 +382,10 @@ TEST(ParameterFileTest, TwoWritersOfOneFileBothSucceed) {
   GyroParameters a = sampleParameters(), b = sampleParameters();
   b.correction.p[0] = 5e-4;
   saveParameterFile(path, a);
-  pid_t children[2];
-  for (int c = 0; c < 2; ++c) {
-    children[c] = ::fork();
-    ASSERT_GE(children[c], 0);
-    if (children[c] == 0) {
-      try {
-        for (int i = 0; i < 150; ++i) saveParameterFile(path, c == 0 ? a : b);
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "writer %d: %s\n", c, e.what());
-        ::_exit(1);
-      }
-      ::_exit(0);
-    }
-  }
-  for (pid_t child : children) {
-    int status = 0;
-    ASSERT_EQ(::waitpid(child, &status, 0), child);
-    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "a writer failed (see its message above)";
-  }
+  const std::vector<bool> ok = testing::runConcurrentWriters(2, [&](int c) {
+    for (int i = 0; i < 150; ++i) saveParameterFile(path, c == 0 ? a : b);
+  });
+  EXPECT_EQ(ok, std::vector<bool>(2, true)) << "a writer failed (see its message above)";
   const GyroParameters now = loadParameterFile(path), backup = loadParameterFile(path + ".bak");
   EXPECT_TRUE(now == a || now == b);
   EXPECT_TRUE(backup == a || backup == b);

@@ -29,6 +29,16 @@ struct AngleLevelGyro {
   std::function<double(double)> frequency;
 };
 
+/// The reference gyro of the calibration tests (K0 = -0.56, our electrical convention): harmonics of
+/// a few 1e-4 in K and a drift with a 2theta term, so that drift leaking into K would show.
+inline AngleLevelGyro referenceGyro() {
+  AngleLevelGyro g;
+  g.k = HarmonicModel({2, 4}, -0.56, {-6e-4, 2e-3}, {4e-4, 0.0});
+  g.d = HarmonicModel({2}, 1e-5, {2e-5}, {-1e-5});
+  g.earth_rate = verticalEarthRate(0.9);
+  return g;
+}
+
 /// Calls sink(stamp, table_angle, table_rate_reported, theta_measured, frequency) for every sample.
 inline void runAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profile,
                           const std::function<void(Nanoseconds, double, double, double, double)>& sink) {
