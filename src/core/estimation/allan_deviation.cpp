@@ -78,6 +78,8 @@ AllanResult allanDeviation(const std::vector<double>& angle, double tau0, int po
     flat.value = lowest / 0.664;
   }
   r.bias_instability = flat;
+  // The +1/2 line reaches sigma = K at tau = 3 s: K is sqrt(3) times its amplitude at 1 s.
+  r.rate_random_walk = readSlope(r.curve, 0.5, 0.15, std::sqrt(3.0));
   return r;
 }
 

@@ -73,6 +73,36 @@ TEST(AllanDeviationTest, FlickerLikeBiasGivesAFlatBottomAndB) {
   EXPECT_NEAR(r.bias_instability.value, 1.04e-6 / 0.664, 0.06 * 1.04e-6 / 0.664);
 }
 
+TEST(AllanDeviationTest, RateRandomWalkHasSlopePlusHalfAndGivesK) {
+  // A rate that random-walks: sigma(tau) = K sqrt(tau / 3), so sigma(3 s) = K.
+  GaussianNoise g(4);
+  const double k = 2e-6, tau0 = 0.05;  // rad/s/sqrt(s)
+  std::vector<double> angle(400000);
+  double rate = 0.0, theta = 0.0;
+  for (double& a : angle) {
+    rate += k * std::sqrt(tau0) * g.next();
+    theta += rate * tau0;
+    a = theta;
+  }
+  const AllanResult r = allanDeviation(angle, tau0);
+  ASSERT_TRUE(r.rate_random_walk.identified);
+  EXPECT_NEAR(r.rate_random_walk.value, k, 0.1 * k);
+  EXPECT_FALSE(r.angle_random_walk.identified);
+  EXPECT_FALSE(r.bias_instability.identified);
+}
+
+TEST(AllanDeviationTest, WhiteRateNoiseShowsNoRateRandomWalk) {
+  GaussianNoise g(5);
+  const double n = 1e-4, tau0 = 0.01;
+  std::vector<double> angle(200000);
+  double theta = 0.0;
+  for (double& a : angle) {
+    theta += n * std::sqrt(tau0) * g.next();
+    a = theta;
+  }
+  EXPECT_FALSE(allanDeviation(angle, tau0).rate_random_walk.identified);
+}
+
 TEST(AllanDeviationTest, TooShortGivesNothing) {
   EXPECT_TRUE(allanDeviation({1.0, 2.0, 3.0}, 0.1).curve.empty());
   EXPECT_TRUE(allanDeviation(std::vector<double>(100, 0.0), 0.0).curve.empty());

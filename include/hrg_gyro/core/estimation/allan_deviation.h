@@ -7,6 +7,7 @@
 //   slope -1    angle (quantisation) white noise Q:   sigma = sqrt(3) Q / tau
 //   slope -1/2  angle random walk N:                  sigma = N / sqrt(tau)   (read at tau = 1 s)
 //   slope  0    bias instability B:                   sigma_min = 0.664 B
+//   slope +1/2  rate random walk K:                   sigma = K sqrt(tau / 3)  (read at tau = 3 s)
 // A reading is reported only where the curve shows that slope (within tolerance) over at least a
 // factor of 3 in tau; otherwise it is marked as not identified rather than guessed.
 #pragma once
@@ -26,7 +27,7 @@ struct AllanPoint {
 
 struct NoiseReading {
   bool identified = false;
-  double value = 0.0;                   ///< Q (rad), N (rad/sqrt(s)) or B (rad/s)
+  double value = 0.0;                   ///< Q (rad), N (rad/sqrt(s)), B (rad/s) or K (rad/s/sqrt(s))
   double tau_min = 0.0, tau_max = 0.0;  ///< s, range of the curve it was read from
 };
 
@@ -35,6 +36,7 @@ struct AllanResult {
   NoiseReading angle_white_noise;  ///< Q
   NoiseReading angle_random_walk;  ///< N
   NoiseReading bias_instability;   ///< B
+  NoiseReading rate_random_walk;   ///< K
 };
 
 /// `angle` sampled every `tau0` seconds; `points_per_decade` of the tau grid.
