@@ -1,4 +1,6 @@
 // hrg_bag allan: overlapping Allan deviation of the compensated rate (IEEE 952 readings).
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,7 +18,8 @@ namespace hrg_gyro {
 namespace {
 
 struct AllanOptions {
-  std::string bag, params, csv, plot;
+  std::string bag, params, csv, plot, yaml;
+  double from = -INFINITY, to = INFINITY;  ///< s, channel stamps analysed (the processor sees them all)
   bag_tools::GyroTopics topics;
   core::ProcessorConfig processor;
 };
@@ -24,7 +27,8 @@ struct AllanOptions {
 int runAllan(const AllanOptions& o) {
   using namespace bag_tools;
   checkProcessorConfig(o.processor);
-  checkOutputPaths({o.bag, o.params}, {o.csv, o.plot});
+  checkOutputPaths({o.bag, o.params}, {o.csv, o.plot, o.yaml});
+  if (!(o.from < o.to)) throw UsageError("--from must be before --to");
   const auto params = std::make_shared<const core::GyroParameters>(
       o.params.empty() ? core::GyroParameters() : core::loadParameterFile(o.params));
   const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
@@ -34,8 +38,15 @@ int runAllan(const AllanOptions& o) {
   std::vector<double> current, best, dts;
   replayChannels(
       *bag, topics.channels, processor,
-      [&](const ChannelAmplitudes&, const core::ProcessorResult& r) {
+      [&](const ChannelAmplitudes& c, const core::ProcessorResult& r) {
         if (!r.has_output) return;
+        const double stamp = c.header.stamp.toSec();
+        if (stamp < o.from || stamp > o.to) {
+          // Outside the window: ends the stretch being collected, as a gap would.
+          if (current.size() > best.size()) best.swap(current);
+          current.clear();
+          return;
+        }
         if (r.flags & (core::kFlagGap | core::kFlagReset)) {
           if (current.size() > best.size()) best.swap(current);
           current.clear();
@@ -64,6 +75,32 @@ int runAllan(const AllanOptions& o) {
   reading("angle white noise Q", a.angle_white_noise, 180.0 / M_PI * 3600.0, "arcsec", 1.0, "rad");
   reading("angle random walk N", a.angle_random_walk, 180.0 / M_PI * 60.0, "deg/sqrt(h)", 1.0, "rad/sqrt(s)");
   reading("bias instability B", a.bias_instability, kDegPerHour, "deg/h", 1.0, "rad/s");
+  reading("rate random walk K", a.rate_random_walk, kDegPerHour * 60.0, "deg/h/sqrt(h)", 1.0, "rad/s/sqrt(s)");
+  if (!o.yaml.empty()) {
+    // The readings in SI for reports: what was read, from which tau range, and the record they came from.
+    YAML::Emitter y;
+    y << YAML::BeginMap;
+    y << YAML::Key << "samples" << YAML::Value << best.size();
+    y << YAML::Key << "tau0" << YAML::Value << tau0;
+    y << YAML::Key << "record_length" << YAML::Value << tau0 * static_cast<double>(best.size());
+    auto emit = [&y](const char* key, const core::NoiseReading& r) {
+      y << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap;
+      y << YAML::Key << "identified" << YAML::Value << r.identified;
+      y << YAML::Key << "value" << YAML::Value << r.value;
+      y << YAML::Key << "tau_min" << YAML::Value << r.tau_min;
+      y << YAML::Key << "tau_max" << YAML::Value << r.tau_max;
+      y << YAML::EndMap;
+    };
+    emit("angle_white_noise", a.angle_white_noise);  // rad
+    emit("angle_random_walk", a.angle_random_walk);  // rad/sqrt(s)
+    emit("bias_instability", a.bias_instability);    // rad/s
+    emit("rate_random_walk", a.rate_random_walk);    // rad/s/sqrt(s)
+    y << YAML::EndMap;
+    OutputText yaml_file(o.yaml);
+    yaml_file.stream() << "# hrg_bag allan readings, SI: Q rad, N rad/sqrt(s), B rad/s, K rad/s/sqrt(s); tau in s.\n"
+                       << y.c_str() << "\n";
+    yaml_file.commit();
+  }
   if (!o.csv.empty()) {
     OutputText csv_file(o.csv);
     std::ostream& csv = csv_file.stream();
@@ -92,14 +129,18 @@ Command addAllanCommand(CLI::App& root) {
   CLI::Option* csv = cmd->add_option("--csv", o->csv, "output CSV: tau (s), deviation and its error (rad/s), clusters")
                          ->check(tools::notEmpty());
   cmd->add_option("--plot", o->plot, "PNG drawn from the CSV")->needs(csv)->check(tools::notEmpty());
+  cmd->add_option("--yaml", o->yaml, "output YAML: the readings in SI with their tau ranges")->check(tools::notEmpty());
+  cmd->add_option("--from", o->from, "first channel stamp analysed (s; default: the first)");
+  cmd->add_option("--to", o->to, "last channel stamp analysed (s; default: the last)");
   addTopicOptions(*cmd, &o->topics, false);
   addProcessorOptions(*cmd, &o->processor);
   cmd->footer(
       "Computes the overlapping Allan deviation of the compensated rate from the integrated angle over its\n"
-      "longest continuous stretch (no gap or reset). Prints the readings: angle white noise Q (slope -1),\n"
-      "angle random walk N (slope -1/2, at tau = 1 s), bias instability B (flat bottom / 0.664), each\n"
-      "with the tau range it was read from, or 'not identified'.\n"
-      "The CSV and the plot replace their paths only when complete.\n"
+      "longest continuous stretch (no gap or reset) within --from..--to (every sample still goes through\n"
+      "the processor). Prints the readings: angle white noise Q (slope -1), angle random walk N (slope\n"
+      "-1/2, at tau = 1 s), bias instability B (flat bottom / 0.664), rate random walk K (slope +1/2, at\n"
+      "tau = 3 s), each with the tau range it was read from, or 'not identified'.\n"
+      "The CSV, the YAML and the plot replace their paths only when complete.\n"
       "Exit 0 success, 2 bad usage, unreadable input or fewer than 100 continuous samples, 3 an output\n"
       "could not be written (nothing left at its path, an existing file unchanged).");
   return [o] { return runAllan(*o); };
