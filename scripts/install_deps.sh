@@ -11,7 +11,7 @@ PACKAGES=(
   libnodeletlib-dev libnodeletlib-tools libnodelet-dev pluginlib-dev
   libdiagnostic-updater-dev libstd-srvs-dev libsensor-msgs-dev
   python3-std-srvs python3-sensor-msgs python3-diagnostic-msgs python3-yaml
-  python3-numpy python3-matplotlib
+  python3-numpy python3-matplotlib python3-jinja2 chromium
   libcli11-dev
   tf2-tools libtf2-ros-dev python3-rosunit catkin-lint python3-nodelet clang-format
 )
@@ -21,6 +21,8 @@ PACKAGES=(
 # tf2-tools and libtf2-ros-dev: static_transform_publisher and the tf2_ros package of the example
 # stack launch; python3-rosunit and catkin-lint: the install-space and package checks of make test;
 # python3-nodelet: the nodelet manager's list service in two_gyros.test; clang-format: the format check.
+# python3-jinja2: the HTML calibration report (scripts/hrg_report.py); chromium: the report test renders
+# it headless as a reader's browser would.
 # Extra packages for one target, e.g. `install_deps.sh clang-14 libclang-rt-14-dev` for `make fuzz`.
 PACKAGES+=("$@")
 
