@@ -5,6 +5,7 @@
 #   make soak   1 simulated h at 10 kHz through the nodes (sim clock, 2x), memory and drops watched
 #   make fuzz   libFuzzer + ASan/UBSan on the parameter loader and the sample path (FUZZ_SECONDS each)
 #   make figures  the main job, then the documentation figures docs/figures/*.png from its output
+#                 (with a screenshot of its HTML calibration report)
 # Everything builds in .ws/, a catkin workspace inside the checkout (ignored by git) whose
 # src/hrg_gyro links back to this directory; source .ws/devel/setup.bash to use the package.
 # (A dot directory: roslaunch/rosrun search the package tree following links and skip dot dirs.)
@@ -45,8 +46,11 @@ run: build
 
 # The documentation figures (README, docs/testing.md): K(theta) and D(theta) against the binned data,
 # the nonlinearity before/after and an Allan deviation, from the run_output/ of the main job.
+# Also the example report's first page (docs/test_engineer_workflow.md), as headless Chromium shows it.
 figures: run
 	cd $(WS) && source devel/setup.bash && /usr/bin/python3 $(ROOT)/scripts/make_doc_figures.py
+	chromium --headless --disable-gpu --no-sandbox --hide-scrollbars --window-size=900,1700 \
+	  --screenshot=$(ROOT)/docs/figures/example_report.png file://$(ROOT)/run_output/report.html 2> /dev/null
 
 # Benchmarks: Google Benchmark core suites, calibration, offline and live pipelines (about 12 min);
 # figures in bench_output/results.md. BENCH_ONLY=core,... selects parts (see bench/run_benchmarks.py).

@@ -180,10 +180,14 @@ class ReportTest(unittest.TestCase):
         self.assertEqual(code, 0, err[-2000:])
         with open(pdf, "rb") as f:
             data = f.read()
-        self.assertTrue(data.startswith(b"%PDF"))
         pages = len(re.findall(rb"/Type\s*/Page[^s]", data))
         self.assertGreaterEqual(pages, 3)
-        self.assertIn(b"/MediaBox [0 0 595", data, "A4 pages (595 x 842 pt)")
+        boxes = re.findall(rb"/MediaBox \[0 0 ([0-9.]+) ([0-9.]+)\]", data)
+        self.assertEqual(len(boxes), pages)
+        for w, h in boxes:
+            self.assertTrue(abs(float(w) - 595.3) < 1.0 and abs(float(h) - 841.9) < 1.0, "A4 is 595 x 842 pt, not %s x %s"
+                            % (w.decode(), h.decode()))
+        self.assertTrue(data.startswith(b"%PDF"), "not a PDF")
 
     def test_the_allan_readings_find_the_simulated_angle_random_walk(self):
         code, params, report_path, log = self.calibrate("noisy")
