@@ -317,16 +317,21 @@ def model_figure(theta, binned, estimate, k0, scale, ylabel, band_sigma):
         tr_std = lambda s: s * scale  # noqa: E731
     fit = [tr(model(estimate, t)) for t in grid]
     half = [band_sigma * tr_std(model_std(estimate, t)) for t in grid]
-    fig, ax = plt.subplots(figsize=(7.2, 2.8))
+    fig, (ax, ax_band) = plt.subplots(2, 1, figsize=(7.2, 3.8), sharex=True, gridspec_kw={"height_ratios": [3, 1.2]})
     if theta and binned:
         ax.plot(theta, [tr(v) for v in binned], ".", ms=3, color="tab:gray", label="binned data")
     ax.fill_between(grid, [f - h for f, h in zip(fit, half)], [f + h for f, h in zip(fit, half)], color="tab:blue",
                     alpha=0.3, label="95 % confidence band of the fit")
     ax.plot(grid, fit, "-", lw=1.0, color="tab:blue", label="fitted model")
-    ax.set_xlabel("theta (electrical rad)")
     ax.set_ylabel(ylabel)
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=8)
+    # The band is often far narrower than the curve's swing: its half-width on its own scale.
+    ax_band.plot(grid, half, "-", lw=1.0, color="tab:blue")
+    ax_band.set_ylim(0.0, 1.15 * max(half))
+    ax_band.set_ylabel("band half-width", fontsize=8)
+    ax_band.set_xlabel("theta (electrical rad)")
+    ax_band.grid(True, lw=0.3)
     fig.tight_layout()
     return figure_uri(fig)
 

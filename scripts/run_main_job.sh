@@ -29,7 +29,7 @@ echo "make run: done in $(( $(date +%s) - start )) s; calibrated parameters in $
      "calibration report in $out/params.dual_rate.report.yaml, logs in $out/roslaunch.log" >&2
 # The report needs the session as a bag: the same scenario and seed through `hrg_bag simulate` (the
 # turntable profile and the rest for the Allan deviation); the calibration is the pipeline's own.
-echo "make run: writing the HTML calibration report (the session re-simulated as a bag, ~40 s)..." >&2
+echo "make run: writing the HTML calibration report (the session re-simulated as a bag, about 45 s)..." >&2
 hrg_bag="$(catkin_find --first-only --libexec hrg_gyro hrg_bag)"
 "$hrg_bag" simulate --scenario "$root/config/scenarios/demo.yaml" --out "$out/session.bag" > "$out/report.log" 2>&1
 /usr/bin/python3 "$root/scripts/hrg_report.py" "$out/params.dual_rate.report.yaml" --bag "$out/session.bag" \

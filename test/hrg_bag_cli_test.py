@@ -306,6 +306,8 @@ class HrgBagCli(unittest.TestCase):
             (["calibrate", bag, "--method", "step"], "--out", "required"),
             (common["allan"] + ["--plot", self.path("x.png")], "--plot", "--csv"),
             (common["allan"] + ["--csv"], "--csv", "missing"),
+            (common["allan"] + ["--from", "abc"], "--from", "finite number"),
+            (common["allan"] + ["--from", "5", "--to", "1"], "--from", "before --to"),
         ]
         for args, option, why in cases:
             self.assertRefused(hrg_bag(*args), option, why, args)

@@ -5,7 +5,6 @@ numbers the browser shows must equal those of the calibration report YAML. The A
 checked against a simulated gyro whose angle random walk is known. Needs no master; run as a rostest
 for the package environment."""
 import html.parser
-import math
 import os
 import re
 import shutil
@@ -205,6 +204,15 @@ class ReportTest(unittest.TestCase):
         self.assertTrue(page.by_id["allan-rate_random_walk"].startswith("\u2264"), page.by_id["allan-rate_random_walk"])
         self.assertTrue(page.by_id["allan-bias_instability"].startswith("\u2264"))
 
+    def test_hrg_bag_runs_the_scripts_with_their_own_help(self):
+        for command, script in (("report", "hrg_report.py"), ("batch", "hrg_batch.py")):
+            code, stdout, err = run(HRG_BAG, command, "--help")
+            self.assertEqual(code, 0, err)
+            self.assertIn("usage: " + script, stdout)
+        code, _, err = run(HRG_BAG, "report", self.path("missing.report.yaml"), "--out", self.path("m.html"))
+        self.assertEqual(code, 2, err)
+        self.assertIn("no such file", err)
+
     def test_a_bad_specification_is_refused_with_its_key(self):
         code, params, report_path, log = self.calibrate("quiet")
         self.assertEqual(code, 0, log)
@@ -258,11 +266,12 @@ class ReportTest(unittest.TestCase):
         for name, row in rows[1:]:
             self.assertIn(">PASS<", row, name)
             self.assertIn('href="%s/report.html"' % name, row)
-        # Every bag of the folder passing exits 0.
+        # Every bag of the folder passing exits 0 (through hrg_bag, which runs the script beside itself).
         os.remove(os.path.join(bags, "gyro0_broken.bag"))
-        code, stdout, err = run("/usr/bin/python3", os.path.join(self.pkg, "scripts", "hrg_batch.py"), bags,
-                                self.path("campaign_ok"), "--params", self.prior, "--spec", self.spec)
+        code, stdout, err = run(HRG_BAG, "batch", bags, self.path("campaign_ok"), "--params", self.prior, "--spec",
+                                self.spec)
         self.assertEqual(code, 0, stdout + err)
+        self.assertIn("2 of 2 passed", stdout)
 
 
 if __name__ == "__main__":

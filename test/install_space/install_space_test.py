@@ -38,7 +38,8 @@ class InstallSpace(unittest.TestCase):
 
     def test_everything_a_user_runs_is_installed(self):
         for exe in ("driver_sim", "processor", "calibrator", "session_monitor", "hrg_bag", "hrg_session",
-                    "plot_calibration.py", "hrg_gyro_core_bench", "hrg_gyro_calibration_bench"):
+                    "plot_calibration.py", "hrg_report.py", "hrg_batch.py", "hrg_gyro_core_bench",
+                    "hrg_gyro_calibration_bench"):
             path = os.path.join(PREFIX, "lib", "hrg_gyro", exe)
             self.assertTrue(os.access(path, os.X_OK), path)
         for lib in ("libhrg_gyro_core.so", "libhrg_gyro_ros.so", "libhrg_gyro_nodelets.so"):
@@ -48,7 +49,9 @@ class InstallSpace(unittest.TestCase):
                     "share/hrg_gyro/package.xml", "share/hrg_gyro/launch/processor.launch",
                     "share/hrg_gyro/launch/example_navigation_stack.launch", "share/hrg_gyro/config/processor.yaml",
                     "share/hrg_gyro/config/calibrator.yaml", "share/hrg_gyro/config/driver_sim.yaml",
-                    "share/hrg_gyro/config/params_uncalibrated.yaml", "share/hrg_gyro/config/scenarios/dual_rate.yaml"):
+                    "share/hrg_gyro/config/params_uncalibrated.yaml", "share/hrg_gyro/config/scenarios/dual_rate.yaml",
+                    "share/hrg_gyro/config/report_spec.yaml", "share/hrg_gyro/templates/report.html.j2",
+                    "share/hrg_gyro/templates/index.html.j2"):
             self.assertTrue(os.path.isfile(os.path.join(PREFIX, rel)), rel)
 
     def test_rosrun_hrg_bag_help(self):
@@ -63,6 +66,17 @@ class InstallSpace(unittest.TestCase):
         p = run("/usr/bin/python3", os.path.join(PREFIX, "lib", "hrg_gyro", "plot_calibration.py"))
         self.assertIn("plot_calibration.py", p.stdout)
         self.assertNotIn("Traceback", p.stdout)
+
+    def test_report_scripts_find_their_templates_and_hrg_bag_in_the_install_space(self):
+        lib = os.path.join(PREFIX, "lib", "hrg_gyro")
+        p = run("/usr/bin/python3", "-c", "import sys; sys.path.insert(0, %r); import hrg_report; "
+                "print(hrg_report.find_template_dir()); print(hrg_report.hrg_bag_executable())" % lib)
+        self.assertEqual(p.stdout.split(), [os.path.join(PREFIX, "share", "hrg_gyro", "templates"),
+                                            os.path.join(lib, "hrg_bag")], p.stdout)
+        for script in ("hrg_report.py", "hrg_batch.py"):
+            p = run("/usr/bin/python3", os.path.join(lib, script), "--help")
+            self.assertEqual(p.returncode, 0, p.stdout)
+            self.assertNotIn("Traceback", p.stdout)
 
     def test_nodelets_are_found(self):
         p = run("rospack", "plugins", "--attrib=plugin", "nodelet")

@@ -130,8 +130,9 @@ Command addAllanCommand(CLI::App& root) {
                          ->check(tools::notEmpty());
   cmd->add_option("--plot", o->plot, "PNG drawn from the CSV")->needs(csv)->check(tools::notEmpty());
   cmd->add_option("--yaml", o->yaml, "output YAML: the readings in SI with their tau ranges")->check(tools::notEmpty());
-  cmd->add_option("--from", o->from, "first channel stamp analysed (s; default: the first)");
-  cmd->add_option("--to", o->to, "last channel stamp analysed (s; default: the last)");
+  cmd->add_option("--from", o->from, "first channel stamp analysed (s; default: the first)")
+      ->check(tools::finiteNumber());
+  cmd->add_option("--to", o->to, "last channel stamp analysed (s; default: the last)")->check(tools::finiteNumber());
   addTopicOptions(*cmd, &o->topics, false);
   addProcessorOptions(*cmd, &o->processor);
   cmd->footer(

@@ -293,28 +293,22 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
   return n;
 }
 
-namespace {
-
-/// plot_calibration.py is installed beside hrg_bag (lib/hrg_gyro, devel and install space alike);
-/// a source checkout without that copy falls back to the package's scripts/.
-std::string plotScript() {
+std::string packageScript(const std::string& name) {
   char self[4096];
   const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
   if (n > 0) {
     std::string dir(self, static_cast<std::size_t>(n));
     dir.erase(dir.find_last_of('/') + 1);
-    const std::string beside = dir + "plot_calibration.py";
+    const std::string beside = dir + name;
     if (::access(beside.c_str(), R_OK) == 0) return beside;
   }
-  return ros::package::getPath("hrg_gyro") + "/scripts/plot_calibration.py";
+  return ros::package::getPath("hrg_gyro") + "/scripts/" + name;
 }
-
-}  // namespace
 
 namespace {
 
 int runPlotter(const std::vector<std::string>& arguments) {
-  const std::string script = plotScript();
+  const std::string script = packageScript("plot_calibration.py");
   std::vector<std::string> argv_s{"/usr/bin/python3", script};
   argv_s.insert(argv_s.end(), arguments.begin(), arguments.end());
   std::vector<char*> argv;

@@ -45,6 +45,9 @@ Command addInfoCommand(CLI::App& root);
 Command addProcessCommand(CLI::App& root);
 Command addCalibrateCommand(CLI::App& root);
 Command addAllanCommand(CLI::App& root);
+/// report and batch: the HTML report and the campaign, run by the Python scripts beside hrg_bag.
+Command addReportCommand(CLI::App& root);
+Command addBatchCommand(CLI::App& root);
 
 /// Opens a bag for reading; missing, unindexed, truncated or corrupt files become UsageErrors
 /// that say which.
@@ -144,7 +147,11 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
                              const std::function<void(const ChannelAmplitudes&, const core::ProcessorResult&)>& sink,
                              const std::string& progress_label);
 
-/// Runs scripts/plot_calibration.py (found through the package path) without a shell: `kind`
+/// The package's Python script `name`: installed beside hrg_bag (lib/hrg_gyro, devel and install
+/// space alike); a source checkout without that copy falls back to the package's scripts/.
+std::string packageScript(const std::string& name);
+
+/// Runs scripts/plot_calibration.py (found by packageScript) without a shell: `kind`
 /// (calibration, allan) drawn from `input` into `png`. The plotter writes a temporary beside `png`
 /// that replaces it only when the plotter succeeded; otherwise OutputError and `png` unchanged.
 void plot(const std::string& kind, const std::string& input, const std::string& png);
