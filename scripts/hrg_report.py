@@ -176,7 +176,7 @@ def read_session(bag_path, stride=10):
     return session
 
 
-def longest_rest(times, rates, tolerance=1e-6, trim=1.0):
+def longest_rest(times, rates, tolerance, trim=1.0):
     """(from, to) of the longest stretch with |table rate| <= tolerance, `trim` s cut at each end."""
     best, start = None, None
     for i, (t, r) in enumerate(zip(times, rates)):
@@ -422,6 +422,8 @@ def build(args):
                                   (args.verification, key))
     if args.rest and not args.rest[0] < args.rest[1]:
         raise ReportError("--rest FROM TO: FROM must be before TO")
+    if not args.rest_max_rate >= 0.0 or not math.isfinite(args.rest_max_rate):
+        raise ReportError("--rest-max-rate must be a finite number >= 0, not %r" % args.rest_max_rate)
 
     k_est = (report.get("scale_factor") or [None])[0]
     d_est = (report.get("drift") or [None])[0]
@@ -456,7 +458,12 @@ def build(args):
     try:
         if args.bag:
             session = read_session(args.bag)
-            window = tuple(args.rest) if args.rest else longest_rest(session["table_t"], session["table_rate"])
+            if args.rest:
+                window = tuple(args.rest)
+            elif session["table_topic"]:
+                window = longest_rest(session["table_t"], session["table_rate"], args.rest_max_rate)
+            else:  # a static recording without a table: all of it is at rest
+                window = (session["channels_t0"], session["channels_t1"])
             ctx["session"] = {"duration": session["channels_t1"] - session["channels_t0"],
                               "has_table": bool(session["table_t"]), "has_temperature": bool(session["temperature"])}
             if session["temperature"]:
@@ -535,6 +542,8 @@ def main(argv):
     parser.add_argument("--verification", help="session_monitor summary YAML (before_ppm, after_ppm)")
     parser.add_argument("--rest", nargs=2, type=float, metavar=("FROM", "TO"),
                         help="channel stamps (s) of the rest for the Allan deviation (default: the longest)")
+    parser.add_argument("--rest-max-rate", type=float, default=1e-5, metavar="RAD_S",
+                        help="largest |table rate| counted as at rest (default 1e-5 rad/s)")
     parser.add_argument("--title", help="page title")
     args = parser.parse_args(argv[1:])
     for name in ("report", "bag", "params", "spec", "verification"):
