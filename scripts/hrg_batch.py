@@ -81,7 +81,8 @@ def main(argv):
     parser = argparse.ArgumentParser(prog="hrg_batch.py", description=__doc__.split("\n\n")[0])
     parser.add_argument("bag_dir", help="folder of .bag files")
     parser.add_argument("out_dir", help="output folder (created)")
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="bags at once (default: the cores)")
+    parser.add_argument("--jobs", type=int, default=len(os.sched_getaffinity(0)),
+                        help="bags at once (default: the cores this process may use, as nproc counts them)")
     parser.add_argument("--method", help="calibration method (hrg_bag calibrate --method)")
     parser.add_argument("--params", help="prior parameter file")
     parser.add_argument("--config", help="calibrator settings YAML")
