@@ -2,7 +2,7 @@
 """A calibration campaign: every bag of a folder calibrated in parallel, one report per bag.
 
   hrg_batch.py BAG_DIR OUT_DIR [--jobs N] [--method M] [--params PRIOR.yaml] [--config CAL.yaml]
-               [--spec SPEC.yaml]
+               [--spec LIMITS.yaml]
 
 For each BAG_DIR/<name>.bag (sorted by name), in OUT_DIR/<name>/: `hrg_bag calibrate` writes
 params.yaml (only when every quality gate passes) and report.yaml, then hrg_report.py writes
@@ -86,7 +86,7 @@ def main(argv):
     parser.add_argument("--method", help="calibration method (hrg_bag calibrate --method)")
     parser.add_argument("--params", help="prior parameter file")
     parser.add_argument("--config", help="calibrator settings YAML")
-    parser.add_argument("--spec", help="specification YAML for the pass/fail")
+    parser.add_argument("--spec", metavar="LIMITS.yaml", help="specification YAML for the pass/fail")
     args = parser.parse_args(argv[1:])
     if args.jobs < 1:
         sys.stderr.write("hrg_batch: --jobs must be at least 1\n")

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """One calibration as a self-contained HTML report a test engineer can sign.
 
-  hrg_report.py REPORT.yaml --out OUT.html [--bag BAG] [--params CALIBRATED.yaml] [--spec SPEC.yaml]
+  hrg_report.py REPORT.yaml --out OUT.html [--bag BAG] [--params CALIBRATED.yaml] [--spec LIMITS.yaml]
                 [--verification SUMMARY.yaml] [--rest FROM TO] [--title TEXT]
 
 REPORT.yaml is the calibration report (`hrg_bag calibrate --report`, or the calibrator node's
@@ -538,7 +538,7 @@ def main(argv):
     parser.add_argument("--out", required=True, help="HTML file to write")
     parser.add_argument("--bag", help="the session's bag: profile, temperature, Allan deviation at rest")
     parser.add_argument("--params", help="calibrated parameter file for the Allan deviation")
-    parser.add_argument("--spec", help="specification YAML: pass/fail table")
+    parser.add_argument("--spec", metavar="LIMITS.yaml", help="specification YAML: pass/fail table")
     parser.add_argument("--verification", help="session_monitor summary YAML (before_ppm, after_ppm)")
     parser.add_argument("--rest", nargs=2, type=float, metavar=("FROM", "TO"),
                         help="channel stamps (s) of the rest for the Allan deviation (default: the longest)")
