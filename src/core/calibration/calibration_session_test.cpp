@@ -325,6 +325,19 @@ TEST(CalibrationSessionTest, RefusalNamesAMissingOrUnsynchronizedWave) {
   std::printf("[ measured ] %s\n[ measured ] %s\n", no_wave.reason.c_str(), late_wave.reason.c_str());
 }
 
+TEST(CalibrationSessionTest, ANanAngleIsRateOnlyFromTheStartAndAGlitchAfterALoggedAngle) {
+  CalibrationSession rate_only(settings(CalibrationMethodKind::kDualRate), prior());
+  for (int i = 1; i <= 100; ++i) EXPECT_TRUE(rate_only.addTurntable(toNanoseconds(i * 0.01), NAN, 0.05));
+  EXPECT_EQ(rate_only.counters().rejected.total(), 0u);
+  CalibrationSession logged(settings(CalibrationMethodKind::kDualRate), prior());
+  for (int i = 1; i <= 100; ++i) {
+    const double t = i * 0.01;
+    EXPECT_EQ(logged.addTurntable(toNanoseconds(t), i == 50 ? NAN : 0.05 * t, 0.05), i != 50) << i;
+  }
+  EXPECT_EQ(logged.counters().rejected.bad_angle, 1u);
+  EXPECT_EQ(logged.counters().rejected.total(), 1u);
+}
+
 TEST(CalibrationSessionTest, StepMethodOnARateOnlyStreamUsesTheRateIntegral) {
   // The step method measures each step by the table angle: from a rate-only stream, the integral of
   // the reported rate. It agrees with the angle-logging stream.
