@@ -22,12 +22,13 @@ constexpr double kAngleSlack = 0.01;
 constexpr std::uint64_t kMinSpuriousBreaks = 10;
 constexpr double kSpuriousShare = 0.2;
 
-// Gates that fail when too few wave samples landed on settled plateaus.
-bool refusedForLackOfPlateaus(const CalibrationOutcome& o) {
+// Gates that fail when too few wave samples landed on settled plateaus, and (with_coverage) the
+// coverage gate, which fails too when plateaus are broken into pieces none of which sweeps theta.
+bool refusedForLackOfPlateaus(const CalibrationOutcome& o, bool with_coverage) {
   for (const GateResult& g : o.gates) {
     if (g.passed) continue;
     if (g.name == "samples" || g.name == "plateau_groups" || g.name == "data" || g.name == "steps" ||
-        g.name == "dwell_time") {
+        g.name == "dwell_time" || (with_coverage && g.name == "coverage")) {
       return true;
     }
   }
@@ -221,7 +222,10 @@ bool CalibrationSession::shouldFinish() const {
   return last.plateau.is_static && toSeconds(last.stamp - last.plateau.start) >= settings_.auto_finish_idle;
 }
 
-std::string CalibrationSession::plateauDiagnosis() const {
+std::string CalibrationSession::plateauDiagnosis(bool* names_a_cause) const {
+  bool named = true;
+  if (!names_a_cause) names_a_cause = &named;
+  *names_a_cause = true;
   const SessionCounters& c = counters_;
   const PlateauSettings& ps = settings_.plateau;
   const PlateauStatistics st = detector_.statistics();
@@ -268,6 +272,7 @@ std::string CalibrationSession::plateauDiagnosis() const {
            ": the rate never stayed within tolerance for plateau/settle_time (" + seconds(ps.settle_time) +
            "); the longest plateau lasted " + seconds(longest);
   }
+  *names_a_cause = false;
   return std::to_string(c.unsettled) + " of " + std::to_string(c.wave) +
          " wave samples fell outside settled plateaus; the table was on settled plateaus for " +
          seconds(st.settled_moving) + " moving and " + seconds(st.settled_static) + " at rest (" +
@@ -276,9 +281,12 @@ std::string CalibrationSession::plateauDiagnosis() const {
 
 CalibrationOutcome CalibrationSession::finish() const {
   CalibrationOutcome o = method_->finish(prior_);
-  if (!o.accepted && !traitsOf(settings_.method).uses_generator_pairs && refusedForLackOfPlateaus(o)) {
+  bool names_a_cause = false;
+  const std::string cause =
+      o.accepted || traitsOf(settings_.method).uses_generator_pairs ? std::string() : plateauDiagnosis(&names_a_cause);
+  // A coverage shortfall is put down to the plateaus only when the session found a cause.
+  if (!cause.empty() && refusedForLackOfPlateaus(o, names_a_cause)) {
     // Name the cause first: the method's own gate says how few samples, this says why.
-    const std::string cause = plateauDiagnosis();
     o.gates.insert(o.gates.begin(), {"plateaus", false, static_cast<double>(counters_.used),
                                      static_cast<double>(settings_.gates.min_samples), cause});
     o.reason = "plateaus: " + cause + " (" + o.reason + ")";

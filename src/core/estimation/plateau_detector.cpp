@@ -6,9 +6,10 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-constexpr double kScatterBlock = 1.0;        // s of records per scatter block
-constexpr std::size_t kMinBlockRecords = 8;  // fewer: the block's scatter is not measured
-constexpr std::size_t kMaxBlocks = 4096;     // newest blocks kept for the medians
+constexpr double kScatterBlock = 1.0;          // s: shortest scatter block
+constexpr double kSpansPerJudgedBlock = 10.0;  // the judged rate's blocks are this many spans long
+constexpr std::size_t kMinBlockRecords = 8;    // fewer: the block's scatter is not measured
+constexpr std::size_t kMaxBlocks = 4096;       // newest blocks kept for the medians
 
 double median(std::vector<double> v) {
   if (v.empty()) return NAN;
@@ -117,7 +118,7 @@ PlateauRecord PlateauDetector::judge(const Held& h, double judged_rate) {
   const double dt = last_judged_ != 0 ? toSeconds(h.stamp - last_judged_) : 0.0;
   if (start) {
     if (segment_start_) {
-      block_reported_ = block_judged_ = LineSums();  // a block never spans a gap
+      reported_block_ = judged_block_ = ScatterBlock();  // a block never spans a gap
       has_previous_ = false;
     } else {
       ++stats_.breaks;
@@ -153,43 +154,43 @@ PlateauRecord PlateauDetector::judge(const Held& h, double judged_rate) {
   stats_.longest = std::max(stats_.longest, age);
   if (!state_.is_static) stats_.longest_moving = std::max(stats_.longest_moving, age);
 
-  // Scatter, per block, about the block's linear trend.
-  if (block_reported_.n == 0.0) {
-    block_start_ = h.stamp;
-    block_rate0_ = h.rate;
-    block_judged0_ = judged_rate;
-  }
-  const double bt = toSeconds(h.stamp - block_start_);
-  block_reported_.add(bt, h.rate - block_rate0_);
-  block_judged_.add(bt, judged_rate - block_judged0_);
-  if (bt >= kScatterBlock) closeBlock();
+  addToBlock(&reported_block_, h.stamp, h.rate, kScatterBlock, &reported_scatter_);
+  addToBlock(&judged_block_, h.stamp, judged_rate,
+             std::max(kScatterBlock, kSpansPerJudgedBlock * settings_.smoothing_span), &judged_scatter_);
 
   return {h.stamp, h.angle, h.rate, judged_rate, angle_logged_, state_};
 }
 
-void PlateauDetector::closeBlock() {
-  if (block_reported_.n >= kMinBlockRecords) {
-    const double rate = block_judged0_ + block_judged_.y / block_judged_.n;
-    if (std::abs(rate) >= settings_.static_rate) {
-      const double judged_std = block_judged_.residualStd();
-      blocks_.push_back({block_reported_.residualStd() / std::abs(rate), judged_std / std::abs(rate),
-                         judged_std / tolerance(rate), std::abs(rate)});
-      if (blocks_.size() > kMaxBlocks) blocks_.pop_front();
+void PlateauDetector::addToBlock(ScatterBlock* block, Nanoseconds stamp, double value, double length,
+                                 std::deque<Scatter>* closed) {
+  if (block->sums.n == 0.0) {
+    block->start = stamp;
+    block->first = value;
+  }
+  const double t = toSeconds(stamp - block->start);
+  block->sums.add(t, value - block->first);
+  if (t < length) return;
+  if (block->sums.n >= kMinBlockRecords) {
+    const double rate = std::abs(block->first + block->sums.y / block->sums.n);
+    if (rate >= settings_.static_rate) {
+      const double scatter = block->sums.residualStd();
+      closed->push_back({scatter / rate, scatter / tolerance(rate), rate});
+      if (closed->size() > kMaxBlocks) closed->pop_front();
     }
   }
-  block_reported_ = block_judged_ = LineSums();
+  *block = ScatterBlock();
 }
 
 PlateauStatistics PlateauDetector::statistics() const {
   PlateauStatistics s = stats_;
   std::vector<double> reported, judged, ratio, rate;
-  for (const Block& b : blocks_) {
-    reported.push_back(b.reported);
-    judged.push_back(b.judged);
+  for (const Scatter& b : reported_scatter_) reported.push_back(b.relative);
+  for (const Scatter& b : judged_scatter_) {
+    judged.push_back(b.relative);
     ratio.push_back(b.ratio);
     rate.push_back(b.rate);
   }
-  s.scatter_blocks = blocks_.size();
+  s.scatter_blocks = judged_scatter_.size();
   s.reported_scatter = median(reported);
   s.judged_scatter = median(judged);
   s.noise_to_tolerance = median(ratio);

@@ -67,12 +67,13 @@ class CalibrationSession {
   /// the correction matrix: the generator sweep has ended).
   bool shouldFinish() const;
   /// Fits, applies the gates and builds the new parameters (does not write anything). When the
-  /// method found too few samples on settled plateaus, a failed `plateaus` gate says why, from what
-  /// the session saw.
+  /// method found too few samples on settled plateaus (or too little coverage, for a named cause),
+  /// a failed `plateaus` gate comes first and says why, from what the session saw.
   CalibrationOutcome finish() const;
   /// Why few wave samples landed on settled plateaus, in the test engineer's terms, from the
-  /// counters and the detector's measurements.
-  std::string plateauDiagnosis() const;
+  /// counters and the detector's measurements. *names_a_cause: false when it can only say how much
+  /// of the data lay on settled plateaus.
+  std::string plateauDiagnosis(bool* names_a_cause = nullptr) const;
 
  private:
   struct WaveRecord {

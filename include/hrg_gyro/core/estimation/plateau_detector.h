@@ -18,8 +18,9 @@
 // below static_rate) are the dwells of the step and constant-rate methods.
 //
 // The detector also measures what the session needs to explain a refusal: how long plateaus lasted
-// and how much the reported and judged rates scatter on a moving table (per block of 1 s, about the
-// block's linear trend, so that ramps do not count as scatter).
+// and how much the reported and judged rates scatter on a moving table (about the linear trend of
+// blocks of 1 s for the reported rate, of 10 spans for the judged rate whose values within a span are
+// correlated; the trend keeps ramps from counting as scatter).
 #pragma once
 
 #include <cmath>
@@ -76,7 +77,7 @@ struct PlateauStatistics {
   double longest_moving = 0.0;       ///< s, longest plateau whose rate is not static
   double settled_moving = 0.0;       ///< s of records on settled moving plateaus
   double settled_static = 0.0;       ///< s of records on settled static plateaus
-  std::uint64_t scatter_blocks = 0;  ///< blocks of 1 s on a moving table behind the figures below
+  std::uint64_t scatter_blocks = 0;  ///< blocks on a moving table behind the figures below (judged rate)
   double reported_scatter = NAN;     ///< median over those blocks of std(reported rate) / |rate|
   double judged_scatter = NAN;       ///< the same for the judged rate
   double noise_to_tolerance = NAN;   ///< median of std(judged rate) / plateau tolerance at that rate
@@ -108,14 +109,20 @@ class PlateauDetector {
     Nanoseconds stamp;
     double angle, rate;
   };
-  struct Block {
-    double reported, judged, ratio, rate;
-  };
   struct LineSums {  // least-squares line y(t) through the points, t and y relative to the first point
     double n = 0, t = 0, tt = 0, y = 0, ty = 0, yy = 0;
     void add(double dt, double dy);
     double slope() const;
     double residualStd() const;
+  };
+  /// Scatter of one rate about its linear trend over a block of records.
+  struct ScatterBlock {
+    Nanoseconds start = 0;
+    double first = 0.0;  // the block's first value: keeps its sums small
+    LineSums sums;
+  };
+  struct Scatter {
+    double relative, ratio, rate;  // std / |rate|, std / tolerance, |rate|
   };
 
   double tolerance(double rate) const {
@@ -124,7 +131,8 @@ class PlateauDetector {
   /// Decides one record's plateau from its judged rate.
   PlateauRecord judge(const Held& h, double judged_rate);
   void judgeReady(bool all, std::vector<PlateauRecord>* out);
-  void closeBlock();
+  /// Adds a value to a block; closes it after `length` s, keeping its scatter if on a moving table.
+  void addToBlock(ScatterBlock* block, Nanoseconds stamp, double value, double length, std::deque<Scatter>* closed);
 
   PlateauSettings settings_;
   PlateauState state_;
@@ -145,11 +153,9 @@ class PlateauDetector {
   double previous_mean_ = 0.0;  // its mean judged rate
   LineSums plateau_line_;
   Nanoseconds last_judged_ = 0;
-  // The current scatter block.
-  Nanoseconds block_start_ = 0;
-  double block_rate0_ = 0.0, block_judged0_ = 0.0;  // first rates of the block: keeps its sums small
-  LineSums block_reported_, block_judged_;
-  std::deque<Block> blocks_;
+  // The current scatter blocks and the newest closed ones.
+  ScatterBlock reported_block_, judged_block_;
+  std::deque<Scatter> reported_scatter_, judged_scatter_;
 };
 
 }  // namespace core
