@@ -16,6 +16,27 @@ constexpr std::size_t kMaxHistory = 400000;
 // rad: the angle a good record may differ from the last good one beyond max_rate * dt (reporting
 // jitter between the angle and the stamp).
 constexpr double kAngleSlack = 0.01;
+// Scatter is named as the cause of a refusal when at least this many (and this share) of the plateau
+// breaks were spurious: the judged rate left the tolerance and came straight back. A real rate change
+// (a ramp) breaks plateaus too, but its rate does not come back.
+constexpr std::uint64_t kMinSpuriousBreaks = 10;
+constexpr double kSpuriousShare = 0.2;
+
+// Gates that fail when too few wave samples landed on settled plateaus, and (with_coverage) the
+// coverage gate, which fails too when plateaus are broken into pieces none of which sweeps theta.
+bool refusedForLackOfPlateaus(const CalibrationOutcome& o, bool with_coverage) {
+  for (const GateResult& g : o.gates) {
+    if (g.passed) continue;
+    if (g.name == "samples" || g.name == "plateau_groups" || g.name == "data" || g.name == "steps" ||
+        g.name == "dwell_time" || (with_coverage && g.name == "coverage")) {
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string percent(double fraction) { return formatShort(100.0 * fraction, 2) + " %"; }
+std::string seconds(double s) { return formatShort(s, 3) + " s"; }
 
 }  // namespace
 
@@ -34,16 +55,17 @@ bool CalibrationSession::plausible(Nanoseconds stamp, double angle, double rate)
     ++counters_.rejected.bad_rate;
     return false;
   }
+  // A NaN angle before any finite one: the stream does not log the angle (rate-only).
+  if (std::isnan(angle) && !detector_.angleLogged()) return true;
   if (!std::isfinite(angle)) {
     ++counters_.rejected.bad_angle;
     return false;
   }
-  if (!turntable_.empty() && stamp > turntable_.back().stamp) {
-    const TurntableRecord& last = turntable_.back();
-    const double reach = settings_.plateau.max_rate * toSeconds(stamp - last.stamp) + kAngleSlack;
+  if (has_last_good_ && std::isfinite(last_good_angle_) && stamp > last_good_stamp_) {
+    const double reach = settings_.plateau.max_rate * toSeconds(stamp - last_good_stamp_) + kAngleSlack;
     // A few in a row: a glitch. More than backward_persist: the table's angle really is elsewhere
     // (the good record kept last was the glitch, or the encoder was re-zeroed); take the new one.
-    if (std::abs(angle - last.angle) > reach && ++bad_angle_run_ <= settings_.backward_persist) {
+    if (std::abs(angle - last_good_angle_) > reach && ++bad_angle_run_ <= settings_.backward_persist) {
       ++counters_.rejected.bad_angle;
       return false;
     }
@@ -75,7 +97,12 @@ bool CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double ra
       ++counters_.rejected.out_of_order;
       return false;
   }
-  turntable_.push_back({stamp, angle, rate, detector_.update(stamp, rate)});
+  has_last_good_ = true;
+  last_good_stamp_ = stamp;
+  if (std::isfinite(angle)) last_good_angle_ = angle;
+  judged_.clear();
+  detector_.add(stamp, angle, rate, &judged_);
+  for (const PlateauRecord& r : judged_) turntable_.push_back(r);
   drain();
   // Keep history for waiting samples and for wave samples that lag behind this stream.
   Nanoseconds keep_from = std::min(stamp, last_wave_stamp_ > 0 ? last_wave_stamp_ : stamp);
@@ -102,6 +129,9 @@ void CalibrationSession::restart() {
   counters_.out_of_order = out_of_order;
   counters_.turntable_total = turntable_total;
   bad_angle_run_ = 0;
+  has_last_good_ = false;
+  last_good_stamp_ = 0;
+  last_good_angle_ = NAN;
   last_wave_stamp_ = 0;
   last_generator_stamp_ = 0;
   generator_ended_ = false;
@@ -155,13 +185,13 @@ void CalibrationSession::drain() {
 void CalibrationSession::classify(const WaveRecord& w) {
   // The last state at or before the sample and the first at or after it.
   const std::size_t after =
-      turntable_.lowerBound(w.stamp, [](const TurntableRecord& r, Nanoseconds t) { return r.stamp < t; });
+      turntable_.lowerBound(w.stamp, [](const PlateauRecord& r, Nanoseconds t) { return r.stamp < t; });
   if (after == turntable_.size() || (after == 0 && turntable_[0].stamp != w.stamp)) {
     ++counters_.unsynchronized;
     return;
   }
-  const TurntableRecord& b = turntable_[after];
-  const TurntableRecord& a = b.stamp == w.stamp ? b : turntable_[after - 1];
+  const PlateauRecord& b = turntable_[after];
+  const PlateauRecord& a = b.stamp == w.stamp ? b : turntable_[after - 1];
   if (toSeconds(b.stamp - a.stamp) > settings_.plateau.max_gap) {
     ++counters_.unsynchronized;
     return;
@@ -179,6 +209,7 @@ void CalibrationSession::classify(const WaveRecord& w) {
   const double f = span > 0.0 ? toSeconds(w.stamp - a.stamp) / span : 0.0;
   s.table_angle = a.angle + f * (b.angle - a.angle);
   s.table_rate = a.rate + f * (b.rate - a.rate);
+  s.angle_logged = a.angle_logged && b.angle_logged;
   method_->addSample(s);
   ++counters_.used;
 }
@@ -187,12 +218,79 @@ bool CalibrationSession::shouldFinish() const {
   if (settings_.auto_finish_idle <= 0.0 || !method_->complete()) return false;
   if (traitsOf(settings_.method).uses_generator_pairs) return generator_ended_;
   if (turntable_.empty()) return false;
-  const TurntableRecord& last = turntable_.back();
+  const PlateauRecord& last = turntable_.back();
   return last.plateau.is_static && toSeconds(last.stamp - last.plateau.start) >= settings_.auto_finish_idle;
+}
+
+std::string CalibrationSession::plateauDiagnosis(bool* names_a_cause) const {
+  bool named = true;
+  if (!names_a_cause) names_a_cause = &named;
+  *names_a_cause = true;
+  const SessionCounters& c = counters_;
+  const PlateauSettings& ps = settings_.plateau;
+  const PlateauStatistics st = detector_.statistics();
+  if (c.turntable == 0) {
+    return "no turntable record arrived" +
+           (c.rejected.total() > 0 ? " that was not a glitch (" + std::to_string(c.rejected.total()) + " dropped)"
+                                   : std::string()) +
+           ": check the turntable stream";
+  }
+  if (c.wave == 0) {
+    return "turntable records arrived without the wave (" + std::to_string(c.turntable) +
+           " turntable records, no wave sample)";
+  }
+  if (c.unsynchronized > c.used + c.unsettled) {
+    return std::to_string(c.unsynchronized) + " of " + std::to_string(c.wave) +
+           " wave samples had no turntable record around their stamp: the two streams' stamps do not overlap, "
+           "or the turntable records are more than plateau/max_gap (" +
+           seconds(ps.max_gap) + ") apart";
+  }
+  if (st.scatter_blocks > 0 && st.spurious_breaks >= kMinSpuriousBreaks &&
+      st.spurious_breaks >= kSpuriousShare * st.breaks) {
+    const double tolerance = (ps.rate_tolerance + ps.relative_tolerance * st.typical_rate) / st.typical_rate;
+    const std::string against =
+        " against a plateau tolerance of " + percent(tolerance) + " at " + formatShort(st.typical_rate, 3) + " rad/s";
+    if (ps.smoothing_span <= 0.0) {
+      return "reported rate scatter " + percent(st.reported_scatter) + " hides the plateaus (" + against.substr(1) +
+             ", judged record by record as plateau/smoothing_span is 0); " +
+             (detector_.angleLogged() ? "set plateau/smoothing_span" : "log the angle, set plateau/smoothing_span") +
+             " or raise plateau/relative_tolerance";
+    }
+    if (detector_.angleLogged()) {
+      return "the table angle's slope over plateau/smoothing_span (" + seconds(ps.smoothing_span) + ") scatters by " +
+             percent(st.judged_scatter) + against + " (reported rate: " + percent(st.reported_scatter) +
+             "); lengthen plateau/smoothing_span or raise plateau/relative_tolerance";
+    }
+    return "reported rate scatter " + percent(st.reported_scatter) + " (" + percent(st.judged_scatter) +
+           " averaged over plateau/smoothing_span, " + seconds(ps.smoothing_span) + ")" + against +
+           " hides the plateaus; log the angle, lengthen plateau/smoothing_span or raise plateau/relative_tolerance";
+  }
+  const bool needs_motion = settings_.method != CalibrationMethodKind::kStep;
+  const double longest = needs_motion ? st.longest_moving : st.longest;
+  if (longest < ps.settle_time) {
+    return std::string("no settled plateau") + (needs_motion ? " at a moving rate" : "") +
+           ": the rate never stayed within tolerance for plateau/settle_time (" + seconds(ps.settle_time) +
+           "); the longest plateau lasted " + seconds(longest);
+  }
+  *names_a_cause = false;
+  return std::to_string(c.unsettled) + " of " + std::to_string(c.wave) +
+         " wave samples fell outside settled plateaus; the table was on settled plateaus for " +
+         seconds(st.settled_moving) + " moving and " + seconds(st.settled_static) + " at rest (" +
+         std::to_string(st.plateaus) + " plateaus started)";
 }
 
 CalibrationOutcome CalibrationSession::finish() const {
   CalibrationOutcome o = method_->finish(prior_);
+  bool names_a_cause = false;
+  const std::string cause =
+      o.accepted || traitsOf(settings_.method).uses_generator_pairs ? std::string() : plateauDiagnosis(&names_a_cause);
+  // A coverage shortfall is put down to the plateaus only when the session found a cause.
+  if (!cause.empty() && refusedForLackOfPlateaus(o, names_a_cause)) {
+    // Name the cause first: the method's own gate says how few samples, this says why.
+    o.gates.insert(o.gates.begin(), {"plateaus", false, static_cast<double>(counters_.used),
+                                     static_cast<double>(settings_.gates.min_samples), cause});
+    o.reason = "plateaus: " + cause + " (" + o.reason + ")";
+  }
   o.quadrature_ratio = quadrature_count_ > 0 ? quadrature_sum_ / quadrature_count_ : 0.0;
   diagnose(&o, prior_.correction);
   o.turntable_records = counters_.turntable_total;

@@ -18,8 +18,8 @@ std::vector<int> parseEvenOrders(const YamlField& f) {
 }
 
 // The keys, listed once: parse() refuses any other, keyPaths() lists them for the node's template check.
-const std::vector<std::string> kPlateauKeys = {
-    "rate_tolerance", "relative_tolerance", "settle_time", "static_rate", "max_gap", "max_rate"};
+const std::vector<std::string> kPlateauKeys = {"rate_tolerance", "relative_tolerance", "settle_time",   "static_rate",
+                                               "max_gap",        "max_rate",           "smoothing_span"};
 const std::vector<std::string> kGateKeys = {"min_coverage",   "min_rate_separation", "max_rate_noise",
                                             "min_samples",    "max_condition",       "max_relative_residual",
                                             "max_k0_change",  "max_harmonic_std",    "min_steps",
@@ -82,6 +82,10 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
     s.plateau.static_rate = positive(p, "static_rate", s.plateau.static_rate);
     s.plateau.max_gap = positive(p, "max_gap", s.plateau.max_gap);
     s.plateau.max_rate = positive(p, "max_rate", s.plateau.max_rate);
+    // Records wait half the span to be judged; wave samples wait for them at most a minute.
+    s.plateau.smoothing_span = p.getDouble("smoothing_span", s.plateau.smoothing_span);
+    if (!(s.plateau.smoothing_span >= 0.0 && s.plateau.smoothing_span <= 20.0))
+      p["smoothing_span"].fail("must be in [0, 20] s");
   }
   if (root.has("gates")) {
     const YamlField g = root["gates"];

@@ -20,11 +20,14 @@ namespace core {
 
 struct PlateauSample {
   Nanoseconds stamp = 0;
-  double theta = 0.0;        ///< measured electrical angle, rad (continuous)
-  double frequency = NAN;    ///< Hz
-  PlateauState plateau;      ///< settled plateau this sample belongs to
-  double table_angle = 0.0;  ///< rad, interpolated at the stamp
-  double table_rate = 0.0;   ///< rad/s, as reported
+  double theta = 0.0;      ///< measured electrical angle, rad (continuous)
+  double frequency = NAN;  ///< Hz
+  PlateauState plateau;    ///< settled plateau this sample belongs to
+  /// rad, a continuous angle of the table at the stamp: the logged angle interpolated, or (in a
+  /// rate-only stream, angle_logged false) the integral of the reported rate.
+  double table_angle = 0.0;
+  double table_rate = 0.0;    ///< rad/s, as reported, interpolated at the stamp
+  bool angle_logged = false;  ///< the turntable stream logs the table angle
 };
 
 struct CalibrationProgress {

@@ -6,16 +6,24 @@
 // method with that plateau, the interpolated table angle and the reported rate. Memory is bounded:
 // the wave queue and the turntable history are trimmed by age, the methods keep bins.
 //
-// A glitched turntable record (a non-finite or impossible rate, a non-finite angle or one the rate
-// bound cannot reach, a zero, duplicate or backward stamp) is dropped and counted by reason before
-// the plateau detector sees it, so it cannot end a plateau. A stream whose stamps go back for good
-// (settings backward_reset and backward_persist, a looping bag) restarts the run from the prior: the
+// The turntable stream always carries an angle and a rate. A stream whose angle is NaN from its start
+// does not log the angle (rate-only): the table angle is then the integral of the reported rate. From
+// its first finite angle a stream logs angles, and a NaN angle in it is a glitch. The plateau detector
+// judges each record over a span centred on it, so records (and the wave samples between them) are
+// classified half a smoothing span after they arrive.
+//
+// A glitched turntable record (a non-finite or impossible rate, an infinite angle, a NaN angle or one
+// the rate bound cannot reach in an angle-logging stream, a zero, duplicate or backward stamp) is
+// dropped and counted by reason before the plateau detector sees it, so it cannot end a plateau. A stream whose stamps
+// go back for good (settings backward_reset and backward_persist, a looping bag) restarts the run from the prior: the
 // bins hold the previous pass. The live calibrator and hrg_bag calibrate both rely on this.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "hrg_gyro/core/calibration/calibration_method_interface.h"
 #include "hrg_gyro/core/common/ring_buffer.h"
@@ -58,15 +66,16 @@ class CalibrationSession {
   /// Auto-finish rule: the data are complete and the table has rested for auto_finish_idle s (for
   /// the correction matrix: the generator sweep has ended).
   bool shouldFinish() const;
-  /// Fits, applies the gates and builds the new parameters (does not write anything).
+  /// Fits, applies the gates and builds the new parameters (does not write anything). When the
+  /// method found too few samples on settled plateaus (or too little coverage, for a named cause),
+  /// a failed `plateaus` gate comes first and says why, from what the session saw.
   CalibrationOutcome finish() const;
+  /// Why few wave samples landed on settled plateaus, in the test engineer's terms, from the
+  /// counters and the detector's measurements. *names_a_cause: false when it can only say how much
+  /// of the data lay on settled plateaus.
+  std::string plateauDiagnosis(bool* names_a_cause = nullptr) const;
 
  private:
-  struct TurntableRecord {
-    Nanoseconds stamp;
-    double angle, rate;
-    PlateauState plateau;
-  };
   struct WaveRecord {
     Nanoseconds stamp;
     double theta, frequency;
@@ -82,13 +91,17 @@ class CalibrationSession {
   GyroParameters prior_;
   std::unique_ptr<CalibrationMethod> method_;
   PlateauDetector detector_;
-  RingBuffer<TurntableRecord> turntable_;
+  RingBuffer<PlateauRecord> turntable_;  // judged records
+  std::vector<PlateauRecord> judged_;    // scratch: records the detector has just judged
   RingBuffer<WaveRecord> pending_;
   SessionCounters counters_;
   StampTimeline turntable_timeline_;
   StampTimeline wave_timeline_;
   Nanoseconds last_wave_stamp_ = 0;
-  int bad_angle_run_ = 0;  // turntable records in a row whose angle the rate bound cannot reach
+  int bad_angle_run_ = 0;       // turntable records in a row whose angle the rate bound cannot reach
+  bool has_last_good_ = false;  // the last turntable record accepted, for the angle bound
+  Nanoseconds last_good_stamp_ = 0;
+  double last_good_angle_ = NAN;
   Nanoseconds last_generator_stamp_ = 0;
   bool generator_ended_ = false;
   double quadrature_sum_ = 0.0;  // of |B/A|, for the diagnosis's F factor
