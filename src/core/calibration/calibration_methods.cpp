@@ -208,6 +208,19 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
     return o;
   }
   o.binned = e.binned;
+  // The error budget of the K harmonics (largest term of each kind), stated in the report.
+  auto largest = [&](const std::vector<double>& v) {
+    double m = 0.0;
+    for (std::size_t i = 1; i < v.size(); ++i) m = std::max(m, v[i]);
+    return formatShort(1e6 * m / std::abs(e.k.mean));
+  };
+  o.notes.push_back("K harmonic standard errors, ppm of |K0| (largest of each kind): statistical " +
+                    largest(e.budget.statistical) + " (white wave-angle noise alone " + largest(e.budget.angle_noise) +
+                    ", beyond it " + largest(e.budget.beyond_noise) + "), Earth rate " + largest(e.budget.earth_rate) +
+                    ", basis-noise correction " + largest(e.budget.basis_noise) + "; phi from the " +
+                    (use_angle ? "logged table angle" : "integrated table rate") + ", window " +
+                    formatShort(e.mean_window) + " s, angle noise " + formatShort(e.angle_noise) + " rad, " +
+                    std::to_string(e.increments) + " increments in " + std::to_string(e.blocks) + " blocks");
   o.smoothing_factor = 1.0;  // nothing is smoothed: the increments are fitted through their exact integrals
   // The gate judges the table by its effect on K: what the data scatter beyond the white wave-angle
   // noise, all charged to the table angle (or the rate integral) as an upper estimate -- angle random

@@ -278,8 +278,9 @@ IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std
     const LeastSquaresSolution moved = solveAt(earth_rate + earth_rate_std);
     if (moved.ok) earth_shift = (moved.coefficients - beta).cwiseAbs();
   }
-  // Noise of theta inside the basis attenuates order k by exp(-k^2 s^2 / 2); undo it. Half the
-  // correction is taken as its uncertainty (the noise estimate itself is statistical).
+  // Noise of theta inside the basis attenuates order k by exp(-k^2 s^2 / 2); undo it. A tenth of the
+  // correction is taken as its uncertainty: the noise is estimated well (0.05 % at 0.2 rad), but
+  // noise correlated from sample to sample would make the estimate off by more.
   auto attenuation = [&](int k) { return std::exp(-0.5 * k * k * fit.angle_noise * fit.angle_noise); };
   std::vector<double> scale(p, 1.0);
   for (int j = 0; j < n_k; ++j) scale[1 + j] = scale[1 + n_k + j] = attenuation(k_orders_[j]);
@@ -293,7 +294,7 @@ IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std
     const double noise = std::sqrt(std::max(0.0, white(i, i))) * scale[i];
     const double beyond = std::sqrt(std::max(0.0, sandwich(i, i) - white(i, i))) * scale[i];
     const double earth = earth_shift(i);
-    const double basis = 0.5 * std::abs(beta(i)) * (1.0 - scale[i]);
+    const double basis = 0.1 * std::abs(beta(i)) * (1.0 - scale[i]);
     total_std[i] = std::sqrt(statistical * statistical + earth * earth + basis * basis);
     if (i < n_kterms) {
       budget.statistical.push_back(statistical);

@@ -25,7 +25,7 @@
 //
 // Noise of theta inside cos(k theta) attenuates the regressors by exp(-k^2 s^2 / 2) on average
 // (s the per-sample angle noise, estimated from the samples); the fitted harmonics are corrected by
-// that factor.
+// that factor (a tenth of the correction counts as its uncertainty).
 #pragma once
 
 #include <Eigen/Core>
