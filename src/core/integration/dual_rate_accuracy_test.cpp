@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -68,7 +69,7 @@ std::vector<Case> cases() {
   out.push_back({"no angle logged, rate differenced at 100 Hz", g, rate_only});
   AngleLevelGyro strong = g;
   strong.k = strongK();
-  out.push_back({"strong nonlinearity 3 % cos4, 0.3 % cos8", strong, ripple});
+  out.push_back({"strong nonlinearity 3 % cos4, 0.3 % cos8, with ripple", strong, ripple});
   AngleLevelGyro arw = g;
   arw.angle_random_walk = 3e-7;
   out.push_back({"angle random walk 0.3 urad/sqrt(s)", arw, perfect, false});
@@ -84,6 +85,49 @@ double maxHarmonicStdPpm(const HarmonicFitResult& k) {
   double m = 0.0;
   for (std::size_t j = 0; j < k.orders.size(); ++j) m = std::max({m, k.cos_std[j], k.sin_std[j]});
   return 1e6 * m / std::abs(k.mean);
+}
+
+TEST(DualRateAccuracyTest, TableSessionIsFastAndLogsTheAngleTurned) {
+  // 1800 s at 1 kHz with every imperfection: the logged angle follows the profile's angle (the ripple
+  // adds at most 2 ripple rate / (2 pi f) per plateau, and the generator takes well under a second.
+  AngleLevelGyro g = testing::referenceGyro();
+  g.noise = kNominalNoise;
+  g.angle_random_walk = 3e-7;
+  g.k = strongK();
+  TableImperfections t;
+  t.ripple = 2e-3;
+  t.ripple_frequency = 0.37;
+  t.encoder_noise = 2e-6;
+  t.log_hz = 100.0;
+  t.rate_from_angle = true;
+  t.drop_fraction = 0.01;
+  t.gap_period = 47.0;
+  t.gap_length = 1.5;
+  const TurntableProfile profile = testing::dualRateProfile(0.05, -0.05, 880.0);
+  long records = 0, samples = 0;
+  double worst = 0.0;
+  const auto start = std::chrono::steady_clock::now();
+  const std::clock_t cpu_start = std::clock();
+  testing::runTableSession(
+      g, t, profile,
+      [&](Nanoseconds stamp, double angle, double) {
+        double expected, rate;
+        profile.evaluate(toSeconds(stamp) - 1.0, &expected, &rate);
+        worst = std::max(worst, std::abs(angle - expected));
+        ++records;
+      },
+      [&](Nanoseconds, double, double) { ++samples; });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double cpu = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  std::printf(
+      "%.0f s session: %ld table records, %ld wave samples in %.3f s of CPU (%.3f s of wall time); logged angle within "
+      "%.2g rad of the "
+      "profile\n",
+      profile.duration(), records, samples, cpu, seconds, worst);
+  EXPECT_NEAR(records, profile.duration() * 100, 2);
+  EXPECT_GT(samples, 0.95 * profile.duration() * 1000);
+  EXPECT_LT(samples, 0.97 * profile.duration() * 1000);  // 1 % dropped, 1.5 s of every 47 s in gaps
+  EXPECT_LT(worst, 4 * 2e-3 * 0.05 / (2 * kPi * 0.37) + 1e-5);
 }
 
 TEST(DualRateAccuracyTest, PeakErrorAgainstTheExactModelPerImperfection) {

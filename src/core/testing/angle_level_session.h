@@ -109,7 +109,7 @@ inline void runTableSession(const AngleLevelGyro& g, const TableImperfections& t
   auto tableRate = [&](double t) {
     double angle, rate;
     profile.evaluate(t, &angle, &rate);
-    return rate * (1.0 + table.ripple * std::sin(2.0 * kPi * table.ripple_frequency * t));
+    return table.ripple > 0.0 ? rate * (1.0 + table.ripple * std::sin(2.0 * kPi * table.ripple_frequency * t)) : rate;
   };
   auto thetaRate = [&](double t, double th, double table_rate) {
     double k, d;
@@ -120,6 +120,7 @@ inline void runTableSession(const AngleLevelGyro& g, const TableImperfections& t
   double unused_angle, rate0;
   profile.evaluate(0.0, &unused_angle, &rate0);
   bool first_record = true;
+  double next_rate = tableRate(0.0);
   const long steps = static_cast<long>(profile.duration() * g.rate_hz);
   for (long i = 0; i < steps; ++i) {
     const double t = i * h;
@@ -138,7 +139,8 @@ inline void runTableSession(const AngleLevelGyro& g, const TableImperfections& t
     const double measured = theta + g.noise * noise.next();
     if (!in_gap && !dropped) wave_sink(stamp, measured, frequency(t));
     // RK4 of (theta, phi) together: phi is the table angle actually turned.
-    const double w1 = tableRate(t), w2 = tableRate(t + h / 2), w4 = tableRate(t + h);
+    const double w1 = next_rate, w2 = tableRate(t + h / 2), w4 = tableRate(t + h);
+    next_rate = w4;
     const double k1 = thetaRate(t, theta, w1), k2 = thetaRate(t + h / 2, theta + h / 2 * k1, w2),
                  k3 = thetaRate(t + h / 2, theta + h / 2 * k2, w2), k4 = thetaRate(t + h, theta + h * k3, w4);
     theta += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
