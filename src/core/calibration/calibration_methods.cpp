@@ -105,7 +105,9 @@ double DualRateMethod::windowFor(double table_rate) const {
 }
 
 void DualRateMethod::addSample(const PlateauSample& s) {
-  if (s.plateau.is_static) return;
+  // A non-finite angle would poison every sum of the regression: such a sample is not data.
+  if (s.plateau.is_static || !std::isfinite(s.theta) || !std::isfinite(s.table_angle) || !std::isfinite(s.table_rate))
+    return;
   groups_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.table_rate);
   ++samples_;
   const bool gap = in_chain_ && toSeconds(s.stamp - last_stamp_) > settings_.plateau.max_gap;

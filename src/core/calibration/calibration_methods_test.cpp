@@ -51,6 +51,21 @@ TEST(DualRateTest, RecoversKAndDAndCancelsTheDrift) {
   EXPECT_GT(o.error_bound, 0.0);
 }
 
+TEST(DualRateTest, NonFiniteWaveAnglesAreSkipped) {
+  const AngleLevelGyro g = referenceGyro();
+  CalibrationSession session(settings("dual_rate"), priorFor(g));
+  long i = 0;
+  testing::runAngleLevel(g, dualRateProfile(0.05, -0.05, 120.0),
+                         [&](Nanoseconds t, double angle, double rate, double theta) {
+                           session.addTurntable(t, angle, rate);
+                           session.addWave(t, ++i % 997 == 0 ? NAN : theta, NAN);
+                         });
+  const CalibrationOutcome o = session.finish();
+  ASSERT_TRUE(o.accepted) << o.reason;
+  EXPECT_NEAR(o.scale_factor[0].mean, -0.56, 1e-7);
+  EXPECT_NEAR(o.scale_factor[0].cos[1], 2e-3, 1e-7);
+}
+
 TEST(DualRateTest, SameSignRatesWorkToo) {
   const AngleLevelGyro g = referenceGyro();
   const CalibrationOutcome o =
