@@ -51,6 +51,21 @@ TEST(DualRateTest, RecoversKAndDAndCancelsTheDrift) {
   EXPECT_GT(o.error_bound, 0.0);
 }
 
+TEST(DualRateTest, NonFiniteWaveAnglesAreSkipped) {
+  const AngleLevelGyro g = referenceGyro();
+  CalibrationSession session(settings("dual_rate"), priorFor(g));
+  long i = 0;
+  testing::runAngleLevel(g, dualRateProfile(0.05, -0.05, 120.0),
+                         [&](Nanoseconds t, double angle, double rate, double theta) {
+                           session.addTurntable(t, angle, rate);
+                           session.addWave(t, ++i % 997 == 0 ? NAN : theta, NAN);
+                         });
+  const CalibrationOutcome o = session.finish();
+  ASSERT_TRUE(o.accepted) << o.reason;
+  EXPECT_NEAR(o.scale_factor[0].mean, -0.56, 1e-7);
+  EXPECT_NEAR(o.scale_factor[0].cos[1], 2e-3, 1e-7);
+}
+
 TEST(DualRateTest, SameSignRatesWorkToo) {
   const AngleLevelGyro g = referenceGyro();
   const CalibrationOutcome o =
@@ -152,14 +167,21 @@ TEST(QualityGatesTest, RefuseInsufficientData) {
   o = calibrateAngleLevel(g, dualRateProfile(0.05, 0.055, 130.0), settings("dual_rate"), priorFor(g));
   EXPECT_FALSE(o.accepted);
   EXPECT_TRUE(gateFailed(o, "rate_separation")) << o.reason;
-  // Noisy turntable rate reading.
+  // A noisy reported rate does not matter where the angle is logged: the logged angle is integrated.
   AngleLevelGyro noisy = g;
   noisy.rate_noise = 1e-4;
   CalibrationSettings loose = settings("dual_rate");
   loose.plateau.rate_tolerance = 1e-3;
   o = calibrateAngleLevel(noisy, dualRateProfile(0.05, -0.05, 120.0), loose, priorFor(g));
+  EXPECT_TRUE(o.accepted) << o.reason;
+  EXPECT_NEAR(o.scale_factor[0].cos[1], 2e-3, 1e-7);
+  // A noisy logged angle does: the gate judges its effect on the K harmonics.
+  testing::TableImperfections shaky;
+  shaky.encoder_noise = 1e-2;
+  o = testing::calibrateTableSession(g, shaky, dualRateProfile(0.05, -0.05, 120.0), loose, priorFor(g));
   EXPECT_FALSE(o.accepted);
-  EXPECT_TRUE(gateFailed(o, "rate_noise")) << o.reason;
+  EXPECT_TRUE(gateFailed(o, "table_error")) << o.reason;
+  EXPECT_NE(o.reason.find("table angle errors add"), std::string::npos) << o.reason;
   // Too few samples.
   CalibrationSettings many = settings("dual_rate");
   many.gates.min_samples = 10000000;

@@ -20,10 +20,11 @@ std::vector<int> parseEvenOrders(const YamlField& f) {
 // The keys, listed once: parse() refuses any other, keyPaths() lists them for the node's template check.
 const std::vector<std::string> kPlateauKeys = {"rate_tolerance", "relative_tolerance", "settle_time",   "static_rate",
                                                "max_gap",        "max_rate",           "smoothing_span"};
-const std::vector<std::string> kGateKeys = {"min_coverage",   "min_rate_separation", "max_rate_noise",
-                                            "min_samples",    "max_condition",       "max_relative_residual",
-                                            "max_k0_change",  "max_harmonic_std",    "min_steps",
-                                            "min_dwell_time", "min_pairs",           "max_p_condition"};
+const std::vector<std::string> kGateKeys = {
+    "min_coverage",     "min_rate_separation", "max_rate_noise",        "max_table_error",
+    "min_samples",      "max_condition",       "max_relative_residual", "max_k0_change",
+    "max_harmonic_std", "min_steps",           "min_dwell_time",        "min_pairs",
+    "max_p_condition"};
 const std::vector<std::string> kThermalKeys = {"frequency_nodes", "node_count", "interpolation", "slice_width",
                                                "max_slices"};
 const std::vector<std::string> kScalarKeys = {
@@ -95,6 +96,7 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
     if (q.min_coverage < 0.0 || q.min_coverage > 1.0) g["min_coverage"].fail("must be in [0, 1]");
     q.min_rate_separation = positive(g, "min_rate_separation", q.min_rate_separation);
     q.max_rate_noise = positive(g, "max_rate_noise", q.max_rate_noise);
+    q.max_table_error = positive(g, "max_table_error", q.max_table_error);
     const long min_samples = g.getInteger("min_samples", static_cast<long>(q.min_samples));
     if (min_samples < 0) g["min_samples"].fail("must be >= 0");
     q.min_samples = static_cast<std::uint64_t>(min_samples);

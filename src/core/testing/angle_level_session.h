@@ -2,8 +2,16 @@
 // d theta = K(theta) (Omega_table + Omega_E) dt + D(theta) dt, sampled at `rate_hz` with white
 // noise -- fed into a calibration session together with the turntable states. K and D may depend
 // on the resonator frequency, given as a function of time (a temperature ramp at angle level).
+//
+// runTableSession adds what a real rate table and its controller do (TableImperfections): a drive
+// whose rate ripples, an encoder angle with noise and quantisation logged at its own rate, the rate
+// logged as that angle differenced (or no angle at all), dropped wave samples and gaps; and angle
+// random walk of the wave. The table angle and the wave angle are integrated together with RK4, so
+// the injected K and D are met exactly whatever the ripple or the non-uniform sweep.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 
 #include "hrg_gyro/core/calibration/calibration_session.h"
@@ -24,6 +32,7 @@ struct AngleLevelGyro {
   double rate_hz = 1000.0;
   double theta0 = 0.2;
   std::uint64_t seed = 7;
+  double angle_random_walk = 0.0;  ///< rad/sqrt(s) of wave angle (runTableSession only)
   /// Resonator frequency (Hz) at t s from the start, where K and D are evaluated and which the
   /// samples report; empty: unknown (NaN).
   std::function<double(double)> frequency;
@@ -71,6 +80,93 @@ inline void runAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profi
                           const std::function<void(Nanoseconds, double, double, double)>& sink) {
   runAngleLevel(g, profile,
                 [&](Nanoseconds t, double angle, double rate, double theta, double) { sink(t, angle, rate, theta); });
+}
+
+/// What a real table and its logs add (runTableSession).
+struct TableImperfections {
+  double ripple = 0.0;            ///< relative amplitude of the drive's rate ripple, rate (1 + a sin 2 pi f t)
+  double ripple_frequency = 0.0;  ///< Hz
+  double encoder_noise = 0.0;     ///< rad, white noise of the logged angle
+  double encoder_step = 0.0;      ///< rad, quantisation of the logged angle (0: none)
+  double log_hz = 0.0;            ///< turntable records per s (0: one per wave sample); divides rate_hz
+  bool rate_from_angle = false;   ///< the logged rate is the logged angle differenced between records
+  bool angle_logged = true;       ///< false: the controller logs no angle (the field stays 0)
+  double drop_fraction = 0.0;     ///< wave samples dropped at random
+  double gap_period = 0.0;        ///< s: a gap in the wave stream every gap_period s (0: none) ...
+  double gap_length = 0.0;        ///< ... lasting this long
+};
+
+/// table_sink(stamp, angle, rate) per turntable record, wave_sink(stamp, theta, frequency) per wave
+/// sample, in time order (a record and a sample at the same stamp: the record first).
+inline void runTableSession(const AngleLevelGyro& g, const TableImperfections& table, const TurntableProfile& profile,
+                            const std::function<void(Nanoseconds, double, double)>& table_sink,
+                            const std::function<void(Nanoseconds, double, double)>& wave_sink) {
+  ModelPairEvaluator models(g.k, g.d);
+  GaussianNoise noise(g.seed), table_noise(g.seed ^ 0x9e3779b97f4a7c15ULL), drops(g.seed ^ 0x51ed27a3ULL);
+  const double h = 1.0 / g.rate_hz;
+  const long log_every = table.log_hz > 0.0 ? std::max(1L, std::lround(g.rate_hz / table.log_hz)) : 1;
+  auto frequency = [&](double t) { return g.frequency ? g.frequency(t) : NAN; };
+  auto tableRate = [&](double t) {
+    double angle, rate;
+    profile.evaluate(t, &angle, &rate);
+    return table.ripple > 0.0 ? rate * (1.0 + table.ripple * std::sin(2.0 * kPi * table.ripple_frequency * t)) : rate;
+  };
+  auto thetaRate = [&](double t, double th, double table_rate) {
+    double k, d;
+    models.evaluate(th, frequency(t), &k, &d);
+    return k * (table_rate + g.earth_rate) + d;
+  };
+  double theta = g.theta0, phi = 0.0, logged_previous = 0.0;
+  double unused_angle, rate0;
+  profile.evaluate(0.0, &unused_angle, &rate0);
+  bool first_record = true;
+  double next_rate = tableRate(0.0);
+  const long steps = static_cast<long>(profile.duration() * g.rate_hz);
+  for (long i = 0; i < steps; ++i) {
+    const double t = i * h;
+    const Nanoseconds stamp = toNanoseconds(1.0 + t);
+    if (i % log_every == 0) {
+      double logged = phi + table.encoder_noise * table_noise.next();
+      if (table.encoder_step > 0.0) logged = table.encoder_step * std::round(logged / table.encoder_step);
+      double rate = tableRate(t) + g.rate_noise * table_noise.next();
+      if (table.rate_from_angle) rate = first_record ? rate0 : (logged - logged_previous) / (log_every * h);
+      table_sink(stamp, table.angle_logged ? logged : 0.0, rate);
+      logged_previous = logged;
+      first_record = false;
+    }
+    const bool in_gap = table.gap_period > 0.0 && std::fmod(t, table.gap_period) > table.gap_period - table.gap_length;
+    const bool dropped = table.drop_fraction > 0.0 && drops.uniform() < table.drop_fraction;
+    const double measured = theta + g.noise * noise.next();
+    if (!in_gap && !dropped) wave_sink(stamp, measured, frequency(t));
+    // RK4 of (theta, phi) together: phi is the table angle actually turned.
+    const double w1 = next_rate, w2 = tableRate(t + h / 2), w4 = tableRate(t + h);
+    next_rate = w4;
+    const double k1 = thetaRate(t, theta, w1), k2 = thetaRate(t + h / 2, theta + h / 2 * k1, w2),
+                 k3 = thetaRate(t + h / 2, theta + h / 2 * k2, w2), k4 = thetaRate(t + h, theta + h * k3, w4);
+    theta += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    phi += h / 6 * (w1 + 4 * w2 + w4);
+    if (g.angle_random_walk > 0.0) theta += g.angle_random_walk * std::sqrt(h) * noise.next();
+  }
+}
+
+inline CalibrationOutcome calibrateTableSession(const AngleLevelGyro& g, const TableImperfections& table,
+                                                const TurntableProfile& profile, const CalibrationSettings& settings,
+                                                const GyroParameters& prior) {
+  CalibrationSession session(settings, prior);
+  runTableSession(
+      g, table, profile, [&](Nanoseconds t, double angle, double rate) { session.addTurntable(t, angle, rate); },
+      [&](Nanoseconds t, double theta, double frequency) { session.addWave(t, theta, frequency); });
+  return session.finish();
+}
+
+/// Peak of |K_estimated(theta) - K_true(theta)| / |K0_true| over theta, ppm.
+inline double peakErrorPpm(const HarmonicModel& estimated, const HarmonicModel& truth) {
+  double peak = 0.0;
+  for (int i = 0; i < 720; ++i) {
+    const double theta = i * kPi / 720;
+    peak = std::max(peak, std::abs(estimated(theta) - truth(theta)));
+  }
+  return 1e6 * peak / std::abs(truth.meanAt(NAN));
 }
 
 inline CalibrationOutcome calibrateAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profile,

@@ -1,5 +1,6 @@
 // The four calibration methods (docs/math.md, 'Calibration methods' and 'Correction matrix'):
-//   DualRateMethod         theta-binned rates at two table rates; drift cancels (method 3)
+//   DualRateMethod         window increments at two (or more) table rates, one exact regression; drift
+//                          cancels (method 3)
 //   ConstantRateMethod     one table rate and a dwell for the rest rate; drift leaks into K (method 2)
 //   StepMethod             steps of the table angle between dwells; the dwells give D (method 1)
 //   CorrectionMatrixMethod P from generator pairs (the paper's first refinement stage)
@@ -11,6 +12,7 @@
 
 #include "hrg_gyro/core/calibration/calibration_method_interface.h"
 #include "hrg_gyro/core/estimation/dwell_fit.h"
+#include "hrg_gyro/core/estimation/increment_regression.h"
 #include "hrg_gyro/core/estimation/rate_groups.h"
 #include "hrg_gyro/core/model/correction_matrix.h"
 
@@ -29,8 +31,22 @@ class DualRateMethod : public CalibrationMethod {
 
  private:
   double minBinTime() const { return 0.25 * settings_.window; }
+  /// The averaging window of a plateau at this table rate, s (see docs/calibration.md).
+  double windowFor(double table_rate) const;
   CalibrationSettings settings_;
-  RateGroups groups_;
+  double k0_;
+  RateGroups groups_;  // coverage, progress and the plateau summaries
+  // The estimate, twice: with phi the logged table angle, and with phi the integral of the logged
+  // rate (for a controller that logs no angle); finish() uses the first where the angle moves with
+  // the integrated rate.
+  IncrementRegression by_angle_, by_rate_;
+  std::vector<double> group_rates_;  // plateau rate of each regression group
+  bool in_chain_ = false;
+  std::uint64_t chain_plateau_ = 0;
+  Nanoseconds last_stamp_ = 0;
+  double last_table_angle_ = 0.0, last_table_rate_ = 0.0, unwrap_ = 0.0, rate_angle_ = 0.0;
+  double chain_angle_ = 0.0, chain_rate_angle_ = 0.0;  // of the open chain
+  double angle_moved_ = 0.0, rate_moved_ = 0.0;        // |angle turned| per chain, summed
   std::uint64_t samples_ = 0;
 };
 

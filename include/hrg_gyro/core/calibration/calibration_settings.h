@@ -19,6 +19,7 @@ struct QualityLimits {
   double min_coverage = 0.95;           ///< fraction of theta bins with data, per plateau group
   double min_rate_separation = 0.01;    ///< rad/s between the two dual-rate groups
   double max_rate_noise = 1e-3;         ///< std of the reported table rate / |rate| within a group
+  double max_table_error = 2e-5;        ///< dual-rate: K-harmonic error from table errors (upper estimate) / |K0|
   std::uint64_t min_samples = 1000;     ///< wave samples used
   double max_condition = 1e4;           ///< of the harmonic design matrix
   double max_relative_residual = 1e-3;  ///< rms of binned K about the fit / |K0|

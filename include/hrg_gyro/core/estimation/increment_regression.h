@@ -1,0 +1,137 @@
+// K(theta) and D(theta) fitted to window increments of the wave angle, exact for any window and any
+// sweep, however non-uniform.
+//
+// The model d theta/dt = K(theta) dphi/dt + D(theta), with phi the body angle (table angle plus the
+// Earth's vertical rate times t) and K, D harmonic in theta, integrates along the session to
+//   theta(t) - theta(t0) = K0 Phi0 + sum_k (a_k Phic_k + b_k Phis_k) + D0 T + sum_k (c_k Tc_k + d_k Ts_k)
+// with Phi0 = integral dphi, Phic_k = integral cos(k theta) dphi, Tc_k = integral cos(k theta) dt and
+// so on, all from t0 to t. The identity is linear in the unknown coefficients, and it stays exact
+// after averaging both sides over any window and after differencing consecutive window means. Each
+// sample adds its trapezoid to the integrals, computed with the measured theta (at 1 kHz theta moves
+// ~1e-4 rad per sample, so the trapezoid is exact to far below a ppm). No window or bin smoothing is
+// left to correct, and table rate ripple cancels because the actual dphi enters.
+//
+// Why increments of window means rather than the window means themselves: white wave-angle noise
+// makes consecutive increments anti-correlated only at lag one, and angle random walk (rate noise)
+// makes them white; the window means would instead carry a random walk along a whole chain. So the
+// regression needs no intercept per chain and its errors are local, which lets a cluster sandwich
+// (blocks of consecutive increments) estimate the covariance without assuming white errors.
+//
+// Streaming, in memory that does not grow with the session: the products of the increments are
+// summed per block (p^2 each); when the blocks exceed a bound, neighbours are merged (exactly: the
+// sums add), so the covariance always rests on 32..64 blocks. A chain is a stretch of one plateau
+// without a gap: increments never span two chains. Per wave-angle bin and plateau group the
+// increments' sums are kept too, for the binned K(theta) and D(theta) the report shows.
+//
+// Noise of theta inside cos(k theta) attenuates the regressors by exp(-k^2 s^2 / 2) on average
+// (s the per-sample angle noise, estimated from the samples); the fitted harmonics are corrected by
+// that factor (a tenth of the correction counts as its uncertainty).
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
+#include "hrg_gyro/core/estimation/harmonic_fit.h"
+#include "hrg_gyro/core/model/harmonic_basis.h"
+
+namespace hrg_gyro {
+namespace core {
+
+/// What the reported standard error of each K term is made of (term order: mean, cos..., sin...).
+struct IncrementErrorBudget {
+  std::vector<double> statistical;   ///< from the data: block sandwich, never below the white-noise prediction
+  std::vector<double> angle_noise;   ///< predicted by the white wave-angle noise alone
+  std::vector<double> beyond_noise;  ///< statistical beyond that: table angle/rate errors, rate noise, drift
+  std::vector<double> earth_rate;    ///< from the Earth-rate uncertainty
+  std::vector<double> basis_noise;   ///< from the uncertainty of the basis-noise correction
+};
+
+struct IncrementFit {
+  bool ok = false;
+  std::string reason;
+  HarmonicFitResult k;  ///< K(theta), standard errors include the systematic terms of `budget`
+  HarmonicFitResult d;  ///< D(theta), rad/s
+  IncrementErrorBudget budget;
+  std::vector<BinnedCurvePoint> binned;  ///< fitted model plus the binned residual of the two main groups
+  double angle_noise = 0.0;              ///< estimated white wave-angle noise per sample, rad
+  double mean_window = 0.0;              ///< s between consecutive window means
+  std::size_t increments = 0;
+  std::size_t blocks = 0;  ///< blocks of the sandwich covariance
+};
+
+class IncrementRegression {
+ public:
+  /// Orders must be positive. bins: wave-angle bins over [0, pi) for the binned curves.
+  IncrementRegression(const std::vector<int>& k_orders, const std::vector<int>& d_orders, int bins);
+
+  /// Starts a chain of plateau group `group` averaged over windows of `window` s (ends any open chain).
+  void startChain(int group, double window);
+  /// Adds a sample of the open chain: theta the measured wave angle, phi the table angle (without the
+  /// Earth rate, which solve() adds); stamps increasing.
+  void add(Nanoseconds stamp, double theta, double phi);
+  /// Closes the open chain (its last, partial window is left out).
+  void endChain();
+  bool inChain() const { return in_chain_; }
+
+  std::size_t increments() const { return increments_; }
+
+  /// earth_rate: rad/s added to dphi/dt; earth_rate_std: its uncertainty (propagated to K).
+  /// min_bin_time: s of increments a bin needs in both groups to be shown.
+  IncrementFit solve(double earth_rate, double earth_rate_std, double min_bin_time, double max_condition) const;
+
+ private:
+  struct Block {
+    Eigen::MatrixXd products;  // sum w w^T of its increments, w = (dz, dy)
+    std::size_t count = 0;
+  };
+  struct BinSums {
+    Eigen::VectorXd w;  // sum of the increments' w
+    double dt = 0.0, dphi = 0.0;
+  };
+  struct WindowMean {
+    Eigen::VectorXd w;  // mean of (z, y)
+    double t = 0.0, theta = 0.0, phi = 0.0, count = 0.0;
+  };
+
+  void closeWindow();
+  void addIncrement(const WindowMean& a, const WindowMean& b);
+
+  std::vector<int> k_orders_, d_orders_, all_orders_;
+  int bins_;
+  int m_;  // regressors: K block (1 + 2 nK), then T and the T harmonics of every order
+  HarmonicBasis basis_;
+  // The open chain.
+  bool in_chain_ = false, has_sample_ = false, has_mean_ = false;
+  int group_ = 0;
+  double window_ = 0.0;
+  Nanoseconds origin_ = 0;
+  double t_prev_ = 0.0, phi_prev_ = 0.0, theta_start_ = 0.0;
+  std::vector<int> k_in_all_;  // index of each K order in all_orders_
+  Eigen::VectorXd cos_prev_, sin_prev_, cos_now_, sin_now_, integrals_;
+  long window_index_ = 0;
+  WindowMean sum_, previous_mean_;
+  Eigen::VectorXd previous_dz_;  // last increment of the chain, for the lag-one products
+  double previous_inverse_count_ = 0.0;
+  bool has_previous_dz_ = false;
+  // Accumulated over the session.
+  std::vector<Block> blocks_;
+  Block open_block_;
+  std::size_t block_size_ = 8;
+  Eigen::MatrixXd white_lag0_, white_lag1_;  // predicted white-noise products, per unit variance
+  std::map<int, std::vector<BinSums>> bins_by_group_;
+  std::map<int, double> group_time_;
+  std::size_t increments_ = 0;
+  double increment_time_ = 0.0;
+  // Per-sample angle noise from deviations from the line through the neighbours.
+  int history_ = 0;
+  double h_theta_[2] = {0.0, 0.0}, h_t_[2] = {0.0, 0.0};
+  double noise_sum_ = 0.0;
+  std::size_t noise_count_ = 0;
+};
+
+}  // namespace core
+}  // namespace hrg_gyro
