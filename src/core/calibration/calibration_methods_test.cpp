@@ -177,10 +177,16 @@ TEST(QualityGatesTest, RefuseInsufficientData) {
   EXPECT_NEAR(o.scale_factor[0].cos[1], 2e-3, 1e-7);
   // A noisy logged angle does: the gate judges its effect on the K harmonics.
   testing::TableImperfections shaky;
-  shaky.encoder_noise = 1e-2;
-  o = testing::calibrateTableSession(g, shaky, dualRateProfile(0.05, -0.05, 120.0), loose, priorFor(g));
+  shaky.encoder_noise = 1e-3;
+  CalibrationSettings smoothed = loose;  // long enough a span that the plateaus are still found
+  smoothed.plateau.smoothing_span = 10.0;
+  smoothed.gates.max_table_error = 5e-6;  // 1 mrad of encoder noise costs the K harmonics ~10 ppm
+  o = testing::calibrateTableSession(g, shaky, dualRateProfile(0.05, -0.05, 150.0), smoothed, priorFor(g));
   EXPECT_FALSE(o.accepted);
   EXPECT_TRUE(gateFailed(o, "table_error")) << o.reason;
+  for (const auto& gate : o.gates) {
+    if (gate.name == "table_error") std::cout << "1 mrad encoder noise: table_error " << gate.value * 1e6 << " ppm\n";
+  }
   EXPECT_NE(o.reason.find("table angle errors add"), std::string::npos) << o.reason;
   // Too few samples.
   CalibrationSettings many = settings("dual_rate");

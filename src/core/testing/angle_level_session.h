@@ -90,7 +90,7 @@ struct TableImperfections {
   double encoder_step = 0.0;      ///< rad, quantisation of the logged angle (0: none)
   double log_hz = 0.0;            ///< turntable records per s (0: one per wave sample); divides rate_hz
   bool rate_from_angle = false;   ///< the logged rate is the logged angle differenced between records
-  bool angle_logged = true;       ///< false: the controller logs no angle (the field stays 0)
+  bool angle_logged = true;       ///< false: the controller logs no angle (the field is NaN)
   double drop_fraction = 0.0;     ///< wave samples dropped at random
   double gap_period = 0.0;        ///< s: a gap in the wave stream every gap_period s (0: none) ...
   double gap_length = 0.0;        ///< ... lasting this long
@@ -130,7 +130,7 @@ inline void runTableSession(const AngleLevelGyro& g, const TableImperfections& t
       if (table.encoder_step > 0.0) logged = table.encoder_step * std::round(logged / table.encoder_step);
       double rate = tableRate(t) + g.rate_noise * table_noise.next();
       if (table.rate_from_angle) rate = first_record ? rate0 : (logged - logged_previous) / (log_every * h);
-      table_sink(stamp, table.angle_logged ? logged : 0.0, rate);
+      table_sink(stamp, table.angle_logged ? logged : NAN, rate);
       logged_previous = logged;
       first_record = false;
     }
