@@ -45,6 +45,8 @@ Command addInfoCommand(CLI::App& root);
 Command addProcessCommand(CLI::App& root);
 Command addCalibrateCommand(CLI::App& root);
 Command addAllanCommand(CLI::App& root);
+Command addImportCommand(CLI::App& root);
+Command addExportCommand(CLI::App& root);
 
 /// Opens a bag for reading; missing, unindexed, truncated or corrupt files become UsageErrors
 /// that say which.

@@ -19,7 +19,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   const std::map<std::string, Command> commands = {
       {"simulate", addSimulateCommand(app)},   {"info", addInfoCommand(app)},   {"process", addProcessCommand(app)},
-      {"calibrate", addCalibrateCommand(app)}, {"allan", addAllanCommand(app)},
+      {"calibrate", addCalibrateCommand(app)}, {"allan", addAllanCommand(app)}, {"import", addImportCommand(app)},
+      {"export", addExportCommand(app)},
   };
   if (argc < 2) {
     std::cerr << app.help();
