@@ -98,7 +98,7 @@ int runImport(const ImportOptions& o) {
   } catch (const std::runtime_error& e) {
     throw UsageError(e.what());  // no header, no delimiter, a missing column: the mapping is wrong
   }
-  if (turntable && turntable->derivesRate() && !o.quiet) {
+  if (turntable && turntable->derivesRate()) {
     std::cerr << "import: " << o.turntable << " has no rate column: the rate is the central difference of the "
               << "neighbouring angles\n";
   }
@@ -199,7 +199,7 @@ Command addImportCommand(CLI::App& root) {
       ->check(CLI::IsMember({"rad/s", "deg/s"}))
       ->capture_default_str();
   cmd->add_flag("--skip-bad-rows", o->skip_bad_rows, "skip bad records and count them by reason (default: refuse)");
-  cmd->add_flag("--quiet", o->quiet, "no progress on stderr");
+  cmd->add_flag("--quiet", o->quiet, "no progress on stderr (the summary and notes stay)");
   cmd->add_option("--channels-topic", o->channels_topic, "topic of the channel amplitudes")
       ->check(tools::notEmpty())
       ->capture_default_str();
