@@ -118,7 +118,8 @@ int runImport(const ImportOptions& o) {
       if (have_channel && (!have_turntable || c.stamp <= t.stamp)) {
         ChannelAmplitudes m;
         m.header.stamp = toRosTime(c.stamp);
-        m.header.seq = static_cast<std::uint32_t>(channel_count++);
+        // A skipped record leaves a gap in the sequence, which the processor node reports as a lost sample.
+        m.header.seq = static_cast<std::uint32_t>(channel_count++ + channel_skips.total());
         m.header.frame_id = o.frame_id;
         m.c_in = c.ac;
         m.c_quad = c.bc;
