@@ -157,6 +157,7 @@ class HrgBagImport(unittest.TestCase):
             (["--channels", ch, "--out", out, "--column", "ac=Ac_V"], "no column 'Ac_V' for ac"),
             (["--channels", ch, "--out", out, "--angle-unit", "grad"], "--angle-unit"),
             (["--channels", ch, "--out", out, "--delimiter", "pipe"], "--delimiter"),
+            (["--channels", ch, "--out", out, "--no-header"], "--column stamp=#N"),
             (["--channels", ch, "--out", ch], "refused"),
             (["--channels", ch, "--turntable", self.write("no_rate.csv", "stamp,speed\n1,2\n"), "--out", out],
              "needs an angle or a rate column"),

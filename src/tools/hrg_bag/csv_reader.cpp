@@ -188,9 +188,12 @@ core::Nanoseconds parseStamp(std::string_view field, StampFormat format) {
   }
 }
 
-CsvReader::CsvReader(std::istream& in, std::string name, char delimiter)
+CsvReader::CsvReader(std::istream& in, std::string name, char delimiter, bool has_header)
     : in_(in), name_(std::move(name)), delimiter_(delimiter) {
-  if (!readLine()) throw std::runtime_error(name_ + ": no header row (the file is empty or only comments)");
+  if (!readLine()) {
+    throw std::runtime_error(name_ + (has_header ? ": no header row" : ": no record") +
+                             " (the file is empty or only comments)");
+  }
   if (delimiter_ == 0) {
     int kinds = 0;
     for (char c : {',', ';', '\t'}) {
@@ -205,13 +208,19 @@ CsvReader::CsvReader(std::istream& in, std::string name, char delimiter)
     }
   }
   split();
-  for (std::string_view f : fields_) header_.emplace_back(f);
+  if (has_header) {
+    for (std::string_view f : fields_) header_.emplace_back(f);
+  } else {
+    header_.assign(fields_.size(), std::string());
+    first_record_pending_ = true;
+  }
 }
 
 bool CsvReader::readLine() {
   while (std::getline(in_, text_)) {
     ++line_;
     bytes_ += text_.size() + 1;
+    if (line_ == 1 && text_.compare(0, 3, "\xEF\xBB\xBF") == 0) text_.erase(0, 3);  // UTF-8 byte-order mark
     const std::string_view t = trim(text_);
     if (t.empty() || t.front() == '#') continue;
     return true;
@@ -233,6 +242,10 @@ void CsvReader::split() {
 }
 
 bool CsvReader::next() {
+  if (first_record_pending_) {
+    first_record_pending_ = false;
+    return true;
+  }
   if (!readLine()) return false;
   split();
   return true;
@@ -255,7 +268,7 @@ int CsvReader::column(const std::string& wanted) const {
   };
   int found = -1;
   for (std::size_t i = 0; i < header_.size(); ++i) {
-    if (lower(header_[i]) != lower(wanted)) continue;
+    if (header_[i].empty() || lower(header_[i]) != lower(wanted)) continue;
     if (found >= 0) throw std::runtime_error(name_ + ": the header names column " + quoted(wanted) + " twice");
     found = static_cast<int>(i);
   }

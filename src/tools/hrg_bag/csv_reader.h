@@ -39,13 +39,15 @@ double parseNumber(std::string_view field);
 core::Nanoseconds parseStamp(std::string_view field, StampFormat format);
 
 /// The reader of one delimited file. The first line that is neither empty nor a comment ('#'
-/// first) is the header; every following such line is a record.
+/// first) is the header; every following such line is a record. A file without a header row
+/// (`has_header` false) has columns named only by index ("#N"), as many as its first record's.
+/// A UTF-8 byte-order mark (as spreadsheet programs write) before the first line is ignored.
 class CsvReader {
  public:
   /// `delimiter` 0: taken from the header line (the one of ',' ';' '\t' it holds; a header holding
   /// none or several of them is refused: give it). std::runtime_error (naming `name`) on an empty
   /// file or an undecidable delimiter.
-  CsvReader(std::istream& in, std::string name, char delimiter = 0);
+  CsvReader(std::istream& in, std::string name, char delimiter = 0, bool has_header = true);
 
   const std::vector<std::string>& header() const { return header_; }
   char delimiter() const { return delimiter_; }
@@ -58,7 +60,8 @@ class CsvReader {
   std::uint64_t bytesRead() const { return bytes_; }
   const std::string& name() const { return name_; }
 
-  /// The index of a column: "#N" is the N-th column (1-based), anything else a header name
+  /// The index of a column: "#N" is the N-th column (1-based), anything else a header name (never
+  /// found in a file without a header)
   /// compared without regard to case. -1 when no header name matches; std::runtime_error for a
   /// "#N" out of range or a name the header holds twice.
   int column(const std::string& wanted) const;
@@ -75,6 +78,7 @@ class CsvReader {
   std::vector<std::string> header_;
   std::uint64_t line_ = 0;
   std::uint64_t bytes_ = 0;
+  bool first_record_pending_ = false;  ///< without a header, the first line read is already a record
 };
 
 }  // namespace csv

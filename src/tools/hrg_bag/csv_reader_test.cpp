@@ -115,6 +115,28 @@ TEST(CsvReaderTest, ColumnsByNameInAnyCaseOrByIndex) {
   EXPECT_THROW(CsvReader(twice, "t").column("a"), std::runtime_error);
 }
 
+TEST(CsvReaderTest, ByteOrderMarkIsIgnored) {
+  std::istringstream in("\xEF\xBB\xBFstamp,ac\n1,2\n");
+  CsvReader reader(in, "bom");
+  EXPECT_EQ(reader.header()[0], "stamp");
+  EXPECT_EQ(reader.column("stamp"), 0);
+}
+
+TEST(CsvReaderTest, WithoutHeaderTheFirstLineIsARecordAndColumnsGoByIndex) {
+  std::istringstream in("# no header\n1.0;2;3\n2.0;4;5\n");
+  CsvReader reader(in, "raw", 0, false);
+  EXPECT_EQ(reader.delimiter(), ';');
+  EXPECT_EQ(reader.header().size(), 3u);
+  EXPECT_EQ(reader.column("stamp"), -1);
+  EXPECT_EQ(reader.column("#2"), 1);
+  ASSERT_TRUE(reader.next());
+  EXPECT_EQ(reader.line(), 2u);
+  EXPECT_EQ(reader.fields()[0], "1.0");
+  ASSERT_TRUE(reader.next());
+  EXPECT_EQ(reader.fields()[2], "5");
+  EXPECT_FALSE(reader.next());
+}
+
 }  // namespace
 }  // namespace csv
 }  // namespace hrg_gyro

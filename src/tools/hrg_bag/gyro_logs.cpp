@@ -51,7 +51,7 @@ std::string BadRowCounts::summary() const {
 
 RecordSource::RecordSource(std::istream& in, const std::string& name, const LogSettings& settings,
                            BadRowCounts* skipped)
-    : csv_(in, name, settings.delimiter),
+    : csv_(in, name, settings.delimiter, settings.has_header),
       settings_(settings),
       skipped_(skipped),
       stamp_column_(column("stamp", true)) {}
@@ -61,6 +61,10 @@ int RecordSource::column(const std::string& key, bool required) const {
   const std::string wanted = given == settings_.columns.end() ? key : given->second;
   const int index = csv_.column(wanted);
   if (index < 0 && (required || given != settings_.columns.end())) {
+    if (!settings_.has_header) {
+      throw std::runtime_error(csv_.name() + ": no header row, so " + key + " needs its column by index: --column " +
+                               key + "=#N (N from 1 to " + std::to_string(csv_.header().size()) + ")");
+    }
     std::string names;
     for (const std::string& h : csv_.header()) names += (names.empty() ? "'" : ", '") + h + "'";
     throw std::runtime_error(csv_.name() + ":" + std::to_string(csv_.line()) + ": no column '" + wanted + "' for " +

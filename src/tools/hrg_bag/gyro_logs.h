@@ -40,7 +40,8 @@ struct BadRowError : std::runtime_error {
 
 struct LogSettings {
   StampFormat stamp_format = StampFormat::kAuto;
-  char delimiter = 0;  ///< 0: taken from the header
+  char delimiter = 0;      ///< 0: taken from the header
+  bool has_header = true;  ///< false: no header row, every column mapped by "#N"
   /// Column of each key ("ac" -> "Ac_V" or "#3"); a key not given is looked up by its own name.
   std::map<std::string, std::string> columns;
   double angle_scale = 1.0;  ///< to rad

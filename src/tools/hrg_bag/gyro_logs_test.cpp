@@ -82,6 +82,23 @@ TEST(GyroLogsTest, ColumnsMappedByNameOrIndex) {
   EXPECT_THROW(readChannels(std::string(kHeader) + "1,1,2,3,4\n", settings), std::runtime_error);
 }
 
+TEST(GyroLogsTest, WithoutHeaderEveryColumnByIndex) {
+  LogSettings settings;
+  settings.has_header = false;
+  settings.columns = {{"stamp", "#1"}, {"ac", "#2"}, {"bc", "#3"}, {"as", "#4"}, {"bs", "#5"}};
+  const auto records = readChannels("1000,1,2,3,4\n2000,5,6,7,8\n", settings);
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_EQ(records[0].stamp, 1000);
+  EXPECT_EQ(records[1].bs, 8.0);
+  settings.columns.erase("bs");
+  try {
+    readChannels("1000,1,2,3,4\n", settings);
+    FAIL() << "bs without a column was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("--column bs=#N (N from 1 to 5)"), std::string::npos) << e.what();
+  }
+}
+
 TEST(GyroLogsTest, EveryBadRowReasonWithItsLineNumber) {
   const std::string ok = std::string(kHeader) + "1.0,1,2,3,4\n";
   EXPECT_NE(refusal(ok + "2.0,1,2,3\n").find("ch.csv:3: wrong field count: 4 fields, the header has 5"),

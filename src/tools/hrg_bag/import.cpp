@@ -24,7 +24,7 @@ struct ImportOptions {
   std::string channels_topic = "/channels", turntable_topic = "/turntable/state";
   std::string angle_unit = "rad", rate_unit = "rad/s", stamp_format = "auto", delimiter = "auto";
   std::vector<std::string> columns;
-  bool skip_bad_rows = false, quiet = false;
+  bool skip_bad_rows = false, quiet = false, no_header = false;
 };
 
 const std::vector<std::string> kChannelKeys = {"stamp", "ac", "bc", "as", "bs", "frequency", "temperature", "periods"};
@@ -40,6 +40,7 @@ void logSettings(const ImportOptions& o, csv::LogSettings* channels, csv::LogSet
   common.angle_scale = o.angle_unit == "deg" ? M_PI / 180.0 : 1.0;
   common.rate_scale = o.rate_unit == "deg/s" ? M_PI / 180.0 : 1.0;
   common.skip_bad_rows = o.skip_bad_rows;
+  common.has_header = !o.no_header;
   *channels = common;
   *turntable = common;
   auto is = [](const std::vector<std::string>& keys, const std::string& key) {
@@ -186,6 +187,8 @@ Command addImportCommand(CLI::App& root) {
   cmd->add_option("--column", o->columns,
                   "KEY=COLUMN, repeatable: the header name (any case) or #N (N-th column, from 1) holding KEY")
       ->take_all();
+  cmd->add_flag("--no-header", o->no_header,
+                "the logs have no header row: every column by index (--column stamp=#1 ac=#2 ...)");
   cmd->add_option("--stamp-format", o->stamp_format,
                   "auto (ISO 8601 if it holds a T, seconds if it holds a '.', else nanoseconds), s, ns, iso")
       ->check(CLI::IsMember({"auto", "s", "ns", "iso"}))
