@@ -2,7 +2,8 @@
 """hrg_bag import and export as a test engineer runs them: a simulated dual-rate session exported to
 the two CSV logs and imported back calibrates to the same parameter file; bad records are refused
 with file:line (exit 1, nothing written) or skipped and counted; bad options exit 2 naming them; a
-2-million-record log is imported in the same peak memory as a small one. Needs no master."""
+full disk exits 3 leaving nothing; a 2-million-record log is imported in the same peak memory as a
+small one. Needs no master."""
 import math
 import os
 import shutil
@@ -168,6 +169,26 @@ class HrgBagImport(unittest.TestCase):
             self.assertIn(fragment, err, args)
             self.assertNotIn("terminate called", err)
             self.assertFalse(os.path.exists(out), args)
+
+    def test_a_full_disk_fails_with_exit_3_and_leaves_nothing(self):
+        ch = self.path("disk_channels.csv")
+        with open(ch, "w") as f:
+            f.write(CHANNELS_HEADER)
+            f.writelines("%d,0.9,0.1,-0.2,0.01\n" % (1000000000 + i * 5000000) for i in range(20000))
+        disk = self.path("full_disk")
+        os.makedirs(disk)
+        mount = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", disk], stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, universal_newlines=True)
+        if mount.returncode != 0:
+            self.skipTest("cannot mount a 64 KiB tmpfs to fill (needs root): " + mount.stdout.strip())
+        try:
+            out = os.path.join(disk, "full.bag")
+            code, _, err = hrg_bag("import", "--channels", ch, "--out", out, "--quiet")
+            self.assertEqual(code, 3, err)
+            self.assertIn("No space left on device", err)
+            self.assertEqual(os.listdir(disk), [])
+        finally:
+            subprocess.run(["umount", disk])
 
     def test_a_large_log_is_streamed_in_flat_memory(self):
         row = "0.9374203025250911,-0.2941238247148178,0.1959980714562781,-0.040112536931700485,5000,21.5,25\n"

@@ -146,6 +146,8 @@ int runImport(const ImportOptions& o) {
         progress->update(done, channel_count + turntable_count);
       }
     }
+  } catch (const OutputError&) {
+    throw;  // exit 3, not a bad input
   } catch (const csv::BadRowError& e) {
     std::cerr << "hrg_bag import: " << e.what() << "\nhrg_bag import: " << o.out
               << " not written (--skip-bad-rows skips and counts such records)\n";
