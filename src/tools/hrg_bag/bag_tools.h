@@ -48,6 +48,8 @@ Command addAllanCommand(CLI::App& root);
 /// report and batch: the HTML report and the campaign, run by the Python scripts beside hrg_bag.
 Command addReportCommand(CLI::App& root);
 Command addBatchCommand(CLI::App& root);
+Command addImportCommand(CLI::App& root);
+Command addExportCommand(CLI::App& root);
 
 /// Opens a bag for reading; missing, unindexed, truncated or corrupt files become UsageErrors
 /// that say which.

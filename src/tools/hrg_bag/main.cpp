@@ -18,9 +18,9 @@ int main(int argc, char** argv) {
       "not be written (nothing is left at its path; an existing file is unchanged).");
   app.require_subcommand(1);
   const std::map<std::string, Command> commands = {
-      {"simulate", addSimulateCommand(app)},   {"info", addInfoCommand(app)},   {"process", addProcessCommand(app)},
-      {"calibrate", addCalibrateCommand(app)}, {"allan", addAllanCommand(app)}, {"report", addReportCommand(app)},
-      {"batch", addBatchCommand(app)},
+      {"simulate", addSimulateCommand(app)},   {"info", addInfoCommand(app)},     {"process", addProcessCommand(app)},
+      {"calibrate", addCalibrateCommand(app)}, {"allan", addAllanCommand(app)},   {"report", addReportCommand(app)},
+      {"batch", addBatchCommand(app)},         {"import", addImportCommand(app)}, {"export", addExportCommand(app)},
   };
   if (argc < 2) {
     std::cerr << app.help();

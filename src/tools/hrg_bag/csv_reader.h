@@ -1,0 +1,85 @@
+// A streaming reader of the delimited text logs a test bench writes (one record a line, a header
+// row naming the columns), and the strict field parsers behind `hrg_bag import`. It holds one line
+// at a time, so a log of any size is read in constant memory. Numbers are read whole ("1.5abc" and
+// "1,5" are errors, never 1.5 or 1), stamps exactly as integer nanoseconds. No ROS.
+#pragma once
+
+#include <cstdint>
+#include <istream>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "hrg_gyro/core/common/units.h"
+
+namespace hrg_gyro {
+namespace csv {
+
+/// How the stamp column is written. kAuto decides per field: an ISO 8601 date-time when it holds a
+/// 'T', seconds when it holds a '.', otherwise a whole number of nanoseconds.
+enum class StampFormat { kAuto, kSeconds, kNanoseconds, kIso8601 };
+/// "auto", "s", "ns", "iso"; std::invalid_argument otherwise.
+StampFormat parseStampFormat(const std::string& name);
+
+/// A field that is not what its column holds; the message says why (the caller adds file:line).
+struct FieldError : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+
+/// A decimal number, the whole field ("nan" allowed here; the caller decides where NaN may stand).
+/// Surrounding blanks are ignored; "1.5abc", "1,5", "", "0x10" throw FieldError.
+double parseNumber(std::string_view field);
+/// A stamp as nanoseconds since the Unix epoch, read without floating point:
+///   seconds      "1700000000.123456789" (decimals beyond the 9th round to the nearest ns)
+///   nanoseconds  "1700000000123456789"
+///   ISO 8601     "2026-11-23T10:00:00.123456789Z" or with an offset "+01:00", "-0530"; a
+///                date-time without a zone is refused (local time would be a guess).
+/// Negative stamps and values beyond the signed 64-bit nanosecond range throw FieldError.
+core::Nanoseconds parseStamp(std::string_view field, StampFormat format);
+
+/// The reader of one delimited file. The first line that is neither empty nor a comment ('#'
+/// first) is the header; every following such line is a record. A file without a header row
+/// (`has_header` false) has columns named only by index ("#N"), as many as its first record's.
+/// A UTF-8 byte-order mark (as spreadsheet programs write) before the first line is ignored.
+class CsvReader {
+ public:
+  /// `delimiter` 0: taken from the header line (the one of ',' ';' '\t' it holds; a header holding
+  /// none or several of them is refused: give it). std::runtime_error (naming `name`) on an empty
+  /// file or an undecidable delimiter.
+  CsvReader(std::istream& in, std::string name, char delimiter = 0, bool has_header = true);
+
+  const std::vector<std::string>& header() const { return header_; }
+  char delimiter() const { return delimiter_; }
+  /// Reads the next record; false at the end of the file.
+  bool next();
+  /// The fields of the current record, blanks and surrounding double quotes removed.
+  const std::vector<std::string_view>& fields() const { return fields_; }
+  /// 1-based line number of the current record (or of the header before the first next()).
+  std::uint64_t line() const { return line_; }
+  std::uint64_t bytesRead() const { return bytes_; }
+  const std::string& name() const { return name_; }
+
+  /// The index of a column: "#N" is the N-th column (1-based), anything else a header name (never
+  /// found in a file without a header)
+  /// compared without regard to case. -1 when no header name matches; std::runtime_error for a
+  /// "#N" out of range or a name the header holds twice.
+  int column(const std::string& wanted) const;
+
+ private:
+  bool readLine();
+  void split();
+
+  std::istream& in_;
+  std::string name_;
+  char delimiter_;
+  std::string text_;
+  std::vector<std::string_view> fields_;
+  std::vector<std::string> header_;
+  std::uint64_t line_ = 0;
+  std::uint64_t bytes_ = 0;
+  bool first_record_pending_ = false;  ///< without a header, the first line read is already a record
+};
+
+}  // namespace csv
+}  // namespace hrg_gyro

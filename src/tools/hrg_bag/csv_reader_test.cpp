@@ -1,0 +1,142 @@
+#include "csv_reader.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace hrg_gyro {
+namespace csv {
+namespace {
+
+TEST(CsvReaderTest, StampsInTheThreeFormatsAreExactNanoseconds) {
+  // 1700000000.123456789 s is not representable as a double: the reader never goes through one.
+  EXPECT_EQ(parseStamp("1700000000.123456789", StampFormat::kAuto), 1700000000123456789LL);
+  EXPECT_EQ(parseStamp("1700000000.123456789", StampFormat::kSeconds), 1700000000123456789LL);
+  EXPECT_EQ(parseStamp("1700000000123456789", StampFormat::kAuto), 1700000000123456789LL);
+  EXPECT_EQ(parseStamp("1700000000123456789", StampFormat::kNanoseconds), 1700000000123456789LL);
+  EXPECT_EQ(parseStamp("12", StampFormat::kSeconds), 12000000000LL);
+  EXPECT_EQ(parseStamp("12.", StampFormat::kSeconds), 12000000000LL);
+  EXPECT_EQ(parseStamp("0.5", StampFormat::kAuto), 500000000LL);
+  // Beyond the 9th decimal: rounded to the nearest nanosecond, carrying into the seconds.
+  EXPECT_EQ(parseStamp("1.0000000004", StampFormat::kSeconds), 1000000000LL);
+  EXPECT_EQ(parseStamp("1.0000000005", StampFormat::kSeconds), 1000000001LL);
+  EXPECT_EQ(parseStamp("1.9999999999", StampFormat::kSeconds), 2000000000LL);
+  // 2026-11-23T10:00:00Z is 1795428000 s after the epoch.
+  EXPECT_EQ(parseStamp("2026-11-23T10:00:00.123456789Z", StampFormat::kAuto), 1795428000123456789LL);
+  EXPECT_EQ(parseStamp("2026-11-23T11:00:00.123456789+01:00", StampFormat::kIso8601), 1795428000123456789LL);
+  EXPECT_EQ(parseStamp("2026-11-23T04:30:00.5-0530", StampFormat::kIso8601), 1795428000500000000LL);
+  EXPECT_EQ(parseStamp("1970-01-01T00:00:00Z", StampFormat::kIso8601), 0);
+  EXPECT_EQ(parseStamp("2024-02-29T00:00:00Z", StampFormat::kIso8601), 1709164800000000000LL);
+}
+
+TEST(CsvReaderTest, BadStampsAreRefusedWithTheReason) {
+  auto why = [](const char* text, StampFormat format) -> std::string {
+    try {
+      parseStamp(text, format);
+    } catch (const FieldError& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_NE(why("2026-11-23T10:00:00", StampFormat::kAuto).find("no zone"), std::string::npos);
+  EXPECT_NE(why("2026-02-29T10:00:00Z", StampFormat::kAuto).find("day out of range"), std::string::npos);
+  EXPECT_NE(why("2026-11-23T10:00:00Zx", StampFormat::kAuto).find("trailing"), std::string::npos);
+  EXPECT_NE(why("-1.5", StampFormat::kAuto).find("negative"), std::string::npos);
+  EXPECT_NE(why("1.5e3", StampFormat::kAuto).find("plain decimal"), std::string::npos);
+  EXPECT_NE(why("12.5", StampFormat::kNanoseconds).find("whole number"), std::string::npos);
+  EXPECT_NE(why("99999999999999999999", StampFormat::kNanoseconds).find("out of range"), std::string::npos);
+  EXPECT_NE(why("9999999999999.0", StampFormat::kSeconds).find("out of range"), std::string::npos);
+  EXPECT_NE(why("", StampFormat::kAuto).find("empty"), std::string::npos);
+}
+
+TEST(CsvReaderTest, NumbersAreReadWholeOrRefused) {
+  EXPECT_EQ(parseNumber("1.5"), 1.5);
+  EXPECT_EQ(parseNumber(" -2.5e-3 "), -2.5e-3);
+  EXPECT_EQ(parseNumber("+3"), 3.0);
+  EXPECT_EQ(parseNumber("0.1"), 0.1);  // the same double as the compiler's, bit for bit
+  EXPECT_TRUE(std::isnan(parseNumber("nan")));
+  for (const char* bad : {"1.5abc", "1,5", "", "  ", "0x10", "abc", "1e999"}) {
+    EXPECT_THROW(parseNumber(bad), FieldError) << bad;
+  }
+}
+
+TEST(CsvReaderTest, DelimiterCommentsQuotesAndLineNumbers) {
+  std::istringstream in(
+      "# bench log\n"
+      "\n"
+      "\"Stamp\";Ac_V;Bc\r\n"
+      "# a comment between records\n"
+      "1.0; 0.5 ;\"0.25\"\r\n"
+      "2.0;;x\n");
+  CsvReader reader(in, "bench.csv");
+  EXPECT_EQ(reader.delimiter(), ';');
+  ASSERT_EQ(reader.header().size(), 3u);
+  EXPECT_EQ(reader.header()[0], "Stamp");
+  EXPECT_EQ(reader.line(), 3u);
+  ASSERT_TRUE(reader.next());
+  EXPECT_EQ(reader.line(), 5u);
+  ASSERT_EQ(reader.fields().size(), 3u);
+  EXPECT_EQ(reader.fields()[1], "0.5");
+  EXPECT_EQ(reader.fields()[2], "0.25");
+  ASSERT_TRUE(reader.next());
+  EXPECT_EQ(reader.line(), 6u);
+  EXPECT_EQ(reader.fields()[1], "");
+  EXPECT_FALSE(reader.next());
+}
+
+TEST(CsvReaderTest, DelimiterFromTheHeaderOrGiven) {
+  std::istringstream tabs("stamp\tac\n1\t2\n");
+  EXPECT_EQ(CsvReader(tabs, "t").delimiter(), '\t');
+  std::istringstream mixed("stamp;a,c\n");
+  EXPECT_THROW(CsvReader(mixed, "m"), std::runtime_error);
+  std::istringstream one("stamp\n");
+  EXPECT_THROW(CsvReader(one, "o"), std::runtime_error);
+  std::istringstream given("stamp;a,c\n1;2,5\n");
+  CsvReader reader(given, "g", ';');
+  ASSERT_TRUE(reader.next());
+  EXPECT_EQ(reader.fields()[1], "2,5");  // and parseNumber refuses it: never read as 2
+  EXPECT_THROW(parseNumber(reader.fields()[1]), FieldError);
+  std::istringstream empty("# only a comment\n");
+  EXPECT_THROW(CsvReader(empty, "e"), std::runtime_error);
+}
+
+TEST(CsvReaderTest, ColumnsByNameInAnyCaseOrByIndex) {
+  std::istringstream in("Stamp,AC_V,bc,ac_v2\n");
+  CsvReader reader(in, "c");
+  EXPECT_EQ(reader.column("stamp"), 0);
+  EXPECT_EQ(reader.column("ac_v"), 1);
+  EXPECT_EQ(reader.column("#3"), 2);
+  EXPECT_EQ(reader.column("missing"), -1);
+  EXPECT_THROW(reader.column("#0"), std::runtime_error);
+  EXPECT_THROW(reader.column("#5"), std::runtime_error);
+  EXPECT_THROW(reader.column("#x"), std::runtime_error);
+  std::istringstream twice("stamp,a,A\n");
+  EXPECT_THROW(CsvReader(twice, "t").column("a"), std::runtime_error);
+}
+
+TEST(CsvReaderTest, ByteOrderMarkIsIgnored) {
+  std::istringstream in("\xEF\xBB\xBFstamp,ac\n1,2\n");
+  CsvReader reader(in, "bom");
+  EXPECT_EQ(reader.header()[0], "stamp");
+  EXPECT_EQ(reader.column("stamp"), 0);
+}
+
+TEST(CsvReaderTest, WithoutHeaderTheFirstLineIsARecordAndColumnsGoByIndex) {
+  std::istringstream in("# no header\n1.0;2;3\n2.0;4;5\n");
+  CsvReader reader(in, "raw", 0, false);
+  EXPECT_EQ(reader.delimiter(), ';');
+  EXPECT_EQ(reader.header().size(), 3u);
+  EXPECT_EQ(reader.column("stamp"), -1);
+  EXPECT_EQ(reader.column("#2"), 1);
+  ASSERT_TRUE(reader.next());
+  EXPECT_EQ(reader.line(), 2u);
+  EXPECT_EQ(reader.fields()[0], "1.0");
+  ASSERT_TRUE(reader.next());
+  EXPECT_EQ(reader.fields()[2], "5");
+  EXPECT_FALSE(reader.next());
+}
+
+}  // namespace
+}  // namespace csv
+}  // namespace hrg_gyro

@@ -1,0 +1,210 @@
+#include "gyro_logs.h"
+
+#include <charconv>
+#include <cmath>
+#include <limits>
+
+namespace hrg_gyro {
+namespace csv {
+namespace {
+
+/// A record refused inside RecordSource::nextRecord, before the file:line is added.
+struct Refusal {
+  BadRowReason reason;
+  std::string detail;
+};
+
+}  // namespace
+
+const char* describe(BadRowReason reason) {
+  switch (reason) {
+    case BadRowReason::kFieldCount:
+      return "wrong field count";
+    case BadRowReason::kStamp:
+      return "unreadable stamp";
+    case BadRowReason::kStampOrder:
+      return "stamp not increasing";
+    case BadRowReason::kNumber:
+      return "unreadable number";
+    case BadRowReason::kNotANumber:
+    default:
+      return "NaN or infinity not allowed";
+  }
+}
+
+std::uint64_t BadRowCounts::total() const {
+  std::uint64_t n = 0;
+  for (std::uint64_t c : by_reason) n += c;
+  return n;
+}
+
+std::string BadRowCounts::summary() const {
+  std::string s = std::to_string(total());
+  std::string parts;
+  for (std::size_t i = 0; i < kBadRowReasons; ++i) {
+    if (by_reason[i] == 0) continue;
+    parts += (parts.empty() ? "" : ", ") + std::string(describe(static_cast<BadRowReason>(i))) + " " +
+             std::to_string(by_reason[i]);
+  }
+  return parts.empty() ? s : s + " (" + parts + ")";
+}
+
+RecordSource::RecordSource(std::istream& in, const std::string& name, const LogSettings& settings,
+                           BadRowCounts* skipped)
+    : csv_(in, name, settings.delimiter, settings.has_header),
+      settings_(settings),
+      skipped_(skipped),
+      stamp_column_(column("stamp", true)) {}
+
+int RecordSource::column(const std::string& key, bool required) const {
+  const auto given = settings_.columns.find(key);
+  const std::string wanted = given == settings_.columns.end() ? key : given->second;
+  const int index = csv_.column(wanted);
+  if (index < 0 && (required || given != settings_.columns.end())) {
+    if (!settings_.has_header) {
+      throw std::runtime_error(csv_.name() + ": no header row, so " + key + " needs its column by index: --column " +
+                               key + "=#N (N from 1 to " + std::to_string(csv_.header().size()) + ")");
+    }
+    std::string names;
+    for (const std::string& h : csv_.header()) names += (names.empty() ? "'" : ", '") + h + "'";
+    throw std::runtime_error(csv_.name() + ":" + std::to_string(csv_.line()) + ": no column '" + wanted + "' for " +
+                             key + " in the header (" + names + "): name it with the column option");
+  }
+  return index;
+}
+
+void RecordSource::bad(BadRowReason reason, const std::string& detail) const { throw Refusal{reason, detail}; }
+
+double RecordSource::number(int column, const char* key, bool nan_allowed) const {
+  double value = 0.0;
+  try {
+    value = parseNumber(csv_.fields()[column]);
+  } catch (const FieldError& e) {
+    bad(BadRowReason::kNumber, std::string(key) + ": " + e.what());
+  }
+  if (std::isinf(value) || (std::isnan(value) && !nan_allowed)) {
+    bad(BadRowReason::kNotANumber, std::string(key) + " is " + std::string(csv_.fields()[column]) +
+                                       (nan_allowed ? "" : " (a number is required here)"));
+  }
+  return value;
+}
+
+std::uint32_t RecordSource::count(int column, const char* key) const {
+  const std::string_view field = csv_.fields()[column];
+  std::uint32_t value = 0;
+  const auto r = std::from_chars(field.data(), field.data() + field.size(), value);
+  if (field.empty() || r.ec != std::errc() || r.ptr != field.data() + field.size()) {
+    bad(BadRowReason::kNumber,
+        std::string(key) + ": '" + std::string(field) + "' is not a whole number in [0, 2^32 - 1]");
+  }
+  return value;
+}
+
+bool RecordSource::nextRecord(const std::function<void(core::Nanoseconds)>& parse) {
+  while (csv_.next()) {
+    try {
+      if (csv_.fields().size() != csv_.header().size()) {
+        bad(BadRowReason::kFieldCount,
+            std::to_string(csv_.fields().size()) + " fields, the header has " + std::to_string(csv_.header().size()));
+      }
+      core::Nanoseconds stamp = 0;
+      try {
+        stamp = parseStamp(csv_.fields()[stamp_column_], settings_.stamp_format);
+      } catch (const FieldError& e) {
+        bad(BadRowReason::kStamp, e.what());
+      }
+      if (have_last_ && stamp <= last_) {
+        bad(BadRowReason::kStampOrder, "stamp " + std::to_string(stamp) + " ns is not after the previous record's " +
+                                           std::to_string(last_) + " ns (the log must be sorted by stamp)");
+      }
+      parse(stamp);
+      have_last_ = true;
+      last_ = stamp;
+      return true;
+    } catch (const Refusal& r) {
+      if (!settings_.skip_bad_rows || skipped_ == nullptr) {
+        throw BadRowError(
+            r.reason, csv_.name() + ":" + std::to_string(csv_.line()) + ": " + describe(r.reason) + ": " + r.detail);
+      }
+      ++skipped_->by_reason[static_cast<std::size_t>(r.reason)];
+    }
+  }
+  return false;
+}
+
+ChannelLogReader::ChannelLogReader(std::istream& in, const std::string& name, const LogSettings& settings,
+                                   BadRowCounts* skipped)
+    : source_(in, name, settings, skipped),
+      ac_(source_.column("ac", true)),
+      bc_(source_.column("bc", true)),
+      as_(source_.column("as", true)),
+      bs_(source_.column("bs", true)),
+      frequency_(source_.column("frequency", false)),
+      temperature_(source_.column("temperature", false)),
+      periods_(source_.column("periods", false)) {}
+
+bool ChannelLogReader::next(ChannelRecord* r) {
+  return source_.next([&](core::Nanoseconds stamp) {
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    r->stamp = stamp;
+    r->ac = source_.number(ac_, "ac", false);
+    r->bc = source_.number(bc_, "bc", false);
+    r->as = source_.number(as_, "as", false);
+    r->bs = source_.number(bs_, "bs", false);
+    r->frequency = frequency_ < 0 ? kNaN : source_.number(frequency_, "frequency", true);
+    r->temperature = temperature_ < 0 ? kNaN : source_.number(temperature_, "temperature", true);
+    r->periods = periods_ < 0 ? 0 : source_.count(periods_, "periods");
+  });
+}
+
+TurntableLogReader::TurntableLogReader(std::istream& in, const std::string& name, const LogSettings& settings,
+                                       BadRowCounts* skipped)
+    : source_(in, name, settings, skipped),
+      angle_(source_.column("angle", false)),
+      rate_(source_.column("rate", false)),
+      angle_scale_(settings.angle_scale),
+      rate_scale_(settings.rate_scale) {
+  if (angle_ < 0 && rate_ < 0) {
+    throw std::runtime_error(name + ": the turntable log needs an angle or a rate column (or both)");
+  }
+}
+
+bool TurntableLogReader::readRecord(TurntableRecord* r) {
+  return source_.next([&](core::Nanoseconds stamp) {
+    r->stamp = stamp;
+    // With a rate logged the calibration can integrate it, so a missing angle (NaN) is allowed;
+    // without one the angle is all there is.
+    r->angle = angle_ < 0 ? std::numeric_limits<double>::quiet_NaN()
+                          : source_.number(angle_, "angle", rate_ >= 0) * angle_scale_;
+    r->rate = rate_ < 0 ? 0.0 : source_.number(rate_, "rate", false) * rate_scale_;
+  });
+}
+
+bool TurntableLogReader::next(TurntableRecord* record) {
+  if (!derivesRate()) return readRecord(record);
+  if (!primed_) {
+    primed_ = true;
+    have_current_ = readRecord(&current_);
+    have_after_ = have_current_ && readRecord(&after_);
+    if (have_current_ && !have_after_) {
+      throw std::runtime_error(source_.csv().name() +
+                               ": one turntable record: the rate cannot be derived from the "
+                               "angle without a neighbour (log the rate, or more records)");
+    }
+  }
+  if (!have_current_) return false;
+  // Central difference over the neighbours; one-sided at the two ends of the log.
+  const TurntableRecord& a = have_before_ ? before_ : current_;
+  const TurntableRecord& b = have_after_ ? after_ : current_;
+  *record = current_;
+  record->rate = (b.angle - a.angle) / (static_cast<double>(b.stamp - a.stamp) * 1e-9);
+  before_ = current_;
+  have_before_ = true;
+  current_ = after_;
+  have_current_ = have_after_;
+  have_after_ = have_current_ && readRecord(&after_);
+  return true;
+}
+
+}  // namespace csv
+}  // namespace hrg_gyro

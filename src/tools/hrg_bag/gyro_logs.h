@@ -1,0 +1,129 @@
+// The two logs a test bench keeps beside the gyro, read record by record from delimited text: the
+// channel amplitudes (stamp, Ac, Bc, As, Bs and optionally frequency, temperature, periods) and the
+// turntable (stamp and angle and/or rate). Each reader checks every record (field count, numbers,
+// NaN where none may stand, stamps strictly increasing) and either refuses the first bad one with
+// file:line and the reason, or skips it and counts it by reason. Where the turntable log holds only
+// the angle, the rate is derived from it by the central difference of the neighbouring records.
+// No ROS: `hrg_bag import` turns the records into messages.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "csv_reader.h"
+
+namespace hrg_gyro {
+namespace csv {
+
+enum class BadRowReason { kFieldCount, kStamp, kStampOrder, kNumber, kNotANumber };
+constexpr std::size_t kBadRowReasons = 5;
+const char* describe(BadRowReason reason);
+
+/// Records skipped by reason (with --skip-bad-rows).
+struct BadRowCounts {
+  std::array<std::uint64_t, kBadRowReasons> by_reason{};
+  std::uint64_t total() const;
+  /// "3 (wrong field count 1, stamp not increasing 2)", or "0".
+  std::string summary() const;
+};
+
+/// A refused record: "file:line: reason: detail". Exit code 1 in hrg_bag.
+struct BadRowError : std::runtime_error {
+  BadRowError(BadRowReason why, const std::string& message) : std::runtime_error(message), reason(why) {}
+  BadRowReason reason;
+};
+
+struct LogSettings {
+  StampFormat stamp_format = StampFormat::kAuto;
+  char delimiter = 0;      ///< 0: taken from the header
+  bool has_header = true;  ///< false: no header row, every column mapped by "#N"
+  /// Column of each key ("ac" -> "Ac_V" or "#3"); a key not given is looked up by its own name.
+  std::map<std::string, std::string> columns;
+  double angle_scale = 1.0;  ///< to rad
+  double rate_scale = 1.0;   ///< to rad/s
+  bool skip_bad_rows = false;
+};
+
+struct ChannelRecord {
+  core::Nanoseconds stamp = 0;
+  double ac = 0, bc = 0, as = 0, bs = 0;
+  double frequency = 0, temperature = 0;  ///< NaN when not logged
+  std::uint32_t periods = 0;              ///< 0 when not logged
+};
+
+struct TurntableRecord {
+  core::Nanoseconds stamp = 0;
+  double angle = 0;  ///< rad; NaN when only the rate is logged
+  double rate = 0;   ///< rad/s
+};
+
+/// The records of one log and the rules every record meets; shared by the two readers below.
+class RecordSource {
+ public:
+  RecordSource(std::istream& in, const std::string& name, const LogSettings& settings, BadRowCounts* skipped);
+  /// The column of `key`, -1 when absent and not `required`; std::runtime_error naming the key and
+  /// the file when a required column, or one named by an option, is missing.
+  int column(const std::string& key, bool required) const;
+  /// Reads records until one passes `parse` (called with the record's stamp); false at the end.
+  template <class Parse>
+  bool next(Parse&& parse);
+  /// A number of the current record; NaN only where `nan_allowed`, infinities never.
+  double number(int column, const char* key, bool nan_allowed) const;
+  /// A whole number in [0, 2^32 - 1] of the current record.
+  std::uint32_t count(int column, const char* key) const;
+  const CsvReader& csv() const { return csv_; }
+
+ private:
+  [[noreturn]] void bad(BadRowReason reason, const std::string& detail) const;
+  bool nextRecord(const std::function<void(core::Nanoseconds)>& parse);
+
+  CsvReader csv_;
+  LogSettings settings_;
+  BadRowCounts* skipped_;
+  int stamp_column_;
+  bool have_last_ = false;
+  core::Nanoseconds last_ = 0;
+};
+
+class ChannelLogReader {
+ public:
+  ChannelLogReader(std::istream& in, const std::string& name, const LogSettings& settings, BadRowCounts* skipped);
+  bool next(ChannelRecord* record);
+  const CsvReader& csv() const { return source_.csv(); }
+
+ private:
+  RecordSource source_;
+  int ac_, bc_, as_, bs_, frequency_, temperature_, periods_;
+};
+
+class TurntableLogReader {
+ public:
+  TurntableLogReader(std::istream& in, const std::string& name, const LogSettings& settings, BadRowCounts* skipped);
+  bool next(TurntableRecord* record);
+  const CsvReader& csv() const { return source_.csv(); }
+  /// True when the rate is derived from the angle (no rate column).
+  bool derivesRate() const { return rate_ < 0; }
+
+ private:
+  bool readRecord(TurntableRecord* record);
+
+  RecordSource source_;
+  int angle_, rate_;
+  double angle_scale_, rate_scale_;
+  // The derivation's window: the record before, the one being returned, the one after.
+  TurntableRecord before_, current_, after_;
+  bool primed_ = false, have_before_ = false, have_current_ = false, have_after_ = false;
+};
+
+template <class Parse>
+bool RecordSource::next(Parse&& parse) {
+  return nextRecord(std::function<void(core::Nanoseconds)>(std::forward<Parse>(parse)));
+}
+
+}  // namespace csv
+}  // namespace hrg_gyro

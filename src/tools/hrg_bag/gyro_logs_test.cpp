@@ -1,0 +1,192 @@
+#include "gyro_logs.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+namespace hrg_gyro {
+namespace csv {
+namespace {
+
+std::vector<ChannelRecord> readChannels(const std::string& text, const LogSettings& settings = {},
+                                        BadRowCounts* skipped = nullptr) {
+  std::istringstream in(text);
+  ChannelLogReader reader(in, "ch.csv", settings, skipped);
+  std::vector<ChannelRecord> records;
+  ChannelRecord r;
+  while (reader.next(&r)) records.push_back(r);
+  return records;
+}
+
+std::vector<TurntableRecord> readTurntable(const std::string& text, const LogSettings& settings = {}) {
+  std::istringstream in(text);
+  TurntableLogReader reader(in, "tt.csv", settings, nullptr);
+  std::vector<TurntableRecord> records;
+  TurntableRecord r;
+  while (reader.next(&r)) records.push_back(r);
+  return records;
+}
+
+/// The message of the refusal of `text`, "" when it was accepted.
+std::string refusal(const std::string& text) {
+  try {
+    readChannels(text);
+  } catch (const BadRowError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const char* kHeader = "stamp,ac,bc,as,bs\n";
+
+TEST(GyroLogsTest, ChannelRecordsWithDefaultNamesAndOptionalColumns) {
+  const auto records = readChannels(
+      "stamp,Ac,Bc,As,Bs,frequency,temperature,periods\n"
+      "1.5,0.9,0.1,-0.2,0.01,5000.25,nan,25\n"
+      "1700000000123456789,1,2,3,4,5001,21.5,0\n");
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_EQ(records[0].stamp, 1500000000LL);
+  EXPECT_EQ(records[0].ac, 0.9);
+  EXPECT_EQ(records[0].bs, 0.01);
+  EXPECT_EQ(records[0].frequency, 5000.25);
+  EXPECT_TRUE(std::isnan(records[0].temperature));
+  EXPECT_EQ(records[0].periods, 25u);
+  EXPECT_EQ(records[1].stamp, 1700000000123456789LL);
+  EXPECT_EQ(records[1].temperature, 21.5);
+  const auto minimal = readChannels(std::string(kHeader) + "1,1,2,3,4\n");
+  ASSERT_EQ(minimal.size(), 1u);
+  EXPECT_TRUE(std::isnan(minimal[0].frequency));
+  EXPECT_TRUE(std::isnan(minimal[0].temperature));
+  EXPECT_EQ(minimal[0].periods, 0u);
+}
+
+TEST(GyroLogsTest, ColumnsMappedByNameOrIndex) {
+  LogSettings settings;
+  settings.columns = {{"stamp", "t_ns"}, {"ac", "Ac_V"}, {"bc", "#3"}, {"as", "As_V"}, {"bs", "Bs_V"}};
+  const auto records = readChannels("t_ns;Ac_V;quad;As_V;Bs_V\n1000;1;2;3;4\n", settings);
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0].stamp, 1000);
+  EXPECT_EQ(records[0].bc, 2.0);
+  // A column that is neither in the header nor mapped: named with the file and the key.
+  try {
+    readChannels("stamp,ac,bc,as\n1,1,2,3\n");
+    FAIL() << "a log without bs was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no column 'bs' for bs"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("ch.csv:1"), std::string::npos) << e.what();
+  }
+  // An optional column named by an option must exist.
+  settings.columns = {{"temperature", "T_degC"}};
+  EXPECT_THROW(readChannels(std::string(kHeader) + "1,1,2,3,4\n", settings), std::runtime_error);
+}
+
+TEST(GyroLogsTest, WithoutHeaderEveryColumnByIndex) {
+  LogSettings settings;
+  settings.has_header = false;
+  settings.columns = {{"stamp", "#1"}, {"ac", "#2"}, {"bc", "#3"}, {"as", "#4"}, {"bs", "#5"}};
+  const auto records = readChannels("1000,1,2,3,4\n2000,5,6,7,8\n", settings);
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_EQ(records[0].stamp, 1000);
+  EXPECT_EQ(records[1].bs, 8.0);
+  settings.columns.erase("bs");
+  try {
+    readChannels("1000,1,2,3,4\n", settings);
+    FAIL() << "bs without a column was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("--column bs=#N (N from 1 to 5)"), std::string::npos) << e.what();
+  }
+}
+
+TEST(GyroLogsTest, EveryBadRowReasonWithItsLineNumber) {
+  const std::string ok = std::string(kHeader) + "1.0,1,2,3,4\n";
+  EXPECT_NE(refusal(ok + "2.0,1,2,3\n").find("ch.csv:3: wrong field count: 4 fields, the header has 5"),
+            std::string::npos);
+  EXPECT_NE(refusal(ok + "# c\n2.0,1,2,3,4,5\n").find("ch.csv:4: wrong field count"), std::string::npos);
+  EXPECT_NE(refusal(ok + "abc,1,2,3,4\n").find("ch.csv:3: unreadable stamp"), std::string::npos);
+  EXPECT_NE(refusal(ok + "0.5,1,2,3,4\n").find("ch.csv:3: stamp not increasing"), std::string::npos);
+  EXPECT_NE(refusal(ok + "1.0,1,2,3,4\n").find("ch.csv:3: stamp not increasing"), std::string::npos);
+  EXPECT_NE(refusal(ok + "2.0,1.5abc,2,3,4\n").find("ch.csv:3: unreadable number: ac: '1.5abc' is not a number"),
+            std::string::npos);
+  EXPECT_NE(refusal(ok + "2.0,1,2,nan,4\n").find("ch.csv:3: NaN or infinity not allowed: as is nan"),
+            std::string::npos);
+  EXPECT_NE(refusal(ok + "2.0,1,2,3,inf\n").find("ch.csv:3: NaN or infinity not allowed: bs"), std::string::npos);
+  EXPECT_EQ(refusal(ok + "2.0,1,2,3,4\n"), "");
+  // "1,5" under a ';' delimiter is a number refused, never 1.
+  EXPECT_NE(refusal("stamp;ac;bc;as;bs\n1.0;1,5;2;3;4\n").find("ch.csv:2: unreadable number: ac: '1,5'"),
+            std::string::npos);
+  const std::string periods = "stamp,ac,bc,as,bs,periods\n";
+  EXPECT_NE(refusal(periods + "1,1,2,3,4,-1\n").find("periods"), std::string::npos);
+  EXPECT_NE(refusal(periods + "1,1,2,3,4,2.5\n").find("periods"), std::string::npos);
+}
+
+TEST(GyroLogsTest, SkippedRowsAreCountedByReason) {
+  LogSettings settings;
+  settings.skip_bad_rows = true;
+  BadRowCounts skipped;
+  const auto records = readChannels(std::string(kHeader) +
+                                        "1.0,1,2,3,4\n"
+                                        "2.0,1,2,3\n"    // field count
+                                        "0.5,1,2,3,4\n"  // stamp going back
+                                        "1.0,1,2,3,4\n"  // stamp repeated
+                                        "x,1,2,3,4\n"    // stamp
+                                        "3.0,1,y,3,4\n"  // number
+                                        "4.0,1,2,nan,4\n"
+                                        "5.0,5,6,7,8\n",
+                                    settings, &skipped);
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_EQ(records[1].stamp, 5000000000LL);
+  EXPECT_EQ(records[1].ac, 5.0);
+  EXPECT_EQ(skipped.total(), 6u);
+  EXPECT_EQ(skipped.by_reason[static_cast<std::size_t>(BadRowReason::kFieldCount)], 1u);
+  EXPECT_EQ(skipped.by_reason[static_cast<std::size_t>(BadRowReason::kStampOrder)], 2u);
+  EXPECT_EQ(skipped.by_reason[static_cast<std::size_t>(BadRowReason::kStamp)], 1u);
+  EXPECT_EQ(skipped.by_reason[static_cast<std::size_t>(BadRowReason::kNumber)], 1u);
+  EXPECT_EQ(skipped.by_reason[static_cast<std::size_t>(BadRowReason::kNotANumber)], 1u);
+  EXPECT_EQ(skipped.summary(),
+            "6 (wrong field count 1, unreadable stamp 1, stamp not increasing 2, unreadable number 1, NaN or "
+            "infinity not allowed 1)");
+}
+
+TEST(GyroLogsTest, TurntableUnitsAreConverted) {
+  LogSettings settings;
+  settings.angle_scale = M_PI / 180.0;
+  settings.rate_scale = M_PI / 180.0;
+  const auto records = readTurntable("stamp\tangle_deg\trate_dps\n1\t180\t-90\n", [&] {
+    settings.columns = {{"angle", "angle_deg"}, {"rate", "rate_dps"}};
+    return settings;
+  }());
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0].stamp, 1);
+  EXPECT_DOUBLE_EQ(records[0].angle, M_PI);
+  EXPECT_DOUBLE_EQ(records[0].rate, -M_PI / 2);
+}
+
+TEST(GyroLogsTest, RateFromAngleIsTheCentralDifference) {
+  // Angle t^2 (rad, t in s) at uneven spacing: the central difference of a parabola is exact at
+  // the midpoint of its neighbours, the ends are one-sided.
+  const auto records = readTurntable("stamp,angle\n0.0,0\n1.0,1\n3.0,9\n4.0,16\n");
+  ASSERT_EQ(records.size(), 4u);
+  EXPECT_DOUBLE_EQ(records[0].rate, 1.0);  // (1 - 0) / 1
+  EXPECT_DOUBLE_EQ(records[1].rate, 3.0);  // (9 - 0) / 3
+  EXPECT_DOUBLE_EQ(records[2].rate, 5.0);  // (16 - 1) / 3
+  EXPECT_DOUBLE_EQ(records[3].rate, 7.0);  // (16 - 9) / 1
+  EXPECT_EQ(records[2].angle, 9.0);
+  // A derived rate needs a neighbour; an angle-only log also needs every angle.
+  EXPECT_THROW(readTurntable("stamp,angle\n0.0,0\n"), std::runtime_error);
+  EXPECT_THROW(readTurntable("stamp,angle\n0.0,0\n1.0,nan\n"), BadRowError);
+}
+
+TEST(GyroLogsTest, RateOnlyLeavesTheAngleNaN) {
+  const auto records = readTurntable("stamp,rate\n1.0,0.05\n2.0,0.05\n");
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_TRUE(std::isnan(records[0].angle));
+  EXPECT_EQ(records[1].rate, 0.05);
+  EXPECT_THROW(readTurntable("stamp,rate\n1.0,nan\n"), BadRowError);
+  EXPECT_THROW(readTurntable("stamp,speed\n1.0,0\n"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace csv
+}  // namespace hrg_gyro
