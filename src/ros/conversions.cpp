@@ -72,6 +72,18 @@ TurntableState toTurntableMessage(const core::SimulationSample& s, const std_msg
   return m;
 }
 
+TurntableState toTurntableMessage(const core::TurntableLogRecord& r, core::Nanoseconds origin, std::uint32_t seq,
+                                  const std::string& frame_id) {
+  TurntableState m;
+  m.header.seq = seq;
+  // A zero stamp is what a glitched controller sends, whatever the clock's origin.
+  m.header.stamp = r.stamp == 0 ? ros::Time() : toRosTime(origin + r.stamp);
+  m.header.frame_id = frame_id;
+  m.angle = r.angle;
+  m.rate = r.rate;
+  return m;
+}
+
 GroundTruth toTruthMessage(const core::SimulationSample& s, const std_msgs::Header& header) {
   GroundTruth t;
   t.header = header;
