@@ -64,14 +64,6 @@ ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::
   return m;
 }
 
-TurntableState toTurntableMessage(const core::SimulationSample& s, const std_msgs::Header& header) {
-  TurntableState m;
-  m.header = header;
-  m.angle = s.truth.table_angle;
-  m.rate = s.truth.table_rate;
-  return m;
-}
-
 TurntableState toTurntableMessage(const core::TurntableLogRecord& r, core::Nanoseconds origin, std::uint32_t seq,
                                   const std::string& frame_id) {
   TurntableState m;
