@@ -17,7 +17,7 @@ seen by the cosine and sine pickoff channels, demodulated against cos(wt) and si
     Ac =  A cos th cos tau - B sin th sin tau      Bc = -A cos th sin tau - B sin th cos tau
     As =  A sin th cos tau + B cos th sin tau      Bs = -A sin th sin tau + B cos th cos tau
 
-Usage: independent_session.py --out BAG --truth YAML [--ripple 0.002] [--encoder-noise 2e-6]
+Usage: independent_session.py --out BAG --truth YAML [--acceleration 0.5] [--ripple 0.002] [--encoder-noise 2e-6]
        [--encoder-bits 23] [--differenced-rate] [--cos4 0.03] [--cos8 0.003] [--seed 1]
 """
 import argparse
@@ -90,6 +90,7 @@ def main(argv):
     parser.add_argument("--truth", required=True, help="YAML with the injected K and D")
     parser.add_argument("--rate", type=float, default=0.4, help="plateau rates +-rate, rad/s")
     parser.add_argument("--pairs", type=int, default=6, help="plateau pairs, each sweeping theta by 2 pi")
+    parser.add_argument("--acceleration", type=float, default=0.5, help="drive acceleration limit, rad/s^2")
     parser.add_argument("--output-hz", type=float, default=200.0)
     parser.add_argument("--log-hz", type=float, default=100.0, help="turntable log rate")
     parser.add_argument("--cos4", type=float, default=0.03, help="relative cos 4theta term of K")
@@ -108,7 +109,7 @@ def main(argv):
     gyro = Gyro(-0.56, [(2, 4e-4, -3e-4), (4, a.cos4, 2e-4), (6, 1e-4, 0.0), (8, a.cos8, -1e-4)],
                 1e-5, [(2, 2e-5, -1e-5)])
     amplitude, quadrature, tau = 1.0, 0.02, 0.3
-    profile = Profile(acceleration=0.5)
+    profile = Profile(acceleration=a.acceleration)
     profile.hold(0.0, 5.0)
     sweep = 2.0 * math.pi / (abs(gyro.k0) * a.rate)
     for _ in range(a.pairs):

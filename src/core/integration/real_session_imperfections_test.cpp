@@ -115,6 +115,15 @@ TEST(RealSessionImperfectionsTest, SlowDriveAcceleration) {
   expectWithinOnePpm(calibrate("acceleration 0.02 rad/s^2", shortDualRate(0.4, 0.02)));
 }
 
+// Enabled when the plateau and estimator work lands: with 40 s ramps K0 comes out 2.2 ppm off (about
+// 60 reported sigmas); the independent generator (test/independent_session.py --acceleration 0.02)
+// shows the same 1.5 ppm, so it is the calibration's, not the simulator's.
+TEST(RealSessionImperfectionsTest, DISABLED_SlowDriveAccelerationLeavesK0Exact) {
+  const Measured m = calibrate("acceleration 0.02 rad/s^2, K0", shortDualRate(0.4, 0.02));
+  ASSERT_TRUE(m.accepted) << m.reason;
+  EXPECT_LE(std::abs(m.k0_ppm), 1.0);
+}
+
 TEST(RealSessionImperfectionsTest, LostMessagesAndGapsInBothStreams) {
   SimulationConfig c = shortDualRate();
   c.channels.drop_probability = 0.002;
