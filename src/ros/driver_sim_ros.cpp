@@ -111,7 +111,7 @@ void DriverSimRos::run() {
   schedule.start(wall_start.toSec());
   core::SimulationSample s;
   double next_clock = 0.0;
-  std::uint32_t seq = 0, table_seq = 0;
+  std::uint32_t seq = 0;
   while (!stop_ && ros::ok() && sim.next(&s)) {
     const ros::Time stamp = toRosTime(origin + s.stamp);
     double late = 0.0;
@@ -140,7 +140,8 @@ void DriverSimRos::run() {
         toChannelsMessage(s, stamp, static_cast<std::uint32_t>(s.index), frame_id_));
     if (s.channels_delivered) channels_pub_.publish(channels);
     for (const core::TurntableLogRecord& r : s.turntable) {
-      turntable_pub_.publish(boost::make_shared<TurntableState>(toTurntableMessage(r, origin, table_seq++, frame_id_)));
+      turntable_pub_.publish(boost::make_shared<TurntableState>(
+          toTurntableMessage(r, origin, static_cast<std::uint32_t>(r.index), frame_id_)));
     }
     if (truth_pub_.getNumSubscribers() > 0) {
       truth_pub_.publish(boost::make_shared<GroundTruth>(toTruthMessage(s, channels->header)));

@@ -64,6 +64,7 @@ TurntableLogger::TurntableLogger(const TurntableLogConfig& config, std::uint64_t
 void TurntableLogger::log(double t, Nanoseconds stamp, double angle, double rate,
                           std::vector<TurntableLogRecord>* out) {
   TurntableLogRecord r;
+  r.index = counters_.logged;
   r.time = t;
   r.stamp = stamp;
   r.angle = angle;

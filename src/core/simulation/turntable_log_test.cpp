@@ -231,6 +231,7 @@ TEST(TurntableLogTest, GlitchedRecordsOfEachKindByTheirRateAndSeed) {
     ++seen[static_cast<int>(r.glitch)];
   }
   EXPECT_EQ(seen, a.glitches);
+  for (std::size_t k = 0; k < r1.size(); ++k) EXPECT_EQ(r1[k].index, k);
 }
 
 TEST(TurntableLogTest, DefaultLogIsTheExactStateWithEverySample) {
@@ -244,6 +245,7 @@ TEST(TurntableLogTest, DefaultLogIsTheExactStateWithEverySample) {
     EXPECT_EQ(s.turntable[0].stamp, s.stamp);
     EXPECT_EQ(s.turntable[0].angle, s.truth.table_angle);
     EXPECT_EQ(s.turntable[0].rate, s.truth.table_rate);
+    EXPECT_EQ(s.turntable[0].index, s.index);  // the records' sequence is the samples'
   }
   EXPECT_EQ(sim.turntableLogCounters().lost, 0u);
 }

@@ -27,7 +27,7 @@ int runSimulate(const SimulateOptions& o) {
   core::GyroSimulator sim(config);
   Progress progress("simulate", sim.duration());
   core::SimulationSample s;
-  std::uint32_t seq = 0, table_seq = 0;
+  std::uint32_t seq = 0;
   while (sim.next(&s)) {
     const ros::Time stamp = toRosTime(s.stamp);
     // The channel sequence number is the sample's index, so a lost sample leaves a gap in it.
@@ -36,7 +36,7 @@ int runSimulate(const SimulateOptions& o) {
     // The table's records, recorded when they were made (a glitched stamp does not move them).
     for (const core::TurntableLogRecord& r : s.turntable) {
       bag.write("/turntable/state", toRosTime(core::toNanoseconds(config.start_time + r.time)),
-                toTurntableMessage(r, 0, table_seq++, o.frame_id));
+                toTurntableMessage(r, 0, static_cast<std::uint32_t>(r.index), o.frame_id));
     }
     if (truth) bag.write("/truth", stamp, toTruthMessage(s, ch.header));
     progress.update(sim.elapsed(), ++seq);

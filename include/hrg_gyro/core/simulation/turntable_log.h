@@ -54,10 +54,11 @@ struct TurntableLogConfig {
 };
 
 struct TurntableLogRecord {
-  double time = 0.0;      ///< true time of the record, s from the scenario start
-  Nanoseconds stamp = 0;  ///< as logged (a stamp glitch spoils it)
-  double angle = 0.0;     ///< rad, as logged
-  double rate = 0.0;      ///< rad/s, as logged
+  std::uint64_t index = 0;  ///< the controller's record count (a lost record leaves a gap in it)
+  double time = 0.0;        ///< true time of the record, s from the scenario start
+  Nanoseconds stamp = 0;    ///< as logged (a stamp glitch spoils it)
+  double angle = 0.0;       ///< rad, as logged
+  double rate = 0.0;        ///< rad/s, as logged
   TurntableGlitch glitch = TurntableGlitch::kNone;
 };
 
