@@ -64,11 +64,15 @@ ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::
   return m;
 }
 
-TurntableState toTurntableMessage(const core::SimulationSample& s, const std_msgs::Header& header) {
+TurntableState toTurntableMessage(const core::TurntableLogRecord& r, core::Nanoseconds origin, std::uint32_t seq,
+                                  const std::string& frame_id) {
   TurntableState m;
-  m.header = header;
-  m.angle = s.truth.table_angle;
-  m.rate = s.truth.table_rate;
+  m.header.seq = seq;
+  // A zero stamp is what a glitched controller sends, whatever the clock's origin.
+  m.header.stamp = r.stamp == 0 ? ros::Time() : toRosTime(origin + r.stamp);
+  m.header.frame_id = frame_id;
+  m.angle = r.angle;
+  m.rate = r.rate;
   return m;
 }
 

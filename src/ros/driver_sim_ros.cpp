@@ -20,7 +20,7 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   config_ = std::make_unique<core::SimulationConfig>(
       core::SimulationConfig::parse(core::YamlField(params, ""), core::nodeOnlyScenarioKeys()));
   // The scenario sections are the core parser's (it refuses unknown keys in them).
-  params_.claim({"seed", "start_time", "resonator", "pickoff", "turntable", "generator", "thermal"}, true);
+  params_.claim({"seed", "start_time", "resonator", "pickoff", "turntable", "generator", "thermal", "channels"}, true);
   time_scale_ = params_.get("time_scale", time_scale_);
   clock_period_ = params_.get("clock_period", clock_period_);
   max_lag_ = params_.get("max_lag", max_lag_);
@@ -135,9 +135,14 @@ void DriverSimRos::run() {
       clock_pub_.publish(c);
       next_clock = sim.elapsed() + clock_period_;
     }
-    auto channels = boost::make_shared<ChannelAmplitudes>(toChannelsMessage(s, stamp, seq, frame_id_));
-    channels_pub_.publish(channels);
-    turntable_pub_.publish(boost::make_shared<TurntableState>(toTurntableMessage(s, channels->header)));
+    // The sequence number is the sample's index, so a lost sample leaves a gap in it.
+    auto channels = boost::make_shared<ChannelAmplitudes>(
+        toChannelsMessage(s, stamp, static_cast<std::uint32_t>(s.index), frame_id_));
+    if (s.channels_delivered) channels_pub_.publish(channels);
+    for (const core::TurntableLogRecord& r : s.turntable) {
+      turntable_pub_.publish(boost::make_shared<TurntableState>(
+          toTurntableMessage(r, origin, static_cast<std::uint32_t>(r.index), frame_id_)));
+    }
     if (truth_pub_.getNumSubscribers() > 0) {
       truth_pub_.publish(boost::make_shared<GroundTruth>(toTruthMessage(s, channels->header)));
     }

@@ -37,7 +37,10 @@ GyroOutput toOutputMessage(const std_msgs::Header& header, const core::Processor
 // The messages of one simulated sample (driver_sim and `hrg_bag simulate`).
 ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::Time& stamp, std::uint32_t seq,
                                     const std::string& frame_id);
-TurntableState toTurntableMessage(const core::SimulationSample& s, const std_msgs::Header& header);
+/// A turntable record as the simulated table controller logged it; `origin` shifts its stamp (wall-clock playback), a
+/// zero stamp stays 0.
+TurntableState toTurntableMessage(const core::TurntableLogRecord& r, core::Nanoseconds origin, std::uint32_t seq,
+                                  const std::string& frame_id);
 GroundTruth toTruthMessage(const core::SimulationSample& s, const std_msgs::Header& header);
 
 HarmonicEstimate toMessage(const core::HarmonicFitResult& fit, double frequency);

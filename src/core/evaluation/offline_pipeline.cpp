@@ -17,11 +17,14 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
   SimulationSample s;
   while (sim.next(&s)) {
     if (s.truth.generator) {
+      if (!s.channels_delivered) continue;
       pairing.addRaw(s.stamp, s.z);
       pairing.addReference(s.stamp, {s.truth.amplitude, s.truth.quadrature, s.truth.theta, s.truth.phase});
       continue;
     }
-    session.addTurntable(s.stamp, s.truth.table_angle, s.truth.table_rate);
+    // What the table controller logged, not the truth.
+    for (const TurntableLogRecord& record : s.turntable) session.addTurntable(record.stamp, record.angle, record.rate);
+    if (!s.channels_delivered) continue;
     const ProcessorResult r = proc.process({s.stamp, s.z, s.frequency, s.temperature});
     if (r.has_wave)
       session.addWave(s.stamp, r.wave.theta, s.frequency, quadratureRatio(r.wave.quadrature, r.wave.amplitude));
@@ -47,6 +50,7 @@ std::vector<EvaluationResult> verifyOnSimulation(const SimulationConfig& scenari
   }
   SimulationSample s;
   while (sim.next(&s)) {
+    if (!s.channels_delivered) continue;
     for (std::size_t i = 0; i < processors.size(); ++i) {
       const ProcessorResult r = processors[i].process({s.stamp, s.z, s.frequency, s.temperature});
       if (!r.has_output) continue;

@@ -15,8 +15,31 @@ GyroSimulator::GyroSimulator(const SimulationConfig& config)
       frequency_(config_.resonator.frequency),
       amplitude_(config_.resonator.amplitude),
       earth_rate_(verticalEarthRate(config_.latitude)),
-      theta_(config_.resonator.initial_theta) {
+      theta_(config_.resonator.initial_theta),
+      logger_(config_.turntable_log, config_.seed),
+      channel_delivery_(config_.channels, config_.seed ^ 0x9b05688c2b3e6c1fULL) {
+  if (config_.ripple.amplitude > 0.0) {
+    config_.profile.setRipple(config_.ripple.amplitude, config_.ripple.frequency, config_.ripple.phase);
+  }
   if (config_.thermal.enabled) updateTemperature(0.0);
+}
+
+void GyroSimulator::logTurntable(double t_center, SimulationSample* out) {
+  out->turntable.clear();
+  out->channels_delivered = channel_delivery_.delivered(t_center);
+  const double log_rate = config_.turntable_log.rate;
+  if (log_rate == 0.0) {
+    // One record with the sample, stamped like it, from the sample's own truth.
+    logger_.log(t_center, out->stamp, out->truth.table_angle, out->truth.table_rate, &out->turntable);
+    return;
+  }
+  for (;; ++next_log_) {
+    const double t = static_cast<double>(next_log_) / log_rate;
+    if (t > t_center) break;
+    double angle, rate;
+    config_.profile.evaluate(t - generatorDuration(), &angle, &rate);
+    logger_.log(t, toNanoseconds(config_.start_time + t), angle, rate, &out->turntable);
+  }
 }
 
 void GyroSimulator::updateTemperature(double t) {
@@ -126,6 +149,7 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
   truth.frequency = frequency_;
   truth.temperature = temperature_;
   truth.generator = false;
+  logTurntable(t_center, out);
 }
 
 void GyroSimulator::nextGenerator(SimulationSample* out) {
@@ -163,6 +187,7 @@ void GyroSimulator::nextGenerator(SimulationSample* out) {
   truth.inertial_angle = earth_rate_ * 0.5 * (t_start + t_);
   truth.generator = true;
   truth.segment = &generator_label_;
+  logTurntable(0.5 * (t_start + t_), out);
   if (++generator_outputs_in_state_ >= per_state) {
     generator_outputs_in_state_ = 0;
     ++generator_state_;

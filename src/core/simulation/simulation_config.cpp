@@ -73,7 +73,7 @@ SimulationConfig atTemperature(const SimulationConfig& config, double temperatur
 SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
   root.requireMap();
   std::vector<std::string> allowed = {"seed",      "start_time", "resonator", "pickoff",
-                                      "turntable", "generator",  "thermal"};
+                                      "turntable", "generator",  "thermal",   "channels"};
   allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
   root.rejectUnknownKeys(allowed);
   SimulationConfig c;
@@ -149,12 +149,34 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
 
   if (root.has("turntable")) {
     const YamlField t = root["turntable"];
-    t.rejectUnknownKeys({"latitude", "acceleration", "profile"});
+    t.rejectUnknownKeys({"latitude", "acceleration", "profile", "ripple", "log"});
     c.latitude = t.getDouble("latitude", 0.0);
     if (std::abs(c.latitude) > kPi / 2) t["latitude"].fail("must be in [-pi/2, pi/2] rad");
     c.acceleration = t.getDouble("acceleration", c.acceleration);
     if (!(c.acceleration > 0.0)) t["acceleration"].fail("must be positive (rad/s^2)");
     if (t.has("profile")) c.profile = TurntableProfile::parse(t["profile"], c.acceleration);
+    if (t.has("ripple")) {
+      const YamlField r = t["ripple"];
+      r.requireMap();
+      r.rejectUnknownKeys({"amplitude", "frequency", "phase"});
+      c.ripple.amplitude = r.getDouble("amplitude", 0.0);
+      if (!(c.ripple.amplitude >= 0.0 && c.ripple.amplitude < 1.0)) {
+        r["amplitude"].fail("must be in [0, 1): a fraction of the commanded rate");
+      }
+      c.ripple.frequency = r.getDouble("frequency", 0.0);
+      if (c.ripple.amplitude > 0.0 && !(std::isfinite(c.ripple.frequency) && c.ripple.frequency > 0.0)) {
+        r["frequency"].fail("must be positive (Hz) when the ripple has an amplitude");
+      }
+      c.ripple.phase = r.getDouble("phase", 0.0);
+      if (!std::isfinite(c.ripple.phase)) r["phase"].fail("must be finite (rad)");
+    }
+    if (t.has("log")) c.turntable_log = TurntableLogConfig::parse(t["log"]);
+  }
+  if (root.has("channels")) {
+    const YamlField ch = root["channels"];
+    ch.requireMap();
+    ch.rejectUnknownKeys({"drop_probability", "gaps"});
+    c.channels = DeliveryConfig::parse(ch);
   }
   if (root.has("thermal")) {
     c.thermal = ThermalConfig::parse(root["thermal"]);

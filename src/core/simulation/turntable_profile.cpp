@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hrg_gyro/core/common/units.h"
+
 namespace hrg_gyro {
 namespace core {
 
@@ -19,6 +21,33 @@ void TurntableProfile::append(double duration, double rate0, double accel, const
   p.accel = accel;
   p.label = label;
   pieces_.push_back(p);
+  if (ripple_fraction_ != 0.0) updateRippleOrigins();
+}
+
+void TurntableProfile::setRipple(double fraction, double frequency, double phase) {
+  ripple_fraction_ = fraction;
+  ripple_frequency_ = frequency;
+  ripple_phase_ = phase;
+  updateRippleOrigins();
+}
+
+double TurntableProfile::rippleIntegral(const Piece& p, double tau) const {
+  // With u = w (start + s) + phi: the integral of (r0 + a s) sin(u) ds is
+  // -(r0 + a s) cos(u) / w + a sin(u) / w^2.
+  const double w = kTwoPi * ripple_frequency_;
+  auto primitive = [&](double s) {
+    const double u = w * (p.start + s) + ripple_phase_;
+    return -(p.rate0 + p.accel * s) * std::cos(u) / w + p.accel * std::sin(u) / (w * w);
+  };
+  return primitive(tau) - primitive(0.0);
+}
+
+void TurntableProfile::updateRippleOrigins() {
+  double sum = 0.0;
+  for (Piece& p : pieces_) {
+    p.ripple0 = sum;
+    if (ripple_fraction_ != 0.0) sum += rippleIntegral(p, p.duration);
+  }
 }
 
 double TurntableProfile::finalRate() const {
@@ -151,6 +180,13 @@ void TurntableProfile::evaluate(double t, double* angle, double* rate, const std
   *angle = p.angle0 + p.rate0 * tau + 0.5 * p.accel * tau * tau;
   *rate = p.rate0 + p.accel * tau;
   if (t > p.start + p.duration) *angle += *rate * (t - p.start - p.duration);  // hold after the end
+  if (ripple_fraction_ != 0.0) {
+    // The ripple stops where the profile ends (its last piece comes to rest when parsed).
+    *angle += ripple_fraction_ * (p.ripple0 + rippleIntegral(p, tau));
+    if (t <= p.start + p.duration) {
+      *rate *= 1.0 + ripple_fraction_ * std::sin(kTwoPi * ripple_frequency_ * (p.start + tau) + ripple_phase_);
+    }
+  }
   if (label) *label = &p.label;
 }
 

@@ -30,11 +30,16 @@ int runSimulate(const SimulateOptions& o) {
   std::uint32_t seq = 0;
   while (sim.next(&s)) {
     const ros::Time stamp = toRosTime(s.stamp);
-    const ChannelAmplitudes ch = toChannelsMessage(s, stamp, seq++, o.frame_id);
-    bag.write("/channels", stamp, ch);
-    bag.write("/turntable/state", stamp, toTurntableMessage(s, ch.header));
+    // The channel sequence number is the sample's index, so a lost sample leaves a gap in it.
+    const ChannelAmplitudes ch = toChannelsMessage(s, stamp, static_cast<std::uint32_t>(s.index), o.frame_id);
+    if (s.channels_delivered) bag.write("/channels", stamp, ch);
+    // The table's records, recorded when they were made (a glitched stamp does not move them).
+    for (const core::TurntableLogRecord& r : s.turntable) {
+      bag.write("/turntable/state", toRosTime(core::toNanoseconds(config.start_time + r.time)),
+                toTurntableMessage(r, 0, static_cast<std::uint32_t>(r.index), o.frame_id));
+    }
     if (truth) bag.write("/truth", stamp, toTruthMessage(s, ch.header));
-    progress.update(sim.elapsed(), seq);
+    progress.update(sim.elapsed(), ++seq);
   }
   bag.commit();
   progress.finish(seq);

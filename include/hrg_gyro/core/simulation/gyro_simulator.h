@@ -10,6 +10,12 @@
 // session starts with a known sweep of (theta, B, tau) at rest (for the correction-matrix fit), and
 // the turntable profile, if any, follows it.
 //
+// The turntable records are those the table controller logs (TurntableLogger): by default one per
+// output sample with its stamp and the exact table state, otherwise at the log rate with encoder
+// noise, quantisation, a differenced rate, losses and glitches. Channel samples may be lost too
+// (SimulationConfig::channels); a lost one is still simulated (its index counts, as a publisher's
+// sequence number does) but flagged not delivered. The truth is always the exact motion.
+//
 // With a thermal section (thermal_model.h) the temperature is evaluated at the centre of each
 // output window and held over it: the pickoff defects, the amplitude and the intrinsic K and D are
 // those of that temperature, and the sample reports T and f(T). Without one every sample reports
@@ -18,12 +24,15 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/model_pair_evaluator.h"
 #include "hrg_gyro/core/simulation/gaussian_noise.h"
 #include "hrg_gyro/core/simulation/signal_synthesizer.h"
 #include "hrg_gyro/core/simulation/simulation_config.h"
+#include "hrg_gyro/core/simulation/stream_delivery.h"
+#include "hrg_gyro/core/simulation/turntable_log.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -51,6 +60,10 @@ struct SimulationSample {
   double temperature = NAN;  ///< degC
   std::uint32_t periods = 0;
   TruthState truth;
+  /// False: this channel sample was lost on its way (consumers must not see it).
+  bool channels_delivered = true;
+  /// Turntable records logged since the previous sample, up to this one's stamp, in log order.
+  std::vector<TurntableLogRecord> turntable;
 };
 
 class GyroSimulator {
@@ -70,6 +83,9 @@ class GyroSimulator {
   /// The next output sample; false once the scenario is complete.
   bool next(SimulationSample* out);
 
+  /// What the table controller has logged so far (records made, lost, glitched).
+  const TurntableLogCounters& turntableLogCounters() const { return logger_.counters(); }
+
  private:
   double thetaRate(double t, double theta);
   void nextDynamic(SimulationSample* out);
@@ -79,6 +95,8 @@ class GyroSimulator {
   void stamp(double t_center, SimulationSample* out) const;
   /// Thermal scenarios: moves the gyro to the temperature at time t (s from the start).
   void updateTemperature(double t);
+  /// Fills out->turntable with the records logged up to the sample's centre time t_center.
+  void logTurntable(double t_center, SimulationSample* out);
 
   SimulationConfig config_;
   SignalSynthesizer synth_;
@@ -94,6 +112,9 @@ class GyroSimulator {
   double t_compensation_ = 0.0;
   double theta_;  // true electrical angle at t_
   std::uint64_t index_ = 0;
+  TurntableLogger logger_;
+  StreamDelivery channel_delivery_;
+  std::uint64_t next_log_ = 0;  // index of the next record at the turntable log rate
   std::uint64_t generator_state_ = 0;
   std::uint64_t generator_outputs_in_state_ = 0;
   std::string generator_label_ = "generator";

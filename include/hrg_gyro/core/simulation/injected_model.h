@@ -3,7 +3,7 @@
 // The processor measures theta~ = g(theta) through the pickoffs (and the correction P it applies),
 // so what it sees is d theta~ = g'(theta) [K(theta) (d alpha + Omega_E dt) + D(theta) dt]: the
 // effective models are K_eff(theta~) = g' K and D_eff(theta~) = g' D. g is measured noise free at
-// signal level on a fine grid of true angles, g' by central differences, and both effective models
+// signal level on a fine grid of true angles, g' by five-point central differences, and both effective models
 // are fitted with harmonics of theta~. This is the "injected" reference of the summaries and tests.
 #pragma once
 

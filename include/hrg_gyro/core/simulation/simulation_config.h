@@ -11,7 +11,9 @@
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/model/harmonic_model.h"
 #include "hrg_gyro/core/signal/pickoff_array.h"
+#include "hrg_gyro/core/simulation/stream_delivery.h"
 #include "hrg_gyro/core/simulation/temperature_dependence.h"
+#include "hrg_gyro/core/simulation/turntable_log.h"
 #include "hrg_gyro/core/simulation/turntable_profile.h"
 
 namespace hrg_gyro {
@@ -40,6 +42,14 @@ struct GeneratorConfig {
   double dwell = 0.05;                   ///< s per generator state
 };
 
+/// Speed ripple of the table drive (TurntableProfile::setRipple): the true rate is the commanded
+/// rate times 1 + amplitude sin(2 pi frequency t + phase). Off (amplitude 0) by default.
+struct TableRippleConfig {
+  double amplitude = 0.0;  ///< fraction of the commanded rate
+  double frequency = 0.0;  ///< Hz
+  double phase = 0.0;      ///< rad at the profile start
+};
+
 struct SimulationConfig {
   std::uint64_t seed = 1;
   double start_time = 1.0;  ///< s: stamp of the first instant (ROS treats time 0 as unset)
@@ -47,7 +57,10 @@ struct SimulationConfig {
   PickoffDefects pickoff;
   double latitude = 0.0;      ///< rad
   double acceleration = 0.5;  ///< rad/s^2 of the turntable
-  TurntableProfile profile;
+  TurntableProfile profile;   ///< commanded motion; the simulator adds `ripple` to it
+  TableRippleConfig ripple;
+  TurntableLogConfig turntable_log;  ///< what the table controller logs (default: the exact state)
+  DeliveryConfig channels;           ///< lost channel-amplitude samples (default: none)
   GeneratorConfig generator;
   ThermalConfig thermal;  ///< disabled unless the scenario has a thermal section
 

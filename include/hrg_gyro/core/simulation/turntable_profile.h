@@ -10,6 +10,11 @@
 //   piecewise  {points: [[t, rate], ...]}      rate linear between points (t from segment start)
 // Every segment may carry a `label` (ground truth reports it). Rate changes use
 // turntable.acceleration (rad/s^2).
+//
+// Optional drive ripple (turntable.ripple): the true rate is r(t) (1 + a sin(2 pi f t + phi)), a
+// fraction `a` of the commanded rate r(t), as a drive's speed ripple scales with its speed. The angle
+// holds its exact integral (closed form over each piece), so the gyro senses the ripple and a logged
+// table angle carries it; at rest there is none.
 #pragma once
 
 #include <string>
@@ -28,6 +33,7 @@ class TurntableProfile {
     double angle0 = 0.0;    ///< rad at start
     double rate0 = 0.0;     ///< rad/s at start
     double accel = 0.0;     ///< rad/s^2 during the piece
+    double ripple0 = 0.0;   ///< integral of r(t) sin(2 pi f t + phi) up to the piece start, rad
     std::string label;
   };
 
@@ -37,6 +43,12 @@ class TurntableProfile {
 
   /// Appends a piece (builders and tests).
   void append(double duration, double rate0, double accel, const std::string& label);
+
+  /// Drive ripple: `fraction` of the commanded rate at `frequency` Hz, phase `phase` rad at t = 0.
+  /// fraction 0 (the default): none, and the motion is exactly the commanded one.
+  void setRipple(double fraction, double frequency, double phase = 0.0);
+  double rippleFraction() const { return ripple_fraction_; }
+  double rippleFrequency() const { return ripple_frequency_; }
 
   double duration() const { return pieces_.empty() ? 0.0 : pieces_.back().start + pieces_.back().duration; }
   double finalRate() const;
@@ -49,8 +61,14 @@ class TurntableProfile {
   const Piece& pieceAt(double t) const;
   void rampTo(double target_rate, double acceleration, const std::string& label);
   void moveBy(double angle, double cruise_rate, double acceleration, const std::string& label);
+  /// Integral over [0, tau] of the piece's commanded rate times the ripple's sine.
+  double rippleIntegral(const Piece& p, double tau) const;
+  void updateRippleOrigins();
 
   std::vector<Piece> pieces_;
+  double ripple_fraction_ = 0.0;
+  double ripple_frequency_ = 0.0;   // Hz
+  double ripple_phase_ = 0.0;       // rad
   mutable std::size_t cursor_ = 0;  // evaluation is nearly always monotonic in t
 };
 

@@ -1,0 +1,94 @@
+// What the table controller logs of the true table motion, as a real controller does it: records at
+// its own log rate (or, by default, one with every output sample of the gyro, stamped like it), the
+// angle read through an encoder (white noise, quantisation to whole counts), the rate either the
+// drive's (true) rate or the logged angle differenced at the log rate, lost records (StreamDelivery),
+// and glitched records (a NaN or absurd rate, an infinite angle, a zero or backward stamp) at a
+// given rate per record. Each random effect draws from its own seeded stream, so a scenario gives
+// the same log run after run and switching one effect on leaves the others' draws unchanged.
+// Defaults: the exact table state, nothing lost, nothing glitched.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
+#include "hrg_gyro/core/simulation/stream_delivery.h"
+
+namespace hrg_gyro {
+namespace core {
+
+/// Where the logged rate comes from.
+enum class LoggedRate {
+  kTable,             ///< the drive's rate (the true table rate)
+  kDifferencedAngle,  ///< (logged angle - previous logged angle) / log period, stamped at the later one
+};
+
+/// The kinds of glitched record, in the order of TurntableGlitchRates.
+enum class TurntableGlitch { kNanRate, kAbsurdRate, kInfiniteAngle, kZeroStamp, kBackwardStamp, kNone };
+constexpr int kTurntableGlitchKinds = 5;
+
+/// Rate at which each kind of glitch replaces a record (a probability per record).
+struct TurntableGlitchRates {
+  std::array<double, kTurntableGlitchKinds> per_record{};  ///< indexed by TurntableGlitch
+  double total() const;
+};
+
+/// The rate an absurd-rate glitch reports (no table turns at 1000 rad/s), and how far back a
+/// backward-stamp glitch puts its stamp.
+constexpr double kAbsurdTableRate = 1000.0;  // rad/s
+constexpr double kBackwardStampJump = 0.5;   // s
+
+struct TurntableLogConfig {
+  double rate = 0.0;              ///< Hz; 0: one record with every output sample, at its stamp
+  double angle_noise = 0.0;       ///< rad, white noise of the logged angle
+  double angle_resolution = 0.0;  ///< rad per encoder count; 0: not quantised
+  LoggedRate logged_rate = LoggedRate::kTable;
+  DeliveryConfig delivery;  ///< lost records
+  TurntableGlitchRates glitches;
+
+  /// Parses turntable.log. Throws ConfigError naming the key.
+  static TurntableLogConfig parse(const YamlField& log);
+};
+
+struct TurntableLogRecord {
+  std::uint64_t index = 0;  ///< the controller's record count (a lost record leaves a gap in it)
+  double time = 0.0;        ///< true time of the record, s from the scenario start
+  Nanoseconds stamp = 0;    ///< as logged (a stamp glitch spoils it)
+  double angle = 0.0;       ///< rad, as logged
+  double rate = 0.0;        ///< rad/s, as logged
+  TurntableGlitch glitch = TurntableGlitch::kNone;
+};
+
+struct TurntableLogCounters {
+  std::uint64_t logged = 0;                                     ///< records the controller made
+  std::uint64_t lost = 0;                                       ///< of those, not delivered
+  std::array<std::uint64_t, kTurntableGlitchKinds> glitches{};  ///< delivered glitched records by kind
+};
+
+class TurntableLogger {
+ public:
+  TurntableLogger(const TurntableLogConfig& config, std::uint64_t seed);
+
+  const TurntableLogConfig& config() const { return config_; }
+  const TurntableLogCounters& counters() const { return counters_; }
+
+  /// Logs the true table state (angle rad, rate rad/s) of true time t (s from the scenario start,
+  /// stamp `stamp`): appends the record to `out` unless it is lost.
+  void log(double t, Nanoseconds stamp, double angle, double rate, std::vector<TurntableLogRecord>* out);
+
+ private:
+  TurntableLogConfig config_;
+  GaussianNoise encoder_noise_;
+  GaussianNoise glitch_draws_;
+  StreamDelivery delivery_;
+  bool has_previous_ = false;
+  double previous_time_ = 0.0;
+  double previous_angle_ = 0.0;  // as logged, before any glitch
+  TurntableLogCounters counters_;
+};
+
+}  // namespace core
+}  // namespace hrg_gyro
