@@ -4,9 +4,9 @@ own dynamics, channel model and table log, no truth topic) are calibrated by `hr
 the nominal prior, and the fitted K is compared with the injected one: the peak over theta of
 |K_fit - K_injected - (K0_fit - K0_injected)| and the K0 error, both <= 1 ppm of |K0|.
 
-test_moderate_nonlinearity_encoder_angle runs today. The three pending cases need the angle-based
-estimator (plateaus and body angle from the logged table angle, window smoothing corrected with the
-model); they are skipped unless HRG_GYRO_RUN_PENDING=1 and are enabled when that estimator lands."""
+Cases: the shipped gyro's magnitudes with an encoder-logged angle, a slow drive (40 s ramps), a
+strong nonlinearity (3 % cos 4theta, 0.3 % cos 8theta) and a real table log (strong nonlinearity,
+0.2 % drive ripple, the rate logged as the differenced encoder angle)."""
 import math
 import os
 import shutil
@@ -21,8 +21,6 @@ import yaml
 HRG_BAG = subprocess.check_output(["catkin_find", "--first-only", "--libexec", "hrg_gyro", "hrg_bag"],
                                   universal_newlines=True).strip()
 GENERATOR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "independent_session.py")
-PENDING = os.environ.get("HRG_GYRO_RUN_PENDING") == "1"
-PENDING_REASON = "enabled when the angle-based estimator lands (set HRG_GYRO_RUN_PENDING=1 to run it now)"
 
 
 def model(section):
@@ -74,7 +72,6 @@ class IndependentSession(unittest.TestCase):
         self.assertLessEqual(residual, 1.0)
         self.assertLessEqual(abs(k0_error), 1.0)
 
-    @unittest.skipUnless(PENDING, PENDING_REASON)
     def test_slow_drive(self):
         # As the moderate case with a drive limited to 0.02 rad/s^2 (40 s ramps).
         residual, k0_error = self.calibrate("slow_drive", "--cos4", "2e-3", "--cos8", "0", "--encoder-noise", "2e-6",
@@ -82,7 +79,6 @@ class IndependentSession(unittest.TestCase):
         self.assertLessEqual(residual, 1.0)
         self.assertLessEqual(abs(k0_error), 1.0)
 
-    @unittest.skipUnless(PENDING, PENDING_REASON)
     def test_strong_nonlinearity(self):
         # 3 % cos 4theta and 0.3 % cos 8theta in K, logs as above.
         residual, k0_error = self.calibrate("strong", "--cos4", "0.03", "--cos8", "0.003", "--encoder-noise", "2e-6",
@@ -90,7 +86,6 @@ class IndependentSession(unittest.TestCase):
         self.assertLessEqual(residual, 1.0)
         self.assertLessEqual(abs(k0_error), 1.0)
 
-    @unittest.skipUnless(PENDING, PENDING_REASON)
     def test_real_table_log(self):
         # Strong nonlinearity, 0.2 % drive ripple at 0.37 Hz, the rate logged as the encoder angle
         # differenced at 100 Hz.
