@@ -192,20 +192,31 @@ inline AngleIncrement GyroProcessor::reanchorIncrement(double theta, double dt, 
 
 ProcessorResult GyroProcessor::process(const ChannelSample& in) {
   ProcessorResult r;
+  process(in, &r);
+  return r;
+}
+
+void GyroProcessor::processBatch(const ChannelSample* in, std::size_t n, ProcessorResult* out) {
+  for (std::size_t i = 0; i < n; ++i) process(in[i], &out[i]);
+}
+
+void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
+  ProcessorResult& r = *result;
+  r = ProcessorResult();
   ++counters_.received;
   Nanoseconds dt_ns = 0;
-  if (!admitStamp(in.stamp, &dt_ns, &r)) return r;
+  if (!admitStamp(in.stamp, &dt_ns, &r)) return;
 
   WaveState wave;
   r.wave_status = estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &wave);
   if (r.wave_status != WaveStatus::kOk) {
     countRejection(r.wave_status);
     reject(SampleVerdict::kRejectedValue, &r);
-    return r;
+    return;
   }
   if (!has_previous_) {
     anchor(in, &wave, &r);
-    return r;
+    return;
   }
 
   const double dt = toSeconds(dt_ns);
@@ -215,7 +226,7 @@ ProcessorResult GyroProcessor::process(const ChannelSample& in) {
   bool integrate = true;
   if (!admitStep(dt, theta - previous_theta, &flags, &integrate)) {
     reject(SampleVerdict::kRejectedJump, &r);
-    return r;
+    return;
   }
   unwrapper_.unwrap(theta);
   wave.rebase(theta);
@@ -240,7 +251,6 @@ ProcessorResult GyroProcessor::process(const ChannelSample& in) {
   r.rejected_before = rejected_since_output_;
   rejected_since_output_ = 0;
   pending_flags_ = 0;
-  return r;
 }
 
 }  // namespace core
