@@ -94,6 +94,7 @@ void GyroProcessor::countRejection(WaveStatus status) {
 
 inline void GyroProcessor::reject(SampleVerdict verdict, ProcessorResult* r) {
   ++rejected_since_output_;
+  *r = ProcessorResult();
   r->verdict = verdict;
 }
 
@@ -136,6 +137,7 @@ inline void GyroProcessor::remember(const ChannelSample& in, const WaveState& wa
 inline void GyroProcessor::anchor(const ChannelSample& in, WaveState* wave, ProcessorResult* r) {
   wave->rebase(unwrapper_.unwrap(wave->theta));
   remember(in, *wave);
+  *r = ProcessorResult();
   r->verdict = SampleVerdict::kFirst;
   r->has_wave = true;
   r->wave = *wave;
@@ -201,17 +203,19 @@ void GyroProcessor::processBatch(const ChannelSample* in, std::size_t n, Process
 }
 
 void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
+  // Every path sets every field of *result: rejections and the first sample start from a default
+  // result, the accepted path (the hot one) writes each field itself.
   ProcessorResult& r = *result;
-  r = ProcessorResult();
   ++counters_.received;
   Nanoseconds dt_ns = 0;
   if (!admitStamp(in.stamp, &dt_ns, &r)) return;
 
   WaveState wave;
-  r.wave_status = estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &wave);
-  if (r.wave_status != WaveStatus::kOk) {
-    countRejection(r.wave_status);
+  const WaveStatus status = estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &wave);
+  if (status != WaveStatus::kOk) {
+    countRejection(status);
     reject(SampleVerdict::kRejectedValue, &r);
+    r.wave_status = status;
     return;
   }
   if (!has_previous_) {
@@ -221,7 +225,7 @@ void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
 
   const double dt = toSeconds(dt_ns);
   const double previous_theta = unwrapper_.last();
-  const double theta = wave.theta + kPi * std::round((previous_theta - wave.theta) / kPi);
+  const double theta = wave.theta + kPi * roundHalfAway((previous_theta - wave.theta) / kPi);
   std::uint8_t flags = pending_flags_;
   bool integrate = true;
   if (!admitStep(dt, theta - previous_theta, &flags, &integrate)) {
@@ -243,6 +247,7 @@ void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
   remember(in, wave);
   ++counters_.outputs;
   r.verdict = SampleVerdict::kAccepted;
+  r.wave_status = WaveStatus::kOk;
   r.has_wave = true;
   r.wave = wave;
   r.has_output = true;

@@ -24,16 +24,6 @@ const char* toString(WaveStatus status) {
   return "unknown";
 }
 
-void WaveState::rebase(double continuous_theta) {
-  const long long half_turns = std::llround((continuous_theta - theta) / kPi);
-  if (half_turns & 1) {
-    phase = wrapToPi(phase + kPi);
-    cos_theta = -cos_theta;
-    sin_theta = -sin_theta;
-  }
-  theta = continuous_theta;
-}
-
 WaveStatus estimateWave(const ChannelVector& z, const WaveLimits& limits, WaveState* state) {
   const double ac = z[kAc], bc = z[kBc], as = z[kAs], bs = z[kBs];
   const double e = ac * ac + bc * bc + as * as + bs * bs;
