@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 namespace hrg_gyro {
 namespace core {
 namespace {
@@ -24,6 +28,34 @@ TEST(GaussianNoiseTest, HasUnitNormalMoments) {
   EXPECT_NEAR(m2, 1.0, 5 * std::sqrt(2.0 / n));
   EXPECT_NEAR(m4, 3.0, 0.03);                // kurtosis of a normal
   EXPECT_NEAR(tail / n, 0.0026998, 0.0003);  // P(|x| > 3)
+}
+
+// The whole distribution, not only its moments: the empirical CDF against the normal CDF on a grid
+// finer than the ziggurat's narrowest strips near 0, and the frequency of the tail beyond the bottom
+// strip's edge r = 3.654 (drawn by its own method) and beyond 4.5.
+TEST(GaussianNoiseTest, FollowsTheNormalDistributionIncludingItsTails) {
+  GaussianNoise g(2026);
+  const int n = 4000000;
+  std::vector<double> x(n);
+  for (double& v : x) v = g.next();
+  std::sort(x.begin(), x.end());
+  auto normalCdf = [](double t) { return 0.5 * std::erfc(-t / std::sqrt(2.0)); };
+  for (int k = -80; k <= 80; ++k) {
+    const double t = 0.05 * k;
+    const double empirical = static_cast<double>(std::lower_bound(x.begin(), x.end(), t) - x.begin()) / n;
+    const double p = normalCdf(t);
+    EXPECT_NEAR(empirical, p, 5.0 * std::sqrt(p * (1.0 - p) / n) + 1e-7) << "at " << t;
+  }
+  auto countBeyond = [&](double t) {
+    return static_cast<double>((x.end() - std::upper_bound(x.begin(), x.end(), t)) +
+                               (std::lower_bound(x.begin(), x.end(), -t) - x.begin()));
+  };
+  for (double t : {3.6541528853610088, 4.5}) {
+    const double expected = n * std::erfc(t / std::sqrt(2.0));
+    EXPECT_NEAR(countBeyond(t), expected, 5.0 * std::sqrt(expected)) << "beyond " << t;
+  }
+  EXPECT_GT(x.back(), 4.5);
+  EXPECT_LT(x.front(), -4.5);
 }
 
 TEST(GaussianNoiseTest, IsReproducibleBySeed) {

@@ -35,6 +35,7 @@ class SignalSynthesizer {
   PickoffArray pickoffs_;
   SynchronousDemodulator demodulator_;
   GaussianNoise noise_;
+  double carrier_phase_ = 0.0, carrier_cos_ = 1.0, carrier_sin_ = 0.0;  // tau and its cos, sin
 };
 
 }  // namespace core
