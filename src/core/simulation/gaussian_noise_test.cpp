@@ -10,8 +10,13 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-TEST(GaussianNoiseTest, HasUnitNormalMoments) {
-  GaussianNoise g(123);
+// Both methods pass every test.
+class GaussianNoiseTest : public ::testing::TestWithParam<GaussianNoise::Method> {};
+INSTANTIATE_TEST_SUITE_P(Methods, GaussianNoiseTest,
+                         ::testing::Values(GaussianNoise::Method::kPolar, GaussianNoise::Method::kZiggurat));
+
+TEST_P(GaussianNoiseTest, HasUnitNormalMoments) {
+  GaussianNoise g(123, GetParam());
   const int n = 2000000;
   double m1 = 0, m2 = 0, m4 = 0, tail = 0;
   for (int i = 0; i < n; ++i) {
@@ -33,8 +38,8 @@ TEST(GaussianNoiseTest, HasUnitNormalMoments) {
 // The whole distribution, not only its moments: the empirical CDF against the normal CDF on a grid
 // finer than the ziggurat's narrowest strips near 0, and the frequency of the tail beyond the bottom
 // strip's edge r = 3.654 (drawn by its own method) and beyond 4.5.
-TEST(GaussianNoiseTest, FollowsTheNormalDistributionIncludingItsTails) {
-  GaussianNoise g(2026);
+TEST_P(GaussianNoiseTest, FollowsTheNormalDistributionIncludingItsTails) {
+  GaussianNoise g(2026, GetParam());
   const int n = 4000000;
   std::vector<double> x(n);
   for (double& v : x) v = g.next();
@@ -58,8 +63,8 @@ TEST(GaussianNoiseTest, FollowsTheNormalDistributionIncludingItsTails) {
   EXPECT_LT(x.front(), -4.5);
 }
 
-TEST(GaussianNoiseTest, IsReproducibleBySeed) {
-  GaussianNoise a(5), b(5), c(6);
+TEST_P(GaussianNoiseTest, IsReproducibleBySeed) {
+  GaussianNoise a(5, GetParam()), b(5, GetParam()), c(6, GetParam());
   bool differs = false;
   for (int i = 0; i < 1000; ++i) {
     const double x = a.next();
@@ -69,8 +74,8 @@ TEST(GaussianNoiseTest, IsReproducibleBySeed) {
   EXPECT_TRUE(differs);
 }
 
-TEST(GaussianNoiseTest, ConsecutiveValuesAreUncorrelated) {
-  GaussianNoise g(9);
+TEST_P(GaussianNoiseTest, ConsecutiveValuesAreUncorrelated) {
+  GaussianNoise g(9, GetParam());
   const int n = 500000;
   double prev = g.next(), sum = 0;
   for (int i = 0; i < n; ++i) {
@@ -79,6 +84,13 @@ TEST(GaussianNoiseTest, ConsecutiveValuesAreUncorrelated) {
     prev = x;
   }
   EXPECT_NEAR(sum / n, 0.0, 5 / std::sqrt(n));
+}
+
+TEST(GaussianNoiseMethodsTest, TheTwoMethodsAreDifferentStreamsFromOneSeed) {
+  GaussianNoise polar(5), ziggurat(5, GaussianNoise::Method::kZiggurat);
+  int equal = 0;
+  for (int i = 0; i < 1000; ++i) equal += polar.next() == ziggurat.next() ? 1 : 0;
+  EXPECT_LT(equal, 10);
 }
 
 }  // namespace

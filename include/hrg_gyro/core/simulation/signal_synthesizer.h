@@ -4,8 +4,8 @@
 // Within the period the wave angle moves linearly from the value at the period start to the value
 // at its end (A, B and tau are held); sample j is taken at t0 + (j + 1/2) T / N, carrier phase
 // 2 pi (j + 1/2) / N. Noise is drawn
-// per channel sample (see PickoffArray::channelNoiseSigma) from a seeded generator, so a run is
-// reproducible bit for bit.
+// per channel sample (see PickoffArray::channelNoiseSigma) from a seeded generator (the ziggurat
+// method), so a run is reproducible bit for bit.
 #pragma once
 
 #include <cstdint>
