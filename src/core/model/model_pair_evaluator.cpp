@@ -13,6 +13,12 @@ HarmonicBasis basisFor(const HarmonicModel& k, const HarmonicModel& d) {
   return step == 0 ? HarmonicBasis(1, 0) : HarmonicBasis(step, std::max(k.maxOrder(), d.maxOrder()));
 }
 
+std::vector<int> basisIndices(const HarmonicModel& model, const HarmonicBasis& basis) {
+  std::vector<int> indices;
+  for (int order : model.orders()) indices.push_back(order / basis.step());
+  return indices;
+}
+
 }  // namespace
 
 ModelPairEvaluator::ModelPairEvaluator(const HarmonicModel& k, const HarmonicModel& d)
@@ -21,6 +27,8 @@ ModelPairEvaluator::ModelPairEvaluator(const HarmonicModel& k, const HarmonicMod
       basis_(basisFor(k, d)),
       k_coefficients_(k.termCount()),
       d_coefficients_(d.termCount()),
+      k_indices_(basisIndices(k, basis_)),
+      d_indices_(basisIndices(d, basis_)),
       frequency_dependent_(k.frequencyDependent() || d.frequencyDependent()) {
   refresh(NAN);
 }

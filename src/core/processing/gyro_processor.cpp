@@ -94,6 +94,7 @@ void GyroProcessor::countRejection(WaveStatus status) {
 
 inline void GyroProcessor::reject(SampleVerdict verdict, ProcessorResult* r) {
   ++rejected_since_output_;
+  *r = ProcessorResult();
   r->verdict = verdict;
 }
 
@@ -136,6 +137,7 @@ inline void GyroProcessor::remember(const ChannelSample& in, const WaveState& wa
 inline void GyroProcessor::anchor(const ChannelSample& in, WaveState* wave, ProcessorResult* r) {
   wave->rebase(unwrapper_.unwrap(wave->theta));
   remember(in, *wave);
+  *r = ProcessorResult();
   r->verdict = SampleVerdict::kFirst;
   r->has_wave = true;
   r->wave = *wave;
@@ -192,30 +194,43 @@ inline AngleIncrement GyroProcessor::reanchorIncrement(double theta, double dt, 
 
 ProcessorResult GyroProcessor::process(const ChannelSample& in) {
   ProcessorResult r;
+  process(in, &r);
+  return r;
+}
+
+void GyroProcessor::processBatch(const ChannelSample* in, std::size_t n, ProcessorResult* out) {
+  for (std::size_t i = 0; i < n; ++i) process(in[i], &out[i]);
+}
+
+void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
+  // Every path sets every field of *result: rejections and the first sample start from a default
+  // result, the accepted path (the hot one) writes each field itself.
+  ProcessorResult& r = *result;
   ++counters_.received;
   Nanoseconds dt_ns = 0;
-  if (!admitStamp(in.stamp, &dt_ns, &r)) return r;
+  if (!admitStamp(in.stamp, &dt_ns, &r)) return;
 
   WaveState wave;
-  r.wave_status = estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &wave);
-  if (r.wave_status != WaveStatus::kOk) {
-    countRejection(r.wave_status);
+  const WaveStatus status = estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &wave);
+  if (status != WaveStatus::kOk) {
+    countRejection(status);
     reject(SampleVerdict::kRejectedValue, &r);
-    return r;
+    r.wave_status = status;
+    return;
   }
   if (!has_previous_) {
     anchor(in, &wave, &r);
-    return r;
+    return;
   }
 
   const double dt = toSeconds(dt_ns);
   const double previous_theta = unwrapper_.last();
-  const double theta = wave.theta + kPi * std::round((previous_theta - wave.theta) / kPi);
+  const double theta = wave.theta + kPi * roundHalfAway((previous_theta - wave.theta) / kPi);
   std::uint8_t flags = pending_flags_;
   bool integrate = true;
   if (!admitStep(dt, theta - previous_theta, &flags, &integrate)) {
     reject(SampleVerdict::kRejectedJump, &r);
-    return r;
+    return;
   }
   unwrapper_.unwrap(theta);
   wave.rebase(theta);
@@ -232,6 +247,7 @@ ProcessorResult GyroProcessor::process(const ChannelSample& in) {
   remember(in, wave);
   ++counters_.outputs;
   r.verdict = SampleVerdict::kAccepted;
+  r.wave_status = WaveStatus::kOk;
   r.has_wave = true;
   r.wave = wave;
   r.has_output = true;
@@ -240,7 +256,6 @@ ProcessorResult GyroProcessor::process(const ChannelSample& in) {
   r.rejected_before = rejected_since_output_;
   rejected_since_output_ = 0;
   pending_flags_ = 0;
-  return r;
 }
 
 }  // namespace core

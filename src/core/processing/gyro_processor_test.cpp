@@ -3,8 +3,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
 #include <limits>
+#include <random>
+#include <utility>
+#include <vector>
 
+#include "core/testing/faulty_channel_stream.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 
 namespace hrg_gyro {
@@ -275,6 +281,109 @@ TEST(ProcessorConfigTest, AcceptsTheDefaultsAndNamesTheKeyOfEachRefusal) {
     c.limits.min_anisotropy = bad;
     EXPECT_THROW(validate(c), ConfigError);
   }
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Every field of two results, bit for bit (NaN included).
+void expectIdentical(const ProcessorResult& a, const ProcessorResult& b, std::size_t i) {
+  ASSERT_EQ(a.verdict, b.verdict) << i;
+  ASSERT_EQ(a.wave_status, b.wave_status) << i;
+  ASSERT_EQ(a.has_wave, b.has_wave) << i;
+  ASSERT_EQ(a.has_output, b.has_output) << i;
+  ASSERT_EQ(a.flags, b.flags) << i;
+  ASSERT_EQ(a.rejected_before, b.rejected_before) << i;
+  const WaveState &w = a.wave, &v = b.wave;
+  for (auto [x, y] : {std::pair{w.theta, v.theta},
+                      {w.amplitude, v.amplitude},
+                      {w.quadrature, v.quadrature},
+                      {w.phase, v.phase},
+                      {w.energy, v.energy},
+                      {w.quadrature_product, v.quadrature_product},
+                      {w.cos_component, v.cos_component},
+                      {w.sin_component, v.sin_component},
+                      {w.phase_error, v.phase_error},
+                      {w.cos_theta, v.cos_theta},
+                      {w.sin_theta, v.sin_theta}}) {
+    ASSERT_TRUE(sameBits(x, y)) << i << ": wave " << x << " vs " << y;
+  }
+  const AngleIncrement &p = a.increment, &q = b.increment;
+  for (auto [x, y] : {std::pair{p.dt, q.dt},
+                      {p.dtheta, q.dtheta},
+                      {p.theta_mid, q.theta_mid},
+                      {p.frequency, q.frequency},
+                      {p.scale_factor, q.scale_factor},
+                      {p.drift, q.drift},
+                      {p.dalpha, q.dalpha},
+                      {p.dalpha_earth_fixed, q.dalpha_earth_fixed},
+                      {a.alpha, b.alpha}}) {
+    ASSERT_TRUE(sameBits(x, y)) << i << ": output " << x << " vs " << y;
+  }
+}
+
+std::shared_ptr<GyroParameters> batchTestParameters(double p3) {
+  auto p = std::make_shared<GyroParameters>();
+  Eigen::MatrixXd k(9, 3);
+  for (int j = 0; j < 3; ++j) {
+    k(0, j) = -0.56 * (1.0 + 1e-4 * j);
+    for (int i = 0; i < 4; ++i) {
+      k(1 + i, j) = 1e-4 / (i + 1) * (1.0 + 0.1 * j);
+      k(5 + i, j) = -0.5e-4 / (i + 1) * (1.0 - 0.1 * j);
+    }
+  }
+  p->scale_factor = HarmonicModel({2, 4, 6, 8}, FrequencyInterpolator({4990.0, 5000.0, 5010.0}), k);
+  p->drift = HarmonicModel({2, 4}, 1e-5, {2e-5, 1e-6}, {-1e-5, 0.0});
+  p->correction.p = {1e-3, -2e-3, p3, 0.5e-3};
+  return p;
+}
+
+// The batch entry point against one call per sample over a long stream with every kind of fault,
+// batches of random lengths and parameter reloads between batches: the same results bit for bit, the
+// same counters.
+TEST(GyroProcessorBatchTest, MatchesOneCallPerSampleBitForBit) {
+  const std::vector<ChannelSample> in = testing::faultyChannelStream(60000, 16);
+  GyroProcessor single(ProcessorConfig{}, batchTestParameters(1e-3));
+  GyroProcessor batch(ProcessorConfig{}, batchTestParameters(1e-3));
+  std::vector<ProcessorResult> out(in.size());
+  std::mt19937 lengths(7);
+  std::size_t begin = 0, reloads = 0;
+  while (begin < in.size()) {
+    const std::size_t n = std::min<std::size_t>(1 + lengths() % 400, in.size() - begin);
+    batch.processBatch(in.data() + begin, n, out.data() + begin);
+    for (std::size_t i = begin; i < begin + n; ++i) expectIdentical(single.process(in[i]), out[i], i);
+    if (::testing::Test::HasFatalFailure()) return;
+    begin += n;
+    if (lengths() % 8 == 0) {  // a reload: a new P and a new model on both
+      const auto reloaded = batchTestParameters(1e-3 * static_cast<double>(++reloads % 3));
+      single.setParameters(reloaded);
+      batch.setParameters(reloaded);
+    }
+  }
+  EXPECT_GT(reloads, 10u);
+  const ProcessorCounters &a = single.counters(), &b = batch.counters();
+  EXPECT_EQ(a.received, in.size());
+  EXPECT_EQ(a.accepted, b.accepted);
+  EXPECT_EQ(a.outputs, b.outputs);
+  EXPECT_EQ(a.rejected(), b.rejected());
+  EXPECT_EQ(a.gaps, b.gaps);
+  EXPECT_EQ(a.resets, b.resets);
+  EXPECT_EQ(a.frequency_unknown, b.frequency_unknown);
+  EXPECT_EQ(a.frequency_out_of_range, b.frequency_out_of_range);
+  // The stream really exercises every rule.
+  for (std::uint64_t count :
+       {a.non_finite, a.no_signal, a.degenerate, a.amplitude_out_of_range, a.zero_stamp, a.duplicate, a.out_of_order,
+        a.jumps, a.gaps, a.resets, a.frequency_unknown, a.frequency_out_of_range}) {
+    EXPECT_GT(count, 0u);
+  }
+  EXPECT_GT(a.outputs, in.size() / 2);
 }
 
 }  // namespace

@@ -6,13 +6,19 @@ namespace hrg_gyro {
 namespace core {
 
 SignalSynthesizer::SignalSynthesizer(const PickoffDefects& defects, int samples_per_period, std::uint64_t seed)
-    : pickoffs_(defects), demodulator_(samples_per_period), noise_(seed) {}
+    : pickoffs_(defects), demodulator_(samples_per_period), noise_(seed, GaussianNoise::Method::kZiggurat) {}
 
 ChannelVector SignalSynthesizer::period(const WaveParameters& wave, double theta_end) {
   const int n = demodulator_.samplesPerPeriod();
   const double sigma = pickoffs_.channelNoiseSigma();
   // Carrier: cos(2 pi j/N + tau) and sin(...) by rotating the reference table by tau.
-  const double ctau = std::cos(wave.phase), stau = std::sin(wave.phase);
+  // tau is held over long stretches: its sincos is kept from the last period while it is unchanged.
+  if (!(wave.phase == carrier_phase_)) {
+    carrier_phase_ = wave.phase;
+    carrier_cos_ = std::cos(wave.phase);
+    carrier_sin_ = std::sin(wave.phase);
+  }
+  const double ctau = carrier_cos_, stau = carrier_sin_;
   // Wave angle at the sample instants (j + 1/2) T / N: rotate (cos theta, sin theta) by a constant
   // step per sample, starting half a step into the period.
   const double step = (theta_end - wave.theta) / n;

@@ -25,6 +25,21 @@ inline Nanoseconds toNanoseconds(double seconds) { return static_cast<Nanosecond
 /// axis along the local up direction (REP-103 z up) sees at rest.
 inline double verticalEarthRate(double latitude) { return kEarthRotationRate * std::sin(latitude); }
 
+/// std::round (halves away from zero, sign of zero kept) without the library call: the per-sample
+/// path rounds angle ratios several times. Exact: x - trunc(x) has no rounding error; beyond 2^52
+/// (every such double is already an integer) and for NaN it defers to std::round.
+inline double roundHalfAway(double x) {
+  if (!(std::abs(x) < 0x1p52)) return std::round(x);
+  double t = static_cast<double>(static_cast<std::int64_t>(x));
+  const double fraction = x - t;
+  if (fraction >= 0.5) {
+    t += 1.0;
+  } else if (fraction <= -0.5) {
+    t -= 1.0;
+  }
+  return std::copysign(t, x);
+}
+
 /// x mod period, in [0, period).
 inline double positiveModulo(double x, double period) {
   double r = std::fmod(x, period);

@@ -26,6 +26,9 @@ class HarmonicBasis {
   /// k must be a multiple of step() in [0, maxOrder()].
   double cosOf(int k) const { return cos_[k / step_]; }
   double sinOf(int k) const { return sin_[k / step_]; }
+  /// By index m (order m step()): for callers that have converted their orders once.
+  double cosAt(int m) const { return cos_[m]; }
+  double sinAt(int m) const { return sin_[m]; }
 
  private:
   int step_;

@@ -24,25 +24,36 @@ class ModelPairEvaluator {
     const bool same = frequency == cached_frequency_ || (std::isnan(frequency) && cached_is_nan_);
     if (frequency_dependent_ && !same) refresh(frequency);
     basis_.evaluate(theta);
-    *k = k_->evaluate(basis_, k_coefficients_.data());
-    *d = d_->evaluate(basis_, d_coefficients_.data());
+    *k = sum(k_coefficients_.data(), k_indices_);
+    *d = sum(d_coefficients_.data(), d_indices_);
   }
   /// The same with c2 = cos 2 theta and s2 = sin 2 theta supplied (the per-sample path).
   void evaluate(double theta, double c2, double s2, double frequency, double* k, double* d) {
     const bool same = frequency == cached_frequency_ || (std::isnan(frequency) && cached_is_nan_);
     if (frequency_dependent_ && !same) refresh(frequency);
     basis_.evaluate(theta, c2, s2);
-    *k = k_->evaluate(basis_, k_coefficients_.data());
-    *d = d_->evaluate(basis_, d_coefficients_.data());
+    *k = sum(k_coefficients_.data(), k_indices_);
+    *d = sum(d_coefficients_.data(), d_indices_);
   }
 
  private:
   void refresh(double frequency);
+  /// HarmonicModel::evaluate with the orders already converted to basis indices (no integer division
+  /// per term), the same operations in the same order, so the same bits.
+  double sum(const double* coefficients, const std::vector<int>& indices) const {
+    double m = coefficients[0];
+    const std::size_t n = indices.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      m += coefficients[1 + i] * basis_.cosAt(indices[i]) + coefficients[1 + n + i] * basis_.sinAt(indices[i]);
+    }
+    return m;
+  }
 
   const HarmonicModel* k_;
   const HarmonicModel* d_;
   HarmonicBasis basis_;
   std::vector<double> k_coefficients_, d_coefficients_;
+  std::vector<int> k_indices_, d_indices_;  // basis index of each order
   bool frequency_dependent_;
   double cached_frequency_ = 0.0;
   bool cached_is_nan_ = false;

@@ -15,6 +15,7 @@
 // that is rejected reaches the integrated angle, and no output is ever NaN.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 
@@ -101,6 +102,13 @@ class GyroProcessor {
   const ProcessorConfig& config() const { return config_; }
 
   ProcessorResult process(const ChannelSample& sample);
+  /// The same step writing into a caller's result (every field is set, whatever the verdict): the
+  /// form to use in a loop, since it reuses the caller's storage.
+  void process(const ChannelSample& sample, ProcessorResult* result);
+  /// Processes n queued samples in order: out[i] is bit for bit what process(in[i]) would return,
+  /// counters and state included, so a batch can be split anywhere. For offline tools and for a
+  /// live node that drains a queue; in and out must not overlap.
+  void processBatch(const ChannelSample* in, std::size_t n, ProcessorResult* out);
 
   const ProcessorCounters& counters() const { return counters_; }
   /// Forgets the state (next sample is a first sample, alpha restarts at 0); counters are kept.

@@ -5,13 +5,20 @@
 // (at 1 kHz that is 1500 rad/s of electrical angle).
 #pragma once
 
+#include "hrg_gyro/core/common/units.h"
+
 namespace hrg_gyro {
 namespace core {
 
 class ThetaUnwrapper {
  public:
   /// Returns the continuous angle for a principal value (any branch of theta modulo pi).
-  double unwrap(double theta);
+  double unwrap(double theta) {
+    if (initialized_) theta += kPi * roundHalfAway((last_ - theta) / kPi);
+    initialized_ = true;
+    last_ = theta;
+    return theta;
+  }
   void reset() { initialized_ = false; }
   bool initialized() const { return initialized_; }
   double last() const { return last_; }

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 
+#include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/wave_parameters.h"
 
 namespace hrg_gyro {
@@ -47,7 +48,15 @@ struct WaveState {
 
   /// Moves theta to theta + n pi (as the unwrapper decides) and keeps the phase consistent with it:
   /// (A, theta + pi, tau + pi) is the same wave as (A, theta, tau).
-  void rebase(double continuous_theta);
+  void rebase(double continuous_theta) {
+    const double half_turns = roundHalfAway((continuous_theta - theta) / kPi);
+    if (std::abs(half_turns) < 0x1p62 && (static_cast<std::int64_t>(half_turns) & 1)) {
+      phase = wrapToPi(phase + kPi);
+      cos_theta = -cos_theta;
+      sin_theta = -sin_theta;
+    }
+    theta = continuous_theta;
+  }
 };
 
 /// Fills *state (when the status is kOk) from the channel amplitudes.

@@ -4,8 +4,8 @@
 // Within the period the wave angle moves linearly from the value at the period start to the value
 // at its end (A, B and tau are held); sample j is taken at t0 + (j + 1/2) T / N, carrier phase
 // 2 pi (j + 1/2) / N. Noise is drawn
-// per channel sample (see PickoffArray::channelNoiseSigma) from a seeded generator, so a run is
-// reproducible bit for bit.
+// per channel sample (see PickoffArray::channelNoiseSigma) from a seeded generator (the ziggurat
+// method), so a run is reproducible bit for bit.
 #pragma once
 
 #include <cstdint>
@@ -35,6 +35,7 @@ class SignalSynthesizer {
   PickoffArray pickoffs_;
   SynchronousDemodulator demodulator_;
   GaussianNoise noise_;
+  double carrier_phase_ = 0.0, carrier_cos_ = 1.0, carrier_sin_ = 0.0;  // tau and its cos, sin
 };
 
 }  // namespace core
