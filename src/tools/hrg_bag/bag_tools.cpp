@@ -21,6 +21,7 @@
 #include "hrg_gyro/core/common/output_directory.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "reused_message_reader.h"
 
 namespace hrg_gyro {
 namespace bag_tools {
@@ -277,17 +278,22 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
                              const std::string& progress_label) {
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   Progress progress(progress_label, view.size());
+  // One message, deserialised into again and again: no allocation per sample.
+  ReusedMessageReader<ChannelAmplitudes> reader;
+  ChannelAmplitudes msg;
   std::uint64_t n = 0;
   try {
     for (const rosbag::MessageInstance& m : view) {
-      const ChannelAmplitudes::ConstPtr msg = m.instantiate<ChannelAmplitudes>();
-      if (!msg) continue;
-      sink(*msg, processor.process(fromMessage(*msg)));
+      if (!reader.read(m, &msg)) continue;
+      sink(msg, processor.process(fromMessage(msg)));
       ++n;
-      progress.update(n, n);
+      if (n % 4096 == 0) progress.update(n, n);  // the clock read not on every sample
     }
   } catch (const rosbag::BagException& e) {
     throw UsageError(std::string("bag read error after ") + std::to_string(n) + " samples (truncated?): " + e.what());
+  } catch (const ros::serialization::StreamOverrunException& e) {
+    throw UsageError(std::string("bag read error after ") + std::to_string(n) +
+                     " samples: a message shorter than its type (corrupt?): " + e.what());
   }
   progress.finish(n);
   return n;
