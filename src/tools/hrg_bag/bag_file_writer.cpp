@@ -78,9 +78,11 @@ BagFileWriter::BagFileWriter(const std::string& path, Compression compression, s
   chunk_.reserve(chunk_threshold_ + (64u << 10));
   writeFile(kMagic, sizeof kMagic - 1);
   writeFileHeader(0);  // rewritten by close() with the index position
+  worker_ = std::make_unique<SerialWorker>();
 }
 
 BagFileWriter::~BagFileWriter() {
+  worker_.reset();  // no write may still be under way when the descriptor closes
   if (fd_ >= 0) ::close(fd_);
 }
 
@@ -150,17 +152,29 @@ void BagFileWriter::endMessage() {
 
 void BagFileWriter::flushChunk() {
   if (chunk_.empty()) return;
-  const std::uint8_t* data = chunk_.data();
-  std::size_t size = chunk_.size();
+  // The full chunk goes to the worker; a fresh buffer of the same size takes the next messages.
+  auto chunk = std::make_shared<std::vector<std::uint8_t>>(std::move(chunk_));
+  auto index = std::make_shared<std::vector<ChunkIndex>>(std::move(chunk_index_));
+  chunk_ = std::vector<std::uint8_t>();
+  chunk_.reserve(chunk_threshold_ + (64u << 10));
+  chunk_index_.clear();
+  const ros::Time start = chunk_start_, end = chunk_end_;
+  worker_->submit([this, chunk, index, start, end] { writeChunk(*chunk, *index, start, end); });
+}
+
+void BagFileWriter::writeChunk(const std::vector<std::uint8_t>& chunk, const std::vector<ChunkIndex>& chunk_index,
+                               const ros::Time& start, const ros::Time& end) {
+  const std::uint8_t* data = chunk.data();
+  std::size_t size = chunk.size();
   const char* compression = "none";
   if (compression_ == Compression::kLz4) {
     compression = "lz4";
-    compressed_.resize(chunk_.size() + chunk_.size() / 64 + 4096);
+    compressed_.resize(chunk.size() + chunk.size() / 64 + 4096);
     for (;;) {
       unsigned int out_size = static_cast<unsigned int>(compressed_.size());
-      const int result =
-          roslz4_buffToBuffCompress(reinterpret_cast<char*>(chunk_.data()), static_cast<unsigned int>(chunk_.size()),
-                                    reinterpret_cast<char*>(compressed_.data()), &out_size, kLz4BlockSizeId);
+      const int result = roslz4_buffToBuffCompress(
+          const_cast<char*>(reinterpret_cast<const char*>(chunk.data())), static_cast<unsigned int>(chunk.size()),
+          reinterpret_cast<char*>(compressed_.data()), &out_size, kLz4BlockSizeId);
       if (result == ROSLZ4_OK) {
         size = out_size;
         break;
@@ -171,30 +185,31 @@ void BagFileWriter::flushChunk() {
     data = compressed_.data();
   } else if (compression_ == Compression::kBz2) {
     compression = "bz2";
-    compressed_.resize(chunk_.size() + chunk_.size() / 100 + 4096);  // bzip2's documented worst case is +1 % + 600
+    compressed_.resize(chunk.size() + chunk.size() / 100 + 4096);  // bzip2's documented worst case is +1 % + 600
     unsigned int out_size = static_cast<unsigned int>(compressed_.size());
     if (BZ2_bzBuffToBuffCompress(reinterpret_cast<char*>(compressed_.data()), &out_size,
-                                 reinterpret_cast<char*>(chunk_.data()), static_cast<unsigned int>(chunk_.size()),
-                                 kBz2BlockSize100k, 0, kBz2WorkFactor) != BZ_OK) {
+                                 const_cast<char*>(reinterpret_cast<const char*>(chunk.data())),
+                                 static_cast<unsigned int>(chunk.size()), kBz2BlockSize100k, 0,
+                                 kBz2WorkFactor) != BZ_OK) {
       throw BagWriteError("cannot write " + path_ + ": BZ2 compression failed", 0);
     }
     size = out_size;
     data = compressed_.data();
   }
-  ChunkInfo info{file_position_, chunk_start_, chunk_end_, {}};
+  ChunkInfo info{file_position_, start, end, {}};
   scratch_.clear();
   Bytes out(&scratch_);
   const std::size_t header = out.beginLength();
   out.numberField("op", kOpChunk);
   out.textField("compression", compression);
-  out.numberField("size", static_cast<std::uint32_t>(chunk_.size()));
+  out.numberField("size", static_cast<std::uint32_t>(chunk.size()));
   out.endLength(header);
   out.number(static_cast<std::uint32_t>(size));
   writeFile(scratch_.data(), scratch_.size());
   writeFile(data, size);
   // The index data records of the chunk, one per connection, right after it.
   scratch_.clear();
-  for (const ChunkIndex& index : chunk_index_) {
+  for (const ChunkIndex& index : chunk_index) {
     const auto count = static_cast<std::uint32_t>(index.entries.size());
     const std::size_t index_header = out.beginLength();
     out.numberField("op", kOpIndexData);
@@ -211,12 +226,11 @@ void BagFileWriter::flushChunk() {
   }
   writeFile(scratch_.data(), scratch_.size());
   chunks_.push_back(std::move(info));
-  chunk_.clear();
-  chunk_index_.clear();
 }
 
 void BagFileWriter::close() {
   flushChunk();
+  worker_->finish();
   const std::uint64_t index_position = file_position_;
   scratch_.clear();
   Bytes out(&scratch_);

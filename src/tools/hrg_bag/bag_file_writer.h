@@ -2,8 +2,9 @@
 // chunks. rosbag::Bag::write seeks to the end of the file twice per message, and each seek of its
 // stdio stream costs a flush, a stat, a seek and a read: about six system calls per message, which
 // made writing the output bag of `hrg_bag process` ten times slower than reading its input. Here a
-// message is serialised straight into the chunk in memory (no allocation once the buffers have
-// grown), and the file sees one large write per chunk plus the index at the end.
+// message is serialised straight into the chunk in memory, and the file sees one large write per
+// chunk plus the index at the end. A full chunk is compressed and written by a background thread
+// (SerialWorker) while the next one fills.
 // Layout written: the file header record (padded to 4 KiB like rosbag's, rewritten on close), then
 // per chunk a chunk record (connection records of the connections it introduces, then the message
 // data records; none, LZ4 or BZ2 compressed) followed by its index data records, and at the end the
@@ -15,9 +16,12 @@
 #include <ros/time.h>
 
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "serial_worker.h"
 
 namespace hrg_gyro {
 namespace bag_tools {
@@ -78,6 +82,9 @@ class BagFileWriter {
   std::uint8_t* beginMessage(std::uint32_t connection, const ros::Time& time, std::uint32_t length);
   void endMessage();
   void flushChunk();
+  /// In the worker: compresses `chunk` and writes it and its index records.
+  void writeChunk(const std::vector<std::uint8_t>& chunk, const std::vector<ChunkIndex>& index, const ros::Time& start,
+                  const ros::Time& end);
   void writeFileHeader(std::uint64_t index_position);
   void writeFile(const void* data, std::size_t size);
   void seekFile(std::uint64_t position);
@@ -88,11 +95,14 @@ class BagFileWriter {
   std::uint32_t chunk_threshold_;
   std::uint64_t file_position_ = 0;
   std::vector<Connection> connections_;
-  std::size_t last_connection_ = 0;  // the connection of the previous write: looked at first
-  std::vector<std::uint8_t> chunk_, compressed_, scratch_;
+  std::size_t last_connection_ = 0;      // the connection of the previous write: looked at first
+  std::vector<std::uint8_t> chunk_;      // the open chunk, filled by write()
   std::vector<ChunkIndex> chunk_index_;  // the open chunk's messages, per connection
   ros::Time chunk_start_, chunk_end_;
+  // Used by the worker while it runs, by close() once it has finished.
+  std::vector<std::uint8_t> compressed_, scratch_;
   std::vector<ChunkInfo> chunks_;
+  std::unique_ptr<SerialWorker> worker_;  // stopped before the file is closed
 };
 
 }  // namespace bag_tools
