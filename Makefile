@@ -48,7 +48,7 @@ run: build
 figures: run
 	cd $(WS) && source devel/setup.bash && /usr/bin/python3 $(ROOT)/scripts/make_doc_figures.py
 
-# Benchmarks: Google Benchmark core suites, calibration, offline and live pipelines (about 12 min);
+# Benchmarks: Google Benchmark core suites, calibration, offline and live pipelines (about 15 min);
 # figures in bench_output/results.md. BENCH_ONLY=core,... selects parts (see bench/run_benchmarks.py).
 bench: build
 	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) hrg_gyro_benchmarks
