@@ -10,12 +10,14 @@
      from the node's diagnostics). The bags are simulated once into bench_output/ and reused;
   4. live: driver_sim -> processor at 1, 5 and 10 kHz, separate processes vs nodelets: drops,
      latency p50/p99/max, CPU per process (from /proc).
-Environment: BENCH_LIVE_SECONDS (default 60), BENCH_CAL_HOURS (default 24), BENCH_ONLY (comma list
+Environment: BENCH_LIVE_SECONDS (default 60), BENCH_CAL_HOURS (default 24), BENCH_OFFLINE_REPEATS
+(default 3, medians), BENCH_ONLY (comma list
 of core,calibration,offline,live)."""
 import json
 import os
 import random
 import re
+import resource
 import signal
 import subprocess
 import sys
@@ -121,12 +123,19 @@ def offline_bag(millions, duration):
 
 
 def timed(argv, pattern):
-    """Runs argv as a whole process; wall clock (startup and exit included) and the sample count it prints."""
-    t = time.time()
-    p = subprocess.run(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True, check=True)
-    wall = time.time() - t
-    m = re.search(pattern, p.stdout + p.stderr)
-    return int(m.group(1)), wall
+    """Runs argv as a whole process BENCH_OFFLINE_REPEATS times (default 3): the median wall clock
+    (startup and exit included), the median CPU time (user + system, steadier on a shared machine)
+    and the sample count it prints."""
+    walls, cpus = [], []
+    for _ in range(int(os.environ.get("BENCH_OFFLINE_REPEATS", "3"))):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        t = time.time()
+        p = subprocess.run(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True, check=True)
+        walls.append(time.time() - t)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpus.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+        n = int(re.search(pattern, p.stdout + p.stderr).group(1))
+    return n, sorted(walls)[len(walls) // 2], sorted(cpus)[len(cpus) // 2]
 
 
 def offline(results):
@@ -139,25 +148,26 @@ def offline(results):
         bag = offline_bag(millions, duration)
         size = {}
         for mode in ("reused", "instantiate", "view"):
-            n, wall = timed([floor_bin, bag, mode], r"floor \w+: (\d+) messages")
-            size["floor_" + mode] = {"samples": n, "wall_s": wall, "samples_per_s": n / wall}
-        floor_wall = size["floor_reused"]["wall_s"]
+            n, wall, cpu = timed([floor_bin, bag, mode], r"floor \w+: (\d+) messages")
+            size["floor_" + mode] = {"samples": n, "wall_s": wall, "cpu_s": cpu, "samples_per_s": n / wall}
+        floor_wall, floor_cpu = size["floor_reused"]["wall_s"], size["floor_reused"]["cpu_s"]
         for variant, args in (("dry", []),
                               ("csv", ["--csv", os.path.join(OUT, "offline_out.csv")]),
                               ("bag", ["--out", os.path.join(OUT, "offline_out.bag")]),
                               ("bag_uncompressed", ["--out", os.path.join(OUT, "offline_out.bag"), "--compression",
                                                     "none"])):
-            n, wall = timed([os.path.join(BIN, "hrg_bag"), "process", bag, "--params", params] + args,
-                            r"done, (\d+) samples")
-            size["process_" + variant] = {"samples": n, "wall_s": wall, "samples_per_s": n / wall,
-                                          "ratio_to_floor": wall / floor_wall}
+            n, wall, cpu = timed([os.path.join(BIN, "hrg_bag"), "process", bag, "--params", params] + args,
+                                 r"done, (\d+) samples")
+            size["process_" + variant] = {"samples": n, "wall_s": wall, "cpu_s": cpu, "samples_per_s": n / wall,
+                                          "ratio_to_floor": wall / floor_wall, "cpu_ratio_to_floor": cpu / floor_cpu}
         for name in ("offline_out.csv", "offline_out.bag"):  # gigabytes at 5 M samples
             if os.path.exists(os.path.join(OUT, name)):
                 os.remove(os.path.join(OUT, name))
         for k, v in sorted(size.items()):
-            log("  %d M %-26s %9.0f samples/s %7.2f s wall%s" % (
-                millions, k, v["samples_per_s"], v["wall_s"],
-                "  %.2fx the floor" % v["ratio_to_floor"] if "ratio_to_floor" in v else ""))
+            log("  %d M %-26s %9.0f samples/s %7.2f s wall %7.2f s CPU%s" % (
+                millions, k, v["samples_per_s"], v["wall_s"], v["cpu_s"],
+                "  %.2fx the floor (CPU %.2fx)" % (v["ratio_to_floor"], v["cpu_ratio_to_floor"])
+                if "ratio_to_floor" in v else ""))
         out["sizes"]["%dM" % millions] = size
     bag = offline_bag(*OFFLINE_SIZES[0])
     # The playback path: rosbag play --immediate into the processor node.
@@ -263,15 +273,17 @@ def markdown(results):
                  ("process_dry", "hrg_bag process (no output files)"), ("process_csv", "hrg_bag process --csv"),
                  ("process_bag", "hrg_bag process --out (LZ4)"),
                  ("process_bag_uncompressed", "hrg_bag process --out --compression none"))
-        lines += ["", "## Offline: hrg_bag process beside the floor (whole processes, wall clock)", "",
-                  "| path | " + " | ".join("%s samples/s | x floor" % k for k in o["sizes"]) + " |",
+        lines += ["", "## Offline: hrg_bag process beside the floor (whole processes, median of %s runs)" %
+                  os.environ.get("BENCH_OFFLINE_REPEATS", "3"), "",
+                  "Ratios: wall clock (and CPU time, user + system) over the reused-message floor's on the same bag.",
+                  "", "| path | " + " | ".join("%s samples/s | x floor (CPU)" % k for k in o["sizes"]) + " |",
                   "| --- |" + " --- | --- |" * len(o["sizes"])]
         for k, name in names:
             cells = []
             for size in o["sizes"].values():
                 r = size[k]
-                cells.append("%.0f | %s" % (r["samples_per_s"],
-                                             "%.2f" % r["ratio_to_floor"] if "ratio_to_floor" in r else "-"))
+                cells.append("%.0f | %s" % (r["samples_per_s"], "%.2f (%.2f)" % (
+                    r["ratio_to_floor"], r["cpu_ratio_to_floor"]) if "ratio_to_floor" in r else "-"))
             lines.append("| %s | %s |" % (name, " | ".join(cells)))
         lines += ["", "| path | samples/s | notes |", "| --- | --- | --- |"]
         p = o["playback"]
