@@ -4,16 +4,20 @@
   1. core suites (Google Benchmark, 5 repetitions, medians): demodulation, wave state, compensation
      with 0/4/8 harmonics and K(theta, f), the whole per-sample processor, fits, simulator RTF;
   2. calibration: 24 h of 1 kHz streams through the dual-rate session (time, peak RSS);
-  3. offline: `hrg_bag process` on a 1 M-sample bag vs `rosbag play --immediate` of the same bag
-     into the processor node (processed and dropped counted from the node's diagnostics);
+  3. offline: `hrg_bag process` (no output, --csv, --out) on bags of 1 M and 5 M samples beside its floor,
+     hrg_gyro_bag_read_floor reading the same bag and nothing else (whole processes, wall clock, ratio);
+     `rosbag play --immediate` of the 1 M bag into the processor node (processed and dropped counted
+     from the node's diagnostics). The bags are simulated once into bench_output/ and reused;
   4. live: driver_sim -> processor at 1, 5 and 10 kHz, separate processes vs nodelets: drops,
      latency p50/p99/max, CPU per process (from /proc).
-Environment: BENCH_LIVE_SECONDS (default 60), BENCH_CAL_HOURS (default 24), BENCH_ONLY (comma list
+Environment: BENCH_LIVE_SECONDS (default 60), BENCH_CAL_HOURS (default 24), BENCH_OFFLINE_REPEATS
+(default 3, medians), BENCH_ONLY (comma list
 of core,calibration,offline,live)."""
 import json
 import os
 import random
 import re
+import resource
 import signal
 import subprocess
 import sys
@@ -89,26 +93,83 @@ def process_cpu(patterns):
     return {name: ticks for name, (_, ticks) in proc_stats.scan(patterns).items()}
 
 
-def offline(results):
-    bag = os.path.join(OUT, "offline_1M.bag")
-    params = os.path.join(ROOT, "config", "params_uncalibrated.yaml")
-    log("offline: simulating a 1 M-sample bag")
-    subprocess.run([os.path.join(BIN, "hrg_bag"), "simulate", "--scenario", os.path.join(ROOT, "bench",
-                    "offline_scenario.yaml"), "--out", bag], check=True, stderr=subprocess.PIPE)
-    out = {}
-    for variant, args in (("dry", []),
-                          ("csv", ["--csv", os.path.join(OUT, "offline_out.csv")]),
-                          ("bag", ["--out", os.path.join(OUT, "offline_out.bag")]),
-                          ("bag_uncompressed", ["--out", os.path.join(OUT, "offline_out.bag"), "--compression",
-                                                "none"])):
+OFFLINE_SIZES = ((1, "1000.0"), (5, "5000.0"))  # millions of samples, session seconds at 1 kHz
+
+
+def offline_bag(millions, duration):
+    """The offline scenario simulated for `duration` s (millions of 1 kHz samples), built once: the bag is
+    reused while the scenario text it was made from is unchanged (the 5 M bag takes a minute or more;
+    delete bench_output/offline_*.bag to simulate them again)."""
+    with open(os.path.join(ROOT, "bench", "offline_scenario.yaml")) as f:
+        scenario = f.read()
+    if "duration: 1000.0" not in scenario:
+        raise RuntimeError("bench/offline_scenario.yaml: its profile must say 'duration: 1000.0'")
+    scenario = scenario.replace("duration: 1000.0", "duration: " + duration)
+    bag = os.path.join(OUT, "offline_%dM.bag" % millions)
+    recipe = bag + ".scenario.yaml"
+    if os.path.exists(bag) and os.path.exists(recipe):
+        with open(recipe) as f:
+            if f.read() == scenario:
+                log("offline: reusing %s" % bag)
+                return bag
+    log("offline: simulating a %d M-sample bag (once; reused by later runs)" % millions)
+    with open(recipe, "w") as f:
+        f.write(scenario)
+    t = time.time()
+    subprocess.run([os.path.join(BIN, "hrg_bag"), "simulate", "--scenario", recipe, "--out", bag, "--no-truth"],
+                   check=True, stderr=subprocess.PIPE)
+    log("  simulated in %.0f s" % (time.time() - t))
+    return bag
+
+
+def timed(argv, pattern):
+    """Runs argv as a whole process BENCH_OFFLINE_REPEATS times (default 3): the median wall clock
+    (startup and exit included), the median CPU time (user + system, steadier on a shared machine)
+    and the sample count it prints."""
+    walls, cpus = [], []
+    for _ in range(int(os.environ.get("BENCH_OFFLINE_REPEATS", "3"))):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t = time.time()
-        p = subprocess.run([os.path.join(BIN, "hrg_bag"), "process", bag, "--params", params] + args,
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True, check=True)
-        wall = time.time() - t
-        m = re.search(r"done, (\d+) samples in ([0-9.]+) s", p.stderr)
-        out["process_" + variant] = {"samples": int(m.group(1)), "loop_s": float(m.group(2)), "wall_s": wall,
-                                     "samples_per_s": int(m.group(1)) / wall}
-        log("  hrg_bag process (%s): %.0f samples/s" % (variant, int(m.group(1)) / wall))
+        p = subprocess.run(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True, check=True)
+        walls.append(time.time() - t)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpus.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+        n = int(re.search(pattern, p.stdout + p.stderr).group(1))
+    return n, sorted(walls)[len(walls) // 2], sorted(cpus)[len(cpus) // 2]
+
+
+def offline(results):
+    """hrg_bag process beside its floor (reading the same bag and nothing else), side by side on 1 M and
+    5 M samples: samples/s as whole processes and the ratio of the wall clocks to the floor's."""
+    params = os.path.join(ROOT, "config", "params_uncalibrated.yaml")
+    floor_bin = os.path.join(BIN, "hrg_gyro_bag_read_floor")
+    out = {"sizes": {}}
+    for millions, duration in OFFLINE_SIZES:
+        bag = offline_bag(millions, duration)
+        size = {}
+        for mode in ("reused", "instantiate", "view"):
+            n, wall, cpu = timed([floor_bin, bag, mode], r"floor \w+: (\d+) messages")
+            size["floor_" + mode] = {"samples": n, "wall_s": wall, "cpu_s": cpu, "samples_per_s": n / wall}
+        floor_wall, floor_cpu = size["floor_reused"]["wall_s"], size["floor_reused"]["cpu_s"]
+        for variant, args in (("dry", []),
+                              ("csv", ["--csv", os.path.join(OUT, "offline_out.csv")]),
+                              ("bag", ["--out", os.path.join(OUT, "offline_out.bag")]),
+                              ("bag_uncompressed", ["--out", os.path.join(OUT, "offline_out.bag"), "--compression",
+                                                    "none"])):
+            n, wall, cpu = timed([os.path.join(BIN, "hrg_bag"), "process", bag, "--params", params] + args,
+                                 r"done, (\d+) samples")
+            size["process_" + variant] = {"samples": n, "wall_s": wall, "cpu_s": cpu, "samples_per_s": n / wall,
+                                          "ratio_to_floor": wall / floor_wall, "cpu_ratio_to_floor": cpu / floor_cpu}
+        for name in ("offline_out.csv", "offline_out.bag"):  # gigabytes at 5 M samples
+            if os.path.exists(os.path.join(OUT, name)):
+                os.remove(os.path.join(OUT, name))
+        for k, v in sorted(size.items()):
+            log("  %d M %-26s %9.0f samples/s %7.2f s wall %7.2f s CPU%s" % (
+                millions, k, v["samples_per_s"], v["wall_s"], v["cpu_s"],
+                "  %.2fx the floor (CPU %.2fx)" % (v["ratio_to_floor"], v["cpu_ratio_to_floor"])
+                if "ratio_to_floor" in v else ""))
+        out["sizes"]["%dM" % millions] = size
+    bag = offline_bag(*OFFLINE_SIZES[0])
     # The playback path: rosbag play --immediate into the processor node.
     log("offline: rosbag play --immediate into the processor node")
     master = Master()
@@ -145,7 +206,7 @@ def offline(results):
         os.killpg(launch.pid, signal.SIGINT)
         launch.wait(timeout=30)
     processed = seen["received"]
-    total = out["process_dry"]["samples"]
+    total = out["sizes"]["1M"]["process_dry"]["samples"]
     out["playback"] = {"published": total, "processed": processed, "dropped": total - processed,
                        "play_wall_s": play_wall, "processed_per_s": processed / play_wall}
     log("  playback: %d of %d processed in %.1f s" % (processed, total, play_wall))
@@ -206,13 +267,25 @@ def markdown(results):
         lines += ["", "## Calibration", "", "```", results["calibration"]["output"].rstrip(), "```"]
     if "offline" in results:
         o = results["offline"]
-        lines += ["", "## Offline: 1 M samples", "", "| path | samples/s | notes |", "| --- | --- | --- |"]
-        names = {"process_dry": "hrg_bag process (no output files)", "process_csv": "hrg_bag process --csv",
-                 "process_bag": "hrg_bag process --out (LZ4)",
-                 "process_bag_uncompressed": "hrg_bag process --out --compression none"}
-        for k, name in names.items():
-            lines.append("| %s | %.0f | %d samples in %.2f s wall |" % (
-                name, o[k]["samples_per_s"], o[k]["samples"], o[k]["wall_s"]))
+        names = (("floor_reused", "floor: rosbag::View, deserialised into a reused message"),
+                 ("floor_instantiate", "floor: rosbag::View, MessageInstance::instantiate"),
+                 ("floor_view", "rosbag::View iteration alone (no message data)"),
+                 ("process_dry", "hrg_bag process (no output files)"), ("process_csv", "hrg_bag process --csv"),
+                 ("process_bag", "hrg_bag process --out (LZ4)"),
+                 ("process_bag_uncompressed", "hrg_bag process --out --compression none"))
+        lines += ["", "## Offline: hrg_bag process beside the floor (whole processes, median of %s runs)" %
+                  os.environ.get("BENCH_OFFLINE_REPEATS", "3"), "",
+                  "Ratios: wall clock (and CPU time, user + system) over the reused-message floor's on the same bag.",
+                  "", "| path | " + " | ".join("%s samples/s | x floor (CPU)" % k for k in o["sizes"]) + " |",
+                  "| --- |" + " --- | --- |" * len(o["sizes"])]
+        for k, name in names:
+            cells = []
+            for size in o["sizes"].values():
+                r = size[k]
+                cells.append("%.0f | %s" % (r["samples_per_s"], "%.2f (%.2f)" % (
+                    r["ratio_to_floor"], r["cpu_ratio_to_floor"]) if "ratio_to_floor" in r else "-"))
+            lines.append("| %s | %s |" % (name, " | ".join(cells)))
+        lines += ["", "| path | samples/s | notes |", "| --- | --- | --- |"]
         p = o["playback"]
         lines.append("| rosbag play --immediate -> processor node | %.0f | %d processed, %d dropped of %d, %.1f s |" % (
             p["processed_per_s"], p["processed"], p["dropped"], p["published"], p["play_wall_s"]))

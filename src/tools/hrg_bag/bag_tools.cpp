@@ -21,6 +21,7 @@
 #include "hrg_gyro/core/common/output_directory.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "reused_message_reader.h"
 
 namespace hrg_gyro {
 namespace bag_tools {
@@ -38,10 +39,10 @@ void addCompressionOption(CLI::App& command, std::string* compression) {
 
 namespace {
 
-rosbag::compression::CompressionType compressionType(const std::string& name) {
-  if (name == "none") return rosbag::compression::Uncompressed;
-  if (name == "lz4") return rosbag::compression::LZ4;
-  if (name == "bz2") return rosbag::compression::BZ2;
+BagFileWriter::Compression compressionType(const std::string& name) {
+  if (name == "none") return BagFileWriter::Compression::kNone;
+  if (name == "lz4") return BagFileWriter::Compression::kLz4;
+  if (name == "bz2") return BagFileWriter::Compression::kBz2;
   throw UsageError("--compression must be none, lz4 or bz2, got '" + name + "'");
 }
 
@@ -79,32 +80,22 @@ void checkOutputPaths(const std::vector<std::string>& inputs, const std::vector<
 }
 
 OutputBag::OutputBag(const std::string& path, const std::string& compression) : path_(path) {
-  const rosbag::compression::CompressionType type = compressionType(compression);
+  const BagFileWriter::Compression type = compressionType(compression);
   openOutput(&file_, path);
-  bag_ = std::make_unique<rosbag::Bag>();
   try {
-    // rosbag truncates and rewrites the temporary in place; file_ renames it on commit.
-    bag_->open(file_->temporaryPath(), rosbag::bagmode::Write);
-    bag_->setCompression(type);
-  } catch (const rosbag::BagException& e) {
-    failed(e.what(), errno);
+    // The writer truncates and rewrites the temporary in place; file_ renames it on commit.
+    bag_ = std::make_unique<BagFileWriter>(file_->temporaryPath(), type);
+  } catch (const BagWriteError& e) {
+    failed(e.what(), e.error);
   }
 }
 
 OutputBag::~OutputBag() { abandon(); }
 
-void OutputBag::abandon() noexcept {
-  if (!bag_) return;
-  try {
-    bag_->close();
-    bag_.reset();
-  } catch (...) {
-    (void)bag_.release();  // see the header: its destructor would throw again
-  }
-}
+void OutputBag::abandon() noexcept { bag_.reset(); }
 
 void OutputBag::failed(const std::string& why, int error) {
-  // rosbag reports a short write without its reason; a full file system is the usual one.
+  // A full file system is the usual reason of a failed write; say it even when errno was lost.
   std::string reason = why;
   struct statvfs fs {};
   const bool nearly_full = ::statvfs(core::directoryOf(file_->targetPath()).c_str(), &fs) == 0 &&
@@ -124,8 +115,8 @@ void OutputBag::commit() {
   try {
     bag_->close();  // writes the index; a full disk shows here at the latest
     bag_.reset();
-  } catch (const rosbag::BagException& e) {
-    failed(e.what(), errno);
+  } catch (const BagWriteError& e) {
+    failed(e.what(), e.error);
   }
   try {
     file_->commit();
@@ -277,17 +268,22 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
                              const std::string& progress_label) {
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   Progress progress(progress_label, view.size());
+  // One message, deserialised into again and again: no allocation per sample.
+  ReusedMessageReader<ChannelAmplitudes> reader;
+  ChannelAmplitudes msg;
   std::uint64_t n = 0;
   try {
     for (const rosbag::MessageInstance& m : view) {
-      const ChannelAmplitudes::ConstPtr msg = m.instantiate<ChannelAmplitudes>();
-      if (!msg) continue;
-      sink(*msg, processor.process(fromMessage(*msg)));
+      if (!reader.read(m, &msg)) continue;
+      sink(msg, processor.process(fromMessage(msg)));
       ++n;
-      progress.update(n, n);
+      if (n % 4096 == 0) progress.update(n, n);  // the clock read not on every sample
     }
   } catch (const rosbag::BagException& e) {
     throw UsageError(std::string("bag read error after ") + std::to_string(n) + " samples (truncated?): " + e.what());
+  } catch (const ros::serialization::StreamOverrunException& e) {
+    throw UsageError(std::string("bag read error after ") + std::to_string(n) +
+                     " samples: a message shorter than its type (corrupt?): " + e.what());
   }
   progress.finish(n);
   return n;

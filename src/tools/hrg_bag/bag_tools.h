@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "bag_file_writer.h"
 #include "hrg_gyro/ChannelAmplitudes.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
@@ -96,10 +97,11 @@ void addCompressionOption(CLI::App& command, std::string* compression);
 /// directory). Empty paths (options not given) are skipped.
 void checkOutputPaths(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
 
-/// A bag written whole or not at all: the rosbag::Bag writes a temporary beside `path`
-/// (core::AtomicOutputFile), and commit() closes it and renames it over `path`. Every rosbag error
-/// while writing or closing becomes an OutputError naming `path`. Destroyed without a commit (an
-/// error, a refusal), the temporary is removed and `path` is left as it was.
+/// A bag written whole or not at all: a BagFileWriter (whole chunks, no per-message system call)
+/// writes a temporary beside `path` (core::AtomicOutputFile), and commit() closes it and renames it
+/// over `path`. Every error while writing or closing becomes an OutputError naming `path`.
+/// Destroyed without a commit (an error, a refusal), the temporary is removed and `path` is left as
+/// it was.
 class OutputBag {
  public:
   OutputBag(const std::string& path, const std::string& compression);
@@ -111,8 +113,8 @@ class OutputBag {
   void write(const std::string& topic, const ros::Time& time, const Message& message) {
     try {
       bag_->write(topic, time, message);
-    } catch (const rosbag::BagException& e) {
-      failed(e.what(), errno);
+    } catch (const BagWriteError& e) {
+      failed(e.what(), e.error);
     }
   }
   void commit();
@@ -120,14 +122,12 @@ class OutputBag {
  private:
   /// `error`: errno right after the failure (rosbag's messages do not say why a write failed).
   [[noreturn]] void failed(const std::string& why, int error);
-  /// Closes the bag after a failure, swallowing its errors. A bag whose close fails is left
-  /// unclosed on purpose: rosbag::Bag's destructor would retry the close, and an exception
-  /// escaping a destructor ends the process with a signal instead of an exit code.
+  /// Drops the bag after a failure (its file descriptor closed, nothing more written).
   void abandon() noexcept;
 
   std::string path_;
   std::unique_ptr<core::AtomicOutputFile> file_;
-  std::unique_ptr<rosbag::Bag> bag_;
+  std::unique_ptr<BagFileWriter> bag_;
 };
 
 /// A text output (CSV, report) written whole or not at all, like OutputBag.

@@ -9,6 +9,7 @@
 #include "bag_tools.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "serial_worker.h"
 
 namespace hrg_gyro {
 namespace {
@@ -33,45 +34,132 @@ const char* verdictName(const core::ProcessorResult& r) {
   return "unknown";
 }
 
-// One CSV row. Numbers in the shortest form that reads back to the same double (std::to_chars),
-// several times faster than printf's %.17g and just as exact.
-class CsvRow {
+// CSV text, appended to one large buffer that is written out in pieces of about a megabyte (no
+// per-row stream call, no flush). Numbers in the shortest form that reads back to the same double
+// (std::to_chars), several times faster than printf's %.17g and just as exact.
+class CsvText {
  public:
-  void clear() { line_.clear(); }
+  explicit CsvText(std::ostream& out) : out_(out) { text_.reserve(kFlushSize + 4096); }
   void number(double v, bool present = true) {
     separator();
-    if (!present) return;
-    char buf[32];
-    line_.append(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
+    if (present) append(std::to_chars(scratch_, scratch_ + sizeof scratch_, v).ptr);
   }
   void integer(std::uint64_t v) {
     separator();
-    char buf[24];
-    line_.append(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
+    append(std::to_chars(scratch_, scratch_ + sizeof scratch_, v).ptr);
   }
+  /// sec.nsec with nine digits after the point, as printf's "%u.%09u".
   void stamp(std::uint32_t sec, std::uint32_t nsec) {
     separator();
-    char buf[24];
-    std::snprintf(buf, sizeof buf, "%u.%09u", sec, nsec);
-    line_ += buf;
+    if (nsec >= 1000000000u) {  // not normalised: printf's own form, as many digits as it takes
+      append(scratch_ + std::snprintf(scratch_, sizeof scratch_, "%u.%09u", sec, nsec));
+      return;
+    }
+    char* end = std::to_chars(scratch_, scratch_ + sizeof scratch_, sec).ptr;
+    *end++ = '.';
+    for (int digit = 8; digit >= 0; --digit, nsec /= 10) end[digit] = static_cast<char>('0' + nsec % 10);
+    append(end + 9);
   }
   void text(const char* t) {
     separator();
-    line_ += t;
+    text_ += t;
   }
-  void end() {
-    line_ += '\n';
+  void endRow() {
+    text_ += '\n';
     first_ = true;
+    if (text_.size() >= kFlushSize) flush();
   }
-  const std::string& line() const { return line_; }
+  void flush() {
+    out_.write(text_.data(), static_cast<std::streamsize>(text_.size()));
+    text_.clear();
+  }
 
  private:
+  static constexpr std::size_t kFlushSize = 1u << 20;
   void separator() {
-    if (!first_) line_ += ',';
+    if (!first_) text_ += ',';
     first_ = false;
   }
-  std::string line_;
+  void append(const char* end) { text_.append(scratch_, static_cast<std::size_t>(end - scratch_)); }
+
+  std::ostream& out_;
+  std::string text_;
+  char scratch_[32];
   bool first_ = true;
+};
+
+// The numbers of one CSV row, kept as they are until the worker formats them.
+struct CsvRow {
+  std::uint32_t sec, nsec, seq;
+  const char* status;
+  bool has_output, has_wave;
+  GyroOutput output;  // meaningful when has_output
+  double alpha;       // meaningful when has_wave
+  double theta, amplitude, quadrature, phase;
+};
+
+// The CSV output of process: rows are collected in batches, and a background thread formats and
+// writes each batch while the next is processed (formatting costs about as much as reading).
+class CsvOutput {
+ public:
+  explicit CsvOutput(std::ostream& out) : text_(out) { rows_.reserve(kBatch); }
+  CsvRow& next() {
+    rows_.emplace_back();
+    return rows_.back();
+  }
+  void endRow() {
+    if (rows_.size() >= kBatch) submit();
+  }
+  /// Formats and writes the rest; rethrows what a batch threw.
+  void finish() {
+    submit();
+    worker_.submit([this] { text_.flush(); });
+    worker_.finish();
+  }
+
+ private:
+  static constexpr std::size_t kBatch = 8192;
+  void submit() {
+    if (rows_.empty()) return;
+    auto batch = std::make_shared<std::vector<CsvRow>>(std::move(rows_));
+    rows_ = std::vector<CsvRow>();
+    rows_.reserve(kBatch);
+    worker_.submit([this, batch] {
+      for (const CsvRow& r : *batch) format(r);
+    });
+  }
+  void format(const CsvRow& r) {
+    const bool o = r.has_output, w = r.has_wave;
+    text_.stamp(r.sec, r.nsec);
+    text_.integer(r.seq);
+    text_.text(r.status);
+    text_.number(r.output.dt, o);
+    text_.number(r.output.dtheta, o);
+    text_.number(r.output.dalpha, o);
+    text_.number(r.output.dalpha_earth_fixed, o);
+    text_.number(r.alpha, w);
+    text_.number(r.output.rate, o);
+    text_.number(r.output.theta_mid, o);
+    text_.number(r.output.frequency, o);
+    text_.number(r.output.scale_factor, o);
+    text_.number(r.output.drift, o);
+    if (o) {
+      text_.integer(r.output.rejected_before);
+      text_.integer(r.output.flags);
+    } else {
+      text_.text("");
+      text_.text("");
+    }
+    text_.number(r.theta, w);
+    text_.number(r.amplitude, w);
+    text_.number(r.quadrature, w);
+    text_.number(r.phase, w);
+    text_.endRow();
+  }
+
+  CsvText text_;  // used by the worker only
+  std::vector<CsvRow> rows_;
+  bag_tools::SerialWorker worker_;  // last: stopped first
 };
 
 struct ProcessOptions {
@@ -91,62 +179,46 @@ int runProcess(const ProcessOptions& o) {
   std::unique_ptr<OutputBag> out;
   if (!o.out.empty()) out = std::make_unique<OutputBag>(o.out, o.compression);
   std::unique_ptr<OutputText> csv_file;
+  std::unique_ptr<CsvOutput> row;
   if (!o.csv.empty()) {
     csv_file = std::make_unique<OutputText>(o.csv);
     csv_file->stream()
         << "stamp,seq,status,dt,dtheta,dalpha,dalpha_earth_fixed,alpha,rate,theta_mid,frequency,scale_factor,drift,"
            "rejected_before,flags,theta,amplitude,quadrature,phase\n";
+    row = std::make_unique<CsvOutput>(csv_file->stream());
   }
   core::GyroProcessor processor(o.processor, params);
   std::uint64_t outputs = 0;
-  CsvRow row;
-  std::string csv_buffer;
+  const std::string wave_topic = "/wave", output_topic = "/output";
   replayChannels(
       *in, topics.channels, processor,
       [&](const ChannelAmplitudes& msg, const core::ProcessorResult& r) {
+        outputs += r.has_output ? 1 : 0;
+        if (!out && !row) return;  // a dry run: the summary only
         const WaveState wave = toWaveMessage(msg, r.wave, o.frame_id);
         const GyroOutput output = toOutputMessage(wave.header, r);
-        if (out && r.has_wave) out->write("/wave", msg.header.stamp, wave);
-        if (out && r.has_output) out->write("/output", msg.header.stamp, output);
-        outputs += r.has_output ? 1 : 0;
-        if (csv_file) {
-          row.clear();
-          row.stamp(msg.header.stamp.sec, msg.header.stamp.nsec);
-          row.integer(msg.header.seq);
-          row.text(verdictName(r));
-          const bool o = r.has_output, w = r.has_wave;
-          row.number(output.dt, o);
-          row.number(output.dtheta, o);
-          row.number(output.dalpha, o);
-          row.number(output.dalpha_earth_fixed, o);
-          row.number(r.alpha, w);
-          row.number(output.rate, o);
-          row.number(output.theta_mid, o);
-          row.number(output.frequency, o);
-          row.number(output.scale_factor, o);
-          row.number(output.drift, o);
-          if (o) {
-            row.integer(output.rejected_before);
-            row.integer(output.flags);
-          } else {
-            row.text("");
-            row.text("");
-          }
-          row.number(wave.theta, w);
-          row.number(wave.amplitude, w);
-          row.number(wave.quadrature, w);
-          row.number(wave.phase, w);
-          row.end();
-          csv_buffer += row.line();
-          if (csv_buffer.size() > (1u << 20)) {
-            csv_file->stream() << csv_buffer;
-            csv_buffer.clear();
-          }
+        if (out && r.has_wave) out->write(wave_topic, msg.header.stamp, wave);
+        if (out && r.has_output) out->write(output_topic, msg.header.stamp, output);
+        if (row) {
+          CsvRow& c = row->next();
+          c.sec = msg.header.stamp.sec;
+          c.nsec = msg.header.stamp.nsec;
+          c.seq = msg.header.seq;
+          c.status = verdictName(r);
+          c.has_output = r.has_output;
+          c.has_wave = r.has_wave;
+          c.output = output;
+          c.alpha = r.alpha;
+          c.theta = wave.theta;
+          c.amplitude = wave.amplitude;
+          c.quadrature = wave.quadrature;
+          c.phase = wave.phase;
+          row->endRow();
         }
       },
       "process");
   if (csv_file) {
-    csv_file->stream() << csv_buffer;
+    row->finish();
     csv_file->commit();
   }
   if (out) out->commit();

@@ -1,0 +1,308 @@
+#include "bag_file_writer.h"
+
+#include <bzlib.h>
+#include <fcntl.h>
+#include <roslz4/lz4s.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace hrg_gyro {
+namespace bag_tools {
+namespace {
+
+// Record kinds ("op" field) and sizes of the bag format 2.0.
+constexpr std::uint8_t kOpMessageData = 0x02, kOpFileHeader = 0x03, kOpIndexData = 0x04, kOpChunk = 0x05,
+                       kOpChunkInfo = 0x06, kOpConnection = 0x07;
+constexpr char kMagic[] = "#ROSBAG V2.0\n";
+constexpr std::uint32_t kFileHeaderLength = 4096;  // the file header record is padded to this, as rosbag's
+constexpr int kLz4BlockSizeId = 6;                 // rosbag's LZ4 block size
+constexpr int kBz2BlockSize100k = 9, kBz2WorkFactor = 30;
+
+/// Little-endian numbers and "name=value" header fields, appended to a byte buffer.
+class Bytes {
+ public:
+  explicit Bytes(std::vector<std::uint8_t>* out) : out_(*out) {}
+  template <class Number>
+  void number(Number value) {
+    const std::size_t at = out_.size();
+    out_.resize(at + sizeof value);
+    std::memcpy(out_.data() + at, &value, sizeof value);
+  }
+  void time(const ros::Time& t) {
+    number(t.sec);
+    number(t.nsec);
+  }
+  void raw(const void* data, std::size_t size) {
+    const auto* bytes = static_cast<const std::uint8_t*>(data);
+    out_.insert(out_.end(), bytes, bytes + size);
+  }
+  void field(const char* name, const void* value, std::size_t size) {
+    const std::size_t name_length = std::strlen(name);
+    number(static_cast<std::uint32_t>(name_length + 1 + size));
+    raw(name, name_length);
+    out_.push_back('=');
+    raw(value, size);
+  }
+  template <class Number>
+  void numberField(const char* name, Number value) {
+    field(name, &value, sizeof value);
+  }
+  void timeField(const char* name, const ros::Time& t) {
+    const std::uint32_t both[2] = {t.sec, t.nsec};
+    field(name, both, sizeof both);
+  }
+  void textField(const char* name, const std::string& value) { field(name, value.data(), value.size()); }
+  /// A length prefix written as 0 and filled in by endLength.
+  std::size_t beginLength() {
+    const std::size_t at = out_.size();
+    number(std::uint32_t{0});
+    return at;
+  }
+  void endLength(std::size_t at) {
+    const auto length = static_cast<std::uint32_t>(out_.size() - at - sizeof(std::uint32_t));
+    std::memcpy(out_.data() + at, &length, sizeof length);
+  }
+
+ private:
+  std::vector<std::uint8_t>& out_;
+};
+
+}  // namespace
+
+BagFileWriter::BagFileWriter(const std::string& path, Compression compression, std::uint32_t chunk_threshold)
+    : path_(path), compression_(compression), chunk_threshold_(chunk_threshold) {
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw BagWriteError("cannot create " + path, errno);
+  chunk_.reserve(chunk_threshold_ + (64u << 10));
+  writeFile(kMagic, sizeof kMagic - 1);
+  writeFileHeader(0);  // rewritten by close() with the index position
+  worker_ = std::make_unique<SerialWorker>();
+}
+
+BagFileWriter::~BagFileWriter() {
+  worker_.reset();  // no write may still be under way when the descriptor closes
+  if (fd_ >= 0) ::close(fd_);
+}
+
+std::uint32_t BagFileWriter::connectionOf(const std::string& topic, const char* datatype, const char* md5sum,
+                                          const char* definition) {
+  if (last_connection_ < connections_.size() && connections_[last_connection_].topic == topic) {
+    return static_cast<std::uint32_t>(last_connection_);
+  }
+  for (std::size_t i = 0; i < connections_.size(); ++i) {
+    if (connections_[i].topic == topic) {
+      last_connection_ = i;
+      return static_cast<std::uint32_t>(i);
+    }
+  }
+  connections_.push_back({topic, datatype, md5sum, definition});
+  last_connection_ = connections_.size() - 1;
+  return static_cast<std::uint32_t>(last_connection_);
+}
+
+std::uint8_t* BagFileWriter::beginMessage(std::uint32_t connection, const ros::Time& time, std::uint32_t length) {
+  if (time < ros::TIME_MIN) throw BagWriteError("cannot write " + path_ + ": a message stamped before 0.000000001", 0);
+  if (chunk_.empty()) {
+    chunk_start_ = chunk_end_ = time;
+  } else {
+    if (time < chunk_start_) chunk_start_ = time;
+    if (time > chunk_end_) chunk_end_ = time;
+  }
+  Bytes out(&chunk_);
+  Connection& c = connections_[connection];
+  if (!c.in_file) {
+    // A connection's record goes into the first chunk that carries it (and into the index at the end).
+    c.in_file = true;
+    const std::size_t header = out.beginLength();
+    out.numberField("op", kOpConnection);
+    out.textField("topic", c.topic);
+    out.numberField("conn", connection);
+    out.endLength(header);
+    const std::size_t data = out.beginLength();
+    out.textField("type", c.datatype);
+    out.textField("md5sum", c.md5sum);
+    out.textField("message_definition", c.definition);
+    out.endLength(data);
+  }
+  ChunkIndex* index = nullptr;
+  for (ChunkIndex& i : chunk_index_) {
+    if (i.connection == connection) index = &i;
+  }
+  if (!index) {
+    chunk_index_.push_back({connection, {}});
+    index = &chunk_index_.back();
+  }
+  index->entries.push_back({time, static_cast<std::uint32_t>(chunk_.size())});
+  const std::size_t header = out.beginLength();
+  out.numberField("op", kOpMessageData);
+  out.numberField("conn", connection);
+  out.timeField("time", time);
+  out.endLength(header);
+  out.number(length);
+  const std::size_t at = chunk_.size();
+  chunk_.resize(at + length);
+  return chunk_.data() + at;
+}
+
+void BagFileWriter::endMessage() {
+  if (chunk_.size() > chunk_threshold_) flushChunk();
+}
+
+void BagFileWriter::flushChunk() {
+  if (chunk_.empty()) return;
+  // The full chunk goes to the worker; a fresh buffer of the same size takes the next messages.
+  auto chunk = std::make_shared<std::vector<std::uint8_t>>(std::move(chunk_));
+  auto index = std::make_shared<std::vector<ChunkIndex>>(std::move(chunk_index_));
+  chunk_ = std::vector<std::uint8_t>();
+  chunk_.reserve(chunk_threshold_ + (64u << 10));
+  chunk_index_.clear();
+  const ros::Time start = chunk_start_, end = chunk_end_;
+  worker_->submit([this, chunk, index, start, end] { writeChunk(*chunk, *index, start, end); });
+}
+
+void BagFileWriter::writeChunk(const std::vector<std::uint8_t>& chunk, const std::vector<ChunkIndex>& chunk_index,
+                               const ros::Time& start, const ros::Time& end) {
+  const std::uint8_t* data = chunk.data();
+  std::size_t size = chunk.size();
+  const char* compression = "none";
+  if (compression_ == Compression::kLz4) {
+    compression = "lz4";
+    compressed_.resize(chunk.size() + chunk.size() / 64 + 4096);
+    for (;;) {
+      unsigned int out_size = static_cast<unsigned int>(compressed_.size());
+      const int result = roslz4_buffToBuffCompress(
+          const_cast<char*>(reinterpret_cast<const char*>(chunk.data())), static_cast<unsigned int>(chunk.size()),
+          reinterpret_cast<char*>(compressed_.data()), &out_size, kLz4BlockSizeId);
+      if (result == ROSLZ4_OK) {
+        size = out_size;
+        break;
+      }
+      if (result != ROSLZ4_OUTPUT_SMALL) throw BagWriteError("cannot write " + path_ + ": LZ4 compression failed", 0);
+      compressed_.resize(compressed_.size() * 2);
+    }
+    data = compressed_.data();
+  } else if (compression_ == Compression::kBz2) {
+    compression = "bz2";
+    compressed_.resize(chunk.size() + chunk.size() / 100 + 4096);  // bzip2's documented worst case is +1 % + 600
+    unsigned int out_size = static_cast<unsigned int>(compressed_.size());
+    if (BZ2_bzBuffToBuffCompress(reinterpret_cast<char*>(compressed_.data()), &out_size,
+                                 const_cast<char*>(reinterpret_cast<const char*>(chunk.data())),
+                                 static_cast<unsigned int>(chunk.size()), kBz2BlockSize100k, 0,
+                                 kBz2WorkFactor) != BZ_OK) {
+      throw BagWriteError("cannot write " + path_ + ": BZ2 compression failed", 0);
+    }
+    size = out_size;
+    data = compressed_.data();
+  }
+  ChunkInfo info{file_position_, start, end, {}};
+  scratch_.clear();
+  Bytes out(&scratch_);
+  const std::size_t header = out.beginLength();
+  out.numberField("op", kOpChunk);
+  out.textField("compression", compression);
+  out.numberField("size", static_cast<std::uint32_t>(chunk.size()));
+  out.endLength(header);
+  out.number(static_cast<std::uint32_t>(size));
+  writeFile(scratch_.data(), scratch_.size());
+  writeFile(data, size);
+  // The index data records of the chunk, one per connection, right after it.
+  scratch_.clear();
+  for (const ChunkIndex& index : chunk_index) {
+    const auto count = static_cast<std::uint32_t>(index.entries.size());
+    const std::size_t index_header = out.beginLength();
+    out.numberField("op", kOpIndexData);
+    out.numberField("ver", std::uint32_t{1});
+    out.numberField("conn", index.connection);
+    out.numberField("count", count);
+    out.endLength(index_header);
+    out.number(static_cast<std::uint32_t>(count * 12u));
+    for (const IndexEntry& e : index.entries) {
+      out.time(e.time);
+      out.number(e.offset);
+    }
+    info.counts.emplace_back(index.connection, count);
+  }
+  writeFile(scratch_.data(), scratch_.size());
+  chunks_.push_back(std::move(info));
+}
+
+void BagFileWriter::close() {
+  flushChunk();
+  worker_->finish();
+  const std::uint64_t index_position = file_position_;
+  scratch_.clear();
+  Bytes out(&scratch_);
+  for (std::size_t id = 0; id < connections_.size(); ++id) {
+    const Connection& c = connections_[id];
+    const std::size_t header = out.beginLength();
+    out.numberField("op", kOpConnection);
+    out.textField("topic", c.topic);
+    out.numberField("conn", static_cast<std::uint32_t>(id));
+    out.endLength(header);
+    const std::size_t data = out.beginLength();
+    out.textField("type", c.datatype);
+    out.textField("md5sum", c.md5sum);
+    out.textField("message_definition", c.definition);
+    out.endLength(data);
+  }
+  for (const ChunkInfo& chunk : chunks_) {
+    const std::size_t header = out.beginLength();
+    out.numberField("op", kOpChunkInfo);
+    out.numberField("ver", std::uint32_t{1});
+    out.numberField("chunk_pos", chunk.position);
+    out.timeField("start_time", chunk.start);
+    out.timeField("end_time", chunk.end);
+    out.numberField("count", static_cast<std::uint32_t>(chunk.counts.size()));
+    out.endLength(header);
+    out.number(static_cast<std::uint32_t>(chunk.counts.size() * 8u));
+    for (const auto& count : chunk.counts) {
+      out.number(count.first);
+      out.number(count.second);
+    }
+  }
+  writeFile(scratch_.data(), scratch_.size());
+  seekFile(sizeof kMagic - 1);
+  writeFileHeader(index_position);
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0) throw BagWriteError("cannot close " + path_, errno);
+}
+
+void BagFileWriter::writeFileHeader(std::uint64_t index_position) {
+  std::vector<std::uint8_t> record;
+  Bytes out(&record);
+  const std::size_t header = out.beginLength();
+  out.numberField("op", kOpFileHeader);
+  out.numberField("index_pos", index_position);
+  out.numberField("conn_count", static_cast<std::uint32_t>(connections_.size()));
+  out.numberField("chunk_count", static_cast<std::uint32_t>(chunks_.size()));
+  out.endLength(header);
+  const std::uint32_t padding = kFileHeaderLength - static_cast<std::uint32_t>(record.size() - sizeof(std::uint32_t));
+  out.number(padding);
+  record.resize(record.size() + padding, ' ');
+  writeFile(record.data(), record.size());
+}
+
+void BagFileWriter::writeFile(const void* data, std::size_t size) {
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  while (size > 0) {
+    const ssize_t written = ::write(fd_, bytes, size);
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      throw BagWriteError("cannot write " + path_, errno);
+    }
+    bytes += written;
+    size -= static_cast<std::size_t>(written);
+    file_position_ += static_cast<std::uint64_t>(written);
+  }
+}
+
+void BagFileWriter::seekFile(std::uint64_t position) {
+  if (::lseek(fd_, static_cast<off_t>(position), SEEK_SET) < 0) throw BagWriteError("cannot seek in " + path_, errno);
+  file_position_ = position;
+}
+
+}  // namespace bag_tools
+}  // namespace hrg_gyro
