@@ -6,7 +6,7 @@ namespace hrg_gyro {
 namespace core {
 
 SignalSynthesizer::SignalSynthesizer(const PickoffDefects& defects, int samples_per_period, std::uint64_t seed)
-    : pickoffs_(defects), demodulator_(samples_per_period), noise_(seed, GaussianNoise::Method::kZiggurat) {}
+    : pickoffs_(defects), demodulator_(samples_per_period), noise_(seed, GaussianNoise::Method::kPolar) {}
 
 ChannelVector SignalSynthesizer::period(const WaveParameters& wave, double theta_end) {
   const int n = demodulator_.samplesPerPeriod();

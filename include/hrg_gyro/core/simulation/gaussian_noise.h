@@ -5,7 +5,7 @@
 // seed (no library-defined algorithm):
 //  - kPolar (the default): Marsaglia's polar method, two normals per accepted pair and one logarithm
 //    per pair. Its streams are the ones the statistical tests and test helpers were written against.
-//  - kZiggurat (the simulator's per-sample sensor noise, ~4x cheaper): a 256-layer ziggurat
+//  - kZiggurat (~4x cheaper; not yet the synthesizer's, see signal_synthesizer.h): a 256-layer ziggurat
 //    (Marsaglia and Tsang): the density exp(-x^2/2) is covered
 // by 256 strips of equal area; one 64-bit draw picks a strip (8 bits) and a signed abscissa (53 bits),
 // and in ~99 % of draws the point lies inside the curve's strip with no further work. Otherwise the
