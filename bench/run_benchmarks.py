@@ -173,7 +173,8 @@ def offline(results):
     # The playback path: rosbag play --immediate into the processor node.
     log("offline: rosbag play --immediate into the processor node")
     master = Master()
-    launch = subprocess.Popen(["roslaunch", "-p", str(master.port), "hrg_gyro", "processor.launch",
+    # ns:=/ : the bag's topics are global (/channels), processor.launch's default namespace is gyro.
+    launch = subprocess.Popen(["roslaunch", "-p", str(master.port), "hrg_gyro", "processor.launch", "ns:=/",
                                "parameter_file:=" + params, "expected_rate:=1000"], env=master.env,
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, preexec_fn=os.setsid)
     seen = {"received": 0, "lost": 0, "updated": time.time()}
