@@ -271,11 +271,14 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
   // One message, deserialised into again and again: no allocation per sample.
   ReusedMessageReader<ChannelAmplitudes> reader;
   ChannelAmplitudes msg;
+  // One result written in place: process() by value would zero-fill a fresh one per sample first.
+  core::ProcessorResult result;
   std::uint64_t n = 0;
   try {
     for (const rosbag::MessageInstance& m : view) {
       if (!reader.read(m, &msg)) continue;
-      sink(msg, processor.process(fromMessage(msg)));
+      processor.process(fromMessage(msg), &result);
+      sink(msg, result);
       ++n;
       if (n % 4096 == 0) progress.update(n, n);  // the clock read not on every sample
     }
