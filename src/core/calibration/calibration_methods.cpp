@@ -91,8 +91,7 @@ DualRateMethod::DualRateMethod(const CalibrationSettings& s, double k0)
       k0_(k0),
       groups_(s.bins, s.window, s.window_span, k0, maxFittedOrder(s.scale_factor_orders, s.drift_orders),
               s.group_tolerance, s.plateau.max_gap),
-      by_angle_(s.scale_factor_orders, s.drift_orders, s.bins),
-      by_rate_(s.scale_factor_orders, s.drift_orders, s.bins) {}
+      regression_(s.scale_factor_orders, s.drift_orders, s.bins) {}
 
 double DualRateMethod::windowFor(double table_rate) const {
   // The regression is exact for any window; the window only sets how much of each harmonic the
@@ -112,10 +111,6 @@ void DualRateMethod::addSample(const PlateauSample& s) {
   ++samples_;
   const bool gap = in_chain_ && toSeconds(s.stamp - last_stamp_) > settings_.plateau.max_gap;
   if (!in_chain_ || s.plateau.id != chain_plateau_ || gap || s.stamp <= last_stamp_) {
-    if (in_chain_) {
-      angle_moved_ += std::abs(chain_angle_);
-      rate_moved_ += std::abs(chain_rate_angle_);
-    }
     int group = -1;
     for (std::size_t g = 0; g < group_rates_.size(); ++g)
       if (std::abs(group_rates_[g] - s.plateau.rate) <= settings_.group_tolerance) group = static_cast<int>(g);
@@ -123,27 +118,21 @@ void DualRateMethod::addSample(const PlateauSample& s) {
       group = static_cast<int>(group_rates_.size());
       group_rates_.push_back(s.plateau.rate);
     }
-    const double window = windowFor(s.plateau.rate);
-    by_angle_.startChain(group, window);
-    by_rate_.startChain(group, window);
+    regression_.startChain(group, windowFor(s.plateau.rate));
     in_chain_ = true;
     chain_plateau_ = s.plateau.id;
-    unwrap_ = rate_angle_ = chain_angle_ = chain_rate_angle_ = 0.0;
+    unwrap_ = 0.0;
   } else {
-    // A controller may log its angle modulo 2 pi: unwrap it. The rate integral is the trapezoid.
+    // A controller may log its angle modulo 2 pi: unwrap it.
     const double step = s.table_angle + unwrap_ - last_table_angle_;
     if (step > kPi) unwrap_ -= 2.0 * kPi;
     if (step < -kPi) unwrap_ += 2.0 * kPi;
-    rate_angle_ += 0.5 * (s.table_rate + last_table_rate_) * toSeconds(s.stamp - last_stamp_);
-    chain_angle_ += s.table_angle + unwrap_ - last_table_angle_;
-    chain_rate_angle_ = rate_angle_;
   }
   const double angle = s.table_angle + unwrap_;
-  by_angle_.add(s.stamp, s.theta, angle);
-  by_rate_.add(s.stamp, s.theta, rate_angle_);
+  regression_.add(s.stamp, s.theta, angle);
+  angle_logged_ = s.angle_logged;
   last_stamp_ = s.stamp;
   last_table_angle_ = angle;
-  last_table_rate_ = s.table_rate;
 }
 
 bool DualRateMethod::complete() const { return progress().fraction >= 1.0; }
@@ -189,21 +178,12 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
          "theta bins covered by both plateaus: " + formatShort(100 * o.coverage) + " %");
   o.gate("rate_separation", std::abs(w1 - w2) >= q.min_rate_separation, std::abs(w1 - w2), q.min_rate_separation,
          "plateau rates " + formatShort(w1) + " and " + formatShort(w2) + " rad/s");
-  // The logged angle is used when it turned as the integrated rate says (within 10 %); a controller
-  // that logs no angle leaves the integral of its rate.
-  double angle_moved = angle_moved_, rate_moved = rate_moved_;
-  if (in_chain_) {
-    angle_moved += std::abs(chain_angle_);
-    rate_moved += std::abs(chain_rate_angle_);
-  }
-  const bool use_angle = rate_moved > 0.0 && std::abs(angle_moved / rate_moved - 1.0) <= 0.1;
   // The Earth rate's uncertainty: the latitude taken as known to 0.01 degree.
   const double earth = prior.earth_rate.verticalRate();
   const double earth_std = prior.earth_rate.enabled
                                ? kEarthRotationRate * std::abs(std::cos(prior.earth_rate.latitude)) * 0.01 * kPi / 180
                                : 0.0;
-  const IncrementRegression& regression = use_angle ? by_angle_ : by_rate_;
-  const IncrementFit e = regression.solve(earth, earth_std, minBinTime(), q.max_condition);
+  const IncrementFit e = regression_.solve(earth, earth_std, minBinTime(), q.max_condition);
   if (!e.ok) {
     o.gate("fit", false, 0.0, 0.0, e.reason);
     o.decide();
@@ -220,7 +200,7 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
                     largest(e.budget.statistical) + " (white wave-angle noise alone " + largest(e.budget.angle_noise) +
                     ", beyond it " + largest(e.budget.beyond_noise) + "), Earth rate " + largest(e.budget.earth_rate) +
                     ", basis-noise correction " + largest(e.budget.basis_noise) + "; phi from the " +
-                    (use_angle ? "logged table angle" : "integrated table rate") + ", window " +
+                    (angle_logged_ ? "logged table angle" : "integrated table rate") + ", window " +
                     formatShort(e.mean_window) + " s, angle noise " + formatShort(e.angle_noise) + " rad, " +
                     std::to_string(e.increments) + " increments in " + std::to_string(e.blocks) + " blocks");
   o.smoothing_factor = 1.0;  // nothing is smoothed: the increments are fitted through their exact integrals
@@ -231,8 +211,9 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
   for (std::size_t i = 1; i < e.budget.beyond_noise.size(); ++i) beyond = std::max(beyond, e.budget.beyond_noise[i]);
   beyond /= std::abs(e.k.mean);
   o.gate("table_error", beyond <= q.max_table_error, beyond, q.max_table_error,
-         std::string(use_angle ? "table angle" : "integrated table rate (no angle logged)") + " errors add at most " +
-             formatShort(beyond * 1e6) + " ppm of |K0| to a K harmonic (scatter beyond the wave-angle noise)");
+         std::string(angle_logged_ ? "table angle" : "integrated table rate (no angle logged)") +
+             " errors add at most " + formatShort(beyond * 1e6) +
+             " ppm of |K0| to a K harmonic (scatter beyond the wave-angle noise)");
   // Paper-style bound per bin: K changing over one window, plus the angle noise of the two window
   // means at each end of a bin (drift cancels in this method).
   const double tau = std::max(g1.rates().effectiveWindow(), g2.rates().effectiveWindow());

@@ -36,17 +36,15 @@ class DualRateMethod : public CalibrationMethod {
   CalibrationSettings settings_;
   double k0_;
   RateGroups groups_;  // coverage, progress and the plateau summaries
-  // The estimate, twice: with phi the logged table angle, and with phi the integral of the logged
-  // rate (for a controller that logs no angle); finish() uses the first where the angle moves with
-  // the integrated rate.
-  IncrementRegression by_angle_, by_rate_;
+  // The estimate, with phi the session's table angle: the logged angle, or the integral of the
+  // logged rate for a controller that logs none (the session decides, PlateauSample::angle_logged).
+  IncrementRegression regression_;
   std::vector<double> group_rates_;  // plateau rate of each regression group
   bool in_chain_ = false;
   std::uint64_t chain_plateau_ = 0;
   Nanoseconds last_stamp_ = 0;
-  double last_table_angle_ = 0.0, last_table_rate_ = 0.0, unwrap_ = 0.0, rate_angle_ = 0.0;
-  double chain_angle_ = 0.0, chain_rate_angle_ = 0.0;  // of the open chain
-  double angle_moved_ = 0.0, rate_moved_ = 0.0;        // |angle turned| per chain, summed
+  double last_table_angle_ = 0.0, unwrap_ = 0.0;
+  bool angle_logged_ = true;  // of the last sample: named in the report
   std::uint64_t samples_ = 0;
 };
 
