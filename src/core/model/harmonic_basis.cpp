@@ -14,38 +14,10 @@ HarmonicBasis::HarmonicBasis(int step, int max_order) : step_(step), max_order_(
   sin_.assign(max_order / step + 1, 0.0);
 }
 
-void HarmonicBasis::evaluate(double theta, double c2, double s2) {
-  const std::size_t n = cos_.size();
-  if (n < 2) return;
-  if (step_ % 2 != 0) {
-    evaluate(theta);
-    return;
-  }
-  // (c1, s1) = (c2, s2)^(step / 2) as a complex power.
-  double c1 = c2, s1 = s2;
-  for (int p = 2; p <= step_ / 2; ++p) {
-    const double c = c1 * c2 - s1 * s2;
-    s1 = s1 * c2 + c1 * s2;
-    c1 = c;
-  }
-  cos_[1] = c1;
-  sin_[1] = s1;
-  for (std::size_t m = 2; m < n; ++m) {
-    cos_[m] = cos_[m - 1] * c1 - sin_[m - 1] * s1;
-    sin_[m] = sin_[m - 1] * c1 + cos_[m - 1] * s1;
-  }
-}
-
 void HarmonicBasis::evaluate(double theta) {
   const std::size_t n = cos_.size();
   if (n < 2) return;
-  const double c1 = std::cos(step_ * theta), s1 = std::sin(step_ * theta);
-  cos_[1] = c1;
-  sin_[1] = s1;
-  for (std::size_t m = 2; m < n; ++m) {
-    cos_[m] = cos_[m - 1] * c1 - sin_[m - 1] * s1;
-    sin_[m] = sin_[m - 1] * c1 + cos_[m - 1] * s1;
-  }
+  fillFrom(std::cos(step_ * theta), std::sin(step_ * theta));
 }
 
 }  // namespace core

@@ -52,12 +52,11 @@ void GyroProcessor::setParameters(std::shared_ptr<const GyroParameters> paramete
   if (has_previous_ && !(compensator_.parameters().correction == old_p)) {
     WaveState w;
     if (estimateWave(compensator_.parameters().correction.apply(previous_z_), config_.limits, &w) == WaveStatus::kOk) {
-      ThetaUnwrapper rebased;
-      rebased.unwrap(unwrapper_.last());
-      const double theta = rebased.unwrap(w.theta);
-      w.rebase(theta);
-      unwrapper_ = ThetaUnwrapper();
-      unwrapper_.unwrap(theta);
+      // The branch of the re-read angle nearest to the angle reached so far.
+      const double principal = w.theta;
+      const double half_turns = roundHalfAway((unwrapper_.last() - principal) / kPi);
+      unwrapper_.accept(principal, half_turns);
+      w.rebase(unwrapper_.last(), half_turns);
       previous_cos_ = w.cos_theta;
       previous_sin_ = w.sin_theta;
     }
@@ -135,7 +134,10 @@ inline void GyroProcessor::remember(const ChannelSample& in, const WaveState& wa
 }
 
 inline void GyroProcessor::anchor(const ChannelSample& in, WaveState* wave, ProcessorResult* r) {
-  wave->rebase(unwrapper_.unwrap(wave->theta));
+  double half_turns;
+  const double theta = unwrapper_.peek(wave->theta, &half_turns);
+  unwrapper_.accept(wave->theta, half_turns);
+  wave->rebase(theta, half_turns);
   remember(in, *wave);
   *r = ProcessorResult();
   r->verdict = SampleVerdict::kFirst;
@@ -192,17 +194,8 @@ inline AngleIncrement GyroProcessor::reanchorIncrement(double theta, double dt, 
   return increment;
 }
 
-ProcessorResult GyroProcessor::process(const ChannelSample& in) {
-  ProcessorResult r;
-  process(in, &r);
-  return r;
-}
-
-void GyroProcessor::processBatch(const ChannelSample* in, std::size_t n, ProcessorResult* out) {
-  for (std::size_t i = 0; i < n; ++i) process(in[i], &out[i]);
-}
-
-void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
+__attribute__((always_inline)) inline void GyroProcessor::advance(const ChannelSample& in, WaveStatus status,
+                                                                  WaveState* wave_state, ProcessorResult* result) {
   // Every path sets every field of *result: rejections and the first sample start from a default
   // result, the accepted path (the hot one) writes each field itself.
   ProcessorResult& r = *result;
@@ -210,8 +203,7 @@ void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
   Nanoseconds dt_ns = 0;
   if (!admitStamp(in.stamp, &dt_ns, &r)) return;
 
-  WaveState wave;
-  const WaveStatus status = estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &wave);
+  WaveState& wave = *wave_state;
   if (status != WaveStatus::kOk) {
     countRejection(status);
     reject(SampleVerdict::kRejectedValue, &r);
@@ -225,15 +217,16 @@ void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
 
   const double dt = toSeconds(dt_ns);
   const double previous_theta = unwrapper_.last();
-  const double theta = wave.theta + kPi * roundHalfAway((previous_theta - wave.theta) / kPi);
+  double half_turns;
+  const double theta = unwrapper_.peek(wave.theta, &half_turns);
   std::uint8_t flags = pending_flags_;
   bool integrate = true;
   if (!admitStep(dt, theta - previous_theta, &flags, &integrate)) {
     reject(SampleVerdict::kRejectedJump, &r);
     return;
   }
-  unwrapper_.unwrap(theta);
-  wave.rebase(theta);
+  unwrapper_.accept(wave.theta, half_turns);
+  wave.rebase(theta, half_turns);
 
   const double f_mid = 0.5 * (in.frequency + previous_frequency_);
   flags |= frequencyFlags(f_mid);
@@ -256,6 +249,35 @@ void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
   r.rejected_before = rejected_since_output_;
   rejected_since_output_ = 0;
   pending_flags_ = 0;
+}
+
+ProcessorResult GyroProcessor::process(const ChannelSample& in) {
+  ProcessorResult r;
+  process(in, &r);
+  return r;
+}
+
+void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
+  WaveState wave;
+  const WaveStatus status = estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &wave);
+  advance(in, status, &wave, result);
+}
+
+void GyroProcessor::processBatch(const ChannelSample* in, std::size_t n, ProcessorResult* out) {
+  // The wave states of a block first, several samples per instruction (estimateWaves): they depend
+  // on the sample alone and on P, which cannot change inside a batch. Then the rules and the
+  // integration in order, exactly as process() applies them one by one.
+  constexpr std::size_t kBlock = 32;
+  ChannelVector corrected[kBlock];
+  WaveState waves[kBlock];
+  WaveStatus statuses[kBlock];
+  const CorrectionMatrix& correction = compensator_.parameters().correction;
+  for (std::size_t start = 0; start < n; start += kBlock) {
+    const std::size_t m = n - start < kBlock ? n - start : kBlock;
+    for (std::size_t j = 0; j < m; ++j) corrected[j] = correction.apply(in[start + j].z);
+    estimateWaves(corrected, m, config_.limits, waves, statuses);
+    for (std::size_t j = 0; j < m; ++j) advance(in[start + j], statuses[j], &waves[j], &out[start + j]);
+  }
 }
 
 }  // namespace core

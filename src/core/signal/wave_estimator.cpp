@@ -1,10 +1,10 @@
 #include "hrg_gyro/core/signal/wave_estimator.h"
 
 #include <algorithm>
-#include <cmath>
 
-#include "hrg_gyro/core/common/fast_atan2.h"
-#include "hrg_gyro/core/common/units.h"
+// The lanes of four doubles are passed and returned in registers only inside this file (inline
+// helpers), so GCC's note that their calling convention differs without AVX concerns no interface.
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace hrg_gyro {
 namespace core {
@@ -25,56 +25,64 @@ const char* toString(WaveStatus status) {
   return "unknown";
 }
 
-WaveStatus estimateWave(const ChannelVector& z, const WaveLimits& limits, WaveState* state) {
-  const double ac = z[kAc], bc = z[kBc], as = z[kAs], bs = z[kBs];
-  const double e = ac * ac + bc * bc + as * as + bs * bs;
-  if (!std::isfinite(e)) {
-    // Any NaN or infinite component; else finite amplitudes so huge (1e300) that their energy
-    // overflows: those are a value out of range, not a non-finite input.
-    const bool finite = std::isfinite(ac) && std::isfinite(bc) && std::isfinite(as) && std::isfinite(bs);
-    return finite ? WaveStatus::kAmplitudeOutOfRange : WaveStatus::kNonFinite;
-  }
-  if (e <= limits.min_energy) return WaveStatus::kNoSignal;
-  const double r = ac * ac + bc * bc - as * as - bs * bs;
-  const double s = 2.0 * (ac * as + bc * bs);
-  // A^2 - B^2. r^2 + s^2 <= e^2 cannot overflow for the amplitudes a pickoff can report; hypot
-  // (several times slower) only guards the absurd range.
-  const double h = e < 1e150 ? std::sqrt(r * r + s * s) : std::hypot(r, s);
-  if (!(h > limits.min_anisotropy * e)) return WaveStatus::kDegenerate;
-  const double a = std::sqrt(0.5 * (e + h));
-  if (a < limits.min_amplitude || a > limits.max_amplitude) return WaveStatus::kAmplitudeOutOfRange;
+namespace wave_detail {
 
-  const double q = 2.0 * (ac * bs - as * bc);
-  WaveState w;
-  w.theta = 0.5 * std::atan2(s, r);
-  w.amplitude = a;
-  w.quadrature = std::copysign(std::sqrt(std::max(0.0, 0.5 * (e - h))), q);
-  w.energy = e;
-  w.quadrature_product = q;
-  w.cos_component = r;
-  w.sin_component = s;
-  w.phase_error = 2.0 * (ac * bc + as * bs);
-  // Rotate the channels onto the antinode: Ac cos th + As sin th = A cos tau and
-  // Bc cos th + Bs sin th = -A sin tau (the channel amplitudes of docs/math.md with the quadrature
-  // terms cancelling).
-  // (cos th, sin th) up to a positive factor, which atan2 ignores, from the half-angle identities
-  // tan th = s / (h + r) = (h - r) / s, taking the better-conditioned one: no trigonometry.
-  double ct, st;
-  if (r >= 0.0) {
-    ct = h + r;
-    st = s;
-  } else {
-    ct = std::abs(s);
-    st = std::copysign(h - r, s);
-  }
-  // The phase is a diagnostic (published, never integrated): the inline atan2, within 1e-15 rad of the
-  // library's, halves its cost. theta, which is integrated, keeps the library's atan2.
-  w.phase = fastAtan2(-(bc * ct + bs * st), ac * ct + as * st);
-  const double norm = 1.0 / std::sqrt(ct * ct + st * st);
-  w.cos_theta = ct * norm;
-  w.sin_theta = st * norm;
-  *state = w;
+WaveStatus estimateWaveGeneral(double ac, double bc, double as, double bs, const WaveLimits& limits, WaveState* state) {
+  const double largest = std::max(std::max(std::abs(ac), std::abs(bc)), std::max(std::abs(as), std::abs(bs)));
+  const int exponent = std::ilogb(largest);  // the largest amplitude scaled into [1, 2)
+  const double down = std::ldexp(1.0, -exponent);
+  WaveLanes<double> w;
+  computeWave(ac * down, bc * down, as * down, bs * down, &w);
+  // With E >= 1 and A^2 - B^2 > min_anisotropy E, every operand is now in computeWave's range.
+  if (!(w.h > limits.min_anisotropy * w.e)) return WaveStatus::kDegenerate;
+  const double amplitude = std::ldexp(w.amplitude, exponent);
+  if (amplitude < limits.min_amplitude || amplitude > limits.max_amplitude) return WaveStatus::kAmplitudeOutOfRange;
+  w.amplitude = amplitude;
+  w.quadrature = std::ldexp(w.quadrature, exponent);
+  for (double* squared : {&w.e, &w.r, &w.s, &w.q, &w.l}) *squared = std::ldexp(*squared, 2 * exponent);
+  store(w, state);
   return WaveStatus::kOk;
+}
+
+}  // namespace wave_detail
+
+// Built twice, for the x86-64 baseline and for AVX2, the loader picking one by CPU: either way each
+// lane is computed with the operations estimateWave uses, in the same order, so the same bits.
+__attribute__((target_clones("avx2", "default"))) void estimateWaves(const ChannelVector* z, std::size_t n,
+                                                                     const WaveLimits& limits, WaveState* states,
+                                                                     WaveStatus* statuses) {
+  constexpr std::size_t kLanes = 4;
+  std::size_t i = 0;
+  for (; i + kLanes <= n; i += kLanes) {
+    DoubleLanes4 ac, bc, as, bs;
+    for (std::size_t j = 0; j < kLanes; ++j) {
+      ac[j] = z[i + j][kAc];
+      bc[j] = z[i + j][kBc];
+      as[j] = z[i + j][kAs];
+      bs[j] = z[i + j][kBs];
+    }
+    wave_detail::WaveLanes<DoubleLanes4> w;
+    wave_detail::computeWave(ac, bc, as, bs, &w);
+    // The lanes where estimateWave would take computeWave's numbers and accept them; the others
+    // (rare: rejected or extreme values) are estimated one by one.
+    const DoubleLanes4 sum_theta = laneAbs(w.r) + laneAbs(w.s), sum_tau = laneAbs(w.m) + laneAbs(w.l);
+    const auto accepted = (w.e < 1e150) & (w.e > 1e-140) & (w.e > limits.min_energy) & (sum_theta >= 0x1p-1000) &
+                          (sum_theta <= 1.7e308) & (sum_tau >= 0x1p-1000) & (sum_tau <= 1.7e308) &
+                          (w.h > limits.min_anisotropy * w.e) &
+                          ~((w.amplitude < limits.min_amplitude) | (w.amplitude > limits.max_amplitude));
+    for (std::size_t j = 0; j < kLanes; ++j) {
+      if (!accepted[j]) {
+        statuses[i + j] = estimateWave(z[i + j], limits, &states[i + j]);
+        continue;
+      }
+      wave_detail::WaveLanes<double> lane{w.e[j],     w.r[j],         w.s[j],        w.h[j],         w.q[j],
+                                          w.l[j],     w.m[j],         w.theta[j],    w.amplitude[j], w.quadrature[j],
+                                          w.phase[j], w.cos_theta[j], w.sin_theta[j]};
+      wave_detail::store(lane, &states[i + j]);
+      statuses[i + j] = WaveStatus::kOk;
+    }
+  }
+  for (; i < n; ++i) statuses[i] = estimateWave(z[i], limits, &states[i]);
 }
 
 }  // namespace core

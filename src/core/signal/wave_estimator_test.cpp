@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/signal/theta_unwrapper.h"
@@ -73,6 +75,109 @@ TEST(WaveEstimatorTest, DegenerateAndBadInputNeverGiveNaN) {
   // Sign flip of every channel is tau + pi: same angle.
   ASSERT_EQ(estimateWave(-idealChannels({1.0, 0.0, 0.3, 0.1}), WaveLimits{}, &s), WaveStatus::kOk);
   EXPECT_NEAR(s.theta, 0.3, 1e-12);
+}
+
+// The general path (amplitudes beyond the fast arithmetic's range) is the fast one on amplitudes
+// scaled by a power of two: the angles are the same and the amplitudes scale.
+TEST(WaveEstimatorTest, HugeAndTinyAmplitudesGiveTheSameWaveScaled) {
+  WaveLimits wide;
+  wide.min_energy = 0.0;
+  wide.min_amplitude = 0.0;
+  wide.max_amplitude = 1e300;
+  const ChannelVector z = idealChannels({1.0, 0.15, 0.7, -2.1});
+  WaveState reference;
+  ASSERT_EQ(estimateWave(z, wide, &reference), WaveStatus::kOk);
+  for (int exponent : {-530, -400, -300, 260, 400, 500}) {
+    WaveState s;
+    ASSERT_EQ(estimateWave(std::ldexp(1.0, exponent) * z, wide, &s), WaveStatus::kOk) << exponent;
+    EXPECT_EQ(s.theta, reference.theta) << exponent;
+    EXPECT_EQ(s.phase, reference.phase) << exponent;
+    EXPECT_EQ(s.cos_theta, reference.cos_theta) << exponent;
+    EXPECT_NEAR(s.amplitude, std::ldexp(reference.amplitude, exponent), 1e-15 * std::ldexp(1.0, exponent)) << exponent;
+    EXPECT_NEAR(s.quadrature, std::ldexp(reference.quadrature, exponent), 1e-15 * std::ldexp(1.0, exponent))
+        << exponent;
+  }
+}
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// estimateWaves computes four samples per instruction; each must be bit for bit estimateWave's, with
+// every kind of sample side by side in one group of lanes (the processor's batch path relies on it).
+TEST(WaveEstimatorTest, BatchIsBitIdenticalToOneSampleAtATime) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  std::vector<ChannelVector> z;
+  for (int i = 0; i < 20000; ++i) {
+    const WaveParameters w{0.01 + 3.0 * std::abs(u(rng)), 0.5 * u(rng), 4.0 * u(rng), kPi * u(rng)};
+    ChannelVector sample = idealChannels(w) + 1e-3 * ChannelVector(u(rng), u(rng), u(rng), u(rng));
+    switch (rng() % 16) {  // one sample in two odd in some way
+      case 0:
+        sample[rng() % 4] = nan;
+        break;
+      case 1:
+        sample[rng() % 4] = -inf;
+        break;
+      case 2:
+        sample *= 1e200;  // energy overflows
+        break;
+      case 3:
+        sample *= 1e-160;  // below the energy floor
+        break;
+      case 4:
+        sample = idealChannels({1.0, 0.95, w.theta, w.phase});  // degenerate
+        break;
+      case 5:
+        sample *= 1e100;  // general path, then out of range
+        break;
+      case 6:
+        sample = ChannelVector::Zero();
+        break;
+      case 7: {  // random bit patterns
+        for (int k = 0; k < 4; ++k) {
+          const std::uint64_t bits = rng();
+          std::memcpy(&sample[k], &bits, sizeof bits);
+        }
+        break;
+      }
+      default:
+        break;
+    }
+    z.push_back(sample);
+  }
+  WaveLimits limits;
+  limits.max_amplitude = 2.5;  // some ordinary samples out of range too
+  for (std::size_t n : {z.size(), std::size_t{7}, std::size_t{1}}) {
+    std::vector<WaveState> batch(n);
+    std::vector<WaveStatus> statuses(n);
+    estimateWaves(z.data(), n, limits, batch.data(), statuses.data());
+    int accepted = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      WaveState one;
+      const WaveStatus status = estimateWave(z[i], limits, &one);
+      ASSERT_EQ(statuses[i], status) << i;
+      if (status != WaveStatus::kOk) continue;
+      ++accepted;
+      const WaveState& b = batch[i];
+      for (const auto& [x, y] : {std::pair{b.theta, one.theta},
+                                 {b.amplitude, one.amplitude},
+                                 {b.quadrature, one.quadrature},
+                                 {b.phase, one.phase},
+                                 {b.energy, one.energy},
+                                 {b.quadrature_product, one.quadrature_product},
+                                 {b.cos_component, one.cos_component},
+                                 {b.sin_component, one.sin_component},
+                                 {b.phase_error, one.phase_error},
+                                 {b.cos_theta, one.cos_theta},
+                                 {b.sin_theta, one.sin_theta}}) {
+        ASSERT_TRUE(sameBits(x, y)) << i << ": " << x << " vs " << y;
+      }
+    }
+    if (n == z.size()) {
+      EXPECT_GT(accepted, 8000);
+      EXPECT_LT(accepted, 16000);
+    }
+  }
 }
 
 TEST(ThetaUnwrapperTest, FollowsSeveralRevolutionsBothWays) {

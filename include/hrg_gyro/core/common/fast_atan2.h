@@ -1,5 +1,6 @@
-// atan2 for the per-sample path, inline and without the library call (which is most of the cost of a
-// wave-state estimate).
+// atan2 for the per-sample path, inline and without the library call (which was most of the cost of
+// a wave-state estimate), for one double or for lanes of them (double_lanes.h), with the same bits in
+// every lane as for one double.
 //
 // The ratio t = min(|x|, |y|) / max(|x|, |y|) in [0, 1] is moved next to the nearest c = k/8 by
 // atan(t) = atan(c) + atan(u), u = (t - c) / (1 + t c), so |u| <= 1/16, and atan(u) is its Taylor
@@ -12,15 +13,26 @@
 
 #include <cmath>
 
+#include "hrg_gyro/core/common/double_lanes.h"
+
 namespace hrg_gyro {
 namespace core {
 
-inline double fastAtan2(double y, double x) {
-  const double ax = std::abs(x), ay = std::abs(y);
-  // One test for zeros, infinities, NaN and the extremes of the range (where the reduction would
-  // overflow or lose digits to subnormal numbers): the library takes those.
-  if (!(ax + ay >= 0x1p-1000 && ax + ay <= 1.7e308)) return std::atan2(y, x);
-  // atan(k / 8), k = 0 .. 8.
+/// Whether fastAtan2Reduced applies to (y, x): both finite, not both zero, not extreme.
+inline bool fastAtan2Applies(double y, double x) {
+  const double sum = std::abs(x) + std::abs(y);
+  return sum >= 0x1p-1000 && sum <= 1.7e308;
+}
+
+/// The reduction and series alone, for operands where fastAtan2Applies (lane by lane).
+template <class V>
+inline V fastAtan2Reduced(V y, V x) {
+  const V ax = laneAbs(x), ay = laneAbs(y);
+  const auto swapped = ay > ax;
+  const V num = select(swapped, ax, ay), den = select(swapped, ay, ax);
+  // c = the eighth nearest to num / den and base = atan(c), by comparisons rather than a division:
+  // the divider is the busiest unit of the per-sample path (square roots and divisions share it),
+  // and any c next to the ratio keeps |u| within 1/16 up to a rounding.
   static constexpr double kAtanOfEighths[9] = {0.0,
                                                0.12435499454676144,
                                                0.24497866312686414,
@@ -30,20 +42,26 @@ inline double fastAtan2(double y, double x) {
                                                0.6435011087932844,
                                                0.7188299996216245,
                                                0.7853981633974483};
-  const bool swapped = ay > ax;
-  const double num = swapped ? ax : ay, den = swapped ? ay : ax;
-  const int k = static_cast<int>(8.0 * (num / den) + 0.5);
-  const double c = 0.125 * k;
-  const double u = (num - c * den) / (den + c * num);
-  const double u2 = u * u;
-  const double series =
-      u + u * u2 *
-              (-1.0 / 3.0 +
-               u2 * (1.0 / 5.0 + u2 * (-1.0 / 7.0 + u2 * (1.0 / 9.0 + u2 * (-1.0 / 11.0 + u2 * (1.0 / 13.0))))));
-  double a = kAtanOfEighths[k] + series;
-  if (swapped) a = 1.5707963267948966 - a;
-  if (x < 0.0) a = 3.141592653589793 - a;
-  return std::signbit(y) ? -a : a;
+  V c = splat<V>(0.0), base = splat<V>(0.0);
+  for (int k = 1; k <= 8; ++k) {
+    const auto above = num >= ((2 * k - 1) / 16.0) * den;
+    c = select(above, splat<V>(0.125 * k), c);
+    base = select(above, splat<V>(kAtanOfEighths[k]), base);
+  }
+  const V u = (num - c * den) / (den + c * num);
+  // u - u^3/3 + ... + u^13/13 with the polynomial in u^2 by Estrin's scheme: three short chains of
+  // products instead of one long one.
+  const V z = u * u, z2 = z * z, z4 = z2 * z2;
+  const V p =
+      (-1.0 / 3.0 + z * (1.0 / 5.0)) + z2 * (-1.0 / 7.0 + z * (1.0 / 9.0)) + z4 * (-1.0 / 11.0 + z * (1.0 / 13.0));
+  V a = base + (u + (u * z) * p);
+  a = select(swapped, 1.5707963267948966 - a, a);
+  a = select(x < 0.0, 3.141592653589793 - a, a);
+  return laneCopysign(a, y);
+}
+
+inline double fastAtan2(double y, double x) {
+  return fastAtan2Applies(y, x) ? fastAtan2Reduced(y, x) : std::atan2(y, x);
 }
 
 }  // namespace core

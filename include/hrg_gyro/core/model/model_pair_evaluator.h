@@ -27,13 +27,39 @@ class ModelPairEvaluator {
     *k = sum(k_coefficients_.data(), k_indices_);
     *d = sum(d_coefficients_.data(), d_indices_);
   }
-  /// The same with c2 = cos 2 theta and s2 = sin 2 theta supplied (the per-sample path).
+  /// The same with c2 = cos 2 theta and s2 = sin 2 theta supplied (the per-sample path): the orders'
+  /// cos and sin follow by the recurrence in registers and both sums run beside it, every basis
+  /// order present (a missing one has zero coefficients, which adds exactly nothing).
   void evaluate(double theta, double c2, double s2, double frequency, double* k, double* d) {
     const bool same = frequency == cached_frequency_ || (std::isnan(frequency) && cached_is_nan_);
     if (frequency_dependent_ && !same) refresh(frequency);
-    basis_.evaluate(theta, c2, s2);
-    *k = sum(k_coefficients_.data(), k_indices_);
-    *d = sum(d_coefficients_.data(), d_indices_);
+    const int step = basis_.step();
+    if (step % 2 != 0) {
+      basis_.evaluate(theta);
+      *k = sum(k_coefficients_.data(), k_indices_);
+      *d = sum(d_coefficients_.data(), d_indices_);
+      return;
+    }
+    // (c1, s1) = (c2, s2)^(step / 2) as a complex power.
+    double c1 = c2, s1 = s2;
+    for (int p = 2; p <= step / 2; ++p) {
+      const double c = c1 * c2 - s1 * s2;
+      s1 = s1 * c2 + c1 * s2;
+      c1 = c;
+    }
+    double k_sum = k_coefficients_[0], d_sum = d_coefficients_[0];
+    double c = c1, s = s1;
+    const double* t = dense_.data();
+    const std::size_t orders = dense_.size() / 4;
+    for (std::size_t m = 0; m < orders; ++m, t += 4) {
+      k_sum += t[0] * c + t[1] * s;
+      d_sum += t[2] * c + t[3] * s;
+      const double next = c * c1 - s * s1;
+      s = s * c1 + c * s1;
+      c = next;
+    }
+    *k = k_sum;
+    *d = d_sum;
   }
 
  private:
@@ -54,6 +80,8 @@ class ModelPairEvaluator {
   HarmonicBasis basis_;
   std::vector<double> k_coefficients_, d_coefficients_;
   std::vector<int> k_indices_, d_indices_;  // basis index of each order
+  // For basis index m = 1, 2, ...: K's cos and sin coefficients, then D's (zero for an absent order).
+  std::vector<double> dense_;
   bool frequency_dependent_;
   double cached_frequency_ = 0.0;
   bool cached_is_nan_ = false;

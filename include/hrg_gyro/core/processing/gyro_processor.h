@@ -116,6 +116,9 @@ class GyroProcessor {
 
  private:
   void countRejection(WaveStatus status);
+  /// Everything after the wave estimate, in order (the estimate depends on the sample alone, so
+  /// processBatch computes a block of them ahead): status is estimateWave's on (E - P) z.
+  void advance(const ChannelSample& in, WaveStatus status, WaveState* wave, ProcessorResult* result);
   // The phases of process(), in its order.
   /// Counts a rejected sample toward the next output's rejected_before.
   void reject(SampleVerdict verdict, ProcessorResult* r);

@@ -8,8 +8,12 @@
 // numbers are reported by status and never produce a NaN.
 #pragma once
 
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 
+#include "hrg_gyro/core/common/double_lanes.h"
+#include "hrg_gyro/core/common/fast_atan2.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/wave_parameters.h"
 
@@ -48,10 +52,16 @@ struct WaveState {
 
   /// Moves theta to theta + n pi (as the unwrapper decides) and keeps the phase consistent with it:
   /// (A, theta + pi, tau + pi) is the same wave as (A, theta, tau).
-  void rebase(double continuous_theta) {
-    const double half_turns = roundHalfAway((continuous_theta - theta) / kPi);
+  void rebase(double continuous_theta) { rebase(continuous_theta, roundHalfAway((continuous_theta - theta) / kPi)); }
+  /// The same when the number of half turns n is known (ThetaUnwrapper::peek gives it).
+  void rebase(double continuous_theta, double half_turns) {
     if (std::abs(half_turns) < 0x1p62 && (static_cast<std::int64_t>(half_turns) & 1)) {
-      phase = wrapToPi(phase + kPi);
+      // tau + pi wrapped to (-pi, pi]: one subtraction for a phase already in range.
+      if (phase > -kPi && phase <= kPi) {
+        phase = phase > 0.0 ? phase - kPi : phase + kPi;
+      } else {
+        phase = wrapToPi(phase + kPi);
+      }
       cos_theta = -cos_theta;
       sin_theta = -sin_theta;
     }
@@ -59,8 +69,138 @@ struct WaveState {
   }
 };
 
-/// Fills *state (when the status is kOk) from the channel amplitudes.
-WaveStatus estimateWave(const ChannelVector& z, const WaveLimits& limits, WaveState* state);
+namespace wave_detail {
+
+/// The wave state's numbers for one sample (V = double) or a lane of samples (V = DoubleLanes4).
+template <class V>
+struct WaveLanes {
+  V e, r, s, h, q, l, m, theta, amplitude, quadrature, phase, cos_theta, sin_theta;
+};
+
+/// atan2 of two pairs: packed into one pair of lanes for one sample (the two chains run as one),
+/// lane by lane for lanes.
+inline void fastAtan2Twice(double y1, double x1, double y2, double x2, double* a1, double* a2) {
+  const DoubleLanes2 a = fastAtan2Reduced(DoubleLanes2{y1, y2}, DoubleLanes2{x1, x2});
+  *a1 = a[0];
+  *a2 = a[1];
+}
+template <class V>
+inline void fastAtan2Twice(V y1, V x1, V y2, V x2, V* a1, V* a2) {
+  *a1 = fastAtan2Reduced(y1, x1);
+  *a2 = fastAtan2Reduced(y2, x2);
+}
+inline void sqrtTwice(double x1, double x2, double* r1, double* r2) {
+  const DoubleLanes2 r = laneSqrt(DoubleLanes2{x1, x2});
+  *r1 = r[0];
+  *r2 = r[1];
+}
+template <class V>
+inline void sqrtTwice(V x1, V x2, V* r1, V* r2) {
+  *r1 = laneSqrt(x1);
+  *r2 = laneSqrt(x2);
+}
+
+/// The wave state of (corrected) channel amplitudes, valid where waveComputable() holds; the
+/// caller checks the status conditions. Every operation is elementwise, so a lane gets the bits
+/// one sample gets.
+template <class V>
+inline void computeWave(V ac, V bc, V as, V bs, WaveLanes<V>* w) {
+  w->e = ac * ac + bc * bc + as * as + bs * bs;
+  w->r = ac * ac + bc * bc - as * as - bs * bs;
+  w->s = 2.0 * (ac * as + bc * bs);
+  w->q = 2.0 * (ac * bs - as * bc);
+  w->l = 2.0 * (ac * bc + as * bs);
+  // Ac^2 - Bc^2 + As^2 - Bs^2 = (A^2 - B^2) cos 2tau: with L, the doubled temporal phase straight
+  // from the channels, so its atan2 runs beside theta's instead of after the square roots.
+  const V m = ac * ac - bc * bc + as * as - bs * bs;
+  w->m = m;
+  V theta2, tau2;
+  fastAtan2Twice(w->s, w->r, -w->l, m, &theta2, &tau2);
+  w->theta = 0.5 * theta2;
+  // A^2 - B^2. r^2 + s^2 <= e^2 neither overflows nor, unless the wave is degenerate, underflows
+  // where the wave is computable (1e-140 < e < 1e150).
+  const V h = laneSqrt(w->r * w->r + w->s * w->s);
+  w->h = h;
+  const V half_difference = 0.5 * (w->e - h);
+  V b;
+  sqrtTwice(0.5 * (w->e + h), select(0.0 < half_difference, half_difference, splat<V>(0.0)), &w->amplitude, &b);
+  w->quadrature = laneCopysign(b, w->q);
+  // (cos th, sin th) up to a positive factor, from the half-angle identities
+  // tan th = s / (h + r) = (h - r) / s, taking the better-conditioned one: no trigonometry.
+  const auto r_non_negative = w->r >= 0.0;
+  const V ct = select(r_non_negative, h + w->r, laneAbs(w->s));
+  const V st = select(r_non_negative, w->s, laneCopysign(h - w->r, w->s));
+  const V norm = 1.0 / laneSqrt(ct * ct + st * st);
+  w->cos_theta = ct * norm;
+  w->sin_theta = st * norm;
+  // tau is half the doubled phase or that +- pi: the channels rotated onto the antinode give
+  // Ac cos th + As sin th = A cos tau and Bc cos th + Bs sin th = -A sin tau (docs/math.md's channel
+  // amplitudes with the quadrature terms cancelling), and the half angle of (m, -l), up to a
+  // positive factor as above (|(m, -l)| = h), must point the same way.
+  const V half = 0.5 * tau2;
+  const auto m_non_negative = m >= 0.0;
+  const V hc = select(m_non_negative, h + m, laneAbs(w->l));
+  const V hs = select(m_non_negative, -w->l, laneCopysign(h - m, -w->l));
+  const V along = (ac * ct + as * st) * hc - (bc * ct + bs * st) * hs;
+  w->phase = select(along < 0.0, select(half > 0.0, half - 3.141592653589793, half + 3.141592653589793), half);
+}
+
+/// computeWave's numbers stand for the sample: they are within the range its arithmetic assumes (a
+/// sample outside it gets the general path).
+inline bool waveComputable(const WaveLanes<double>& w) {
+  return w.e < 1e150 && w.e > 1e-140 && fastAtan2Applies(w.s, w.r) && fastAtan2Applies(-w.l, w.m);
+}
+
+inline void store(const WaveLanes<double>& w, WaveState* state) {
+  WaveState& out = *state;
+  out.theta = w.theta;
+  out.amplitude = w.amplitude;
+  out.quadrature = w.quadrature;
+  out.phase = w.phase;
+  out.energy = w.e;
+  out.quadrature_product = w.q;
+  out.cos_component = w.r;
+  out.sin_component = w.s;
+  out.phase_error = w.l;
+  out.cos_theta = w.cos_theta;
+  out.sin_theta = w.sin_theta;
+}
+
+/// The wave state of finite amplitudes so large or small that computeWave's arithmetic would
+/// overflow or lose digits: computeWave on the amplitudes scaled by a power of two (exact), the
+/// results scaled back. Not a hot path.
+WaveStatus estimateWaveGeneral(double ac, double bc, double as, double bs, const WaveLimits& limits, WaveState* state);
+
+}  // namespace wave_detail
+
+/// Fills *state (when the status is kOk) from the channel amplitudes. Inline: it is most of the
+/// per-sample step.
+inline WaveStatus estimateWave(const ChannelVector& z, const WaveLimits& limits, WaveState* state) {
+  const double ac = z[kAc], bc = z[kBc], as = z[kAs], bs = z[kBs];
+  wave_detail::WaveLanes<double> w;
+  wave_detail::computeWave(ac, bc, as, bs, &w);
+  if (!std::isfinite(w.e)) {
+    // Any NaN or infinite component; else finite amplitudes so huge (1e300) that their energy
+    // overflows: those are a value out of range, not a non-finite input.
+    const bool finite = std::isfinite(ac) && std::isfinite(bc) && std::isfinite(as) && std::isfinite(bs);
+    return finite ? WaveStatus::kAmplitudeOutOfRange : WaveStatus::kNonFinite;
+  }
+  if (w.e <= limits.min_energy) return WaveStatus::kNoSignal;
+  if (!wave_detail::waveComputable(w)) {
+    return wave_detail::estimateWaveGeneral(ac, bc, as, bs, limits, state);
+  }
+  if (!(w.h > limits.min_anisotropy * w.e)) return WaveStatus::kDegenerate;
+  if (w.amplitude < limits.min_amplitude || w.amplitude > limits.max_amplitude) {
+    return WaveStatus::kAmplitudeOutOfRange;
+  }
+  wave_detail::store(w, state);
+  return WaveStatus::kOk;
+}
+
+/// estimateWave for n samples at once, four lanes at a time (AVX2 where the CPU has it, chosen at
+/// run time): statuses[i] and states[i] are bit for bit what estimateWave(z[i]) gives.
+void estimateWaves(const ChannelVector* z, std::size_t n, const WaveLimits& limits, WaveState* states,
+                   WaveStatus* statuses);
 
 }  // namespace core
 }  // namespace hrg_gyro

@@ -1,0 +1,67 @@
+// Several doubles handled as one value (the GCC/Clang vector extensions), and the handful of
+// elementwise operations the per-sample arithmetic needs, written once for a plain double and for
+// lanes. A function templated on the lane type then computes every lane with the same sequence of
+// correctly rounded operations as the scalar instance (no fused multiply-add: the core is built with
+// -ffp-contract=off), so the batch path and the one-sample path give the same bits.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+namespace hrg_gyro {
+namespace core {
+
+typedef double DoubleLanes2 __attribute__((vector_size(16)));
+typedef double DoubleLanes4 __attribute__((vector_size(32)));
+
+/// x in every lane (x itself for a double).
+template <class V>
+inline V splat(double x) {
+  return V{} + x;
+}
+template <>
+inline double splat<double>(double x) {
+  return x;
+}
+
+/// mask ? a : b, lane by lane (a mask is what a lane comparison returns).
+template <class M, class V>
+inline V select(M mask, V a, V b) {
+  return mask ? a : b;
+}
+
+inline double laneSqrt(double x) { return std::sqrt(x); }
+template <class V>
+inline V laneSqrt(V x) {
+  V r;
+  for (unsigned i = 0; i < sizeof(V) / sizeof(double); ++i) r[i] = std::sqrt(x[i]);
+  return r;
+}
+
+inline double laneAbs(double x) { return std::abs(x); }
+template <class V>
+inline V laneAbs(V x) {
+  typedef std::int64_t Bits __attribute__((vector_size(sizeof(V))));
+  Bits bits;
+  std::memcpy(&bits, &x, sizeof x);
+  bits &= INT64_MAX;
+  std::memcpy(&x, &bits, sizeof x);
+  return x;
+}
+
+/// |magnitude| with the sign bit of sign.
+inline double laneCopysign(double magnitude, double sign) { return std::copysign(magnitude, sign); }
+template <class V>
+inline V laneCopysign(V magnitude, V sign) {
+  typedef std::int64_t Bits __attribute__((vector_size(sizeof(V))));
+  Bits m, s;
+  std::memcpy(&m, &magnitude, sizeof m);
+  std::memcpy(&s, &sign, sizeof s);
+  m = (m & INT64_MAX) | (s & INT64_MIN);
+  std::memcpy(&magnitude, &m, sizeof m);
+  return magnitude;
+}
+
+}  // namespace core
+}  // namespace hrg_gyro
