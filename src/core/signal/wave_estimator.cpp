@@ -2,10 +2,6 @@
 
 #include <algorithm>
 
-// The lanes of four doubles are passed and returned in registers only inside this file (inline
-// helpers), so GCC's note that their calling convention differs without AVX concerns no interface.
-#pragma GCC diagnostic ignored "-Wpsabi"
-
 namespace hrg_gyro {
 namespace core {
 

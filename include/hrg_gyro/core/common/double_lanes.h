@@ -7,13 +7,20 @@
 
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 
 namespace hrg_gyro {
 namespace core {
 
-typedef double DoubleLanes2 __attribute__((vector_size(16)));
 typedef double DoubleLanes4 __attribute__((vector_size(32)));
+
+/// The integer lanes that go with a double lane type: its bits, and 32-bit indices.
+template <class V>
+struct LaneTraits;
+template <>
+struct LaneTraits<DoubleLanes4> {
+  typedef std::int64_t Bits __attribute__((vector_size(32)));
+  typedef std::int32_t Index __attribute__((vector_size(16)));
+};
 
 /// x in every lane (x itself for a double).
 template <class V>
@@ -42,25 +49,16 @@ inline V laneSqrt(V x) {
 inline double laneAbs(double x) { return std::abs(x); }
 template <class V>
 inline V laneAbs(V x) {
-  typedef std::int64_t Bits __attribute__((vector_size(sizeof(V))));
-  Bits bits;
-  std::memcpy(&bits, &x, sizeof x);
-  bits &= INT64_MAX;
-  std::memcpy(&x, &bits, sizeof x);
-  return x;
+  typedef typename LaneTraits<V>::Bits Bits;
+  return (V)((Bits)x & INT64_MAX);
 }
 
 /// |magnitude| with the sign bit of sign.
 inline double laneCopysign(double magnitude, double sign) { return std::copysign(magnitude, sign); }
 template <class V>
 inline V laneCopysign(V magnitude, V sign) {
-  typedef std::int64_t Bits __attribute__((vector_size(sizeof(V))));
-  Bits m, s;
-  std::memcpy(&m, &magnitude, sizeof m);
-  std::memcpy(&s, &sign, sizeof s);
-  m = (m & INT64_MAX) | (s & INT64_MIN);
-  std::memcpy(&magnitude, &m, sizeof m);
-  return magnitude;
+  typedef typename LaneTraits<V>::Bits Bits;
+  return (V)(((Bits)magnitude & INT64_MAX) | ((Bits)sign & INT64_MIN));
 }
 
 }  // namespace core

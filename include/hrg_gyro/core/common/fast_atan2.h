@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 
 #include "hrg_gyro/core/common/double_lanes.h"
 
@@ -24,15 +25,32 @@ inline bool fastAtan2Applies(double y, double x) {
   return sum >= 0x1p-1000 && sum <= 1.7e308;
 }
 
+/// c = k / 8 for the k nearest to 8 t (t in [0, 1]) and table[k] (9 entries), lane by lane. A t
+/// outside [0, 1] (NaN from a rejected sample's 0 / 0, whose result nobody uses) reads entry 0.
+inline void eighthNearest(double t, const double* table, double* c, double* value) {
+  double scaled = 8.0 * t + 0.5;
+  scaled = scaled >= 0.0 && scaled < 9.0 ? scaled : 0.0;
+  const int k = static_cast<int>(scaled);
+  *c = 0.125 * k;
+  *value = table[k];
+}
+template <class V>
+inline void eighthNearest(V t, const double* table, V* c, V* value) {
+  typedef typename LaneTraits<V>::Index Index;
+  V scaled = 8.0 * t + 0.5;
+  scaled = select((scaled >= 0.0) & (scaled < 9.0), scaled, splat<V>(0.0));
+  const Index k = __builtin_convertvector(scaled, Index);  // truncates, as static_cast<int>
+  *c = 0.125 * __builtin_convertvector(k, V);
+  for (unsigned i = 0; i < sizeof(V) / sizeof(double); ++i) (*value)[i] = table[k[i]];
+}
+
 /// The reduction and series alone, for operands where fastAtan2Applies (lane by lane).
 template <class V>
 inline V fastAtan2Reduced(V y, V x) {
   const V ax = laneAbs(x), ay = laneAbs(y);
   const auto swapped = ay > ax;
   const V num = select(swapped, ax, ay), den = select(swapped, ay, ax);
-  // c = the eighth nearest to num / den and base = atan(c), by comparisons rather than a division:
-  // the divider is the busiest unit of the per-sample path (square roots and divisions share it),
-  // and any c next to the ratio keeps |u| within 1/16 up to a rounding.
+  // c = the eighth nearest to num / den and atan(c) from the table.
   static constexpr double kAtanOfEighths[9] = {0.0,
                                                0.12435499454676144,
                                                0.24497866312686414,
@@ -42,12 +60,8 @@ inline V fastAtan2Reduced(V y, V x) {
                                                0.6435011087932844,
                                                0.7188299996216245,
                                                0.7853981633974483};
-  V c = splat<V>(0.0), base = splat<V>(0.0);
-  for (int k = 1; k <= 8; ++k) {
-    const auto above = num >= ((2 * k - 1) / 16.0) * den;
-    c = select(above, splat<V>(0.125 * k), c);
-    base = select(above, splat<V>(kAtanOfEighths[k]), base);
-  }
+  V c, base;
+  eighthNearest(num / den, kAtanOfEighths, &c, &base);
   const V u = (num - c * den) / (den + c * num);
   // u - u^3/3 + ... + u^13/13 with the polynomial in u^2 by Estrin's scheme: three short chains of
   // products instead of one long one.

@@ -77,27 +77,12 @@ struct WaveLanes {
   V e, r, s, h, q, l, m, theta, amplitude, quadrature, phase, cos_theta, sin_theta;
 };
 
-/// atan2 of two pairs: packed into one pair of lanes for one sample (the two chains run as one),
-/// lane by lane for lanes.
-inline void fastAtan2Twice(double y1, double x1, double y2, double x2, double* a1, double* a2) {
-  const DoubleLanes2 a = fastAtan2Reduced(DoubleLanes2{y1, y2}, DoubleLanes2{x1, x2});
-  *a1 = a[0];
-  *a2 = a[1];
-}
+/// Both of computeWave's atan2: lane by lane. (Packing the two of one sample into a pair of lanes
+/// costs more in shuffles and broadcast constants than it saves.)
 template <class V>
 inline void fastAtan2Twice(V y1, V x1, V y2, V x2, V* a1, V* a2) {
   *a1 = fastAtan2Reduced(y1, x1);
   *a2 = fastAtan2Reduced(y2, x2);
-}
-inline void sqrtTwice(double x1, double x2, double* r1, double* r2) {
-  const DoubleLanes2 r = laneSqrt(DoubleLanes2{x1, x2});
-  *r1 = r[0];
-  *r2 = r[1];
-}
-template <class V>
-inline void sqrtTwice(V x1, V x2, V* r1, V* r2) {
-  *r1 = laneSqrt(x1);
-  *r2 = laneSqrt(x2);
 }
 
 /// The wave state of (corrected) channel amplitudes, valid where waveComputable() holds; the
@@ -122,8 +107,8 @@ inline void computeWave(V ac, V bc, V as, V bs, WaveLanes<V>* w) {
   const V h = laneSqrt(w->r * w->r + w->s * w->s);
   w->h = h;
   const V half_difference = 0.5 * (w->e - h);
-  V b;
-  sqrtTwice(0.5 * (w->e + h), select(0.0 < half_difference, half_difference, splat<V>(0.0)), &w->amplitude, &b);
+  w->amplitude = laneSqrt(0.5 * (w->e + h));
+  const V b = laneSqrt(select(0.0 < half_difference, half_difference, splat<V>(0.0)));
   w->quadrature = laneCopysign(b, w->q);
   // (cos th, sin th) up to a positive factor, from the half-angle identities
   // tan th = s / (h + r) = (h - r) / s, taking the better-conditioned one: no trigonometry.
