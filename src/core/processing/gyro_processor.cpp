@@ -139,10 +139,11 @@ inline void GyroProcessor::anchor(const ChannelSample& in, WaveState* wave, Proc
   unwrapper_.accept(wave->theta, half_turns);
   wave->rebase(theta, half_turns);
   remember(in, *wave);
+  const WaveState w = *wave;  // *wave may be r->wave, which the reset below clears
   *r = ProcessorResult();
   r->verdict = SampleVerdict::kFirst;
   r->has_wave = true;
-  r->wave = *wave;
+  r->wave = w;
   r->alpha = alpha_;
 }
 
@@ -242,7 +243,7 @@ __attribute__((always_inline)) inline void GyroProcessor::advance(const ChannelS
   r.verdict = SampleVerdict::kAccepted;
   r.wave_status = WaveStatus::kOk;
   r.has_wave = true;
-  r.wave = wave;
+  if (&r.wave != &wave) r.wave = wave;
   r.has_output = true;
   r.alpha = alpha_;
   r.flags = flags;
@@ -258,9 +259,10 @@ ProcessorResult GyroProcessor::process(const ChannelSample& in) {
 }
 
 void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
-  WaveState wave;
-  const WaveStatus status = estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &wave);
-  advance(in, status, &wave, result);
+  // The wave state is estimated straight into the result (a rejection resets it there).
+  const WaveStatus status =
+      estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &result->wave);
+  advance(in, status, &result->wave, result);
 }
 
 void GyroProcessor::processBatch(const ChannelSample* in, std::size_t n, ProcessorResult* out) {

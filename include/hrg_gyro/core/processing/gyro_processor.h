@@ -117,7 +117,8 @@ class GyroProcessor {
  private:
   void countRejection(WaveStatus status);
   /// Everything after the wave estimate, in order (the estimate depends on the sample alone, so
-  /// processBatch computes a block of them ahead): status is estimateWave's on (E - P) z.
+  /// processBatch computes a block of them ahead): status is estimateWave's on (E - P) z, and wave
+  /// may be result->wave itself.
   void advance(const ChannelSample& in, WaveStatus status, WaveState* wave, ProcessorResult* result);
   // The phases of process(), in its order.
   /// Counts a rejected sample toward the next output's rejected_before.
