@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -22,6 +23,7 @@
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "reused_message_reader.h"
+#include "serial_worker.h"
 
 namespace hrg_gyro {
 namespace bag_tools {
@@ -263,25 +265,55 @@ void checkProcessorConfig(const core::ProcessorConfig& config) {
   }
 }
 
+namespace {
+
+// A run of input messages on its way from the reader to the processor and the sink.
+struct ReplayBlock {
+  static constexpr std::size_t kSize = 4096;
+  std::vector<ChannelAmplitudes> messages = std::vector<ChannelAmplitudes>(kSize);
+  std::vector<core::ChannelSample> samples = std::vector<core::ChannelSample>(kSize);
+  std::vector<core::ProcessorResult> results = std::vector<core::ProcessorResult>(kSize);
+  std::size_t count = 0;
+};
+
+}  // namespace
+
 std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, core::GyroProcessor& processor,
                              const std::function<void(const ChannelAmplitudes&, const core::ProcessorResult&)>& sink,
                              const std::string& progress_label) {
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   Progress progress(progress_label, view.size());
-  // One message, deserialised into again and again: no allocation per sample.
+  // Two stages on two threads: this one reads the bag (the part no faster way of the rosbag API
+  // avoids) into blocks of reused messages; the worker processes each block with processBatch (bit
+  // for bit one process() per sample, in order) and hands every result to the sink. A ring of three
+  // blocks: with at most one block waiting for the worker, the block being filled is never one the
+  // worker still reads (the one before the waiting one has finished when submit returns).
+  std::array<ReplayBlock, 3> blocks;
+  SerialWorker worker(1);  // declared after the blocks: stopped before they go
+  const auto submit = [&](ReplayBlock* block) {
+    worker.submit([block, &processor, &sink] {
+      for (std::size_t i = 0; i < block->count; ++i) block->samples[i] = fromMessage(block->messages[i]);
+      processor.processBatch(block->samples.data(), block->count, block->results.data());
+      for (std::size_t i = 0; i < block->count; ++i) sink(block->messages[i], block->results[i]);
+    });
+  };
   ReusedMessageReader<ChannelAmplitudes> reader;
-  ChannelAmplitudes msg;
-  // One result written in place: process() by value would zero-fill a fresh one per sample first.
-  core::ProcessorResult result;
+  std::size_t filling = 0;
   std::uint64_t n = 0;
   try {
     for (const rosbag::MessageInstance& m : view) {
-      if (!reader.read(m, &msg)) continue;
-      processor.process(fromMessage(msg), &result);
-      sink(msg, result);
+      ReplayBlock& block = blocks[filling];
+      if (!reader.read(m, &block.messages[block.count])) continue;
       ++n;
-      if (n % 4096 == 0) progress.update(n, n);  // the clock read not on every sample
+      if (++block.count == ReplayBlock::kSize) {
+        submit(&block);
+        filling = (filling + 1) % blocks.size();
+        blocks[filling].count = 0;
+        progress.update(n, n);
+      }
     }
+    if (blocks[filling].count > 0) submit(&blocks[filling]);
+    worker.finish();  // rethrows what the processing or the sink threw
   } catch (const rosbag::BagException& e) {
     throw UsageError(std::string("bag read error after ") + std::to_string(n) + " samples (truncated?): " + e.what());
   } catch (const ros::serialization::StreamOverrunException& e) {

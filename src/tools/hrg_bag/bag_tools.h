@@ -144,7 +144,8 @@ class OutputText {
 };
 
 /// Replays the channels topic of `bag` in record order through `processor`, calling `sink` with
-/// every input message and its result.
+/// every input message and its result, in order, on a second thread (while this one reads on): the
+/// sink may keep its own state but must not share it with the caller until the call returns.
 std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, core::GyroProcessor& processor,
                              const std::function<void(const ChannelAmplitudes&, const core::ProcessorResult&)>& sink,
                              const std::string& progress_label);

@@ -1,9 +1,13 @@
 // hrg_bag process: the processor offline. The same core::GyroProcessor and the same message
 // conversions as the node, so the output is bit for bit the node's on the same input.
+#include <array>
 #include <charconv>
+#include <condition_variable>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <mutex>
+#include <vector>
 
 #include "../cli_checks.h"
 #include "bag_tools.h"
@@ -34,132 +38,192 @@ const char* verdictName(const core::ProcessorResult& r) {
   return "unknown";
 }
 
-// CSV text, appended to one large buffer that is written out in pieces of about a megabyte (no
-// per-row stream call, no flush). Numbers in the shortest form that reads back to the same double
-// (std::to_chars), several times faster than printf's %.17g and just as exact.
+// CSV text of a batch of rows, formatted straight into one growing buffer (no per-field string or
+// stream call). Numbers in the shortest form that reads back to the same double (std::to_chars),
+// several times faster than printf's %.17g and just as exact.
 class CsvText {
  public:
-  explicit CsvText(std::ostream& out) : out_(out) { text_.reserve(kFlushSize + 4096); }
+  void clear() { used_ = 0; }
+  const char* data() const { return buffer_.data(); }
+  std::size_t size() const { return used_; }
+  /// Room for one row (at most 19 fields of 32 characters) at the end of the buffer.
+  void beginRow() {
+    if (buffer_.size() < used_ + kRowRoom) buffer_.resize(2 * (used_ + kRowRoom));
+    cursor_ = buffer_.data() + used_;
+    first_ = true;
+  }
   void number(double v, bool present = true) {
     separator();
-    if (present) append(std::to_chars(scratch_, scratch_ + sizeof scratch_, v).ptr);
+    if (present) cursor_ = std::to_chars(cursor_, cursor_ + 32, v).ptr;
   }
   void integer(std::uint64_t v) {
     separator();
-    append(std::to_chars(scratch_, scratch_ + sizeof scratch_, v).ptr);
+    cursor_ = std::to_chars(cursor_, cursor_ + 32, v).ptr;
   }
   /// sec.nsec with nine digits after the point, as printf's "%u.%09u".
   void stamp(std::uint32_t sec, std::uint32_t nsec) {
     separator();
     if (nsec >= 1000000000u) {  // not normalised: printf's own form, as many digits as it takes
-      append(scratch_ + std::snprintf(scratch_, sizeof scratch_, "%u.%09u", sec, nsec));
+      cursor_ += std::snprintf(cursor_, 32, "%u.%09u", sec, nsec);
       return;
     }
-    char* end = std::to_chars(scratch_, scratch_ + sizeof scratch_, sec).ptr;
-    *end++ = '.';
-    for (int digit = 8; digit >= 0; --digit, nsec /= 10) end[digit] = static_cast<char>('0' + nsec % 10);
-    append(end + 9);
+    cursor_ = std::to_chars(cursor_, cursor_ + 16, sec).ptr;
+    *cursor_++ = '.';
+    for (int digit = 8; digit >= 0; --digit, nsec /= 10) cursor_[digit] = static_cast<char>('0' + nsec % 10);
+    cursor_ += 9;
   }
   void text(const char* t) {
     separator();
-    text_ += t;
+    while (*t != '\0') *cursor_++ = *t++;
   }
   void endRow() {
-    text_ += '\n';
-    first_ = true;
-    if (text_.size() >= kFlushSize) flush();
-  }
-  void flush() {
-    out_.write(text_.data(), static_cast<std::streamsize>(text_.size()));
-    text_.clear();
+    *cursor_++ = '\n';
+    used_ = static_cast<std::size_t>(cursor_ - buffer_.data());
   }
 
  private:
-  static constexpr std::size_t kFlushSize = 1u << 20;
+  static constexpr std::size_t kRowRoom = 19 * 33 + 1;
   void separator() {
-    if (!first_) text_ += ',';
+    if (!first_) *cursor_++ = ',';
     first_ = false;
   }
-  void append(const char* end) { text_.append(scratch_, static_cast<std::size_t>(end - scratch_)); }
 
-  std::ostream& out_;
-  std::string text_;
-  char scratch_[32];
+  std::string buffer_;
+  std::size_t used_ = 0;
+  char* cursor_ = nullptr;
   bool first_ = true;
 };
 
-// The numbers of one CSV row, kept as they are until the worker formats them.
+// The numbers of one CSV row, kept as they are until a formatter thread formats them.
 struct CsvRow {
   std::uint32_t sec, nsec, seq;
   const char* status;
   bool has_output, has_wave;
-  GyroOutput output;  // meaningful when has_output
-  double alpha;       // meaningful when has_wave
+  double dt, dtheta, dalpha, dalpha_earth_fixed, rate, theta_mid, frequency, scale_factor, drift;  // has_output
+  std::uint32_t rejected_before;
+  std::uint8_t flags;
+  double alpha;  // meaningful when has_wave
   double theta, amplitude, quadrature, phase;
 };
 
-// The CSV output of process: rows are collected in batches, and a background thread formats and
-// writes each batch while the next is processed (formatting costs about as much as reading).
+// The CSV output of process: rows are collected in batches, and two background threads format
+// alternate batches (formatting costs about twice what reading does) and write them in order.
 class CsvOutput {
  public:
-  explicit CsvOutput(std::ostream& out) : text_(out) { rows_.reserve(kBatch); }
+  explicit CsvOutput(std::ostream& out) : out_(out) { rows_ = takeBatch(); }
+  /// An abandoned output (an error elsewhere): a formatter waiting for its turn gives up.
+  ~CsvOutput() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    failed_ = true;
+    written_turn_.notify_all();
+  }
+  CsvOutput(const CsvOutput&) = delete;
+  CsvOutput& operator=(const CsvOutput&) = delete;
   CsvRow& next() {
-    rows_.emplace_back();
-    return rows_.back();
+    rows_->emplace_back();
+    return rows_->back();
   }
   void endRow() {
-    if (rows_.size() >= kBatch) submit();
+    if (rows_->size() >= kBatch) submit();
   }
   /// Formats and writes the rest; rethrows what a batch threw.
   void finish() {
     submit();
-    worker_.submit([this] { text_.flush(); });
-    worker_.finish();
+    for (Formatter& f : formatters_) f.worker.finish();
   }
 
  private:
-  static constexpr std::size_t kBatch = 8192;
-  void submit() {
-    if (rows_.empty()) return;
-    auto batch = std::make_shared<std::vector<CsvRow>>(std::move(rows_));
-    rows_ = std::vector<CsvRow>();
-    rows_.reserve(kBatch);
-    worker_.submit([this, batch] {
-      for (const CsvRow& r : *batch) format(r);
-    });
-  }
-  void format(const CsvRow& r) {
-    const bool o = r.has_output, w = r.has_wave;
-    text_.stamp(r.sec, r.nsec);
-    text_.integer(r.seq);
-    text_.text(r.status);
-    text_.number(r.output.dt, o);
-    text_.number(r.output.dtheta, o);
-    text_.number(r.output.dalpha, o);
-    text_.number(r.output.dalpha_earth_fixed, o);
-    text_.number(r.alpha, w);
-    text_.number(r.output.rate, o);
-    text_.number(r.output.theta_mid, o);
-    text_.number(r.output.frequency, o);
-    text_.number(r.output.scale_factor, o);
-    text_.number(r.output.drift, o);
-    if (o) {
-      text_.integer(r.output.rejected_before);
-      text_.integer(r.output.flags);
-    } else {
-      text_.text("");
-      text_.text("");
+  static constexpr std::size_t kBatch = 4096;
+  struct Formatter {
+    CsvText text;  // used by its worker only
+    bag_tools::SerialWorker worker{1};
+  };
+
+  std::unique_ptr<std::vector<CsvRow>> takeBatch() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (free_.empty()) {
+      auto batch = std::make_unique<std::vector<CsvRow>>();
+      batch->reserve(kBatch);
+      return batch;
     }
-    text_.number(r.theta, w);
-    text_.number(r.amplitude, w);
-    text_.number(r.quadrature, w);
-    text_.number(r.phase, w);
-    text_.endRow();
+    std::unique_ptr<std::vector<CsvRow>> batch = std::move(free_.back());
+    free_.pop_back();
+    return batch;
   }
 
-  CsvText text_;  // used by the worker only
-  std::vector<CsvRow> rows_;
-  bag_tools::SerialWorker worker_;  // last: stopped first
+  void submit() {
+    if (rows_->empty()) return;
+    const std::uint64_t index = submitted_++;
+    Formatter& f = formatters_[index % 2];
+    std::vector<CsvRow>* batch = rows_.release();
+    rows_ = takeBatch();
+    f.worker.submit([this, &f, batch, index] {
+      std::unique_ptr<std::vector<CsvRow>> rows(batch);
+      std::exception_ptr error;
+      try {
+        f.text.clear();
+        for (const CsvRow& r : *rows) format(r, &f.text);
+      } catch (...) {
+        error = std::current_exception();
+      }
+      // Written in batch order; after a failure (whose worker drops its later batches) nothing more
+      // is written and nobody waits for a turn that will not come.
+      std::unique_lock<std::mutex> lock(mutex_);
+      written_turn_.wait(lock, [&] { return next_to_write_ == index || failed_; });
+      if (!error && !failed_) {
+        try {
+          out_.write(f.text.data(), static_cast<std::streamsize>(f.text.size()));
+        } catch (...) {
+          error = std::current_exception();
+        }
+      }
+      ++next_to_write_;
+      if (error) failed_ = true;
+      rows->clear();
+      free_.push_back(std::move(rows));
+      written_turn_.notify_all();
+      if (error) std::rethrow_exception(error);
+    });
+  }
+
+  static void format(const CsvRow& r, CsvText* text) {
+    const bool o = r.has_output, w = r.has_wave;
+    text->beginRow();
+    text->stamp(r.sec, r.nsec);
+    text->integer(r.seq);
+    text->text(r.status);
+    text->number(r.dt, o);
+    text->number(r.dtheta, o);
+    text->number(r.dalpha, o);
+    text->number(r.dalpha_earth_fixed, o);
+    text->number(r.alpha, w);
+    text->number(r.rate, o);
+    text->number(r.theta_mid, o);
+    text->number(r.frequency, o);
+    text->number(r.scale_factor, o);
+    text->number(r.drift, o);
+    if (o) {
+      text->integer(r.rejected_before);
+      text->integer(r.flags);
+    } else {
+      text->text("");
+      text->text("");
+    }
+    text->number(r.theta, w);
+    text->number(r.amplitude, w);
+    text->number(r.quadrature, w);
+    text->number(r.phase, w);
+    text->endRow();
+  }
+
+  std::ostream& out_;
+  std::mutex mutex_;  // guards free_, next_to_write_ and failed_
+  std::condition_variable written_turn_;
+  std::vector<std::unique_ptr<std::vector<CsvRow>>> free_;
+  std::uint64_t next_to_write_ = 0, submitted_ = 0;
+  bool failed_ = false;
+  std::unique_ptr<std::vector<CsvRow>> rows_;
+  std::array<Formatter, 2> formatters_;  // last: their threads stop first
 };
 
 struct ProcessOptions {
@@ -207,7 +271,17 @@ int runProcess(const ProcessOptions& o) {
           c.status = verdictName(r);
           c.has_output = r.has_output;
           c.has_wave = r.has_wave;
-          c.output = output;
+          c.dt = output.dt;
+          c.dtheta = output.dtheta;
+          c.dalpha = output.dalpha;
+          c.dalpha_earth_fixed = output.dalpha_earth_fixed;
+          c.rate = output.rate;
+          c.theta_mid = output.theta_mid;
+          c.frequency = output.frequency;
+          c.scale_factor = output.scale_factor;
+          c.drift = output.drift;
+          c.rejected_before = output.rejected_before;
+          c.flags = output.flags;
           c.alpha = r.alpha;
           c.theta = wave.theta;
           c.amplitude = wave.amplitude;

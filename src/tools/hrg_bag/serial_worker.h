@@ -5,6 +5,10 @@
 // rethrown, with its type, by the next submit() or finish(); later jobs are then skipped.
 #pragma once
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <condition_variable>
 #include <deque>
 #include <exception>
@@ -17,7 +21,13 @@ namespace bag_tools {
 
 class SerialWorker {
  public:
-  explicit SerialWorker(std::size_t max_pending = 2) : max_pending_(max_pending), thread_([this] { run(); }) {}
+  explicit SerialWorker(std::size_t max_pending = 2)
+      : max_pending_(max_pending), thread_([this] {
+          // Below the thread that reads the input: on two cores the reader is the stage every other one
+          // waits for, so when the stages outnumber the cores it is the one that keeps its core.
+          ::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), kNiceness);
+          run();
+        }) {}
   /// Waits for the running job; the jobs still waiting are dropped (an abandoned output).
   ~SerialWorker() {
     {
@@ -47,6 +57,7 @@ class SerialWorker {
   }
 
  private:
+  static constexpr int kNiceness = 5;
   void rethrow() {
     if (error_) std::rethrow_exception(error_);
   }
