@@ -10,14 +10,12 @@
 // linearChannelMap() gives that map on Z so tests can check that the correction matrix P inverts it.
 #pragma once
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include <Eigen/Core>
 #include <array>
+#include <cstring>
 #include <limits>
 
+#include "hrg_gyro/core/common/double_lanes.h"
 #include "hrg_gyro/core/model/wave_parameters.h"
 
 namespace hrg_gyro {
@@ -61,25 +59,20 @@ class PickoffArray {
   /// for which sensor i reads r_i = cos(2 psi_i) x + sin(2 psi_i) y (psi_i its true position).
   void channels(double x, double y, double* c, double* s) const {
     // Channel-major copies of the sensor constants (c sensors 0, 2, 4, 6, then s sensors 1, 3, 5,
-    // 7): the eight independent divisions go two per SSE2 instruction, with the same IEEE results.
-    alignas(16) double t[8];
-#if defined(__SSE2__)
-    const __m128d xv = _mm_set1_pd(x), yv = _mm_set1_pd(y), one = _mm_set1_pd(1.0), g = _mm_set1_pd(inv_gap_);
-    for (int q = 0; q < 8; q += 2) {
-      const __m128d r =
-          _mm_add_pd(_mm_mul_pd(_mm_load_pd(channel_cos_ + q), xv), _mm_mul_pd(_mm_load_pd(channel_sin_ + q), yv));
-      _mm_store_pd(t + q,
-                   _mm_div_pd(_mm_mul_pd(_mm_load_pd(channel_weight_ + q), r), _mm_sub_pd(one, _mm_mul_pd(r, g))));
+    // 7): the eight independent divisions go four per lane operation (two SSE2 instructions, or one
+    // AVX one in the simulator's AVX2 build), with the same IEEE results as one at a time.
+    DoubleLanes4 t[2];
+    for (int q = 0; q < 2; ++q) {
+      DoubleLanes4 cos2psi, sin2psi, weight;
+      std::memcpy(&cos2psi, channel_cos_ + 4 * q, sizeof cos2psi);
+      std::memcpy(&sin2psi, channel_sin_ + 4 * q, sizeof sin2psi);
+      std::memcpy(&weight, channel_weight_ + 4 * q, sizeof weight);
+      const DoubleLanes4 r = cos2psi * x + sin2psi * y;
+      t[q] = weight * r / (1.0 - r * inv_gap_);
     }
-#else
-    for (int q = 0; q < 8; ++q) {
-      const double r = channel_cos_[q] * x + channel_sin_[q] * y;
-      t[q] = channel_weight_[q] * r / (1.0 - r * inv_gap_);
-    }
-#endif
     // Summed in sensor order, as the definition reads.
-    *c = ((t[0] + t[1]) + t[2]) + t[3];
-    *s = ((t[4] + t[5]) + t[6]) + t[7];
+    *c = ((t[0][0] + t[0][1]) + t[0][2]) + t[0][3];
+    *s = ((t[1][0] + t[1][1]) + t[1][2]) + t[1][3];
   }
 
   /// Standard deviation of the noise of one channel sample: four independent sensor noises of sigma,
@@ -94,9 +87,9 @@ class PickoffArray {
  private:
   PickoffDefects defects_;
   std::array<double, kPickoffCount> cos2psi_{}, sin2psi_{}, weight_{};
-  alignas(16) double channel_cos_[8] = {};
-  alignas(16) double channel_sin_[8] = {};
-  alignas(16) double channel_weight_[8] = {};
+  alignas(32) double channel_cos_[8] = {};
+  alignas(32) double channel_sin_[8] = {};
+  alignas(32) double channel_weight_[8] = {};
   double inv_gap_ = 0.0;
 };
 

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "hrg_gyro/core/model/wave_parameters.h"
 #include "hrg_gyro/core/signal/pickoff_array.h"
@@ -38,6 +39,7 @@ class SignalSynthesizer {
   PickoffArray pickoffs_;
   SynchronousDemodulator demodulator_;
   GaussianNoise noise_;
+  std::vector<double> noise_buffer_;                                    // one period's deviates
   double carrier_phase_ = 0.0, carrier_cos_ = 1.0, carrier_sin_ = 0.0;  // tau and its cos, sin
 };
 
