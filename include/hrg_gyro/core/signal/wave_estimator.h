@@ -160,7 +160,8 @@ WaveStatus estimateWaveGeneral(double ac, double bc, double as, double bs, const
 
 /// Fills *state (when the status is kOk) from the channel amplitudes. Inline: it is most of the
 /// per-sample step.
-inline WaveStatus estimateWave(const ChannelVector& z, const WaveLimits& limits, WaveState* state) {
+__attribute__((always_inline)) inline WaveStatus estimateWave(const ChannelVector& z, const WaveLimits& limits,
+                                                            WaveState* state) {
   const double ac = z[kAc], bc = z[kBc], as = z[kAs], bs = z[kBs];
   wave_detail::WaveLanes<double> w;
   wave_detail::computeWave(ac, bc, as, bs, &w);

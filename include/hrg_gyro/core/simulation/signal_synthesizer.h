@@ -4,9 +4,9 @@
 // Within the period the wave angle moves linearly from the value at the period start to the value
 // at its end (A, B and tau are held); sample j is taken at t0 + (j + 1/2) T / N, carrier phase
 // 2 pi (j + 1/2) / N. Noise is drawn per channel sample (see PickoffArray::channelNoiseSigma) from
-// a seeded generator, so a run is reproducible bit for bit. It is the polar method: the ziggurat
-// (GaussianNoise::Method::kZiggurat) would make the simulator ~1.5x faster (250x instead of 170x
-// real time at 5 kHz, 32 samples/period, 1 kHz output), but it draws another noise realisation for
+// a seeded generator, so a run is reproducible bit for bit; a period's deviates are drawn in one go
+// (GaussianNoise::fill, the same stream). It is the polar method: the ziggurat
+// (GaussianNoise::Method::kZiggurat) is cheaper still, but it draws another noise realisation for
 // every shipped scenario and seed, and the documented figures of `make run` and the tests were
 // measured on this one; switching is a deliberate, separately measured change.
 #pragma once
