@@ -161,7 +161,7 @@ WaveStatus estimateWaveGeneral(double ac, double bc, double as, double bs, const
 /// Fills *state (when the status is kOk) from the channel amplitudes. Inline: it is most of the
 /// per-sample step.
 __attribute__((always_inline)) inline WaveStatus estimateWave(const ChannelVector& z, const WaveLimits& limits,
-                                                            WaveState* state) {
+                                                              WaveState* state) {
   const double ac = z[kAc], bc = z[kBc], as = z[kAs], bs = z[kBs];
   wave_detail::WaveLanes<double> w;
   wave_detail::computeWave(ac, bc, as, bs, &w);
