@@ -36,19 +36,20 @@ ModelPairEvaluator::ModelPairEvaluator(const HarmonicModel& k, const HarmonicMod
 void ModelPairEvaluator::refresh(double frequency) {
   k_->coefficientsAt(frequency, k_coefficients_.data());
   d_->coefficientsAt(frequency, d_coefficients_.data());
-  const std::size_t basis_orders = static_cast<std::size_t>(basis_.step() == 0 ? 0 : basis_.maxOrder() / basis_.step());
-  dense_.assign(4 * basis_orders, 0.0);
-  const auto spread = [&](const std::vector<double>& coefficients, const std::vector<int>& indices, int offset) {
+  const int basis_orders = basis_.step() == 0 ? 0 : basis_.maxOrder() / basis_.step();
+  dense_.assign(2 * static_cast<std::size_t>(basis_orders), DoubleLanes2{0.0, 0.0});
+  dense_orders_ = basis_orders;
+  const auto spread = [&](const std::vector<double>& coefficients, const std::vector<int>& indices, int lane) {
     const std::size_t n = indices.size();
     for (std::size_t i = 0; i < n; ++i) {
       if (indices[i] < 1) continue;  // order 0 lives in the mean
-      double* slot = &dense_[4 * (indices[i] - 1) + offset];
-      slot[0] += coefficients[1 + i];
-      slot[1] += coefficients[1 + n + i];
+      DoubleLanes2* slot = &dense_[2 * static_cast<std::size_t>(indices[i] - 1)];
+      slot[0][lane] += coefficients[1 + i];
+      slot[1][lane] += coefficients[1 + n + i];
     }
   };
   spread(k_coefficients_, k_indices_, 0);
-  spread(d_coefficients_, d_indices_, 2);
+  spread(d_coefficients_, d_indices_, 1);
   cached_frequency_ = frequency;
   cached_is_nan_ = std::isnan(frequency);
 }

@@ -11,6 +11,7 @@
 namespace hrg_gyro {
 namespace core {
 
+typedef double DoubleLanes2 __attribute__((vector_size(16)));
 typedef double DoubleLanes4 __attribute__((vector_size(32)));
 
 /// The integer lanes that go with a double lane type: its bits, and 32-bit indices.

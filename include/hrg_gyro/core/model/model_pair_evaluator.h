@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "hrg_gyro/core/common/double_lanes.h"
 #include "hrg_gyro/core/model/harmonic_model.h"
 
 namespace hrg_gyro {
@@ -47,19 +48,19 @@ class ModelPairEvaluator {
       s1 = s1 * c2 + c1 * s2;
       c1 = c;
     }
-    double k_sum = k_coefficients_[0], d_sum = d_coefficients_[0];
+    // K's and D's sums side by side in one pair of lanes: the same operations on each as two
+    // scalar sums, half the instructions.
+    DoubleLanes2 sums = {k_coefficients_[0], d_coefficients_[0]};
     double c = c1, s = s1;
-    const double* t = dense_.data();
-    const std::size_t orders = dense_.size() / 4;
-    for (std::size_t m = 0; m < orders; ++m, t += 4) {
-      k_sum += t[0] * c + t[1] * s;
-      d_sum += t[2] * c + t[3] * s;
+    const DoubleLanes2* t = dense_.data();
+    for (int m = 0; m < dense_orders_; ++m, t += 2) {
+      sums += t[0] * c + t[1] * s;
       const double next = c * c1 - s * s1;
       s = s * c1 + c * s1;
       c = next;
     }
-    *k = k_sum;
-    *d = d_sum;
+    *k = sums[0];
+    *d = sums[1];
   }
 
  private:
@@ -80,8 +81,10 @@ class ModelPairEvaluator {
   HarmonicBasis basis_;
   std::vector<double> k_coefficients_, d_coefficients_;
   std::vector<int> k_indices_, d_indices_;  // basis index of each order
-  // For basis index m = 1, 2, ...: K's cos and sin coefficients, then D's (zero for an absent order).
-  std::vector<double> dense_;
+  // For basis index m = 1, 2, ...: the cos coefficients of (K, D), then their sin coefficients (zero
+  // for an absent order).
+  std::vector<DoubleLanes2> dense_;
+  int dense_orders_ = 0;
   bool frequency_dependent_;
   double cached_frequency_ = 0.0;
   bool cached_is_nan_ = false;
