@@ -17,7 +17,13 @@ HarmonicBasis::HarmonicBasis(int step, int max_order) : step_(step), max_order_(
 void HarmonicBasis::evaluate(double theta) {
   const std::size_t n = cos_.size();
   if (n < 2) return;
-  fillFrom(std::cos(step_ * theta), std::sin(step_ * theta));
+  const double c1 = std::cos(step_ * theta), s1 = std::sin(step_ * theta);
+  cos_[1] = c1;
+  sin_[1] = s1;
+  for (std::size_t m = 2; m < n; ++m) {
+    cos_[m] = cos_[m - 1] * c1 - sin_[m - 1] * s1;
+    sin_[m] = sin_[m - 1] * c1 + cos_[m - 1] * s1;
+  }
 }
 
 }  // namespace core

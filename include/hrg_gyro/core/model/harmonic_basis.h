@@ -5,7 +5,6 @@
 // is one sincos plus two multiply-adds per order instead of one sincos per order.
 #pragma once
 
-#include <cstddef>
 #include <vector>
 
 namespace hrg_gyro {
@@ -18,24 +17,6 @@ class HarmonicBasis {
   HarmonicBasis(int step, int max_order);
 
   void evaluate(double theta);
-  /// The same from c2 = cos 2 theta, s2 = sin 2 theta (exact; no trigonometry) when every order is
-  /// even; otherwise falls back to evaluate(theta). Inline: the processor calls it for every sample.
-  void evaluate(double theta, double c2, double s2) {
-    const std::size_t n = cos_.size();
-    if (n < 2) return;
-    if (step_ % 2 != 0) {
-      evaluate(theta);
-      return;
-    }
-    // (c1, s1) = (c2, s2)^(step / 2) as a complex power.
-    double c1 = c2, s1 = s2;
-    for (int p = 2; p <= step_ / 2; ++p) {
-      const double c = c1 * c2 - s1 * s2;
-      s1 = s1 * c2 + c1 * s2;
-      c1 = c;
-    }
-    fillFrom(c1, s1);
-  }
 
   int step() const { return step_; }
   int maxOrder() const { return max_order_; }
@@ -47,19 +28,6 @@ class HarmonicBasis {
   double sinAt(int m) const { return sin_[m]; }
 
  private:
-  /// Orders 2 step, 3 step, ... by the angle-addition recurrence from (cos, sin) of the step.
-  void fillFrom(double c1, double s1) {
-    double* c = cos_.data();
-    double* s = sin_.data();
-    const std::size_t n = cos_.size();
-    c[1] = c1;
-    s[1] = s1;
-    for (std::size_t m = 2; m < n; ++m) {
-      c[m] = c[m - 1] * c1 - s[m - 1] * s1;
-      s[m] = s[m - 1] * c1 + c[m - 1] * s1;
-    }
-  }
-
   int step_;
   int max_order_;
   std::vector<double> cos_, sin_;  // index m holds order m * step_
