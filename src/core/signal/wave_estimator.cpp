@@ -31,9 +31,8 @@ WaveStatus estimateWaveGeneral(double ac, double bc, double as, double bs, const
   computeWave(ac * down, bc * down, as * down, bs * down, &w);
   // With E >= 1 and A^2 - B^2 > min_anisotropy E, every operand is now in computeWave's range.
   if (!(w.h > limits.min_anisotropy * w.e)) return WaveStatus::kDegenerate;
-  const double amplitude = std::ldexp(w.amplitude, exponent);
-  if (amplitude < limits.min_amplitude || amplitude > limits.max_amplitude) return WaveStatus::kAmplitudeOutOfRange;
-  w.amplitude = amplitude;
+  w.amplitude = std::ldexp(w.amplitude, exponent);
+  if (!waveAcceptable(w, limits)) return WaveStatus::kAmplitudeOutOfRange;
   w.quadrature = std::ldexp(w.quadrature, exponent);
   for (double* squared : {&w.e, &w.r, &w.s, &w.q, &w.l}) *squared = std::ldexp(*squared, 2 * exponent);
   store(w, state);
@@ -61,11 +60,8 @@ __attribute__((target_clones("avx2", "default"))) void estimateWaves(const Chann
     wave_detail::computeWave(ac, bc, as, bs, &w);
     // The lanes where estimateWave would take computeWave's numbers and accept them; the others
     // (rare: rejected or extreme values) are estimated one by one.
-    const DoubleLanes4 sum_theta = laneAbs(w.r) + laneAbs(w.s), sum_tau = laneAbs(w.m) + laneAbs(w.l);
-    const auto accepted = (w.e < 1e150) & (w.e > 1e-140) & (w.e > limits.min_energy) & (sum_theta >= 0x1p-1000) &
-                          (sum_theta <= 1.7e308) & (sum_tau >= 0x1p-1000) & (sum_tau <= 1.7e308) &
-                          (w.h > limits.min_anisotropy * w.e) &
-                          ~((w.amplitude < limits.min_amplitude) | (w.amplitude > limits.max_amplitude));
+    const auto accepted =
+        wave_detail::waveComputable(w) & (w.e > limits.min_energy) & wave_detail::waveAcceptable(w, limits);
     for (std::size_t j = 0; j < kLanes; ++j) {
       if (!accepted[j]) {
         statuses[i + j] = estimateWave(z[i + j], limits, &states[i + j]);

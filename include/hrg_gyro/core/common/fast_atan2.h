@@ -19,10 +19,12 @@
 namespace hrg_gyro {
 namespace core {
 
-/// Whether fastAtan2Reduced applies to (y, x): both finite, not both zero, not extreme.
-inline bool fastAtan2Applies(double y, double x) {
-  const double sum = std::abs(x) + std::abs(y);
-  return sum >= 0x1p-1000 && sum <= 1.7e308;
+/// Whether fastAtan2Reduced applies to (y, x): both finite, not both zero, not extreme (a bool for a
+/// double, a mask for lanes).
+template <class V>
+inline auto fastAtan2Applies(V y, V x) {
+  const V sum = laneAbs(x) + laneAbs(y);
+  return (sum >= 0x1p-1000) & (sum <= 1.7e308);
 }
 
 /// c = k / 8 for the k nearest to 8 t (t in [0, 1]) and table[k] (9 entries), lane by lane. A t

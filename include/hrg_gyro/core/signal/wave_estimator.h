@@ -77,14 +77,6 @@ struct WaveLanes {
   V e, r, s, h, q, l, m, theta, amplitude, quadrature, phase, cos_theta, sin_theta;
 };
 
-/// Both of computeWave's atan2: lane by lane. (Packing the two of one sample into a pair of lanes
-/// costs more in shuffles and broadcast constants than it saves.)
-template <class V>
-inline void fastAtan2Twice(V y1, V x1, V y2, V x2, V* a1, V* a2) {
-  *a1 = fastAtan2Reduced(y1, x1);
-  *a2 = fastAtan2Reduced(y2, x2);
-}
-
 /// The wave state of (corrected) channel amplitudes, valid where waveComputable() holds; the
 /// caller checks the status conditions. Every operation is elementwise, so a lane gets the bits
 /// one sample gets.
@@ -99,9 +91,8 @@ inline void computeWave(V ac, V bc, V as, V bs, WaveLanes<V>* w) {
   // from the channels, so its atan2 runs beside theta's instead of after the square roots.
   const V m = ac * ac - bc * bc + as * as - bs * bs;
   w->m = m;
-  V theta2, tau2;
-  fastAtan2Twice(w->s, w->r, -w->l, m, &theta2, &tau2);
-  w->theta = 0.5 * theta2;
+  w->theta = 0.5 * fastAtan2Reduced(w->s, w->r);
+  const V tau2 = fastAtan2Reduced(-w->l, m);
   // A^2 - B^2. r^2 + s^2 <= e^2 neither overflows nor, unless the wave is degenerate, underflows
   // where the wave is computable (1e-140 < e < 1e150).
   const V h = laneSqrt(w->r * w->r + w->s * w->s);
@@ -131,9 +122,18 @@ inline void computeWave(V ac, V bc, V as, V bs, WaveLanes<V>* w) {
 }
 
 /// computeWave's numbers stand for the sample: they are within the range its arithmetic assumes (a
-/// sample outside it gets the general path).
-inline bool waveComputable(const WaveLanes<double>& w) {
-  return w.e < 1e150 && w.e > 1e-140 && fastAtan2Applies(w.s, w.r) && fastAtan2Applies(-w.l, w.m);
+/// sample outside it gets the general path). A bool for one sample, a mask for lanes.
+template <class V>
+inline auto waveComputable(const WaveLanes<V>& w) {
+  return (w.e < 1e150) & (w.e > 1e-140) & fastAtan2Applies(w.s, w.r) & fastAtan2Applies(-w.l, w.m);
+}
+
+/// The status checks that follow the finiteness and energy checks, on computable numbers: the
+/// wave is not degenerate and its amplitude is in range (a bool or a mask, as above).
+template <class V>
+inline auto waveAcceptable(const WaveLanes<V>& w, const WaveLimits& limits) {
+  return (w.h > limits.min_anisotropy * w.e) &
+         ((w.amplitude >= limits.min_amplitude) & (w.amplitude <= limits.max_amplitude));
 }
 
 inline void store(const WaveLanes<double>& w, WaveState* state) {
@@ -176,9 +176,7 @@ __attribute__((always_inline)) inline WaveStatus estimateWave(const ChannelVecto
     return wave_detail::estimateWaveGeneral(ac, bc, as, bs, limits, state);
   }
   if (!(w.h > limits.min_anisotropy * w.e)) return WaveStatus::kDegenerate;
-  if (w.amplitude < limits.min_amplitude || w.amplitude > limits.max_amplitude) {
-    return WaveStatus::kAmplitudeOutOfRange;
-  }
+  if (!wave_detail::waveAcceptable(w, limits)) return WaveStatus::kAmplitudeOutOfRange;
   wave_detail::store(w, state);
   return WaveStatus::kOk;
 }
