@@ -55,15 +55,9 @@ class GaussianNoise {
     double u[kPairs], v[kPairs], r2[kPairs];
     while (i < n) {
       const int pairs = std::min(kPairs, (n - i + 1) / 2);
+      for (int k = 0; k < pairs; ++k) polarPair(&u[k], &v[k], &r2[k]);
       for (int k = 0; k < pairs; ++k) {
-        do {
-          u[k] = 2.0 * uniform() - 1.0;
-          v[k] = 2.0 * uniform() - 1.0;
-          r2[k] = u[k] * u[k] + v[k] * v[k];
-        } while (r2[k] >= 1.0 || r2[k] == 0.0);
-      }
-      for (int k = 0; k < pairs; ++k) {
-        const double scale = std::sqrt(-2.0 * std::log(r2[k]) / r2[k]);
+        const double scale = polarScale(r2[k]);
         out[i++] = u[k] * scale;
         if (i < n) {
           out[i++] = v[k] * scale;
@@ -91,18 +85,25 @@ class GaussianNoise {
   }
 
  private:
+  /// The polar method's accepted point: (u, v) uniform in the unit disc without its centre, r2 = u^2 + v^2.
+  void polarPair(double* u, double* v, double* r2) {
+    do {
+      *u = 2.0 * uniform() - 1.0;
+      *v = 2.0 * uniform() - 1.0;
+      *r2 = *u * *u + *v * *v;
+    } while (*r2 >= 1.0 || *r2 == 0.0);
+  }
+  /// The factor that turns an accepted point into two independent standard normal deviates.
+  static double polarScale(double r2) { return std::sqrt(-2.0 * std::log(r2) / r2); }
+
   double nextPolar() {
     if (has_spare_) {
       has_spare_ = false;
       return spare_;
     }
     double u, v, r2;
-    do {
-      u = 2.0 * uniform() - 1.0;
-      v = 2.0 * uniform() - 1.0;
-      r2 = u * u + v * v;
-    } while (r2 >= 1.0 || r2 == 0.0);
-    const double scale = std::sqrt(-2.0 * std::log(r2) / r2);
+    polarPair(&u, &v, &r2);
+    const double scale = polarScale(r2);
     spare_ = v * scale;
     has_spare_ = true;
     return u * scale;
