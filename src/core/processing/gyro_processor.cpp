@@ -52,11 +52,9 @@ void GyroProcessor::setParameters(std::shared_ptr<const GyroParameters> paramete
   if (has_previous_ && !(compensator_.parameters().correction == old_p)) {
     WaveState w;
     if (estimateWave(compensator_.parameters().correction.apply(previous_z_), config_.limits, &w) == WaveStatus::kOk) {
-      // The branch of the re-read angle nearest to the angle reached so far.
-      const double principal = w.theta;
-      const double half_turns = roundHalfAway((unwrapper_.last() - principal) / kPi);
-      unwrapper_.accept(principal, half_turns);
-      w.rebase(unwrapper_.last(), half_turns);
+      double half_turns;
+      const double theta = unwrapper_.reanchor(w.theta, &half_turns);
+      w.rebase(theta, half_turns);
       previous_cos_ = w.cos_theta;
       previous_sin_ = w.sin_theta;
     }

@@ -30,6 +30,14 @@ class ThetaUnwrapper {
     half_turns_ = half_turns;
     last_ = principal + kPi * half_turns;
   }
+  /// After the angle has been measured another way (a new correction matrix): takes the branch of
+  /// `principal` nearest to the latest continuous angle as the new anchor; *half_turns receives its
+  /// count. Returns the continuous angle.
+  double reanchor(double principal, double* half_turns) {
+    *half_turns = roundHalfAway((last_ - principal) * kInversePi);
+    accept(principal, *half_turns);
+    return last_;
+  }
   /// peek() and accept() in one.
   double unwrap(double principal) {
     double half_turns;
