@@ -4,13 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstring>
 #include <limits>
 #include <random>
 #include <utility>
 #include <vector>
 
 #include "core/testing/faulty_channel_stream.h"
+#include "core/testing/same_bits.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 
 namespace hrg_gyro {
@@ -291,8 +291,6 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-
 // Every field of two results, bit for bit (NaN included).
 void expectIdentical(const ProcessorResult& a, const ProcessorResult& b, std::size_t i) {
   ASSERT_EQ(a.verdict, b.verdict) << i;
@@ -301,20 +299,7 @@ void expectIdentical(const ProcessorResult& a, const ProcessorResult& b, std::si
   ASSERT_EQ(a.has_output, b.has_output) << i;
   ASSERT_EQ(a.flags, b.flags) << i;
   ASSERT_EQ(a.rejected_before, b.rejected_before) << i;
-  const WaveState &w = a.wave, &v = b.wave;
-  for (auto [x, y] : {std::pair{w.theta, v.theta},
-                      {w.amplitude, v.amplitude},
-                      {w.quadrature, v.quadrature},
-                      {w.phase, v.phase},
-                      {w.energy, v.energy},
-                      {w.quadrature_product, v.quadrature_product},
-                      {w.cos_component, v.cos_component},
-                      {w.sin_component, v.sin_component},
-                      {w.phase_error, v.phase_error},
-                      {w.cos_theta, v.cos_theta},
-                      {w.sin_theta, v.sin_theta}}) {
-    ASSERT_TRUE(sameBits(x, y)) << i << ": wave " << x << " vs " << y;
-  }
+  ASSERT_TRUE(sameWaveBits(a.wave, b.wave)) << i;
   const AngleIncrement &p = a.increment, &q = b.increment;
   for (auto [x, y] : {std::pair{p.dt, q.dt},
                       {p.dtheta, q.dtheta},

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "core/testing/same_bits.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/signal/theta_unwrapper.h"
 
@@ -99,8 +100,6 @@ TEST(WaveEstimatorTest, HugeAndTinyAmplitudesGiveTheSameWaveScaled) {
   }
 }
 
-bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-
 // estimateWaves computes four samples per instruction; each must be bit for bit estimateWave's, with
 // every kind of sample side by side in one group of lanes (the processor's batch path relies on it).
 TEST(WaveEstimatorTest, BatchIsBitIdenticalToOneSampleAtATime) {
@@ -158,20 +157,7 @@ TEST(WaveEstimatorTest, BatchIsBitIdenticalToOneSampleAtATime) {
       ASSERT_EQ(statuses[i], status) << i;
       if (status != WaveStatus::kOk) continue;
       ++accepted;
-      const WaveState& b = batch[i];
-      for (const auto& [x, y] : {std::pair{b.theta, one.theta},
-                                 {b.amplitude, one.amplitude},
-                                 {b.quadrature, one.quadrature},
-                                 {b.phase, one.phase},
-                                 {b.energy, one.energy},
-                                 {b.quadrature_product, one.quadrature_product},
-                                 {b.cos_component, one.cos_component},
-                                 {b.sin_component, one.sin_component},
-                                 {b.phase_error, one.phase_error},
-                                 {b.cos_theta, one.cos_theta},
-                                 {b.sin_theta, one.sin_theta}}) {
-        ASSERT_TRUE(sameBits(x, y)) << i << ": " << x << " vs " << y;
-      }
+      ASSERT_TRUE(sameWaveBits(batch[i], one)) << i;
     }
     if (n == z.size()) {
       EXPECT_GT(accepted, 8000);
