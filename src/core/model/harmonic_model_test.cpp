@@ -3,8 +3,6 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
-
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/harmonic_basis.h"
 
@@ -96,24 +94,6 @@ TEST(HarmonicModelTest, FrequencyDependentCoefficients) {
   EXPECT_NEAR(c[2], -0.5e-3, 1e-15);
   EXPECT_NEAR(m(0.3, 5010.0), -0.54 + 3e-3 * std::cos(0.6) - 2e-3 * std::sin(0.6), 1e-15);
   EXPECT_NEAR(m.meanAt(NAN), -0.56, 1e-15);  // unknown frequency: the first node
-}
-
-TEST(HarmonicBasisTest, FromTheDoubleAngleEqualsTheTrigonometricEvaluation) {
-  // The per-sample path builds the harmonics from cos 2 theta, sin 2 theta (no sincos).
-  std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> angle(-500.0, 500.0);
-  for (int step : {1, 2, 4}) {
-    HarmonicBasis a(step, 8 * step), b(step, 8 * step);
-    for (int i = 0; i < 200; ++i) {
-      const double theta = angle(rng);
-      a.evaluate(theta);
-      b.evaluate(theta, std::cos(2.0 * theta), std::sin(2.0 * theta));
-      for (int k = step; k <= 8 * step; k += step) {
-        EXPECT_NEAR(a.cosOf(k), b.cosOf(k), 1e-12) << step << " " << k;
-        EXPECT_NEAR(a.sinOf(k), b.sinOf(k), 1e-12) << step << " " << k;
-      }
-    }
-  }
 }
 
 }  // namespace
