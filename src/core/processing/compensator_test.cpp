@@ -5,6 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "core/testing/same_bits.h"
+
 namespace hrg_gyro {
 namespace core {
 namespace {
@@ -68,6 +74,59 @@ TEST(CompensatorTest, EvaluatesFrequencyDependentModelsAtTheGivenFrequency) {
   for (double f : {4990.0, 5000.0, 5010.0, 5000.0}) {
     const AngleIncrement inc = comp.step(0.0, 1e-3, 1e-3, f);
     EXPECT_NEAR(inc.scale_factor, p->scale_factor(5e-4, f), 1e-15) << f;
+  }
+}
+
+TEST(CompensatorTest, StepsOfABatchEqualOneStepEachBitForBit) {
+  // Four at a time where the models allow it (fixed coefficients, even orders), one at a time
+  // otherwise; batches whose length is not a multiple of four leave a remainder.
+  Eigen::MatrixXd k_nodes(3, 2);
+  k_nodes << -0.56, -0.50, 1e-3, 2e-3, -2e-4, 1e-4;
+  std::vector<std::shared_ptr<GyroParameters>> cases;
+  for (int variant = 0; variant < 4; ++variant) {
+    auto p = std::make_shared<GyroParameters>();
+    p->earth_rate.latitude = 0.9;
+    if (variant == 0)
+      p->scale_factor = HarmonicModel({2, 4, 6, 8}, -0.56, {1e-4, 5e-5, 3e-5, 2e-5}, {-5e-5, 0, 1e-5, 0});
+    if (variant == 1) p->scale_factor = HarmonicModel({4, 8}, -0.56, {1e-4, 2e-5}, {-5e-5, 1e-5});  // step 4
+    if (variant == 2) p->scale_factor = HarmonicModel({1, 2}, -0.56, {1e-4, 2e-5}, {-5e-5, 1e-5});  // odd orders
+    if (variant == 3) p->scale_factor = HarmonicModel({2}, FrequencyInterpolator({4990.0, 5010.0}), k_nodes);
+    p->drift = HarmonicModel({2, 4}, 1e-5, {2e-5, 1e-6}, {-1e-5, 0.0});
+    cases.push_back(p);
+  }
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> angle(-50.0, 50.0), step(-0.01, 0.01), frequency(4985.0, 5015.0);
+  for (std::size_t c = 0; c < cases.size(); ++c) {
+    Compensator single(cases[c]), batched(cases[c]);
+    EXPECT_EQ(ModelPairEvaluator(cases[c]->scale_factor, cases[c]->drift).lanesApply(), c < 2) << c;
+    for (std::size_t length : {1u, 3u, 4u, 7u, 32u}) {
+      StepBatch batch;
+      std::vector<AngleIncrement> expected(length), got(length);
+      for (std::size_t i = 0; i < length; ++i) {
+        const double previous = angle(rng), theta = previous + step(rng), f = frequency(rng);
+        const double dt = 1e-3 * (1.0 + 1e-3 * i);
+        expected[i] = single.step(previous, theta, dt, f, std::cos(previous), std::sin(previous), std::cos(theta),
+                                  std::sin(theta));
+        batch.add(previous, theta, dt, f, std::cos(previous), std::sin(previous), std::cos(theta), std::sin(theta),
+                  &got[i]);
+      }
+      batched.steps(&batch);
+      EXPECT_EQ(batch.size, 0u);
+      for (std::size_t i = 0; i < length; ++i) {
+        const AngleIncrement &a = expected[i], &b = got[i];
+        for (auto [x, y] : {std::pair{a.dt, b.dt},
+                            {a.dtheta, b.dtheta},
+                            {a.theta_mid, b.theta_mid},
+                            {a.frequency, b.frequency},
+                            {a.scale_factor, b.scale_factor},
+                            {a.drift, b.drift},
+                            {a.dalpha, b.dalpha},
+                            {a.dalpha_earth_fixed, b.dalpha_earth_fixed}}) {
+          EXPECT_TRUE(sameBits(x, y)) << "case " << c << ", length " << length << ", step " << i << ": " << x << " vs "
+                                      << y;
+        }
+      }
+    }
   }
 }
 

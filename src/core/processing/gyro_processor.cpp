@@ -194,7 +194,8 @@ inline AngleIncrement GyroProcessor::reanchorIncrement(double theta, double dt, 
 }
 
 __attribute__((always_inline)) inline void GyroProcessor::advance(const ChannelSample& in, WaveStatus status,
-                                                                  WaveState* wave_state, ProcessorResult* result) {
+                                                                  WaveState* wave_state, ProcessorResult* result,
+                                                                  StepBatch* deferred) {
   // Every path sets every field of *result: rejections and the first sample start from a default
   // result, the accepted path (the hot one) writes each field itself.
   ProcessorResult& r = *result;
@@ -229,7 +230,11 @@ __attribute__((always_inline)) inline void GyroProcessor::advance(const ChannelS
 
   const double f_mid = 0.5 * (in.frequency + previous_frequency_);
   flags |= frequencyFlags(f_mid);
-  if (integrate) {
+  if (integrate && deferred != nullptr) {
+    // processBatch computes the increment and alpha after the block (r.alpha below is provisional).
+    deferred->add(previous_theta, theta, dt, f_mid, previous_cos_, previous_sin_, wave.cos_theta, wave.sin_theta,
+                  &r.increment);
+  } else if (integrate) {
     r.increment = compensator_.step(previous_theta, theta, dt, f_mid, previous_cos_, previous_sin_, wave.cos_theta,
                                     wave.sin_theta);
     alpha_ += r.increment.dalpha;
@@ -260,23 +265,55 @@ void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
   // The wave state is estimated straight into the result (a rejection resets it there).
   const WaveStatus status =
       estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &result->wave);
-  advance(in, status, &result->wave, result);
+  advance(in, status, &result->wave, result, nullptr);
 }
 
 void GyroProcessor::processBatch(const ChannelSample* in, std::size_t n, ProcessorResult* out) {
-  // The wave states of a block first, several samples per instruction (estimateWaves): they depend
-  // on the sample alone and on P, which cannot change inside a batch. Then the rules and the
-  // integration in order, exactly as process() applies them one by one.
-  constexpr std::size_t kBlock = 32;
-  ChannelVector corrected[kBlock];
-  WaveState waves[kBlock];
+  // A block at a time, in passes that together apply exactly what process() applies sample by
+  // sample:
+  // 1. The wave states of (E - P) z, several samples per instruction (estimateWaves), straight into
+  //    the results: they depend on the sample alone and on P, which cannot change inside a batch.
+  // 2. The rules in order (stamps, unwrapping, gaps, jumps). Where the models allow increments
+  //    four at a time (ModelPairEvaluator::lanesApply), each integrated step's inputs are queued
+  //    instead, and
+  // 3. the queued increments are computed (Compensator::steps), then alpha summed in order.
+  constexpr std::size_t kBlock = StepBatch::kCapacity;
   WaveStatus statuses[kBlock];
+  bool integrated[kBlock];
+  StepBatch steps;
+  StepBatch* const deferred = compensator_.stepsInLanes() ? &steps : nullptr;
   const CorrectionMatrix& correction = compensator_.parameters().correction;
   for (std::size_t start = 0; start < n; start += kBlock) {
     const std::size_t m = n - start < kBlock ? n - start : kBlock;
-    for (std::size_t j = 0; j < m; ++j) corrected[j] = correction.apply(in[start + j].z);
-    estimateWaves(corrected, m, config_.limits, waves, statuses);
-    for (std::size_t j = 0; j < m; ++j) advance(in[start + j], statuses[j], &waves[j], &out[start + j]);
+    ProcessorResult* block = out + start;
+    estimateWaves(&in[start].z, sizeof(ChannelSample), correction, m, config_.limits, &block[0].wave,
+                  sizeof(ProcessorResult), statuses);
+    if (deferred == nullptr) {
+      for (std::size_t j = 0; j < m; ++j) advance(in[start + j], statuses[j], &block[j].wave, &block[j], nullptr);
+      continue;
+    }
+    const double alpha_before = alpha_;
+    for (std::size_t j = 0; j < m; ++j) {
+      const std::size_t queued = steps.size;
+      advance(in[start + j], statuses[j], &block[j].wave, &block[j], &steps);
+      integrated[j] = steps.size != queued;
+    }
+    compensator_.steps(&steps);
+    // alpha as process() accumulates it: a first sample starts it at 0 (a first sample only
+    // follows a start or reset(), which zero it), an integrated step adds its increment.
+    double alpha = alpha_before;
+    for (std::size_t j = 0; j < m; ++j) {
+      ProcessorResult& r = block[j];
+      if (r.verdict == SampleVerdict::kFirst) {
+        alpha = 0.0;
+      } else if (r.verdict != SampleVerdict::kAccepted) {
+        continue;
+      }
+      if (integrated[j]) alpha += r.increment.dalpha;
+      r.alpha = alpha;
+    }
+    // A reset with no first sample after it in this block: alpha waits at 0 for the next one.
+    alpha_ = has_previous_ ? alpha : 0.0;
   }
 }
 

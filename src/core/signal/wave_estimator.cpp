@@ -43,19 +43,28 @@ WaveStatus estimateWaveGeneral(double ac, double bc, double as, double bs, const
 
 // Built twice, for the x86-64 baseline and for AVX2, the loader picking one by CPU: either way each
 // lane is computed with the operations estimateWave uses, in the same order, so the same bits.
-__attribute__((target_clones("avx2", "default"))) void estimateWaves(const ChannelVector* z, std::size_t n,
+__attribute__((target_clones("avx2", "default"))) void estimateWaves(const ChannelVector* z, std::size_t z_stride,
+                                                                     const CorrectionMatrix& correction, std::size_t n,
                                                                      const WaveLimits& limits, WaveState* states,
-                                                                     WaveStatus* statuses) {
+                                                                     std::size_t state_stride, WaveStatus* statuses) {
+  const auto channels = [z, z_stride](std::size_t i) -> const ChannelVector& {
+    return *reinterpret_cast<const ChannelVector*>(reinterpret_cast<const char*>(z) + i * z_stride);
+  };
+  const auto state = [states, state_stride](std::size_t i) {
+    return reinterpret_cast<WaveState*>(reinterpret_cast<char*>(states) + i * state_stride);
+  };
   constexpr std::size_t kLanes = 4;
   std::size_t i = 0;
   for (; i + kLanes <= n; i += kLanes) {
     DoubleLanes4 ac, bc, as, bs;
     for (std::size_t j = 0; j < kLanes; ++j) {
-      ac[j] = z[i + j][kAc];
-      bc[j] = z[i + j][kBc];
-      as[j] = z[i + j][kAs];
-      bs[j] = z[i + j][kBs];
+      const ChannelVector& c = channels(i + j);
+      ac[j] = c[kAc];
+      bc[j] = c[kBc];
+      as[j] = c[kAs];
+      bs[j] = c[kBs];
     }
+    correction.apply(&ac, &bc, &as, &bs);
     wave_detail::WaveLanes<DoubleLanes4> w;
     wave_detail::computeWave(ac, bc, as, bs, &w);
     // The lanes where estimateWave would take computeWave's numbers and accept them; the others
@@ -64,17 +73,17 @@ __attribute__((target_clones("avx2", "default"))) void estimateWaves(const Chann
         wave_detail::waveComputable(w) & (w.e > limits.min_energy) & wave_detail::waveAcceptable(w, limits);
     for (std::size_t j = 0; j < kLanes; ++j) {
       if (!accepted[j]) {
-        statuses[i + j] = estimateWave(z[i + j], limits, &states[i + j]);
+        statuses[i + j] = estimateWave(correction.apply(channels(i + j)), limits, state(i + j));
         continue;
       }
       wave_detail::WaveLanes<double> lane{w.e[j],     w.r[j],         w.s[j],        w.h[j],         w.q[j],
                                           w.l[j],     w.m[j],         w.theta[j],    w.amplitude[j], w.quadrature[j],
                                           w.phase[j], w.cos_theta[j], w.sin_theta[j]};
-      wave_detail::store(lane, &states[i + j]);
+      wave_detail::store(lane, state(i + j));
       statuses[i + j] = WaveStatus::kOk;
     }
   }
-  for (; i < n; ++i) statuses[i] = estimateWave(z[i], limits, &states[i]);
+  for (; i < n; ++i) statuses[i] = estimateWave(correction.apply(channels(i)), limits, state(i));
 }
 
 }  // namespace core

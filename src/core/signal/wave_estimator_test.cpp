@@ -146,22 +146,55 @@ TEST(WaveEstimatorTest, BatchIsBitIdenticalToOneSampleAtATime) {
   }
   WaveLimits limits;
   limits.max_amplitude = 2.5;  // some ordinary samples out of range too
-  for (std::size_t n : {z.size(), std::size_t{7}, std::size_t{1}}) {
-    std::vector<WaveState> batch(n);
-    std::vector<WaveStatus> statuses(n);
-    estimateWaves(z.data(), n, limits, batch.data(), statuses.data());
-    int accepted = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      WaveState one;
-      const WaveStatus status = estimateWave(z[i], limits, &one);
-      ASSERT_EQ(statuses[i], status) << i;
-      if (status != WaveStatus::kOk) continue;
-      ++accepted;
-      ASSERT_TRUE(sameWaveBits(batch[i], one)) << i;
+  CorrectionMatrix none, some;
+  some.p = {1e-3, -2e-3, 3e-3, 0.5e-3};
+  for (const CorrectionMatrix& correction : {none, some}) {
+    for (std::size_t n : {z.size(), std::size_t{7}, std::size_t{1}}) {
+      std::vector<WaveState> batch(n);
+      std::vector<WaveStatus> statuses(n);
+      estimateWaves(z.data(), sizeof(ChannelVector), correction, n, limits, batch.data(), sizeof(WaveState),
+                    statuses.data());
+      int accepted = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        WaveState one;
+        const WaveStatus status = estimateWave(correction.apply(z[i]), limits, &one);
+        ASSERT_EQ(statuses[i], status) << i;
+        if (status != WaveStatus::kOk) continue;
+        ++accepted;
+        ASSERT_TRUE(sameWaveBits(batch[i], one)) << i;
+      }
+      if (n == z.size()) {
+        EXPECT_GT(accepted, 8000);
+        EXPECT_LT(accepted, 16000);
+      }
     }
-    if (n == z.size()) {
-      EXPECT_GT(accepted, 8000);
-      EXPECT_LT(accepted, 16000);
+  }
+  // Channels and states as fields of larger records: the same states, the fields around the states
+  // untouched.
+  struct Record {
+    double before = -1.0;
+    WaveState wave;
+    char after[13] = "untouched";
+  };
+  struct Sample {
+    double stamp;
+    ChannelVector z;
+  };
+  std::vector<Sample> samples(z.size());
+  for (std::size_t i = 0; i < z.size(); ++i) samples[i] = {1.0 * i, z[i]};
+  std::vector<Record> records(z.size());
+  std::vector<WaveState> packed(z.size());
+  std::vector<WaveStatus> record_statuses(z.size()), packed_statuses(z.size());
+  estimateWaves(&samples[0].z, sizeof(Sample), some, z.size(), limits, &records[0].wave, sizeof(Record),
+                record_statuses.data());
+  estimateWaves(z.data(), sizeof(ChannelVector), some, z.size(), limits, packed.data(), sizeof(WaveState),
+                packed_statuses.data());
+  for (std::size_t i = 0; i < z.size(); ++i) {
+    ASSERT_EQ(record_statuses[i], packed_statuses[i]) << i;
+    ASSERT_EQ(records[i].before, -1.0) << i;
+    ASSERT_STREQ(records[i].after, "untouched") << i;
+    if (packed_statuses[i] == WaveStatus::kOk) {
+      ASSERT_TRUE(sameWaveBits(records[i].wave, packed[i])) << i;
     }
   }
 }

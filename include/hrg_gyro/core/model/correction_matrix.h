@@ -25,12 +25,22 @@ struct CorrectionMatrix {
   bool isIdentity() const { return p[0] == 0.0 && p[1] == 0.0 && p[2] == 0.0 && p[3] == 0.0; }
   /// (E - P) z
   ChannelVector apply(const ChannelVector& z) const {
-    ChannelVector out;
-    out[kAc] = (1.0 - p[0]) * z[kAc] - p[2] * z[kAs];
-    out[kBc] = (1.0 - p[0]) * z[kBc] - p[2] * z[kBs];
-    out[kAs] = p[3] * z[kAc] + (1.0 - p[1]) * z[kAs];
-    out[kBs] = p[3] * z[kBc] + (1.0 - p[1]) * z[kBs];
-    return out;
+    double ac = z[kAc], bc = z[kBc], as = z[kAs], bs = z[kBs];
+    apply(&ac, &bc, &as, &bs);
+    return ChannelVector(ac, bc, as, bs);
+  }
+  /// (E - P) z in place on the four channels: doubles, or lanes of samples (each lane then gets the
+  /// bits one sample gets).
+  template <class V>
+  void apply(V* ac, V* bc, V* as, V* bs) const {
+    const V c_ac = (1.0 - p[0]) * *ac - p[2] * *as;
+    const V c_bc = (1.0 - p[0]) * *bc - p[2] * *bs;
+    const V c_as = p[3] * *ac + (1.0 - p[1]) * *as;
+    const V c_bs = p[3] * *bc + (1.0 - p[1]) * *bs;
+    *ac = c_ac;
+    *bc = c_bc;
+    *as = c_as;
+    *bs = c_bs;
   }
   bool operator==(const CorrectionMatrix& o) const { return p == o.p; }
 };

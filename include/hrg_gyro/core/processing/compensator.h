@@ -8,6 +8,7 @@
 // -(...)/K belongs to its convention where K is quoted as a positive magnitude.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 
 #include "hrg_gyro/core/model/gyro_parameters.h"
@@ -25,6 +26,38 @@ struct AngleIncrement {
   double drift = 0.0;               ///< D used, rad/s
   double dalpha = 0.0;              ///< inertial body-angle increment, rad
   double dalpha_earth_fixed = 0.0;  ///< increment relative to the Earth-fixed table, rad
+};
+
+/// The inputs of a run of compensation steps, field by field (so four of each load at once), and
+/// where each result goes. GyroProcessor::processBatch fills one per block of samples.
+struct StepBatch {
+  static constexpr std::size_t kCapacity = 32;
+  std::size_t size = 0;
+  alignas(32) double theta_previous[kCapacity];
+  alignas(32) double theta[kCapacity];
+  alignas(32) double dt[kCapacity];
+  alignas(32) double frequency_mid[kCapacity];
+  alignas(32) double cos_previous[kCapacity];
+  alignas(32) double sin_previous[kCapacity];
+  alignas(32) double cos_theta[kCapacity];
+  alignas(32) double sin_theta[kCapacity];
+  AngleIncrement* out[kCapacity];
+
+  bool full() const { return size == kCapacity; }
+  /// The arguments of Compensator::step (the form with the unit vectors), in its order.
+  void add(double theta_previous_, double theta_, double dt_, double frequency_mid_, double cos_previous_,
+           double sin_previous_, double cos_theta_, double sin_theta_, AngleIncrement* out_) {
+    theta_previous[size] = theta_previous_;
+    theta[size] = theta_;
+    dt[size] = dt_;
+    frequency_mid[size] = frequency_mid_;
+    cos_previous[size] = cos_previous_;
+    sin_previous[size] = sin_previous_;
+    cos_theta[size] = cos_theta_;
+    sin_theta[size] = sin_theta_;
+    out[size] = out_;
+    ++size;
+  }
 };
 
 class Compensator {
@@ -61,6 +94,11 @@ class Compensator {
     inc.dalpha_earth_fixed = inc.dalpha - earth_rate_ * dt;
     return inc;
   }
+  /// Whether steps() computes four at a time (ModelPairEvaluator::lanesApply); otherwise it is
+  /// step() one by one.
+  bool stepsInLanes() const { return models_.lanesApply(); }
+  /// *batch.out[i] = step(the inputs i) for every step of the batch, bit for bit; empties the batch.
+  void steps(StepBatch* batch);
 
  private:
   std::shared_ptr<const GyroParameters> parameters_;

@@ -118,8 +118,10 @@ class GyroProcessor {
   void countRejection(WaveStatus status);
   /// Everything after the wave estimate, in order (the estimate depends on the sample alone, so
   /// processBatch computes a block of them ahead): status is estimateWave's on (E - P) z, and wave
-  /// may be result->wave itself.
-  void advance(const ChannelSample& in, WaveStatus status, WaveState* wave, ProcessorResult* result);
+  /// may be result->wave itself. With `deferred`, an integrated step's inputs are queued there and
+  /// its increment, and alpha, are left to the caller (processBatch).
+  void advance(const ChannelSample& in, WaveStatus status, WaveState* wave, ProcessorResult* result,
+               StepBatch* deferred);
   // The phases of process(), in its order.
   /// Counts a rejected sample toward the next output's rejected_before.
   void reject(SampleVerdict verdict, ProcessorResult* r);

@@ -15,6 +15,7 @@
 #include "hrg_gyro/core/common/double_lanes.h"
 #include "hrg_gyro/core/common/fast_atan2.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/correction_matrix.h"
 #include "hrg_gyro/core/model/wave_parameters.h"
 
 namespace hrg_gyro {
@@ -79,9 +80,10 @@ struct WaveLanes {
 
 /// The wave state of (corrected) channel amplitudes, valid where waveComputable() holds; the
 /// caller checks the status conditions. Every operation is elementwise, so a lane gets the bits
-/// one sample gets.
+/// one sample gets. Always inline: the inliner may decline for the size, and a call would pass
+/// the lanes through memory (and from the AVX2 build into baseline code).
 template <class V>
-inline void computeWave(V ac, V bc, V as, V bs, WaveLanes<V>* w) {
+__attribute__((always_inline)) inline void computeWave(V ac, V bc, V as, V bs, WaveLanes<V>* w) {
   w->e = ac * ac + bc * bc + as * as + bs * bs;
   w->r = ac * ac + bc * bc - as * as - bs * bs;
   w->s = 2.0 * (ac * as + bc * bs);
@@ -181,10 +183,13 @@ __attribute__((always_inline)) inline WaveStatus estimateWave(const ChannelVecto
   return WaveStatus::kOk;
 }
 
-/// estimateWave for n samples at once, four lanes at a time (AVX2 where the CPU has it, chosen at
-/// run time): statuses[i] and states[i] are bit for bit what estimateWave(z[i]) gives.
-void estimateWaves(const ChannelVector* z, std::size_t n, const WaveLimits& limits, WaveState* states,
-                   WaveStatus* statuses);
+/// estimateWave(correction.apply(z_i)) for n samples at once, four lanes at a time (AVX2 where the
+/// CPU has it, chosen at run time), the correction in the same lanes: statuses[i] and the i-th
+/// state are bit for bit what one sample gets. The z_i are `z_stride` bytes apart and the states
+/// `state_stride` bytes apart: arrays of them, or fields of larger records (GyroProcessor::
+/// processBatch reads its samples and estimates straight into its results).
+void estimateWaves(const ChannelVector* z, std::size_t z_stride, const CorrectionMatrix& correction, std::size_t n,
+                   const WaveLimits& limits, WaveState* states, std::size_t state_stride, WaveStatus* statuses);
 
 }  // namespace core
 }  // namespace hrg_gyro
