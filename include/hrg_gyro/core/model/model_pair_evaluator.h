@@ -22,8 +22,7 @@ class ModelPairEvaluator {
 
   /// K(theta, f) and D(theta, f).
   void evaluate(double theta, double frequency, double* k, double* d) {
-    const bool same = frequency == cached_frequency_ || (std::isnan(frequency) && cached_is_nan_);
-    if (frequency_dependent_ && !same) refresh(frequency);
+    if (frequency_dependent_) followFrequency(frequency);
     basis_.evaluate(theta);
     *k = sum(k_coefficients_.data(), k_indices_);
     *d = sum(d_coefficients_.data(), d_indices_);
@@ -32,8 +31,7 @@ class ModelPairEvaluator {
   /// cos and sin follow by the recurrence in registers and both sums run beside it, every basis
   /// order present (a missing one has zero coefficients, which adds exactly nothing).
   void evaluate(double theta, double c2, double s2, double frequency, double* k, double* d) {
-    const bool same = frequency == cached_frequency_ || (std::isnan(frequency) && cached_is_nan_);
-    if (frequency_dependent_ && !same) refresh(frequency);
+    if (frequency_dependent_) followFrequency(frequency);
     const int step = basis_.step();
     if (step % 2 != 0) {
       basis_.evaluate(theta);
@@ -89,6 +87,11 @@ class ModelPairEvaluator {
   }
 
  private:
+  /// Re-interpolates the coefficients when the frequency differs from the last one.
+  void followFrequency(double frequency) {
+    const bool same = frequency == cached_frequency_ || (std::isnan(frequency) && cached_is_nan_);
+    if (!same) refresh(frequency);
+  }
   void refresh(double frequency);
   /// HarmonicModel::evaluate with the orders already converted to basis indices (no integer division
   /// per term), the same operations in the same order, so the same bits.
