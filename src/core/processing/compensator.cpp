@@ -25,7 +25,7 @@ DoubleLanes4 load(const double* four) {
 __attribute__((target_clones("avx2", "default"))) void Compensator::steps(StepBatch* batch) {
   const std::size_t n = batch->size;
   std::size_t i = 0;
-  if (models_.lanesApply()) {
+  if (stepsInLanes()) {
     for (; i + 4 <= n; i += 4) {
       const DoubleLanes4 theta_previous = load(batch->theta_previous + i), theta = load(batch->theta + i);
       const DoubleLanes4 dt = load(batch->dt + i);

@@ -43,7 +43,6 @@ struct StepBatch {
   alignas(32) double sin_theta[kCapacity];
   AngleIncrement* out[kCapacity];
 
-  bool full() const { return size == kCapacity; }
   /// The arguments of Compensator::step (the form with the unit vectors), in its order.
   void add(double theta_previous_, double theta_, double dt_, double frequency_mid_, double cos_previous_,
            double sin_previous_, double cos_theta_, double sin_theta_, AngleIncrement* out_) {
