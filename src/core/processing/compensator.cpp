@@ -20,8 +20,8 @@ DoubleLanes4 load(const double* four) {
 
 }  // namespace
 
-// The lanes are step()'s arithmetic written once more on four samples: the same operations in the
-// same order (compensator_test checks the bits against step()).
+// The lanes go through step()'s operations in its order (the formulas are shared; compensator_test
+// checks the bits against step()).
 __attribute__((target_clones("avx2", "default"))) void Compensator::steps(StepBatch* batch) {
   const std::size_t n = batch->size;
   std::size_t i = 0;
@@ -33,12 +33,10 @@ __attribute__((target_clones("avx2", "default"))) void Compensator::steps(StepBa
       const DoubleLanes4 cos_theta = load(batch->cos_theta + i), sin_theta = load(batch->sin_theta + i);
       const DoubleLanes4 dtheta = theta - theta_previous;
       const DoubleLanes4 theta_mid = 0.5 * (theta + theta_previous);
-      const DoubleLanes4 c2 = cos_previous * cos_theta - sin_previous * sin_theta;
-      const DoubleLanes4 s2 = sin_previous * cos_theta + cos_previous * sin_theta;
-      DoubleLanes4 k, d;
+      DoubleLanes4 c2, s2, k, d, dalpha, dalpha_earth_fixed;
+      doubleMidAngle(cos_previous, sin_previous, cos_theta, sin_theta, &c2, &s2);
       models_.evaluateLanes(c2, s2, &k, &d);
-      const DoubleLanes4 dalpha = (dtheta - d * dt) / k;
-      const DoubleLanes4 dalpha_earth_fixed = dalpha - earth_rate_ * dt;
+      compensate(dtheta, k, d, dt, &dalpha, &dalpha_earth_fixed);
       for (int l = 0; l < 4; ++l) {
         AngleIncrement& inc = *batch->out[i + l];
         inc.dt = dt[l];

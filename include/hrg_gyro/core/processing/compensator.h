@@ -73,8 +73,7 @@ class Compensator {
     inc.theta_mid = 0.5 * (theta + theta_previous);
     inc.frequency = frequency_mid;
     models_.evaluate(inc.theta_mid, frequency_mid, &inc.scale_factor, &inc.drift);
-    inc.dalpha = (inc.dtheta - inc.drift * dt) / inc.scale_factor;
-    inc.dalpha_earth_fixed = inc.dalpha - earth_rate_ * dt;
+    compensate(inc.dtheta, inc.scale_factor, inc.drift, dt, &inc.dalpha, &inc.dalpha_earth_fixed);
     return inc;
   }
   /// The same with the unit vectors (cos, sin) of both angles supplied: cos and sin of
@@ -86,11 +85,10 @@ class Compensator {
     inc.dtheta = theta - theta_previous;
     inc.theta_mid = 0.5 * (theta + theta_previous);
     inc.frequency = frequency_mid;
-    const double c2 = cos_previous * cos_theta - sin_previous * sin_theta;
-    const double s2 = sin_previous * cos_theta + cos_previous * sin_theta;
+    double c2, s2;
+    doubleMidAngle(cos_previous, sin_previous, cos_theta, sin_theta, &c2, &s2);
     models_.evaluate(inc.theta_mid, c2, s2, frequency_mid, &inc.scale_factor, &inc.drift);
-    inc.dalpha = (inc.dtheta - inc.drift * dt) / inc.scale_factor;
-    inc.dalpha_earth_fixed = inc.dalpha - earth_rate_ * dt;
+    compensate(inc.dtheta, inc.scale_factor, inc.drift, dt, &inc.dalpha, &inc.dalpha_earth_fixed);
     return inc;
   }
   /// Whether steps() computes four at a time (ModelPairEvaluator::lanesApply); otherwise it is
@@ -100,6 +98,20 @@ class Compensator {
   void steps(StepBatch* batch);
 
  private:
+  // The two formulas of a step, written once for one step (V = double) and for the lanes of steps().
+  /// cos and sin of 2 theta_mid = theta_previous + theta: the complex product of the unit vectors.
+  template <class V>
+  static void doubleMidAngle(V cos_previous, V sin_previous, V cos_theta, V sin_theta, V* c2, V* s2) {
+    *c2 = cos_previous * cos_theta - sin_previous * sin_theta;
+    *s2 = sin_previous * cos_theta + cos_previous * sin_theta;
+  }
+  /// dalpha = (dtheta - D dt) / K, and the same less the Earth's rotation.
+  template <class V>
+  void compensate(V dtheta, V scale_factor, V drift, V dt, V* dalpha, V* dalpha_earth_fixed) const {
+    *dalpha = (dtheta - drift * dt) / scale_factor;
+    *dalpha_earth_fixed = *dalpha - earth_rate_ * dt;
+  }
+
   std::shared_ptr<const GyroParameters> parameters_;
   ModelPairEvaluator models_;
   double earth_rate_;
