@@ -82,15 +82,16 @@ TEST(CompensatorTest, StepsOfABatchEqualOneStepEachBitForBit) {
   // otherwise; batches whose length is not a multiple of four leave a remainder.
   Eigen::MatrixXd k_nodes(3, 2);
   k_nodes << -0.56, -0.50, 1e-3, 2e-3, -2e-4, 1e-4;
+  const HarmonicModel scale_factors[] = {
+      HarmonicModel({2, 4, 6, 8}, -0.56, {1e-4, 5e-5, 3e-5, 2e-5}, {-5e-5, 0, 1e-5, 0}),  // in lanes
+      HarmonicModel({4, 8}, -0.56, {1e-4, 2e-5}, {-5e-5, 1e-5}),                          // orders 4 apart: lanes
+      HarmonicModel({1, 2}, -0.56, {1e-4, 2e-5}, {-5e-5, 1e-5}),                          // odd orders: one by one
+      HarmonicModel({2}, FrequencyInterpolator({4990.0, 5010.0}), k_nodes)};              // K(theta, f): one by one
   std::vector<std::shared_ptr<GyroParameters>> cases;
-  for (int variant = 0; variant < 4; ++variant) {
+  for (const HarmonicModel& scale_factor : scale_factors) {
     auto p = std::make_shared<GyroParameters>();
     p->earth_rate.latitude = 0.9;
-    if (variant == 0)
-      p->scale_factor = HarmonicModel({2, 4, 6, 8}, -0.56, {1e-4, 5e-5, 3e-5, 2e-5}, {-5e-5, 0, 1e-5, 0});
-    if (variant == 1) p->scale_factor = HarmonicModel({4, 8}, -0.56, {1e-4, 2e-5}, {-5e-5, 1e-5});  // step 4
-    if (variant == 2) p->scale_factor = HarmonicModel({1, 2}, -0.56, {1e-4, 2e-5}, {-5e-5, 1e-5});  // odd orders
-    if (variant == 3) p->scale_factor = HarmonicModel({2}, FrequencyInterpolator({4990.0, 5010.0}), k_nodes);
+    p->scale_factor = scale_factor;
     p->drift = HarmonicModel({2, 4}, 1e-5, {2e-5, 1e-6}, {-1e-5, 0.0});
     cases.push_back(p);
   }

@@ -1,6 +1,6 @@
 // Test support: bit-for-bit comparison of doubles (NaN and signed zeros included) and of whole wave
-// states and angle increments, for the tests that pin two ways of computing to the same numbers (a batch against one
-// sample at a time, say). A mismatch names the field.
+// states and angle increments, for the tests that pin two ways of computing to the same numbers (a
+// batch against one sample at a time, say). A mismatch names the field.
 #pragma once
 
 #include <gtest/gtest.h>
