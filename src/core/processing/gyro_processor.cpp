@@ -255,18 +255,21 @@ __attribute__((always_inline)) inline void GyroProcessor::advance(const ChannelS
   pending_flags_ = 0;
 }
 
-ProcessorResult GyroProcessor::process(const ChannelSample& in) {
-  ProcessorResult r;
-  process(in, &r);
-  return r;
-}
-
-void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) {
+__attribute__((always_inline)) inline void GyroProcessor::processInto(const ChannelSample& in,
+                                                                      ProcessorResult* result) {
   // The wave state is estimated straight into the result (a rejection resets it there).
   const WaveStatus status =
       estimateWave(compensator_.parameters().correction.apply(in.z), config_.limits, &result->wave);
   advance(in, status, &result->wave, result, nullptr);
 }
+
+ProcessorResult GyroProcessor::process(const ChannelSample& in) {
+  ProcessorResult r;
+  processInto(in, &r);
+  return r;
+}
+
+void GyroProcessor::process(const ChannelSample& in, ProcessorResult* result) { processInto(in, result); }
 
 void GyroProcessor::processBatch(const ChannelSample* in, std::size_t n, ProcessorResult* out) {
   // A block at a time, in passes that together apply exactly what process() applies sample by

@@ -116,6 +116,9 @@ class GyroProcessor {
 
  private:
   void countRejection(WaveStatus status);
+  /// The body of both process() forms, inlined into each: the by-value form (the live node's) then
+  /// makes no second call.
+  void processInto(const ChannelSample& in, ProcessorResult* result);
   /// Everything after the wave estimate, in order (the estimate depends on the sample alone, so
   /// processBatch computes a block of them ahead): status is estimateWave's on (E - P) z, and wave
   /// may be result->wave itself. With `deferred`, an integrated step's inputs are queued there and
