@@ -39,13 +39,13 @@ void ModelPairEvaluator::refresh(double frequency) {
   const int basis_orders = basis_.step() == 0 ? 0 : basis_.maxOrder() / basis_.step();
   dense_.assign(2 * static_cast<std::size_t>(basis_orders), DoubleLanes2{0.0, 0.0});
   dense_orders_ = basis_orders;
-  const auto spread = [&](const std::vector<double>& coefficients, const std::vector<int>& indices, int lane) {
+  const auto spread = [&](const std::vector<double>& coefficients, const std::vector<int>& indices, int model) {
     const std::size_t n = indices.size();
     for (std::size_t i = 0; i < n; ++i) {
       if (indices[i] < 1) continue;  // order 0 lives in the mean
-      DoubleLanes2* slot = &dense_[2 * static_cast<std::size_t>(indices[i] - 1)];
-      slot[0][lane] += coefficients[1 + i];
-      slot[1][lane] += coefficients[1 + n + i];
+      DoubleLanes2& slot = dense_[2 * static_cast<std::size_t>(indices[i] - 1) + model];
+      slot[0] += coefficients[1 + i];
+      slot[1] += coefficients[1 + n + i];
     }
   };
   spread(k_coefficients_, k_indices_, 0);

@@ -46,19 +46,19 @@ class ModelPairEvaluator {
       s1 = s1 * c2 + c1 * s2;
       c1 = c;
     }
-    // K's and D's sums side by side in one pair of lanes: the same operations on each as two
-    // scalar sums, half the instructions.
-    DoubleLanes2 sums = {k_coefficients_[0], d_coefficients_[0]};
-    double c = c1, s = s1;
+    // Each model's cos and sin sums side by side in a pair of lanes, and the recurrence on (cos, sin)
+    // as one complex product in lanes: (c, s) (c1, s1) = (c c1 + s (-s1), s c1 + c s1).
+    DoubleLanes2 k_sums = {k_coefficients_[0], 0.0}, d_sums = {d_coefficients_[0], 0.0};
+    DoubleLanes2 cs = {c1, s1};
+    const DoubleLanes2 rotate_cos = {c1, c1}, rotate_sin = {-s1, s1};
     const DoubleLanes2* t = dense_.data();
     for (int m = 0; m < dense_orders_; ++m, t += 2) {
-      sums += t[0] * c + t[1] * s;
-      const double next = c * c1 - s * s1;
-      s = s * c1 + c * s1;
-      c = next;
+      k_sums += t[0] * cs;
+      d_sums += t[1] * cs;
+      cs = cs * rotate_cos + __builtin_shufflevector(cs, cs, 1, 0) * rotate_sin;
     }
-    *k = sums[0];
-    *d = sums[1];
+    *k = k_sums[0] + k_sums[1];
+    *d = d_sums[0] + d_sums[1];
   }
   /// Whether evaluateLanes applies: coefficients that do not depend on the frequency and an even
   /// basis step (the double-angle recurrence above).
@@ -72,18 +72,24 @@ class ModelPairEvaluator {
       s1 = s1 * c2 + c1 * s2;
       c1 = c;
     }
-    DoubleLanes4 k_sum = splat<DoubleLanes4>(k_coefficients_[0]), d_sum = splat<DoubleLanes4>(d_coefficients_[0]);
+    // The cos and sin sums apart and added at the end, and the recurrence's -s1 as a product, as
+    // the lanes of evaluate() compute them.
+    DoubleLanes4 k_cos = splat<DoubleLanes4>(k_coefficients_[0]), k_sin = splat<DoubleLanes4>(0.0);
+    DoubleLanes4 d_cos = splat<DoubleLanes4>(d_coefficients_[0]), d_sin = splat<DoubleLanes4>(0.0);
     DoubleLanes4 c = c1, s = s1;
+    const DoubleLanes4 minus_s1 = -s1;
     const DoubleLanes2* t = dense_.data();
     for (int m = 0; m < dense_orders_; ++m, t += 2) {
-      k_sum += t[0][0] * c + t[1][0] * s;
-      d_sum += t[0][1] * c + t[1][1] * s;
-      const DoubleLanes4 next = c * c1 - s * s1;
+      k_cos += t[0][0] * c;
+      k_sin += t[0][1] * s;
+      d_cos += t[1][0] * c;
+      d_sin += t[1][1] * s;
+      const DoubleLanes4 next = c * c1 + s * minus_s1;
       s = s * c1 + c * s1;
       c = next;
     }
-    *k = k_sum;
-    *d = d_sum;
+    *k = k_cos + k_sin;
+    *d = d_cos + d_sin;
   }
 
  private:
@@ -109,8 +115,7 @@ class ModelPairEvaluator {
   HarmonicBasis basis_;
   std::vector<double> k_coefficients_, d_coefficients_;
   std::vector<int> k_indices_, d_indices_;  // basis index of each order
-  // For basis index m = 1, 2, ...: the cos coefficients of (K, D), then their sin coefficients (zero
-  // for an absent order).
+  // For basis index m = 1, 2, ...: K's (cos, sin) coefficients, then D's (zero for an absent order).
   std::vector<DoubleLanes2> dense_;
   int dense_orders_ = 0;
   bool frequency_dependent_;
