@@ -5,6 +5,7 @@
 #include <roslz4/lz4s.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -75,7 +76,7 @@ BagFileWriter::BagFileWriter(const std::string& path, Compression compression, s
     : path_(path), compression_(compression), chunk_threshold_(chunk_threshold) {
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) throw BagWriteError("cannot create " + path, errno);
-  chunk_.reserve(chunk_threshold_ + (64u << 10));
+  chunk_ = takeChunk();
   writeFile(kMagic, sizeof kMagic - 1);
   writeFileHeader(0);  // rewritten by close() with the index position
   worker_ = std::make_unique<SerialWorker>();
@@ -104,13 +105,14 @@ std::uint32_t BagFileWriter::connectionOf(const std::string& topic, const char* 
 
 std::uint8_t* BagFileWriter::beginMessage(std::uint32_t connection, const ros::Time& time, std::uint32_t length) {
   if (time < ros::TIME_MIN) throw BagWriteError("cannot write " + path_ + ": a message stamped before 0.000000001", 0);
-  if (chunk_.empty()) {
-    chunk_start_ = chunk_end_ = time;
+  Chunk& chunk = *chunk_;
+  if (chunk.bytes.empty()) {
+    chunk.start = chunk.end = time;
   } else {
-    if (time < chunk_start_) chunk_start_ = time;
-    if (time > chunk_end_) chunk_end_ = time;
+    if (time < chunk.start) chunk.start = time;
+    if (time > chunk.end) chunk.end = time;
   }
-  Bytes out(&chunk_);
+  Bytes out(&chunk.bytes);
   Connection& c = connections_[connection];
   if (!c.in_file) {
     // A connection's record goes into the first chunk that carries it (and into the index at the end).
@@ -126,55 +128,73 @@ std::uint8_t* BagFileWriter::beginMessage(std::uint32_t connection, const ros::T
     out.textField("message_definition", c.definition);
     out.endLength(data);
   }
+  // A recycled chunk keeps its connections' index lists (emptied, with their capacity).
   ChunkIndex* index = nullptr;
-  for (ChunkIndex& i : chunk_index_) {
+  for (ChunkIndex& i : chunk.index) {
     if (i.connection == connection) index = &i;
   }
   if (!index) {
-    chunk_index_.push_back({connection, {}});
-    index = &chunk_index_.back();
+    chunk.index.push_back({connection, {}});
+    index = &chunk.index.back();
   }
-  index->entries.push_back({time, static_cast<std::uint32_t>(chunk_.size())});
+  index->entries.push_back({time, static_cast<std::uint32_t>(chunk.bytes.size())});
   const std::size_t header = out.beginLength();
   out.numberField("op", kOpMessageData);
   out.numberField("conn", connection);
   out.timeField("time", time);
   out.endLength(header);
   out.number(length);
-  const std::size_t at = chunk_.size();
-  chunk_.resize(at + length);
-  return chunk_.data() + at;
+  const std::size_t at = chunk.bytes.size();
+  chunk.bytes.resize(at + length);
+  return chunk.bytes.data() + at;
 }
 
 void BagFileWriter::endMessage() {
-  if (chunk_.size() > chunk_threshold_) flushChunk();
+  if (chunk_->bytes.size() > chunk_threshold_) flushChunk();
+}
+
+std::shared_ptr<BagFileWriter::Chunk> BagFileWriter::takeChunk() {
+  {
+    std::lock_guard<std::mutex> lock(spare_mutex_);
+    if (!spare_chunks_.empty()) {
+      std::shared_ptr<Chunk> chunk = std::move(spare_chunks_.back());
+      spare_chunks_.pop_back();
+      return chunk;
+    }
+  }
+  auto chunk = std::make_shared<Chunk>();
+  chunk->bytes.reserve(chunk_threshold_ + (64u << 10));
+  return chunk;
 }
 
 void BagFileWriter::flushChunk() {
-  if (chunk_.empty()) return;
-  // The full chunk goes to the worker; a fresh buffer of the same size takes the next messages.
-  auto chunk = std::make_shared<std::vector<std::uint8_t>>(std::move(chunk_));
-  auto index = std::make_shared<std::vector<ChunkIndex>>(std::move(chunk_index_));
-  chunk_ = std::vector<std::uint8_t>();
-  chunk_.reserve(chunk_threshold_ + (64u << 10));
-  chunk_index_.clear();
-  const ros::Time start = chunk_start_, end = chunk_end_;
-  worker_->submit([this, chunk, index, start, end] { writeChunk(*chunk, *index, start, end); });
+  if (chunk_->bytes.empty()) return;
+  // The full chunk goes to the worker, which returns it to the spares once written; a spare (or,
+  // while the worker holds them all, a new one) takes the next messages.
+  std::shared_ptr<Chunk> full = std::move(chunk_);
+  chunk_ = takeChunk();
+  worker_->submit([this, full] {
+    writeChunk(*full);
+    full->bytes.clear();
+    for (ChunkIndex& index : full->index) index.entries.clear();
+    std::lock_guard<std::mutex> lock(spare_mutex_);
+    spare_chunks_.push_back(full);
+  });
 }
 
-void BagFileWriter::writeChunk(const std::vector<std::uint8_t>& chunk, const std::vector<ChunkIndex>& chunk_index,
-                               const ros::Time& start, const ros::Time& end) {
-  const std::uint8_t* data = chunk.data();
-  std::size_t size = chunk.size();
+void BagFileWriter::writeChunk(Chunk& chunk) {
+  const std::uint8_t* data = chunk.bytes.data();
+  std::size_t size = chunk.bytes.size();
   const char* compression = "none";
   if (compression_ == Compression::kLz4) {
     compression = "lz4";
-    compressed_.resize(chunk.size() + chunk.size() / 64 + 4096);
+    compressed_.resize(chunk.bytes.size() + chunk.bytes.size() / 64 + 4096);
     for (;;) {
       unsigned int out_size = static_cast<unsigned int>(compressed_.size());
-      const int result = roslz4_buffToBuffCompress(
-          const_cast<char*>(reinterpret_cast<const char*>(chunk.data())), static_cast<unsigned int>(chunk.size()),
-          reinterpret_cast<char*>(compressed_.data()), &out_size, kLz4BlockSizeId);
+      const int result =
+          roslz4_buffToBuffCompress(const_cast<char*>(reinterpret_cast<const char*>(chunk.bytes.data())),
+                                    static_cast<unsigned int>(chunk.bytes.size()),
+                                    reinterpret_cast<char*>(compressed_.data()), &out_size, kLz4BlockSizeId);
       if (result == ROSLZ4_OK) {
         size = out_size;
         break;
@@ -185,31 +205,37 @@ void BagFileWriter::writeChunk(const std::vector<std::uint8_t>& chunk, const std
     data = compressed_.data();
   } else if (compression_ == Compression::kBz2) {
     compression = "bz2";
-    compressed_.resize(chunk.size() + chunk.size() / 100 + 4096);  // bzip2's documented worst case is +1 % + 600
+    compressed_.resize(chunk.bytes.size() + chunk.bytes.size() / 100 +
+                       4096);  // bzip2's documented worst case is +1 % + 600
     unsigned int out_size = static_cast<unsigned int>(compressed_.size());
     if (BZ2_bzBuffToBuffCompress(reinterpret_cast<char*>(compressed_.data()), &out_size,
-                                 const_cast<char*>(reinterpret_cast<const char*>(chunk.data())),
-                                 static_cast<unsigned int>(chunk.size()), kBz2BlockSize100k, 0,
+                                 const_cast<char*>(reinterpret_cast<const char*>(chunk.bytes.data())),
+                                 static_cast<unsigned int>(chunk.bytes.size()), kBz2BlockSize100k, 0,
                                  kBz2WorkFactor) != BZ_OK) {
       throw BagWriteError("cannot write " + path_ + ": BZ2 compression failed", 0);
     }
     size = out_size;
     data = compressed_.data();
   }
-  ChunkInfo info{file_position_, start, end, {}};
+  ChunkInfo info{file_position_, chunk.start, chunk.end, {}};
   scratch_.clear();
   Bytes out(&scratch_);
   const std::size_t header = out.beginLength();
   out.numberField("op", kOpChunk);
   out.textField("compression", compression);
-  out.numberField("size", static_cast<std::uint32_t>(chunk.size()));
+  out.numberField("size", static_cast<std::uint32_t>(chunk.bytes.size()));
   out.endLength(header);
   out.number(static_cast<std::uint32_t>(size));
   writeFile(scratch_.data(), scratch_.size());
   writeFile(data, size);
-  // The index data records of the chunk, one per connection, right after it.
+  // The index data records of the chunk, one per connection, right after it, in the order of the
+  // connection ids as rosbag writes them (a recycled chunk lists its connections in the order of
+  // an earlier chunk).
+  std::sort(chunk.index.begin(), chunk.index.end(),
+            [](const ChunkIndex& a, const ChunkIndex& b) { return a.connection < b.connection; });
   scratch_.clear();
-  for (const ChunkIndex& index : chunk_index) {
+  for (const ChunkIndex& index : chunk.index) {
+    if (index.entries.empty()) continue;  // a recycled chunk's connection with no message this time
     const auto count = static_cast<std::uint32_t>(index.entries.size());
     const std::size_t index_header = out.beginLength();
     out.numberField("op", kOpIndexData);
