@@ -27,6 +27,8 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
+const OutputFileOptions kKeepBackup{true, ""};
+
 namespace fs = std::filesystem;
 using fault_injection::OutputFileStep;
 
@@ -88,7 +90,7 @@ TEST_F(AtomicFileTest, ReplacedFileKeepsItsModeOwnerAndGroup) {
   if (root) {
     ASSERT_EQ(::chown(path.c_str(), 4321, 8765), 0);
   }
-  writeFileAtomically(path, "new\n", OutputFileOptions{true});
+  writeFileAtomically(path, "new\n", kKeepBackup);
   EXPECT_EQ(readText(path), "new\n");
   const struct stat st = statOf(path);
   EXPECT_EQ(st.st_mode & 07777, 0640u) << "a 0640 file must not become world-readable";
@@ -108,7 +110,7 @@ TEST_F(AtomicFileTest, SymbolicLinkStaysALinkAndItsTargetIsReplaced) {
   writeText(target, "old\n");
   ASSERT_EQ(::chmod(target.c_str(), 0600), 0);
   ASSERT_EQ(::symlink("../deployed/params.yaml", link.c_str()), 0);  // relative, as deployment tools make them
-  AtomicOutputFile file(link, OutputFileOptions{true});
+  AtomicOutputFile file(link, kKeepBackup);
   EXPECT_EQ(file.targetPath(), at("run/../deployed/params.yaml"));
   file.write("new\n");
   file.commit();
@@ -167,7 +169,7 @@ TEST_F(AtomicFileTest, RefusesToReplaceSomethingThatIsNotARegularFile) {
 TEST_F(AtomicFileTest, ConcurrentWritersUseTheirOwnTemporaries) {
   const std::string path = at("params.yaml");
   writeText(path, "original\n");
-  AtomicOutputFile first(path, OutputFileOptions{true}), second(path, OutputFileOptions{true});
+  AtomicOutputFile first(path, kKeepBackup), second(path, kKeepBackup);
   EXPECT_NE(first.temporaryPath(), second.temporaryPath());
   first.write("first\n");
   second.write("second\n");
@@ -187,11 +189,11 @@ TEST_F(AtomicFileTest, BackupTemporariesAreUniqueToo) {
   fault_injection::setOutputFileFault([&](OutputFileStep step, const std::string&) {
     if (step == OutputFileStep::kRename && !nested_done) {
       nested_done = true;
-      writeFileAtomically(path, "second\n", OutputFileOptions{true});
+      writeFileAtomically(path, "second\n", kKeepBackup);
     }
     return 0;
   });
-  EXPECT_NO_THROW(writeFileAtomically(path, "first\n", OutputFileOptions{true}));
+  EXPECT_NO_THROW(writeFileAtomically(path, "first\n", kKeepBackup));
   EXPECT_TRUE(nested_done);
   EXPECT_EQ(readText(path), "first\n");
   EXPECT_EQ(readText(path + ".bak"), "original\n");  // what the first writer replaced, as it saw it
@@ -203,7 +205,7 @@ TEST_F(AtomicFileTest, TwoProcessesWritingOneFileBothSucceed) {
   const std::string path = at("params.yaml");
   writeText(path, "a\n");
   const std::vector<bool> ok = testing::runConcurrentWriters(2, [&](int c) {
-    for (int i = 0; i < 300; ++i) writeFileAtomically(path, c == 0 ? "a\n" : "b\n", OutputFileOptions{true});
+    for (int i = 0; i < 300; ++i) writeFileAtomically(path, c == 0 ? "a\n" : "b\n", kKeepBackup);
   });
   EXPECT_EQ(ok, std::vector<bool>(2, true)) << "a writer failed (see its message above)";
   const std::string now = readText(path), backup = readText(path + ".bak");
@@ -298,7 +300,7 @@ TEST_F(AtomicFileTest, FailureAtAnyStepLeavesTheOldFileIntact) {
     fault_injection::setOutputFileFault(
         [&](OutputFileStep step, const std::string&) { return step == c.step ? c.error : 0; });
     try {
-      writeFileAtomically(path, std::string(200000, 'n'), OutputFileOptions{true});
+      writeFileAtomically(path, std::string(200000, 'n'), kKeepBackup);
       ADD_FAILURE() << "no failure reported for step " << static_cast<int>(c.step);
     } catch (const std::runtime_error& e) {
       EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos) << e.what();

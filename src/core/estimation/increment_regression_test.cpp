@@ -58,7 +58,9 @@ TEST(IncrementRegressionTest, ExactForAnyWindowUnderStrongNonlinearity) {
     EXPECT_LT(worst / 0.56, 2e-8) << "window " << window;
     EXPECT_NEAR(fit.d.mean, 1e-5, 1e-10);
     EXPECT_NEAR(fit.d.cos[0], 2e-5, 1e-10);
-    if (window <= 2.0) EXPECT_GT(fit.binned.size(), 32u) << "window " << window;  // long windows leave bins empty
+    if (window <= 2.0) {  // long windows leave bins empty
+      EXPECT_GT(fit.binned.size(), 32u) << "window " << window;
+    }
     EXPECT_LT(fit.k.residual_rms / 0.56, 1e-6);
   }
 }
