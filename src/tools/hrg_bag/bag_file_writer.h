@@ -4,11 +4,13 @@
 // made writing the output bag of `hrg_bag process` ten times slower than reading its input. Here a
 // message is serialised straight into the chunk in memory, and the file sees one large write per
 // chunk plus the index at the end. A full chunk is compressed and written by a background thread
-// (SerialWorker) while the next one fills.
+// (SerialWorker) while the next one fills; written chunks come back to be filled again, so memory is
+// allocated once.
 // Layout written: the file header record (padded to 4 KiB like rosbag's, rewritten on close), then
 // per chunk a chunk record (connection records of the connections it introduces, then the message
-// data records; none, LZ4 or BZ2 compressed) followed by its index data records, and at the end the
-// connection records and the chunk info records the file header points at.
+// data records; none, LZ4 or BZ2 compressed) followed by its index data records (by connection id, as
+// rosbag orders them), and at the end the connection records and the chunk info records the file
+// header points at.
 #pragma once
 
 #include <ros/message_traits.h>
