@@ -39,13 +39,8 @@ class ModelPairEvaluator {
       *d = sum(d_coefficients_.data(), d_indices_);
       return;
     }
-    // (c1, s1) = (c2, s2)^(step / 2) as a complex power.
-    double c1 = c2, s1 = s2;
-    for (int p = 2; p <= step / 2; ++p) {
-      const double c = c1 * c2 - s1 * s2;
-      s1 = s1 * c2 + c1 * s2;
-      c1 = c;
-    }
+    double c1, s1;
+    firstOrder(c2, s2, &c1, &s1);
     // Each model's cos and sin sums side by side in a pair of lanes, and the recurrence on (cos, sin)
     // as one complex product in lanes: (c, s) (c1, s1) = (c c1 + s (-s1), s c1 + c s1).
     DoubleLanes2 k_sums = {k_coefficients_[0], 0.0}, d_sums = {d_coefficients_[0], 0.0};
@@ -66,12 +61,8 @@ class ModelPairEvaluator {
   /// The double-angle evaluate() for four samples, one per lane, where lanesApply(): every lane
   /// goes through the same operations as one sample does, so it gets the same bits.
   void evaluateLanes(DoubleLanes4 c2, DoubleLanes4 s2, DoubleLanes4* k, DoubleLanes4* d) const {
-    DoubleLanes4 c1 = c2, s1 = s2;
-    for (int p = 2; p <= basis_.step() / 2; ++p) {
-      const DoubleLanes4 c = c1 * c2 - s1 * s2;
-      s1 = s1 * c2 + c1 * s2;
-      c1 = c;
-    }
+    DoubleLanes4 c1, s1;
+    firstOrder(c2, s2, &c1, &s1);
     // The cos and sin sums apart and added at the end, and the recurrence's -s1 as a product, as
     // the lanes of evaluate() compute them.
     DoubleLanes4 k_cos = splat<DoubleLanes4>(k_coefficients_[0]), k_sin = splat<DoubleLanes4>(0.0);
@@ -93,6 +84,19 @@ class ModelPairEvaluator {
   }
 
  private:
+  /// cos and sin of the basis's first order from the double angle (c2, s2): (c2, s2)^(step / 2) as a
+  /// complex power, for one sample (V = double) or lanes of them, with the same operations.
+  template <class V>
+  void firstOrder(V c2, V s2, V* c1, V* s1) const {
+    V c = c2, s = s2;
+    for (int p = 2; p <= basis_.step() / 2; ++p) {
+      const V next = c * c2 - s * s2;
+      s = s * c2 + c * s2;
+      c = next;
+    }
+    *c1 = c;
+    *s1 = s;
+  }
   /// Re-interpolates the coefficients when the frequency differs from the last one.
   void followFrequency(double frequency) {
     const bool same = frequency == cached_frequency_ || (std::isnan(frequency) && cached_is_nan_);
