@@ -58,15 +58,7 @@ class GaussianNoise {
       // Candidates written in turn and kept by advancing k only for the accepted ones: the same
       // accepted pairs, in the same order, as polarPair's loop, without the branch on r2 that
       // went the wrong way for about one candidate in five.
-      for (int k = 0; k < pairs;) {
-        const double cu = 2.0 * uniform() - 1.0;
-        const double cv = 2.0 * uniform() - 1.0;
-        const double cr2 = cu * cu + cv * cv;
-        u[k] = cu;
-        v[k] = cv;
-        r2[k] = cr2;
-        k += static_cast<int>((cr2 < 1.0) & (cr2 != 0.0));
-      }
+      for (int k = 0; k < pairs;) k += static_cast<int>(polarCandidate(&u[k], &v[k], &r2[k]));
       for (int k = 0; k < pairs; ++k) {
         const double scale = polarScale(r2[k]);
         out[i++] = u[k] * scale;
@@ -96,13 +88,18 @@ class GaussianNoise {
   }
 
  private:
-  /// The polar method's accepted point: (u, v) uniform in the unit disc without its centre, r2 = u^2 + v^2.
+  /// A candidate point (u, v) uniform in the square [-1, 1)^2 and r2 = u^2 + v^2; true when the polar
+  /// method accepts it (inside the unit disc, not its centre). Without a branch: fill() counts on it.
+  bool polarCandidate(double* u, double* v, double* r2) {
+    *u = 2.0 * uniform() - 1.0;
+    *v = 2.0 * uniform() - 1.0;
+    *r2 = *u * *u + *v * *v;
+    return (*r2 < 1.0) & (*r2 != 0.0);
+  }
+  /// The polar method's accepted point: (u, v) uniform in the unit disc without its centre.
   void polarPair(double* u, double* v, double* r2) {
-    do {
-      *u = 2.0 * uniform() - 1.0;
-      *v = 2.0 * uniform() - 1.0;
-      *r2 = *u * *u + *v * *v;
-    } while (*r2 >= 1.0 || *r2 == 0.0);
+    while (!polarCandidate(u, v, r2)) {
+    }
   }
   /// The factor that turns an accepted point into two independent standard normal deviates.
   static double polarScale(double r2) { return std::sqrt(-2.0 * std::log(r2) / r2); }
