@@ -205,8 +205,8 @@ void BagFileWriter::writeChunk(Chunk& chunk) {
     data = compressed_.data();
   } else if (compression_ == Compression::kBz2) {
     compression = "bz2";
-    compressed_.resize(chunk.bytes.size() + chunk.bytes.size() / 100 +
-                       4096);  // bzip2's documented worst case is +1 % + 600
+    // bzip2's documented worst case is +1 % + 600.
+    compressed_.resize(chunk.bytes.size() + chunk.bytes.size() / 100 + 4096);
     unsigned int out_size = static_cast<unsigned int>(compressed_.size());
     if (BZ2_bzBuffToBuffCompress(reinterpret_cast<char*>(compressed_.data()), &out_size,
                                  const_cast<char*>(reinterpret_cast<const char*>(chunk.bytes.data())),
