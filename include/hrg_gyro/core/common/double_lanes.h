@@ -8,6 +8,10 @@
 #include <cmath>
 #include <cstdint>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace hrg_gyro {
 namespace core {
 
@@ -17,6 +21,11 @@ typedef double DoubleLanes4 __attribute__((vector_size(32)));
 /// The integer lanes that go with a double lane type: its bits, and 32-bit indices.
 template <class V>
 struct LaneTraits;
+template <>
+struct LaneTraits<DoubleLanes2> {
+  typedef std::int64_t Bits __attribute__((vector_size(16)));
+  typedef std::int32_t Index __attribute__((vector_size(8)));
+};
 template <>
 struct LaneTraits<DoubleLanes4> {
   typedef std::int64_t Bits __attribute__((vector_size(32)));
@@ -40,6 +49,11 @@ inline V select(M mask, V a, V b) {
 }
 
 inline double laneSqrt(double x) { return std::sqrt(x); }
+#if defined(__SSE2__)
+/// One instruction for both lanes (GCC leaves the loop below on a pair as two scalar roots); the
+/// root is correctly rounded either way, so the bits are the same.
+inline DoubleLanes2 laneSqrt(DoubleLanes2 x) { return _mm_sqrt_pd(x); }
+#endif
 template <class V>
 inline V laneSqrt(V x) {
   V r;

@@ -78,6 +78,31 @@ struct WaveLanes {
   V e, r, s, h, q, l, m, theta, amplitude, quadrature, phase, cos_theta, sin_theta;
 };
 
+/// Two independent atan2 of one sample in the two lanes of a pair, so that each division of the
+/// reduction is one instruction for both; for lanes of samples, one after the other. The same
+/// operations either way, so the same bits.
+template <class V>
+inline void atan2Pair(V y0, V x0, V y1, V x1, V* a0, V* a1) {
+  *a0 = fastAtan2Reduced(y0, x0);
+  *a1 = fastAtan2Reduced(y1, x1);
+}
+inline void atan2Pair(double y0, double x0, double y1, double x1, double* a0, double* a1) {
+  const DoubleLanes2 a = fastAtan2Reduced(DoubleLanes2{y0, y1}, DoubleLanes2{x0, x1});
+  *a0 = a[0];
+  *a1 = a[1];
+}
+/// The same for two independent square roots.
+template <class V>
+inline void sqrtPair(V x0, V x1, V* r0, V* r1) {
+  *r0 = laneSqrt(x0);
+  *r1 = laneSqrt(x1);
+}
+inline void sqrtPair(double x0, double x1, double* r0, double* r1) {
+  const DoubleLanes2 r = laneSqrt(DoubleLanes2{x0, x1});
+  *r0 = r[0];
+  *r1 = r[1];
+}
+
 /// The wave state of (corrected) channel amplitudes, valid where waveComputable() holds; the
 /// caller checks the status conditions. Every operation is elementwise, so a lane gets the bits
 /// one sample gets. Always inline: the inliner may decline for the size, and a call would pass
@@ -93,15 +118,16 @@ __attribute__((always_inline)) inline void computeWave(V ac, V bc, V as, V bs, W
   // from the channels, so its atan2 runs beside theta's instead of after the square roots.
   const V m = ac * ac - bc * bc + as * as - bs * bs;
   w->m = m;
-  w->theta = 0.5 * fastAtan2Reduced(w->s, w->r);
-  const V tau2 = fastAtan2Reduced(-w->l, m);
+  V doubled_theta, tau2;
+  atan2Pair(w->s, w->r, -w->l, m, &doubled_theta, &tau2);
+  w->theta = 0.5 * doubled_theta;
   // A^2 - B^2. r^2 + s^2 <= e^2 neither overflows nor, unless the wave is degenerate, underflows
   // where the wave is computable (1e-140 < e < 1e150).
   const V h = laneSqrt(w->r * w->r + w->s * w->s);
   w->h = h;
   const V half_difference = 0.5 * (w->e - h);
-  w->amplitude = laneSqrt(0.5 * (w->e + h));
-  const V b = laneSqrt(select(0.0 < half_difference, half_difference, splat<V>(0.0)));
+  V b;
+  sqrtPair(0.5 * (w->e + h), select(0.0 < half_difference, half_difference, splat<V>(0.0)), &w->amplitude, &b);
   w->quadrature = laneCopysign(b, w->q);
   // (cos th, sin th) up to a positive factor, from the half-angle identities
   // tan th = s / (h + r) = (h - r) / s, taking the better-conditioned one: no trigonometry.
