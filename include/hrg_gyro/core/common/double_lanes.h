@@ -32,10 +32,11 @@ struct LaneTraits<DoubleLanes4> {
   typedef std::int32_t Index __attribute__((vector_size(16)));
 };
 
-/// x in every lane (x itself for a double).
+/// x in every lane (x itself for a double). x - (+0) is x for every x, -0.0 included (0 + -0.0 would
+/// be +0.0).
 template <class V>
 inline V splat(double x) {
-  return V{} + x;
+  return x - V{};
 }
 template <>
 inline double splat<double>(double x) {
