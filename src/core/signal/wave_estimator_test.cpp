@@ -213,6 +213,22 @@ TEST(ThetaUnwrapperTest, FollowsSeveralRevolutionsBothWays) {
   EXPECT_FALSE(unwrapper.initialized());
 }
 
+// Steps up to just under a quarter turn of the wave (pi/2 of theta) either way are taken the short
+// way, thousands of half turns away from the start too.
+TEST(ThetaUnwrapperTest, TakesTheShortWayForStepsUpToJustUnderPiOverTwo) {
+  for (double step : {0.3, 0.49 * kPi, (0.5 - 1e-9) * kPi}) {
+    for (double sign : {1.0, -1.0}) {
+      ThetaUnwrapper unwrapper;
+      double truth = 0.1;
+      for (int i = 0; i < 5000; ++i) {
+        const double principal = truth - kPi * std::round(truth / kPi);
+        ASSERT_NEAR(unwrapper.unwrap(principal), truth, 1e-9 * (1.0 + std::abs(truth))) << step << " " << i;
+        truth += sign * step;
+      }
+    }
+  }
+}
+
 TEST(WaveEstimatorTest, CarriesTheUnitVectorOfThetaThroughRebase) {
   // cos/sin of theta come from half-angle identities (no trigonometry) and follow the unwrapping.
   std::mt19937_64 rng(9);
