@@ -15,6 +15,7 @@
 #include <ctime>
 #include <fstream>
 #include <iterator>
+#include <new>
 #include <stdexcept>
 
 #include "hrg_gyro/core/common/output_directory.h"
@@ -235,19 +236,25 @@ const char* kindOf(mode_t mode) {
 
 // ---------------------------------------------------------------------------------------------
 // The stream buffer: writes straight to the temporary's descriptor and remembers the first error.
+// With direct I/O the descriptor is switched to O_DIRECT where the file system allows it: whole
+// blocks go from this (block-aligned) buffer to the device, the last partial block is written
+// through the page cache by finish(), and a write the device refuses in that mode (EINVAL: an
+// alignment it requires beyond kBlock) switches the descriptor back and is retried.
 class AtomicOutputFile::Buffer : public std::streambuf {
  public:
-  Buffer(int fd, std::string target) : fd_(fd), target_(std::move(target)), data_(1 << 16) { resetPut(); }
-  int error() const { return error_; }
-  bool flushAll() {
-    if (error_ != 0) return false;
-    const std::size_t pending = static_cast<std::size_t>(pptr() - pbase());
-    if (pending == 0) return true;
-    error_ = injectedFault(OutputFileStep::kWrite, target_);
-    if (error_ == 0) error_ = writeAll(fd_, pbase(), pending);
-    resetPut();
-    return error_ == 0;
+  Buffer(int fd, std::string target, bool direct)
+      : fd_(fd), target_(std::move(target)), data_(static_cast<char*>(std::aligned_alloc(kBlock, kSize))) {
+    if (data_ == nullptr) throw std::bad_alloc();
+    const int flags = ::fcntl(fd_, F_GETFL);
+    direct_ = direct && flags >= 0 && ::fcntl(fd_, F_SETFL, flags | O_DIRECT) == 0;
+    resetPut(0);
   }
+  ~Buffer() override { std::free(data_); }
+  int error() const { return error_; }
+  /// Writes what is buffered: with direct I/O, the whole blocks only (the rest stays buffered).
+  bool flushAll() { return flush(false); }
+  /// Writes everything, the last partial block included.
+  bool finish() { return flush(true); }
 
  protected:
   int_type overflow(int_type ch) override {
@@ -261,11 +268,45 @@ class AtomicOutputFile::Buffer : public std::streambuf {
   int sync() override { return flushAll() ? 0 : -1; }
 
  private:
-  void resetPut() { setp(data_.data(), data_.data() + data_.size()); }
+  static constexpr std::size_t kBlock = 4096, kSize = std::size_t{1} << 20;
+
+  bool flush(bool last) {
+    if (error_ != 0) return false;
+    const std::size_t pending = static_cast<std::size_t>(pptr() - pbase());
+    if (direct_ && last) {
+      if (!setDirect(false)) {
+        error_ = errno != 0 ? errno : EIO;
+        return false;
+      }
+      direct_ = false;
+    }
+    const std::size_t now = direct_ ? pending / kBlock * kBlock : pending;
+    if (now > 0) {
+      error_ = injectedFault(OutputFileStep::kWrite, target_);
+      if (error_ == 0) error_ = writeAll(fd_, pbase(), now);
+      if (error_ == EINVAL && direct_ && setDirect(false)) {
+        direct_ = false;
+        error_ = writeAll(fd_, pbase(), now);
+      }
+    }
+    std::memmove(data_, data_ + now, pending - now);
+    resetPut(pending - now);
+    return error_ == 0;
+  }
+  /// true when O_DIRECT is now as asked.
+  bool setDirect(bool on) {
+    const int flags = ::fcntl(fd_, F_GETFL);
+    return flags >= 0 && ::fcntl(fd_, F_SETFL, on ? flags | O_DIRECT : flags & ~O_DIRECT) == 0;
+  }
+  void resetPut(std::size_t kept) {
+    setp(data_, data_ + kSize);
+    pbump(static_cast<int>(kept));
+  }
 
   int fd_;
   std::string target_;
-  std::vector<char> data_;
+  char* data_;
+  bool direct_ = false;
   int error_ = 0;
 };
 
@@ -292,7 +333,7 @@ AtomicOutputFile::AtomicOutputFile(const std::string& path, const OutputFileOpti
   }
   removeStaleTemporaries(target_path_, now());
   fd_ = createTemporary(target_path_, ".tmp", &temporary_path_, options.temporary_suffix);
-  buffer_ = std::make_unique<Buffer>(fd_, target_path_);
+  buffer_ = std::make_unique<Buffer>(fd_, target_path_, options.direct_io);
   stream_ = std::make_unique<std::ostream>(buffer_.get());
 }
 
@@ -322,7 +363,7 @@ void AtomicOutputFile::commit(const Verifier& verify) {
   const std::string unchanged = target_existed_ ? " (the existing file is unchanged)" : "";
   std::string backup_temporary;
   try {
-    if (!buffer_->flushAll() || !*stream_) {
+    if (!buffer_->finish() || !*stream_) {
       fail("cannot write '" + target_path_ + "'" + unchanged, buffer_->error() != 0 ? buffer_->error() : EIO);
     }
     const int metadata_error = target_existed_ ? copyMetadata(fd_, target_uid_, target_gid_, target_mode_)

@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <filesystem>
@@ -323,6 +324,76 @@ TEST_F(AtomicFileTest, FailureAtAnyStepLeavesTheOldFileIntact) {
   }
   EXPECT_EQ(readText(path), "old content\n");
   EXPECT_EQ(listing(), (std::set<std::string>{"params.yaml", "params.yaml.bak"}));
+}
+
+/// The open-file flags of the descriptor this process holds on `path` (from /proc), -1 if none.
+long openFlagsOf(const std::string& path) {
+  for (const auto& e : fs::directory_iterator("/proc/self/fd")) {
+    std::error_code error;
+    if (fs::read_symlink(e.path(), error).string() != path) continue;
+    std::ifstream info("/proc/self/fdinfo/" + e.path().filename().string());
+    std::string key;
+    std::string value;
+    while (info >> key >> value) {
+      if (key == "flags:") return std::stol(value, nullptr, 8);
+    }
+  }
+  return -1;
+}
+
+// Direct output (whole blocks around the page cache, the last partial block through it): every byte
+// arrives, whatever the sizes of the file and of the pieces it is written in, flushes included.
+TEST_F(AtomicFileTest, DirectOutputKeepsEveryByteWhateverTheSizes) {
+  OutputFileOptions direct;
+  direct.direct_io = true;
+  const std::string path = at("session.csv");
+  const std::size_t mib = std::size_t{1} << 20;
+  const int probe = ::open(at("probe").c_str(), O_WRONLY | O_CREAT | O_DIRECT | O_CLOEXEC, 0600);
+  const bool takesDirectIo = probe >= 0;
+  if (probe >= 0) ::close(probe);
+  ::unlink(at("probe").c_str());
+  for (std::size_t size : {std::size_t{0}, std::size_t{1}, std::size_t{4095}, std::size_t{4096}, std::size_t{4097},
+                           mib - 1, mib, mib + 4097, 3 * mib + 5}) {
+    std::string content(size, ' ');
+    for (std::size_t i = 0; i < size; ++i) content[i] = static_cast<char>('a' + (i * 131 + size) % 26);
+    AtomicOutputFile file(path, direct);
+    if (size == 0 && takesDirectIo) {
+      // Where the file system takes O_DIRECT, the direct path is the one under test.
+      EXPECT_NE(openFlagsOf(file.temporaryPath()) & O_DIRECT, 0);
+    }
+    std::size_t done = 0, piece = 0;
+    const std::size_t pieces[] = {1, 7, 4096, 65537, 1000003};
+    while (done < size) {
+      const std::size_t n = std::min(pieces[piece++ % 5], size - done);
+      file.stream().write(content.data() + done, static_cast<std::streamsize>(n));
+      if (piece == 3) file.stream().flush();
+      done += n;
+    }
+    file.commit();
+    EXPECT_EQ(readText(path), content) << size;
+    EXPECT_EQ(listing(), (std::set<std::string>{"session.csv"})) << size;
+  }
+}
+
+TEST_F(AtomicFileTest, DirectOutputThatFailsLeavesTheOldFileIntact) {
+  OutputFileOptions direct;
+  direct.direct_io = true;
+  const std::string path = at("session.csv");
+  writeText(path, "old content\n");
+  for (std::size_t size : {std::size_t{100}, std::size_t{3} << 20}) {  // failing at commit, and while writing
+    fault_injection::setOutputFileFault(
+        [](OutputFileStep step, const std::string&) { return step == OutputFileStep::kWrite ? ENOSPC : 0; });
+    AtomicOutputFile file(path, direct);
+    file.write(std::string(size, 'x'));
+    try {
+      file.commit();
+      ADD_FAILURE() << "no failure reported for " << size << " bytes";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(readText(path), "old content\n");
+    EXPECT_EQ(listing(), (std::set<std::string>{"session.csv"}));
+  }
 }
 
 TEST_F(AtomicFileTest, MissingDirectoryIsReported) {

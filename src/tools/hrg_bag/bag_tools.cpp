@@ -127,7 +127,11 @@ void OutputBag::commit() {
   }
 }
 
-OutputText::OutputText(const std::string& path) : path_(path) { openOutput(&file_, path); }
+OutputText::OutputText(const std::string& path) : path_(path) {
+  core::OutputFileOptions options;
+  options.direct_io = true;  // CSV files of a long session run to gigabytes
+  openOutput(&file_, path, options);
+}
 
 void OutputText::commit() {
   try {

@@ -34,6 +34,11 @@ struct OutputFileOptions {
   /// Appended to the temporary's name (".png"): for content written by another program that
   /// chooses its format by the name's extension. Letters, digits and dots only.
   std::string temporary_suffix;
+  /// For large outputs written through stream(): whole blocks go to the device around the page
+  /// cache (O_DIRECT, where the file system has it). commit() syncs the file anyway, so the cache
+  /// would only hold a second copy; filling it costs system time, and the sync then waits for all of
+  /// it at once.
+  bool direct_io = false;
 };
 
 class AtomicOutputFile {
