@@ -18,18 +18,16 @@ namespace core {
 typedef double DoubleLanes2 __attribute__((vector_size(16)));
 typedef double DoubleLanes4 __attribute__((vector_size(32)));
 
-/// The integer lanes that go with a double lane type: its bits, and 32-bit indices.
+/// The integer lanes that go with a double lane type: its bits.
 template <class V>
 struct LaneTraits;
 template <>
 struct LaneTraits<DoubleLanes2> {
   typedef std::int64_t Bits __attribute__((vector_size(16)));
-  typedef std::int32_t Index __attribute__((vector_size(8)));
 };
 template <>
 struct LaneTraits<DoubleLanes4> {
   typedef std::int64_t Bits __attribute__((vector_size(32)));
-  typedef std::int32_t Index __attribute__((vector_size(16)));
 };
 
 /// x in every lane (x itself for a double). x - (+0) is x for every x, -0.0 included (0 + -0.0 would
