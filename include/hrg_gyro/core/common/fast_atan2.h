@@ -15,6 +15,7 @@
 #include <cstdint>
 
 #include "hrg_gyro/core/common/double_lanes.h"
+#include "hrg_gyro/core/common/units.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -29,12 +30,11 @@ inline auto fastAtan2Applies(V y, V x) {
 
 /// Where the reduction moves t (in [0, 1]), given t32 = 32 t: k, the whole number nearest to 32 t
 /// (ties to even: either neighbour leaves |u| <= 1/64), as a double, and atan(k / 32) from the table.
-/// Adding 1.5 * 2^52 rounds 32 t to a whole number held in the low bits of the sum: the way to u has
-/// no conversion to int and back and no range check. The table index is those low six bits, and the
-/// table has 64 entries, so a NaN lane (a rejected sample's 0 / 0, whose result nobody uses) reads one
-/// of them too.
+/// Adding kRoundingShift (units.h) rounds 32 t to a whole number held in the low bits of the sum:
+/// the way to u has no conversion to int and back and no range check. The table index is those low
+/// six bits, and the table has 64 entries, so a NaN lane (a rejected sample's 0 / 0, whose result
+/// nobody uses) reads one of them too.
 constexpr double kAtanSteps = 32.0;
-constexpr double kRoundingShift = 0x1.8p52;
 inline void nearestStep(double t32, const double* table, double* k, double* value) {
   const double shifted = t32 + kRoundingShift;
   *k = shifted - kRoundingShift;

@@ -40,6 +40,13 @@ inline double roundHalfAway(double x) {
   return std::copysign(t, x);
 }
 
+/// 1.5 * 2^52: for |x| < 2^51, the sum x + kRoundingShift is a double whose last bit is worth 1, so
+/// it holds x rounded to the nearest whole number (ties to even), also in its low bits.
+constexpr double kRoundingShift = 0x1.8p52;
+/// The whole number nearest to x, |x| < 2^51, ties to even: two additions, about half the chain of
+/// roundHalfAway, for a hot path where a tie may go either way.
+inline double nearestWhole(double x) { return (x + kRoundingShift) - kRoundingShift; }
+
 /// x mod period, in [0, period).
 inline double positiveModulo(double x, double period) {
   double r = std::fmod(x, period);

@@ -20,6 +20,8 @@ class ThetaUnwrapper {
   /// *half_turns receives the count to pass to accept(). The first angle after a reset is its own
   /// continuous value.
   double peek(double principal, double* half_turns) const {
+    // Two principal values are less than a half turn apart, and a tie (a step of exactly pi/2 either
+    // way) has no shorter way to prefer: nearestWhole's shorter chain serves.
     *half_turns = initialized_ ? half_turns_ + nearestWhole((last_principal_ - principal) * kInversePi) : 0.0;
     return principal + kPi * *half_turns;
   }
@@ -52,14 +54,6 @@ class ThetaUnwrapper {
 
  private:
   static constexpr double kInversePi = 1.0 / kPi;
-  /// The whole number nearest to x, |x| < 2^51 (two principal values differ by less than one half
-  /// turn), ties to even: adding 1.5 * 2^52 leaves a sum whose last bit is worth 1. Half as long a
-  /// chain as roundHalfAway on the per-sample path; a tie (a step of exactly pi/2 either way) has no
-  /// smaller change to keep.
-  static double nearestWhole(double x) {
-    constexpr double kShift = 0x1.8p52;
-    return (x + kShift) - kShift;
-  }
   bool initialized_ = false;
   double last_principal_ = 0.0;
   double half_turns_ = 0.0;  // a whole number
