@@ -15,9 +15,9 @@
 #include <ctime>
 #include <fstream>
 #include <iterator>
-#include <new>
 #include <stdexcept>
 
+#include "hrg_gyro/core/common/direct_file_buffer.h"
 #include "hrg_gyro/core/common/output_directory.h"
 
 namespace hrg_gyro {
@@ -235,23 +235,17 @@ const char* kindOf(mode_t mode) {
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
-// The stream buffer: writes straight to the temporary's descriptor and remembers the first error.
-// With direct I/O the descriptor is switched to O_DIRECT where the file system allows it: whole
-// blocks go from this (block-aligned) buffer to the device, the last partial block is written
-// through the page cache by finish(), and a write the device refuses in that mode (EINVAL: an
-// alignment it requires beyond kBlock) switches the descriptor back and is retried.
+// The stream buffer: its put area is a DirectFileBuffer's memory, written to the temporary's
+// descriptor (with direct_io, whole blocks around the page cache until finish()); it remembers the
+// first error.
 class AtomicOutputFile::Buffer : public std::streambuf {
  public:
   Buffer(int fd, std::string target, bool direct)
-      : fd_(fd), target_(std::move(target)), data_(static_cast<char*>(std::aligned_alloc(kBlock, kSize))) {
-    if (data_ == nullptr) throw std::bad_alloc();
-    const int flags = ::fcntl(fd_, F_GETFL);
-    direct_ = direct && flags >= 0 && ::fcntl(fd_, F_SETFL, flags | O_DIRECT) == 0;
-    resetPut(0);
+      : target_(std::move(target)), file_(fd, direct ? std::size_t{1} << 20 : std::size_t{1} << 16, direct) {
+    resetPut();
   }
-  ~Buffer() override { std::free(data_); }
   int error() const { return error_; }
-  /// Writes what is buffered: with direct I/O, the whole blocks only (the rest stays buffered).
+  /// Writes what is buffered (with direct I/O, the whole blocks only; the rest stays buffered).
   bool flushAll() { return flush(false); }
   /// Writes everything, the last partial block included.
   bool finish() { return flush(true); }
@@ -268,45 +262,23 @@ class AtomicOutputFile::Buffer : public std::streambuf {
   int sync() override { return flushAll() ? 0 : -1; }
 
  private:
-  static constexpr std::size_t kBlock = 4096, kSize = std::size_t{1} << 20;
-
-  bool flush(bool last) {
+  bool flush(bool all) {
     if (error_ != 0) return false;
-    const std::size_t pending = static_cast<std::size_t>(pptr() - pbase());
-    if (direct_ && last) {
-      if (!setDirect(false)) {
-        error_ = errno != 0 ? errno : EIO;
-        return false;
-      }
-      direct_ = false;
-    }
-    const std::size_t now = direct_ ? pending / kBlock * kBlock : pending;
-    if (now > 0) {
-      error_ = injectedFault(OutputFileStep::kWrite, target_);
-      if (error_ == 0) error_ = writeAll(fd_, pbase(), now);
-      if (error_ == EINVAL && direct_ && setDirect(false)) {
-        direct_ = false;
-        error_ = writeAll(fd_, pbase(), now);
-      }
-    }
-    std::memmove(data_, data_ + now, pending - now);
-    resetPut(pending - now);
+    file_.setSize(static_cast<std::size_t>(pptr() - pbase()));
+    if (file_.size() == 0) return true;
+    error_ = injectedFault(OutputFileStep::kWrite, target_);
+    if (error_ == 0) error_ = file_.write(all);
+    resetPut();
     return error_ == 0;
   }
-  /// true when O_DIRECT is now as asked.
-  bool setDirect(bool on) {
-    const int flags = ::fcntl(fd_, F_GETFL);
-    return flags >= 0 && ::fcntl(fd_, F_SETFL, on ? flags | O_DIRECT : flags & ~O_DIRECT) == 0;
-  }
-  void resetPut(std::size_t kept) {
-    setp(data_, data_ + kSize);
-    pbump(static_cast<int>(kept));
+  /// The put area over the buffer's memory, after what it still holds.
+  void resetPut() {
+    setp(file_.data(), file_.data() + file_.capacity());
+    pbump(static_cast<int>(file_.size()));
   }
 
-  int fd_;
   std::string target_;
-  char* data_;
-  bool direct_ = false;
+  DirectFileBuffer file_;
   int error_ = 0;
 };
 

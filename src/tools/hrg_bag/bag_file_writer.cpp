@@ -7,9 +7,7 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <cstdlib>
 #include <cstring>
-#include <new>
 
 namespace hrg_gyro {
 namespace bag_tools {
@@ -78,13 +76,12 @@ BagFileWriter::BagFileWriter(const std::string& path, Compression compression, s
     : path_(path), compression_(compression), chunk_threshold_(chunk_threshold) {
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) throw BagWriteError("cannot create " + path, errno);
-  stage_.reset(static_cast<std::uint8_t*>(std::aligned_alloc(kBlock, kStageSize)));
-  if (!stage_) {
+  try {
+    stage_ = std::make_unique<core::DirectFileBuffer>(fd_, std::size_t{4} << 20, true);
+  } catch (...) {
     ::close(fd_);
-    throw std::bad_alloc();
+    throw;
   }
-  const int flags = ::fcntl(fd_, F_GETFL);
-  direct_ = flags >= 0 && ::fcntl(fd_, F_SETFL, flags | O_DIRECT) == 0;
   chunk_ = takeChunk();
   writeFile(kMagic, sizeof kMagic - 1);
   writeFileHeader(0);  // rewritten by close() with the index position
@@ -300,7 +297,7 @@ void BagFileWriter::close() {
   writeFile(scratch_.data(), scratch_.size());
   seekFile(sizeof kMagic - 1);
   writeFileHeader(index_position);
-  flushStaged(true);
+  flushStaged();
   const int fd = fd_;
   fd_ = -1;
   if (::close(fd) != 0) throw BagWriteError("cannot close " + path_, errno);
@@ -322,52 +319,16 @@ void BagFileWriter::writeFileHeader(std::uint64_t index_position) {
 }
 
 void BagFileWriter::writeFile(const void* data, std::size_t size) {
-  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  if (const int error = stage_->append(data, size)) throw BagWriteError("cannot write " + path_, error);
   file_position_ += size;
-  while (size > 0) {
-    const std::size_t n = std::min(size, kStageSize - staged_);
-    std::memcpy(stage_.get() + staged_, bytes, n);
-    staged_ += n;
-    bytes += n;
-    size -= n;
-    if (staged_ == kStageSize) flushStaged(false);
-  }
 }
 
-void BagFileWriter::flushStaged(bool all) {
-  const auto setDirect = [this](bool on) {
-    const int flags = ::fcntl(fd_, F_GETFL);
-    if (flags < 0 || ::fcntl(fd_, F_SETFL, on ? flags | O_DIRECT : flags & ~O_DIRECT) != 0) {
-      throw BagWriteError("cannot write " + path_, errno);
-    }
-  };
-  if (all && direct_) {
-    setDirect(false);
-    direct_ = false;
-  }
-  const std::size_t now = direct_ ? staged_ / kBlock * kBlock : staged_;
-  const std::uint8_t* bytes = stage_.get();
-  std::size_t left = now;
-  while (left > 0) {
-    const ssize_t written = ::write(fd_, bytes, left);
-    if (written < 0) {
-      if (errno == EINTR) continue;
-      if (errno == EINVAL && direct_) {  // an alignment the device wants beyond kBlock: write through the cache
-        setDirect(false);
-        direct_ = false;
-        continue;
-      }
-      throw BagWriteError("cannot write " + path_, errno);
-    }
-    bytes += written;
-    left -= static_cast<std::size_t>(written);
-  }
-  std::memmove(stage_.get(), stage_.get() + now, staged_ - now);
-  staged_ -= now;
+void BagFileWriter::flushStaged() {
+  if (const int error = stage_->write(true)) throw BagWriteError("cannot write " + path_, error);
 }
 
 void BagFileWriter::seekFile(std::uint64_t position) {
-  flushStaged(true);
+  flushStaged();
   if (::lseek(fd_, static_cast<off_t>(position), SEEK_SET) < 0) throw BagWriteError("cannot seek in " + path_, errno);
   file_position_ = position;
 }

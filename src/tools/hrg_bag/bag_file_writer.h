@@ -18,13 +18,13 @@
 #include <ros/time.h>
 
 #include <cstdint>
-#include <cstdlib>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "hrg_gyro/core/common/direct_file_buffer.h"
 #include "serial_worker.h"
 
 namespace hrg_gyro {
@@ -99,22 +99,17 @@ class BagFileWriter {
   /// In the worker: compresses `chunk` and writes it and its index records (sorting the index).
   void writeChunk(Chunk& chunk);
   void writeFileHeader(std::uint64_t index_position);
-  /// Appends to the file through the staging buffer.
+  /// Appends to the file (through stage_).
   void writeFile(const void* data, std::size_t size);
-  /// Writes the staged bytes: whole blocks only while O_DIRECT is on, everything with `all` (which
-  /// turns O_DIRECT off first: a last partial block goes through the page cache).
-  void flushStaged(bool all);
+  /// Writes everything stage_ holds (the last partial block through the page cache).
+  void flushStaged();
   void seekFile(std::uint64_t position);
 
   std::string path_;
   int fd_ = -1;
-  // The file is written in whole blocks around the page cache (O_DIRECT, where the file system
-  // takes it) from this block-aligned buffer: the bag is synced before it replaces its path anyway,
-  // and filling the cache with gigabytes costs more system time than the writing itself.
-  static constexpr std::size_t kBlock = 4096, kStageSize = std::size_t{4} << 20;
-  std::unique_ptr<std::uint8_t, void (*)(void*)> stage_{nullptr, std::free};
-  std::size_t staged_ = 0;
-  bool direct_ = false;
+  // The file goes out through this buffer, in whole blocks around the page cache where the file
+  // system allows (the bag is synced before it replaces its path anyway).
+  std::unique_ptr<core::DirectFileBuffer> stage_;
   Compression compression_;
   std::uint32_t chunk_threshold_;
   std::uint64_t file_position_ = 0;
