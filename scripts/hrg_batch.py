@@ -134,8 +134,8 @@ def main(argv):
                              bag_dir=os.path.abspath(args.bag_dir),
                              generated=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"))
     try:
-        hrg_report.write_atomically(os.path.join(out_dir, "index.html"), html)
-    except OSError as e:
+        hrg_report.hrg_output_file.write_file_atomically(os.path.join(out_dir, "index.html"), html)
+    except hrg_report.hrg_output_file.OutputWriteError as e:
         sys.stderr.write("hrg_batch: %s\n" % e)
         return 3
     print("hrg_batch: %d of %d passed; index in %s" % (passed, len(rows), os.path.join(out_dir, "index.html")))

@@ -14,8 +14,17 @@ profile against ground truth (session_monitor's summary YAML, as `make run` writ
 checks the figures against the gyro's specification (see SPEC_KEYS).
 
 Everything the page shows is embedded (PNG figures as data URIs, styles inline): it opens offline
-and prints on A4. Exit 0 the report was written (whatever the pass/fail), 2 bad usage or input,
-3 the report could not be written.
+and prints on A4. The page is written as the package's C++ tools write their outputs
+(hrg_output_file.py): whole or not at all, a link at --out followed, the mode of a replaced file kept.
+
+Exit codes:
+  0  the report was written (whatever the pass/fail)
+  2  bad usage or input, nothing written: a missing input or one that is not a regular file; --out
+     the same file as an input (also through a link, a hard link or another spelling) or an existing
+     FIFO, device or directory; a YAML input with a key given twice, or a calibration report,
+     specification or verification summary with a missing or malformed field (the message names the
+     file and the key path)
+  3  the report could not be written (full disk...): no temporary left, an existing file unchanged
 """
 import argparse
 import base64
@@ -26,6 +35,8 @@ import math
 import os
 import re
 import shutil
+import signal
+import stat
 import subprocess
 import sys
 import tempfile
@@ -35,6 +46,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import yaml  # noqa: E402
+
+# The shared writer beside this script. Its own folder first: run through catkin's devel-space relay,
+# sys.path[0] is the relay's folder, and __file__ is this source file.
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import hrg_output_file  # noqa: E402
+from hrg_output_file import shown  # noqa: E402
 
 RAD_S_TO_DEG_H = 180.0 / math.pi * 3600.0
 RAD_SQRT_S_TO_DEG_SQRT_H = 180.0 / math.pi * 60.0  # rad/sqrt(s) -> deg/sqrt(h)
@@ -55,10 +72,34 @@ SPEC_KEYS = {
 SPEC_OTHER_KEYS = {"name", "require_accepted"}
 
 MIN_CLUSTERS = 9  # Allan points with fewer independent clusters are drawn, not read (as the core does)
+MAX_YAML_BYTES = 16 << 20  # a calibration report is well below 1 MiB; larger is not one
+
+
+class DuplicateKeyError(yaml.YAMLError):
+    pass
 
 
 class Loader(yaml.SafeLoader):
-    """YAML 1.2 numbers: yaml-cpp writes 1e-05, which PyYAML's YAML 1.1 rules would read as a string."""
+    """YAML 1.2 numbers: yaml-cpp writes 1e-05, which PyYAML's YAML 1.1 rules would read as a string.
+    A key given twice in one map is refused, as the package's C++ reader refuses it: PyYAML would
+    silently keep the last one (a limit typed twice would drop the first)."""
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            first_line = {}
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":
+                    continue  # "<<: *base": keys given beside it override the merged ones
+                key = self.construct_object(key_node, deep=True)
+                try:
+                    line = first_line.get(key)
+                except TypeError:
+                    continue  # an unhashable key: SafeLoader refuses it with its own message
+                if line is not None:
+                    raise DuplicateKeyError("key %s given more than once in the same map (lines %d and %d)" %
+                                            (shown(key), line + 1, key_node.start_mark.line + 1))
+                first_line[key] = key_node.start_mark.line
+        return super().construct_mapping(node, deep)
 
 
 Loader.add_implicit_resolver(
@@ -73,6 +114,12 @@ Loader.add_implicit_resolver(
 
 class ReportError(Exception):
     """Bad usage or input: message printed, exit 2."""
+
+
+def one_line(text, limit=300):
+    """A message on one line, cut to `limit` characters."""
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else "%s... (%d characters)" % (text[:limit], len(text))
 
 
 def fmt(value, digits=6):
@@ -103,28 +150,248 @@ def figure_uri(fig):
 
 
 def load_yaml(path, what):
+    """The YAML map in `path`: a regular file of at most MAX_YAML_BYTES, UTF-8, no key given twice."""
     try:
-        with open(path) as f:
-            data = yaml.load(f, Loader=Loader)
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as e:
-        raise ReportError("cannot read %s %s: %s" % (what, path, e))
+        raw = hrg_output_file.read_regular_file(path, what, MAX_YAML_BYTES)
+    except hrg_output_file.PathRefused as e:
+        raise ReportError(str(e))
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ReportError("cannot read %s %s: not UTF-8 text (byte %d)" % (what, path, e.start))
+    stream = io.StringIO(text)
+    stream.name = path  # PyYAML's messages name the file
+    try:
+        data = yaml.load(stream, Loader=Loader)
+    except DuplicateKeyError as e:
+        raise ReportError("%s %s: %s" % (what, path, e))
+    except yaml.YAMLError as e:
+        raise ReportError("cannot read %s %s: %s" % (what, path, one_line(e)))
+    except RecursionError:
+        raise ReportError("cannot read %s %s: nested too deeply" % (what, path))
     if not isinstance(data, dict):
         raise ReportError("%s %s is not a YAML map" % (what, path))
     return data
+
+
+def positive_number(value):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        return 0.0 < float(value) < math.inf
+    except OverflowError:  # an integer beyond any double
+        return False
 
 
 def load_spec(path):
     spec = load_yaml(path, "--spec")
     for key, value in spec.items():
         if key not in SPEC_KEYS and key not in SPEC_OTHER_KEYS:
-            raise ReportError("--spec %s: unknown key '%s' (known: %s)" %
-                              (path, key, ", ".join(sorted(list(SPEC_KEYS) + list(SPEC_OTHER_KEYS)))))
-        if key in SPEC_KEYS and (isinstance(value, bool) or not isinstance(value, (int, float)) or
-                                 not math.isfinite(value) or value <= 0):
-            raise ReportError("--spec %s: '%s' must be a positive number, not %r" % (path, key, value))
+            raise ReportError("--spec %s: unknown key %s (known: %s)" %
+                              (path, shown(key), ", ".join(sorted(list(SPEC_KEYS) + list(SPEC_OTHER_KEYS)))))
+        if key in SPEC_KEYS and not positive_number(value):
+            raise ReportError("--spec %s: '%s' must be a positive number, not %s" % (path, key, shown(value)))
         if key == "require_accepted" and not isinstance(value, bool):
-            raise ReportError("--spec %s: 'require_accepted' must be true or false, not %r" % (path, value))
+            raise ReportError("--spec %s: 'require_accepted' must be true or false, not %s" % (path, shown(value)))
+        if key == "name" and value is not None:  # "name:" left empty: no name
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                spec[key] = str(value)  # a part number given as a number
+            elif not isinstance(value, str):
+                raise ReportError("--spec %s: 'name' must be text, not %s" % (path, shown(value)))
     return spec
+
+
+# ---------------------------------------------------------------------------------------------
+# The calibration report: every field the page or its figures read, checked before anything is
+# drawn, so that a hand-edited or damaged report is refused naming the key path instead of ending in
+# a traceback. Fields the page does not read are not checked.
+
+# yaml-cpp writes non-finite doubles as nan / inf / -inf, which YAML (1.1 and 1.2) reads as text.
+NON_FINITE = {"nan": math.nan, "-nan": math.nan, "inf": math.inf, "+inf": math.inf, "-inf": -math.inf}
+
+
+class Fields:
+    """Typed reads of a YAML tree; every refusal names the file and the key path. Numbers are
+    normalised to float in place (the page formats them with %g)."""
+
+    def __init__(self, where):
+        self.where = where
+
+    def fail(self, path, rule, value):
+        raise ReportError("%s: %s: must be %s, not %s" % (self.where, path, rule, shown(value)))
+
+    @staticmethod
+    def path(prefix, key):
+        if isinstance(key, int):
+            return "%s[%d]" % (prefix, key)
+        return "%s.%s" % (prefix, key) if prefix else key
+
+    def get(self, m, key, prefix):
+        if isinstance(m, list):
+            return m[key]
+        if key not in m:
+            raise ReportError("%s: %s: missing" % (self.where, self.path(prefix, key)))
+        return m[key]
+
+    def number(self, m, key, prefix="", finite=False, nonzero=False, minimum=None, optional=False):
+        if optional and key not in m:
+            return None
+        value = self.get(m, key, prefix)
+        rule = ("a non-zero finite number" if nonzero else
+                "a finite number >= %g" % minimum if minimum is not None else
+                "a finite number" if finite else "a number")
+        if isinstance(value, str) and value.strip().lower() in NON_FINITE:
+            value = NON_FINITE[value.strip().lower()]
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(self.path(prefix, key), rule, value)
+        try:
+            number = float(value)
+        except OverflowError:  # an integer beyond any double
+            self.fail(self.path(prefix, key), rule, value)
+        if (finite or nonzero or minimum is not None) and not math.isfinite(number):
+            self.fail(self.path(prefix, key), rule, value)
+        if (nonzero and number == 0.0) or (minimum is not None and number < minimum):
+            self.fail(self.path(prefix, key), rule, value)
+        m[key] = number
+        return number
+
+    def count(self, m, key, prefix="", minimum=0):
+        value = self.get(m, key, prefix)
+        if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+            self.fail(self.path(prefix, key), "a whole number >= %d" % minimum, value)
+        return value
+
+    def boolean(self, m, key, prefix=""):
+        value = self.get(m, key, prefix)
+        if not isinstance(value, bool):
+            self.fail(self.path(prefix, key), "true or false (a YAML boolean)", value)
+        return value
+
+    def text(self, m, key, prefix=""):
+        value = self.get(m, key, prefix)
+        if not isinstance(value, str):
+            self.fail(self.path(prefix, key), "text", value)
+        return value
+
+    def mapping(self, m, key, prefix=""):
+        value = self.get(m, key, prefix)
+        if not isinstance(value, dict):
+            self.fail(self.path(prefix, key), "a map", value)
+        return value
+
+    def items(self, m, key, prefix=""):
+        """The entries of a list of maps, each with its key path."""
+        value = self.get(m, key, prefix)
+        if not isinstance(value, list):
+            self.fail(self.path(prefix, key), "a list", value)
+        here = self.path(prefix, key)
+        for i, item in enumerate(value):
+            if not isinstance(item, dict):
+                self.fail(self.path(here, i), "a map", item)
+        return [(self.path(here, i), item) for i, item in enumerate(value)]
+
+    def numbers(self, m, key, prefix="", length=None, optional=False, **rule):
+        """A list of numbers; with length=(n, what), exactly n of them, as many as `what` has."""
+        if optional and key not in m:
+            return None
+        value = self.get(m, key, prefix)
+        here = self.path(prefix, key)
+        if not isinstance(value, list):
+            self.fail(here, "a list of numbers", value)
+        if length is not None and len(value) != length[0]:
+            raise ReportError("%s: %s: must have %d entries, as many as %s, not %d" %
+                              (self.where, here, length[0], length[1], len(value)))
+        for i in range(len(value)):
+            self.number(value, i, here, **rule)
+        return value
+
+
+def validate_report(report, path):
+    """Refuses (ReportError naming the key path) a calibration report the page cannot show."""
+    f = Fields("calibration report %s" % path)
+    f.text(report, "method")
+    f.boolean(report, "accepted")  # "no" in quotes is text, and text is true in Python: refuse it
+    f.text(report, "reason")
+    for key in ("coverage", "smoothing_factor", "nonlinearity_ppm", "duration"):
+        f.number(report, key)
+    f.count(report, "samples")
+    f.numbers(report, "frequency_nodes", optional=True)
+    for part in ("scale_factor", "drift"):
+        for here, fit in f.items(report, part):
+            orders = f.get(fit, "orders", here)
+            if not isinstance(orders, list):
+                f.fail(f.path(here, "orders"), "a list of whole numbers", orders)
+            for i in range(len(orders)):
+                f.count(orders, i, f.path(here, "orders"), minimum=1)
+            f.number(fit, "frequency", here, optional=True)
+            # K0 divides every figure in ppm: zero or non-finite would end in a division by zero or NaNs.
+            f.number(fit, "mean", here, finite=True, nonzero=part == "scale_factor")
+            f.number(fit, "mean_std", here, minimum=0.0)
+            length = (len(orders), f.path(here, "orders"))
+            for key in ("cos", "sin"):
+                f.numbers(fit, key, here, length=length, finite=True)
+            for key in ("cos_std", "sin_std"):
+                f.numbers(fit, key, here, length=length, minimum=0.0)
+            f.number(fit, "residual_rms", here, minimum=0.0)
+            f.count(fit, "points", here)
+    f.count(report, "turntable_records")
+    rejected = f.mapping(report, "turntable_rejected")
+    for key in rejected:
+        if not isinstance(key, str):
+            f.fail("turntable_rejected", "a map of reasons (text) to counts", key)
+        f.count(rejected, key, "turntable_rejected")
+    f.count(report, "restarts")
+    for here, plateau in f.items(report, "plateaus"):
+        for key in ("rate", "rate_std", "duration", "coverage", "turns"):
+            f.number(plateau, key, here)
+        f.count(plateau, "samples", here)
+    for here, d in f.items(report, "diagnosis"):
+        f.text(d, "note", here)
+        if f.boolean(d, "valid", here):
+            for key in ("gain_mismatch", "gain_mismatch_std", "misplacement_difference",
+                        "misplacement_difference_std", "pickoff_ratio", "pickoff_ratio_std"):
+                f.number(d, key, here)
+            f.numbers(d, "recommended_p", here)
+            f.numbers(d, "current_p", here)
+    for here, gate in f.items(report, "gates"):
+        f.text(gate, "name", here)
+        f.boolean(gate, "passed", here)
+        f.number(gate, "value", here)
+        f.number(gate, "limit", here)
+        f.text(gate, "message", here)
+    notes = f.get(report, "notes", "")
+    if not isinstance(notes, list):
+        f.fail("notes", "a list of text", notes)
+    for i, note in enumerate(notes):
+        if not isinstance(note, str):
+            f.fail(f.path("notes", i), "text", note)
+    binned = f.mapping(report, "binned")
+    theta = f.numbers(binned, "theta", "binned")
+    for key in ("k", "d"):
+        f.numbers(binned, key, "binned", length=(len(theta), "binned.theta"))
+    f.text(report, "parameters")
+    return report
+
+
+def load_report(path):
+    report = load_yaml(path, "calibration report")
+    for key in ("method", "accepted"):
+        if key not in report:
+            raise ReportError("%s is not a calibration report: no '%s' key" % (path, key))
+    return validate_report(report, path)
+
+
+def load_verification(path):
+    verification = load_yaml(path, "--verification")
+    f = Fields("--verification %s" % path)
+    for key in ("before_ppm", "after_ppm"):
+        if key not in verification:
+            raise ReportError("--verification %s: no '%s' key (session_monitor's summary YAML)" % (path, key))
+        # NaN is what session_monitor writes when the verification could not be evaluated: shown, and
+        # a specification limit compared with it fails.
+        f.number(verification, key)
+    f.number(verification, "after_sigma_ppm", optional=True)
+    return verification
 
 
 # ---------------------------------------------------------------------------------------------
@@ -222,13 +489,16 @@ def run_allan(bag_path, params_path, window, work):
         cmd += ["--params", params_path]
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
     if p.returncode != 0:
-        raise ReportError("hrg_bag allan failed on %s: %s" % (bag_path, p.stderr.strip().splitlines()[-1:]))
+        last = (p.stderr.strip().splitlines() or ["exit %d" % p.returncode])[-1]
+        raise ReportError("hrg_bag allan failed on %s: %s" % (bag_path, one_line(last)))
     curve = []
-    with open(out_csv) as f:
-        for row in csv.DictReader(f):
-            curve.append({k: float(v) for k, v in row.items()})
-    with open(out_yaml) as f:
-        readings = yaml.load(f, Loader=Loader)
+    try:
+        with open(out_csv) as f:
+            for row in csv.DictReader(f):
+                curve.append({k: float(v) for k, v in row.items()})
+    except (OSError, ValueError, TypeError) as e:
+        raise ReportError("cannot read the Allan deviation hrg_bag allan wrote: %s" % one_line(e))
+    readings = load_yaml(out_yaml, "Allan readings")
     return curve, readings
 
 
@@ -394,32 +664,10 @@ def render(template_name, **context):
     return env.get_template(template_name).render(**context)
 
 
-def write_atomically(path, text):
-    directory = os.path.dirname(os.path.abspath(path))
-    try:
-        fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=directory)
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 would hide the report from the others
-        os.replace(tmp, path)
-    except OSError as e:
-        raise OSError("report %s not written: %s" % (path, e))
-
-
 def build(args):
-    report = load_yaml(args.report, "calibration report")
-    for key in ("method", "accepted"):
-        if key not in report:
-            raise ReportError("%s is not a calibration report: no '%s' key" % (args.report, key))
+    report = load_report(args.report)
     spec = load_spec(args.spec) if args.spec else None
-    verification = load_yaml(args.verification, "--verification") if args.verification else None
-    if verification is not None:
-        for key in ("before_ppm", "after_ppm"):
-            if key not in verification:
-                raise ReportError("--verification %s: no '%s' key (session_monitor's summary YAML)" %
-                                  (args.verification, key))
+    verification = load_verification(args.verification) if args.verification else None
     if args.rest and not args.rest[0] < args.rest[1]:
         raise ReportError("--rest FROM TO: FROM must be before TO")
     if not args.rest_max_rate >= 0.0 or not math.isfinite(args.rest_max_rate):
@@ -511,8 +759,8 @@ def spec_rows(spec, report, ctx):
                 basis = "rms residual of the binned K about the fit (no verification profile given)"
         elif quantity == "harmonic_std":
             k_est = (report.get("scale_factor") or [None])[0]
-            if k_est:
-                stds = list(k_est["cos_std"]) + list(k_est["sin_std"])
+            stds = list(k_est["cos_std"]) + list(k_est["sin_std"]) if k_est else []
+            if stds:  # a K0-only fit has no harmonic to compare: not measured
                 value, basis = 1e6 * max(stds) / abs(k_est["mean"]), "largest K harmonic standard error"
         elif quantity in terms:
             t = terms[quantity]
@@ -546,12 +794,41 @@ def main(argv):
                         help="largest |table rate| counted as at rest (default 1e-5 rad/s)")
     parser.add_argument("--title", help="page title")
     args = parser.parse_args(argv[1:])
+    try:
+        return run(args)
+    except KeyboardInterrupt:
+        sys.stderr.write("hrg_report: interrupted: %s not written\n" % args.out)
+        return 130
+    except Exception as e:  # last resort: a one-line error, never a traceback
+        sys.stderr.write("hrg_report: %s not written: unexpected %s: %s\n" % (args.out, type(e).__name__,
+                                                                              one_line(e)))
+        return 2
+
+
+def run(args):
+    inputs = []
     for name in ("report", "bag", "params", "spec", "verification"):
         path = getattr(args, name)
-        if path and not os.path.isfile(path):
-            sys.stderr.write("hrg_report: --%s %s: no such file\n" % (name, path) if name != "report" else
-                             "hrg_report: %s: no such file\n" % path)
+        if not path:
+            continue
+        what = path if name == "report" else "--%s %s" % (name, path)
+        try:
+            st = os.stat(path)
+        except FileNotFoundError:
+            sys.stderr.write("hrg_report: %s: no such file\n" % what)
             return 2
+        except OSError as e:
+            sys.stderr.write("hrg_report: %s: %s\n" % (what, e.strerror))
+            return 2
+        if not stat.S_ISREG(st.st_mode):  # never opened: a FIFO would block the read
+            sys.stderr.write("hrg_report: %s is %s, not a regular file\n" % (what, hrg_output_file.kind_of(st.st_mode)))
+            return 2
+        inputs.append(path)
+    try:
+        hrg_output_file.check_output_paths(inputs, [args.out])
+    except hrg_output_file.PathRefused as e:
+        sys.stderr.write("hrg_report: refused: %s\n" % e)
+        return 2
     try:
         ctx = build(args)
         html = render("report.html.j2", **ctx)
@@ -559,9 +836,9 @@ def main(argv):
         sys.stderr.write("hrg_report: %s\n" % e)
         return 2
     try:
-        write_atomically(args.out, html)
-    except OSError as e:
-        sys.stderr.write("hrg_report: %s\n" % e)
+        hrg_output_file.write_file_atomically(args.out, html)
+    except hrg_output_file.OutputWriteError as e:
+        sys.stderr.write("hrg_report: report %s not written: %s\n" % (args.out, e))
         return 3
     verdict = "" if ctx["overall"] is None else (" spec PASS" if ctx["overall"] else " spec FAIL")
     print("hrg_report: wrote %s (calibration %s%s)" % (args.out, "ACCEPTED" if ctx["r"]["accepted"] else "REFUSED",
@@ -570,4 +847,6 @@ def main(argv):
 
 
 if __name__ == "__main__":
+    # SIGTERM unwinds like an exception, so that the page's temporary is removed.
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     sys.exit(main(sys.argv))

@@ -2,14 +2,20 @@
 """The HTML calibration report and the batch campaign, looked at as a person would: the page is
 rendered by headless Chromium, must load with no console error and every figure decoded, and the
 numbers the browser shows must equal those of the calibration report YAML. The Allan readings are
-checked against a simulated gyro whose angle random walk is known. Needs no master; run as a rostest
-for the package environment."""
+checked against a simulated gyro whose angle random walk is known. The scripts' file handling is
+checked as the C++ tools' is: an output that is an input or not a regular file is refused, links and
+modes are kept, a full disk leaves nothing behind, malformed inputs are refused naming the key.
+Needs no master; run as a rostest for the package environment."""
+import errno
 import html.parser
 import os
 import re
 import shutil
+import signal
+import stat
 import subprocess
 import sys
+import time
 import unittest
 
 import rospy
@@ -21,10 +27,49 @@ HRG_BAG = subprocess.check_output(["catkin_find", "--first-only", "--libexec", "
 ARW = 1.0e-4  # rad/sqrt(s), resonator.rate_noise of test/scenarios/report_session.yaml
 
 
-def run(*args, timeout=600):
+def run(*args, timeout=600, **kwargs):
     p = subprocess.run(list(args), stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True,
-                       timeout=timeout)
+                       timeout=timeout, **kwargs)
     return p.returncode, p.stdout, p.stderr
+
+
+def snapshot(directory):
+    """Every name under `directory` with its content, mode and inode (links as links): what a refused
+    or failed write must not change. Temporaries left behind show up as new names."""
+    state = {}
+    for root, dirs, files in os.walk(directory):
+        for name in dirs + files:
+            path = os.path.join(root, name)
+            st = os.lstat(path)
+            key = os.path.relpath(path, directory)
+            if stat.S_ISLNK(st.st_mode):
+                state[key] = ("link", os.readlink(path))
+            elif stat.S_ISREG(st.st_mode):
+                with open(path, "rb") as f:
+                    state[key] = ("file", f.read(), st.st_mode, st.st_ino)
+            else:
+                state[key] = ("other", stat.S_IFMT(st.st_mode), st.st_mode, st.st_ino)
+    return state
+
+
+def temporaries(directory):
+    """Writer temporaries (<name>.tmp.<pid>.XXXXXX) anywhere under `directory`."""
+    return [os.path.join(root, n) for root, _, files in os.walk(directory) for n in files if ".tmp." in n]
+
+
+def fill(directory, leave_bytes):
+    """Fills the file system of `directory` until at most `leave_bytes` are free (as hrg_bag_cli_test)."""
+    filler = os.path.join(directory, "filler")
+    st = os.statvfs(directory)
+    with open(filler, "ab") as f:
+        try:
+            f.write(b"\0" * max(0, st.f_bavail * st.f_frsize - leave_bytes))
+            f.flush()
+            os.fsync(f.fileno())
+        except OSError as e:
+            if e.errno != errno.ENOSPC:
+                raise
+    return filler
 
 
 class Page(html.parser.HTMLParser):
@@ -219,6 +264,8 @@ class ReportTest(unittest.TestCase):
         for text, key in (("max_nonlinearity_ppm: 5\nmax_arw: 0.1\n", "'max_arw'"),
                           ("max_nonlinearity_ppm: fast\n", "'max_nonlinearity_ppm'"),
                           ("max_bias_instability_deg_per_h: -1\n", "'max_bias_instability_deg_per_h'"),
+                          ("max_nonlinearity_ppm: 1%s\n" % ("0" * 400), "'max_nonlinearity_ppm'"),
+                          ("name: [a, b]\n", "'name' must be text"),
                           ("- 1\n", "not a YAML map")):
             spec = self.path("bad_spec.yaml")
             with open(spec, "w") as f:
@@ -232,6 +279,244 @@ class ReportTest(unittest.TestCase):
         code, _, err = run("/usr/bin/python3", self.script, self.bags["quiet"], "--out", self.path("bad.html"))
         self.assertEqual(code, 2, err)
         self.assertNotIn("Traceback", err)
+
+    # ---- hrg_report: files ----
+
+    def fresh(self, name):
+        """An empty folder of this test's own under the work folder."""
+        path = self.path(name)
+        shutil.rmtree(path, ignore_errors=True)
+        os.makedirs(path)
+        return path
+
+    def calibrated(self, folder):
+        """A copy of the quiet session's accepted calibration (report, parameters) in `folder`."""
+        if not hasattr(ReportTest, "_quiet"):
+            code, params, report_path, log = self.calibrate("quiet")
+            self.assertEqual(code, 0, log)
+            ReportTest._quiet = (params, report_path)
+        copies = []
+        for source, name in zip(ReportTest._quiet, ("params.yaml", "report.yaml")):
+            shutil.copyfile(source, os.path.join(folder, name))
+            copies.append(os.path.join(folder, name))
+        return copies
+
+    def report(self, *args, **kwargs):
+        return run("/usr/bin/python3", self.script, *args, **kwargs)
+
+    def test_an_output_that_is_an_input_is_refused_by_file_identity(self):
+        d = self.fresh("same_file")
+        params, report = self.calibrated(d)
+        os.link(self.bags["quiet"], os.path.join(d, "session.bag"))  # a name of the bag inside d
+        spec, verification = os.path.join(d, "spec.yaml"), os.path.join(d, "verification.yaml")
+        shutil.copyfile(self.spec, spec)
+        with open(verification, "w") as f:
+            f.write("before_ppm: 3425.0\nafter_ppm: 0.5\n")
+        os.chmod(report, 0o640)
+        os.makedirs(os.path.join(d, "sub"))
+        inputs = ["report.yaml", "--bag", "session.bag", "--params", "params.yaml", "--spec", "spec.yaml",
+                  "--verification", "verification.yaml"]
+        cases = []
+        for name in ("report.yaml", "session.bag", "params.yaml", "spec.yaml", "verification.yaml"):
+            os.symlink(name, os.path.join(d, "link_to_" + name))
+            os.link(os.path.join(d, name), os.path.join(d, "hard_" + name))
+            cases += [(name, name), ("./" + name, name), ("sub/../" + name, name), (os.path.join(d, name), name),
+                      ("link_to_" + name, name), ("hard_" + name, name)]
+        before = snapshot(d)
+        for out, name in cases:
+            code, _, err = self.report(*inputs, "--out", out, cwd=d)
+            self.assertEqual(code, 2, "%s -> %d: %s" % (out, code, err))
+            self.assertIn("output '%s' is the same file as input '%s'" % (out, name), err)
+            self.assertNotIn("Traceback", err)
+            self.assertEqual(snapshot(d), before, "--out %s: every input as it was, no temporary" % out)
+
+    def test_an_output_that_is_not_a_regular_file_is_refused_without_opening_it(self):
+        d = self.fresh("not_regular")
+        _, report = self.calibrated(d)
+        os.mkfifo(os.path.join(d, "fifo.html"))
+        os.makedirs(os.path.join(d, "folder.html"))
+        outs = {"fifo.html": "a FIFO (named pipe)", "folder.html": "a directory"}
+        try:
+            os.mknod(os.path.join(d, "null.html"), 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+            outs["null.html"] = "a character device"
+        except OSError as e:  # mknod needs CAP_MKNOD: the FIFO and the directory are still checked
+            print("report test: no device node (%s)" % e)
+        before = snapshot(d)
+        for out, kind in outs.items():
+            for spelling in (out, "link_" + out):
+                if spelling != out and not os.path.lexists(os.path.join(d, spelling)):
+                    os.symlink(out, os.path.join(d, spelling))
+                    before = snapshot(d)
+                # Opening the FIFO for writing would block: the time limit turns that into an error.
+                code, _, err = self.report("report.yaml", "--out", spelling, cwd=d, timeout=60)
+                self.assertEqual(code, 2, "%s: %s" % (spelling, err))
+                self.assertIn("output '%s' is %s, not a regular file" % (spelling, kind), err)
+                self.assertEqual(snapshot(d), before, spelling)
+
+    def test_a_link_at_the_output_is_followed_and_the_mode_kept(self):
+        d = self.fresh("link_out")
+        self.calibrated(d)
+        os.makedirs(os.path.join(d, "pages"))
+        target = os.path.join(d, "pages", "gyro.html")
+        with open(target, "w") as f:
+            f.write("the previous page\n")
+        os.chmod(target, 0o640)
+        inode = os.stat(target).st_ino
+        os.symlink("pages/gyro.html", os.path.join(d, "gyro.html"))
+        code, _, err = self.report("report.yaml", "--out", "gyro.html", cwd=d)
+        self.assertEqual(code, 0, err)
+        self.assertEqual(os.readlink(os.path.join(d, "gyro.html")), "pages/gyro.html", "the link stays a link")
+        with open(target) as f:
+            self.assertIn("calibration-status", f.read())
+        st = os.stat(target)
+        self.assertEqual(stat.S_IMODE(st.st_mode), 0o640)
+        self.assertNotEqual(st.st_ino, inode, "replaced by a rename, not rewritten in place")
+        self.assertEqual(temporaries(d), [])
+        # A new page: 0644 narrowed by the umask, as the C++ writers create files.
+        code, _, err = self.report("report.yaml", "--out", "new.html", cwd=d, preexec_fn=lambda: os.umask(0o027))
+        self.assertEqual(code, 0, err)
+        self.assertEqual(stat.S_IMODE(os.stat(os.path.join(d, "new.html")).st_mode), 0o640)
+
+    def test_a_full_disk_fails_with_exit_3_and_leaves_no_temporary(self):
+        d = self.fresh("full_disk_report")
+        disk = os.path.join(d, "disk")
+        os.makedirs(disk)
+        self.calibrated(d)
+        mount = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", disk], stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, universal_newlines=True)
+        if mount.returncode != 0:
+            self.skipTest("cannot mount a 64 KiB tmpfs to fill (needs root): " + mount.stdout.strip())
+        try:
+            old = os.path.join(disk, "old.html")
+            with open(old, "w") as f:
+                f.write("the previous page\n")
+            # Nothing free, then 24 KiB: the page (about 100 KiB of figures) fails in the middle.
+            for leave in (0, 24 * 1024):
+                filler = fill(disk, leave)
+                before = snapshot(disk)
+                for out in (old, os.path.join(disk, "new.html")):
+                    code, _, err = self.report(os.path.join(d, "report.yaml"), "--out", out)
+                    self.assertEqual(code, 3, "%s, %d bytes free: %s" % (out, leave, err))
+                    self.assertIn("No space left on device", err)
+                    self.assertIn(out, err)
+                    self.assertNotIn("Traceback", err)
+                    self.assertEqual(snapshot(disk), before, "the old page as it was, no temporary")
+                os.remove(filler)
+        finally:
+            subprocess.run(["umount", disk])
+
+    def test_temporaries_of_a_killed_writer_are_removed_by_the_python_and_the_cpp_writers(self):
+        d = self.fresh("stale")
+        self.calibrated(d)
+        # A writer of the shared module killed in the middle of a page, and of a calibration report.
+        child = ("import sys, time; sys.path.insert(0, %r); import hrg_output_file as h\n"
+                 "files = [h.AtomicOutputFile(p) for p in sys.argv[1:]]\n"
+                 "for f in files: f.write('half a file')\n"
+                 "print(' '.join(f.temporary_path for f in files), flush=True); time.sleep(600)\n"
+                 % os.path.join(self.pkg, "scripts"))
+        page, cal_report = os.path.join(d, "page.html"), os.path.join(d, "cal.report.yaml")
+        writer = subprocess.Popen(["/usr/bin/python3", "-c", child, page, cal_report], stdout=subprocess.PIPE,
+                                  universal_newlines=True)
+        left = writer.stdout.readline().split()
+        writer.send_signal(signal.SIGKILL)
+        writer.wait()
+        writer.stdout.close()
+        self.assertEqual(len(left), 2)
+        for path, target in zip(left, (page, cal_report)):
+            # The C++ naming: <target>.tmp.<pid>.XXXXXX, six letters or digits.
+            self.assertRegex(path, r"^%s\.tmp\.%d\.[A-Za-z0-9]{6}$" % (re.escape(target), writer.pid))
+            self.assertTrue(os.path.isfile(path))
+        not_ours = os.path.join(d, "page.html.tmp.notours")
+        with open(not_ours, "w") as f:
+            f.write("someone else's\n")
+        time.sleep(0.05)  # stale means older than the next write
+        code, _, err = self.report(os.path.join(d, "report.yaml"), "--out", page)
+        self.assertEqual(code, 0, err)
+        self.assertFalse(os.path.exists(left[0]), "hrg_report removed the killed writer's temporary")
+        self.assertTrue(os.path.exists(not_ours), "a name that is not a writer's temporary is never touched")
+        code, _, err = run(HRG_BAG, "calibrate", self.bags["quiet"], "--params", self.prior, "--out",
+                           os.path.join(d, "cal.yaml"), "--report", cal_report)
+        self.assertEqual(code, 0, err)
+        self.assertFalse(os.path.exists(left[1]), "the C++ writer removed the Python writer's temporary")
+
+    # ---- hrg_report: malformed inputs ----
+
+    def test_a_specification_without_a_name_is_accepted(self):
+        d = self.fresh("spec_without_name")
+        self.calibrated(d)
+        with open(os.path.join(d, "spec.yaml"), "w") as f:
+            f.write("max_nonlinearity_ppm: 50\nrequire_accepted: true\n")  # `name` is optional
+        code, stdout, err = self.report("report.yaml", "--spec", "spec.yaml", "--out", "out.html", cwd=d)
+        self.assertEqual(code, 0, err)
+        self.assertIn("spec PASS", stdout)
+        with open(os.path.join(d, "out.html")) as f:
+            self.assertIn('<span id="overall" class="verdict pass">PASS</span>', f.read())
+
+    def test_a_key_given_twice_is_refused_in_every_yaml_read(self):
+        d = self.fresh("duplicates")
+        _, report = self.calibrated(d)
+        with open(report) as f:
+            text = f.read()
+        with open(os.path.join(d, "dup_report.yaml"), "w") as f:
+            f.write(text.replace("\nmethod: ", "\nsamples: 3\nmethod: ", 1))
+        with open(os.path.join(d, "spec.yaml"), "w") as f:
+            f.write("name: gyro\nmax_nonlinearity_ppm: 5000\nmax_nonlinearity_ppm: 50\n")
+        with open(os.path.join(d, "verification.yaml"), "w") as f:
+            f.write("before_ppm: 3425.0\nafter_ppm: 0.5\nafter_ppm: 0.6\n")
+        for args, key, path in ((["dup_report.yaml"], "samples", "dup_report.yaml"),
+                                (["report.yaml", "--spec", "spec.yaml"], "max_nonlinearity_ppm", "spec.yaml"),
+                                (["report.yaml", "--verification", "verification.yaml"], "after_ppm",
+                                 "verification.yaml")):
+            code, _, err = self.report(*args, "--out", "out.html", cwd=d)
+            self.assertEqual(code, 2, err)
+            self.assertIn("key '%s' given more than once" % key, err)
+            self.assertIn(path, err)
+            self.assertFalse(os.path.exists(os.path.join(d, "out.html")))
+
+    def test_a_malformed_calibration_report_is_refused_naming_the_key(self):
+        d = self.fresh("malformed")
+        _, report = self.calibrated(d)
+        with open(report) as f:
+            good = f.read()
+        k0 = re.search(r"\nscale_factor:\n  - orders: \[[^\]]*\]\n    mean: ([^\n]+)\n", good)
+        self.assertIsNotNone(k0, good[:2000])
+
+        def k0_is(text):
+            return good[:k0.start(1)] + text + good[k0.end(1):]
+
+        def without(key):
+            return re.sub(r"\n%s:(\n  [^\n]*| [^\n]*)+" % key, "", good, count=1)
+
+        huge = "x" * 5000000
+        cases = [
+            (k0_is("0"), "scale_factor[0].mean: must be a non-zero finite number, not 0"),
+            (k0_is(".nan"), "scale_factor[0].mean: must be a non-zero finite number, not nan"),
+            (k0_is("abc"), "scale_factor[0].mean: must be a non-zero finite number, not 'abc'"),
+            (k0_is(huge), "scale_factor[0].mean: must be a non-zero finite number, not 'xxxx"),
+            (good.replace("\naccepted: true\n", '\naccepted: "no"\n'), "accepted: must be true or false"),
+            (good.replace("\naccepted: true\n", "\naccepted: 1\n"), "accepted: must be true or false"),
+            (without("binned"), "binned: missing"),
+            (without("turntable_rejected"), "turntable_rejected: missing"),
+            (without("scale_factor"), "scale_factor: missing"),
+            (good.replace("\nrestarts: 0\n", "\nrestarts: many\n"), "restarts: must be a whole number"),
+            (re.sub(r"\n    cos: \[[^\]\n]*\]", "\n    cos: [1.0e-6]", good, count=1),
+             "scale_factor[0].cos: must have 4 entries, as many as scale_factor[0].orders, not 1"),
+            (re.sub(r"\ngates:\n  - \{name: ([a-z_]+), passed: true", r"\ngates:\n  - {name: \1, passed: yes!",
+                    good, count=1), "gates[0].passed: must be true or false"),
+            (good.replace("\nplateaus:\n", "\nplateaus: 3\nunused:\n", 1), "plateaus: must be a list"),
+        ]
+        for text, message in cases:
+            self.assertNotEqual(text, good, message)
+            with open(os.path.join(d, "bad.yaml"), "w") as f:
+                f.write(text)
+            code, _, err = self.report("bad.yaml", "--out", "out.html", cwd=d)
+            self.assertEqual(code, 2, "%s: %s" % (message, err[:2000]))
+            self.assertIn("calibration report bad.yaml: " + message, err)
+            self.assertNotIn("Traceback", err)
+            self.assertLess(len(err), 1000, "a long value is cut in the message")
+            if huge in text:
+                self.assertIn("(5000002 characters)", err, "the message says how long the value was")
+            self.assertFalse(os.path.exists(os.path.join(d, "out.html")))
 
     def test_a_campaign_of_three_bags_one_broken(self):
         bags = self.path("campaign")
