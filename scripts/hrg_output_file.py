@@ -249,7 +249,12 @@ class AtomicOutputFile:
     def write(self, data):
         if self._finished:
             raise ValueError("AtomicOutputFile for '%s' is already committed or discarded" % self.target_path)
-        view = memoryview(data.encode("utf-8") if isinstance(data, str) else data)
+        if isinstance(data, str):
+            try:  # file names that are not UTF-8 come back as they were
+                data = data.encode("utf-8", "surrogateescape")
+            except UnicodeEncodeError:
+                data = data.encode("utf-8", "replace")
+        view = memoryview(data)
         try:
             while view:
                 view = view[os.write(self._fd, view):]
@@ -344,6 +349,8 @@ def _identify(path):
     try:
         st = os.stat(path)
         return ("inode", st.st_dev, st.st_ino)
+    except NotADirectoryError:
+        return ("path", os.path.abspath(path))  # under a file: nothing can exist there, input or output
     except OSError:
         pass
     try:

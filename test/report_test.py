@@ -552,11 +552,191 @@ class ReportTest(unittest.TestCase):
             self.assertIn(">PASS<", row, name)
             self.assertIn('href="%s/report.html"' % name, row)
         # Every bag of the folder passing exits 0 (through hrg_bag, which runs the script beside itself).
+        # The specification without its optional name (which used to fail every bag).
         os.remove(os.path.join(bags, "gyro0_broken.bag"))
+        unnamed = self.path("spec_unnamed.yaml")
+        with open(self.spec) as f, open(unnamed, "w") as g:
+            g.write(re.sub(r"(?m)^name:.*\n", "", f.read()))
         code, stdout, err = run(HRG_BAG, "batch", bags, self.path("campaign_ok"), "--params", self.prior, "--spec",
-                                self.spec)
+                                unnamed)
         self.assertEqual(code, 0, stdout + err)
         self.assertIn("2 of 2 passed", stdout)
+        self.assertEqual(temporaries(self.path("campaign_ok")), [])
+
+    # ---- hrg_batch ----
+
+    def batch(self, *args, **kwargs):
+        return run("/usr/bin/python3", os.path.join(self.pkg, "scripts", "hrg_batch.py"), *args, **kwargs)
+
+    def fake_hrg_bag(self, folder):
+        """A stand-in for hrg_bag (HRG_BAG): `calibrate` of a bag named *slow* hangs with a child of its
+        own (their pids in <bag>.pids); of any other bag it fails at once."""
+        path = os.path.join(folder, "fake_hrg_bag")
+        with open(path, "w") as f:
+            f.write('#!/bin/sh\ncase "$2" in\n  *slow*) sleep 1000 & echo "$$ $!" > "$2.pids"; wait ;;\n'
+                    '  *) echo "fake: cannot calibrate $2"; exit 2 ;;\nesac\n')
+        os.chmod(path, 0o755)
+        return dict(os.environ, HRG_BAG=path)
+
+    @staticmethod
+    def index_rows(out):
+        with open(os.path.join(out, "index.html")) as f:
+            return dict(re.findall(r'<tr class="bag" data-name="([^"]*)">(.*?)</tr>', f.read(), re.S))
+
+    def test_batch_refuses_a_fifo_and_kills_a_bag_at_its_time_limit(self):
+        d = self.fresh("batch_limits")
+        env = self.fake_hrg_bag(d)
+        bags, out = os.path.join(d, "bags"), os.path.join(d, "out")
+        os.makedirs(os.path.join(bags, "folder.bag"))
+        os.mkfifo(os.path.join(bags, "fifo.bag"))  # opening it to read would block the campaign for ever
+        for name in ("a_slow.bag", "b.bag"):
+            open(os.path.join(bags, name), "w").close()
+        start = time.monotonic()
+        code, stdout, err = self.batch(bags, out, "--timeout", "3", "--jobs", "2", env=env, timeout=120)
+        self.assertLess(time.monotonic() - start, 60)
+        self.assertEqual(code, 1, stdout + err)
+        self.assertIn("0 of 4 passed", stdout)
+        rows = self.index_rows(out)
+        self.assertEqual(sorted(rows), ["a_slow", "b", "fifo", "folder"])
+        self.assertIn("not a regular file: it is a FIFO (named pipe)", rows["fifo"])
+        self.assertIn("not a regular file: it is a directory", rows["folder"])
+        self.assertIn("timed out after 3 s", rows["a_slow"])
+        self.assertIn("fake: cannot calibrate", rows["b"], "the other bags go on")
+        self.assertTrue(stat.S_ISFIFO(os.stat(os.path.join(bags, "fifo.bag")).st_mode))
+        with open(os.path.join(out, "a_slow", "log.txt")) as f:
+            self.assertIn("timed out after 3 s: killed", f.read())
+        with open(os.path.join(bags, "a_slow.bag.pids")) as f:
+            pids = [int(p) for p in f.read().split()]
+        for pid in pids:  # the bag's whole process group: a zombie no one reaps is dead too
+            try:
+                with open("/proc/%d/status" % pid) as f:
+                    self.assertIn("State:\tZ", f.read(), "process %d of the timed-out bag still runs" % pid)
+            except FileNotFoundError:
+                pass
+        self.assertEqual(temporaries(out), [])
+
+    def test_batch_writes_the_index_whatever_the_bags_are_named_and_when_every_bag_fails(self):
+        d = self.fresh("batch_names")
+        env = self.fake_hrg_bag(d)
+        bags, out = os.path.join(d, "bags"), os.path.join(d, "out")
+        os.makedirs(bags)
+        # index.html.bag used to make the folder index.html/, which blocked the index; ".bag" and
+        # "...bag" would make the folders "" (OUT_DIR itself) and "..".
+        for name in ("index.html.bag", "index.html_2.bag", ".bag", "...bag"):
+            open(os.path.join(bags, name), "w").close()
+        code, stdout, err = self.batch(bags, out, env=env)
+        self.assertEqual(code, 1, stdout + err)
+        self.assertIn("0 of 4 passed", stdout)
+        self.assertTrue(stat.S_ISREG(os.stat(os.path.join(out, "index.html")).st_mode))
+        rows = self.index_rows(out)
+        for name, folder in (("index.html", "index.html_3"), ("index.html_2", "index.html_2"), ("", "_2"),
+                             ("..", ".._2")):
+            self.assertIn('href="%s/log.txt"' % folder, rows[name], name)
+            self.assertTrue(os.path.isfile(os.path.join(out, folder, "log.txt")), folder)
+        self.assertEqual(sorted(os.listdir(d)), ["bags", "fake_hrg_bag", "out"], "nothing written beside OUT_DIR")
+        self.assertFalse(os.path.exists(os.path.join(out, "log.txt")))
+
+    def test_batch_exit_codes_for_folders_it_cannot_use(self):
+        d = self.fresh("batch_folders")
+        env = self.fake_hrg_bag(d)
+        bags = os.path.join(d, "bags")
+        os.makedirs(bags)
+        open(os.path.join(bags, "b.bag"), "w").close()
+        open(os.path.join(d, "a_file"), "w").close()
+        for out, message in ((os.path.join(d, "a_file", "out"), "cannot create the output folder"),
+                             (os.path.join(d, "a_file"), "it exists and is not a folder")):
+            code, stdout, err = self.batch(bags, out, env=env)
+            self.assertEqual(code, 3, stdout + err)
+            self.assertIn(message, err)
+            self.assertNotIn("Traceback", err)
+        code, _, err = self.batch(os.path.join(d, "missing"), os.path.join(d, "out"), env=env)
+        self.assertEqual(code, 2, err)
+        self.assertIn("is not a folder", err)
+        readonly = os.path.join(d, "readonly")
+        os.makedirs(readonly)
+        mount = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", readonly],
+                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+        if mount.returncode == 0:
+            try:
+                for out in (readonly, os.path.join(readonly, "out")):
+                    code, stdout, err = self.batch(bags, out, env=env)
+                    self.assertEqual(code, 3, stdout + err)
+                    self.assertIn("Read-only file system", err)
+                    self.assertNotIn("Traceback", err)
+            finally:
+                subprocess.run(["umount", readonly])
+        else:
+            print("report test: no read-only tmpfs (%s)" % mount.stdout.strip())
+        if os.geteuid() != 0:
+            return
+        # A bag folder the user may not list (root lists everything: run as nobody).
+        private = os.path.join(d, "private")
+        os.makedirs(private, mode=0o700)
+        mpl = os.path.join(d, "mpl")
+        os.makedirs(mpl)
+        os.chmod(mpl, 0o777)
+
+        def as_nobody():
+            os.setgroups([])
+            os.setgid(65534)
+            os.setuid(65534)
+        code, stdout, err = self.batch(private, os.path.join(d, "out"), env=dict(env, MPLCONFIGDIR=mpl),
+                                       preexec_fn=as_nobody)
+        self.assertEqual(code, 2, stdout + err)
+        self.assertIn("cannot list the bag folder %s: Permission denied" % private, err)
+        self.assertFalse(os.path.exists(os.path.join(d, "out")))
+
+    def test_batch_outputs_are_never_its_inputs(self):
+        d = self.fresh("batch_same_file")
+        env = self.fake_hrg_bag(d)
+        bags, out = os.path.join(d, "bags"), os.path.join(d, "out")
+        os.makedirs(bags)
+        open(os.path.join(bags, "b.bag"), "w").close()
+        os.makedirs(os.path.join(out, "b"))
+        shutil.copyfile(self.prior, os.path.join(out, "b", "params.yaml"))  # last campaign's, as the prior
+        with open(os.path.join(out, "index.html"), "w") as f:
+            f.write("max_nonlinearity_ppm: 50\n")  # a specification where the index goes
+        with open(os.path.join(out, "b", "log.txt"), "w") as f:
+            f.write("{}\n")
+        os.symlink("out/b/params.yaml", os.path.join(d, "prior_link.yaml"))
+        before = snapshot(d)
+        for option, path, output in (("--params", os.path.join(out, "b", "params.yaml"), "b/params.yaml"),
+                                     ("--params", os.path.join(d, "prior_link.yaml"), "b/params.yaml"),
+                                     ("--spec", os.path.join(out, "index.html"), "index.html"),
+                                     ("--config", os.path.join(out, "b", "log.txt"), "b/log.txt")):
+            code, stdout, err = self.batch(bags, out, option, path, env=env)
+            self.assertEqual(code, 2, stdout + err)
+            self.assertIn("refused: output '%s' is the same file as input '%s'" % (os.path.join(out, output), path),
+                          err)
+            self.assertEqual(snapshot(d), before, "%s %s: nothing written" % (option, path))
+
+    def test_batch_on_a_full_disk_exits_3_and_leaves_no_temporary(self):
+        d = self.fresh("batch_full_disk")
+        bags, disk = os.path.join(d, "bags"), os.path.join(d, "disk")
+        os.makedirs(bags)
+        os.makedirs(disk)
+        os.link(self.bags["quiet"], os.path.join(bags, "gyro.bag"))
+        mount = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", disk], stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, universal_newlines=True)
+        if mount.returncode != 0:
+            self.skipTest("cannot mount a 64 KiB tmpfs to fill (needs root): " + mount.stdout.strip())
+        try:
+            out = os.path.join(disk, "out")
+            os.makedirs(os.path.join(out, "gyro"))
+            for name in ("index.html", "gyro/log.txt"):
+                with open(os.path.join(out, name), "w") as f:
+                    f.write("the previous campaign\n")
+            filler = fill(disk, 0)
+            before = snapshot(out)
+            code, stdout, err = self.batch(bags, out, "--params", self.prior)
+            self.assertEqual(code, 3, stdout + err)
+            self.assertIn("the index was not written", err)
+            self.assertIn("No space left on device", err)
+            self.assertNotIn("Traceback", err)
+            self.assertEqual(snapshot(out), before, "the previous index and log as they were, no temporary")
+            os.remove(filler)
+        finally:
+            subprocess.run(["umount", disk])
 
 
 if __name__ == "__main__":
