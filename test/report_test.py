@@ -405,6 +405,26 @@ class ReportTest(unittest.TestCase):
         finally:
             subprocess.run(["umount", disk])
 
+    def test_the_writer_leaves_the_target_as_it_was_on_an_exception_or_an_interrupt(self):
+        d = self.fresh("writer_failures")
+        sys.path.insert(0, os.path.join(self.pkg, "scripts"))
+        import hrg_output_file
+        target = os.path.join(d, "page.html")
+        with open(target, "w") as f:
+            f.write("the previous page\n")
+        before = snapshot(d)
+        for error in (KeyboardInterrupt, ValueError, SystemExit):
+            with self.assertRaises(error):
+                with hrg_output_file.AtomicOutputFile(target) as f:
+                    f.write("half of the new page")
+                    self.assertTrue(os.path.isfile(f.temporary_path))
+                    raise error()
+            self.assertEqual(snapshot(d), before, "%s: the temporary removed, the page as it was" % error.__name__)
+        hrg_output_file.write_file_atomically(target, "the new page\n")
+        with open(target) as f:
+            self.assertEqual(f.read(), "the new page\n")
+        self.assertEqual(sorted(os.listdir(d)), ["page.html"])
+
     def test_temporaries_of_a_killed_writer_are_removed_by_the_python_and_the_cpp_writers(self):
         d = self.fresh("stale")
         self.calibrated(d)
