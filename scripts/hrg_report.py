@@ -780,8 +780,9 @@ def spec_rows(spec, report, ctx):
 
 def main(argv):
     parser = argparse.ArgumentParser(prog="hrg_report.py", description=__doc__.split("\n\n")[0],
-                                     epilog="Specification YAML keys: %s. Unknown keys are refused." %
-                                     ", ".join(sorted(list(SPEC_KEYS) + list(SPEC_OTHER_KEYS))))
+                                     epilog="Specification YAML keys: %s. Unknown keys are refused. Exit 0 the "
+                                     "page was written, 2 bad usage or input (nothing written), 3 the page could "
+                                     "not be written." % ", ".join(sorted(list(SPEC_KEYS) + list(SPEC_OTHER_KEYS))))
     parser.add_argument("report", help="calibration report YAML")
     parser.add_argument("--out", required=True, help="HTML file to write")
     parser.add_argument("--bag", help="the session's bag: profile, temperature, Allan deviation at rest")
