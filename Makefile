@@ -7,8 +7,8 @@
 #   make figures  the main job, then the documentation figures docs/figures/*.png from its output
 #                 (with a screenshot of its HTML calibration report)
 # Everything builds in .ws/, a catkin workspace inside the checkout (ignored by git) whose
-# src/hrg_gyro links back to this directory; source .ws/devel/setup.bash to use the package.
-# (A dot directory: roslaunch/rosrun search the package tree following links and skip dot dirs.)
+# src/hrg_gyro is a folder of links to this directory's entries, the workspace excepted (see
+# scripts/link_workspace.sh); source .ws/devel/setup.bash to use the package.
 SHELL := /bin/bash
 .SHELLFLAGS := -eo pipefail -c
 ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
@@ -24,8 +24,7 @@ deps:
 	@bash $(ROOT)/scripts/install_deps.sh
 
 build: deps
-	@mkdir -p $(WS)/src
-	@ln -sfn $(ROOT) $(WS)/src/hrg_gyro
+	@bash $(ROOT)/scripts/link_workspace.sh $(ROOT) $(WS)
 	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS)
 	@# catkin caches the environment at the first configure, before the generated Python messages
 	@# exist; reconfigure once so tests and tools run with them on PYTHONPATH.
@@ -37,6 +36,9 @@ test: build
 	cd $(WS) && source devel/setup.bash && catkin_make $(CATKIN_ARGS) -j1 run_tests
 	@# The package as a user installs it (fresh prefix, only the install space sourced) and catkin_lint.
 	bash $(ROOT)/test/install_space/run.sh $(WS)
+	@# rosrun finds each documented program once, without a prompt or a warning (devel space sourced).
+	cd $(WS) && source devel/setup.bash && ROS_TEST_RESULTS_DIR=$(WS)/build/test_results \
+	  /usr/bin/python3 $(ROOT)/test/workspace_test.py
 	@# Every C++ file formatted as .clang-format says.
 	ROS_TEST_RESULTS_DIR=$(WS)/build/test_results /usr/bin/python3 $(ROOT)/test/source_format_test.py
 	cd $(WS) && catkin_test_results build/test_results
