@@ -213,6 +213,35 @@ class HrgBagCli(unittest.TestCase):
         self.assertEqual(p["calibration"]["method"], "step")
         self.assertAlmostEqual(p["scale_factor"]["mean"], -0.56, delta=0.56 * 1e-3)
 
+    def test_calibrate_refreshes_its_prior_in_place_keeping_a_backup(self):
+        # --params X --out X, as the live calibrator refreshes its file: accepted -> X replaced and
+        # the prior kept as X.bak; through a link to X too; refused -> X untouched, no backup.
+        d = self.path("in_place")
+        os.makedirs(d)
+        bag, prior = os.path.join(d, "steps.bag"), os.path.join(d, "prior.yaml")
+        self.assertEqual(hrg_bag("simulate", "--scenario", os.path.join(self.pkg, "config/scenarios/steps.yaml"),
+                                 "--out", bag)[0], 0)
+        shutil.copy(self.params, prior)
+        with open(prior, "rb") as f:
+            prior_bytes = f.read()
+        os.symlink("prior.yaml", os.path.join(d, "link.yaml"))
+        code, stdout, err = hrg_bag("calibrate", bag, "--method", "step", "--params", prior, "--out",
+                                    os.path.join(d, "link.yaml"))
+        self.assertEqual(code, 0, stdout + err)
+        self.assertTrue(os.path.islink(os.path.join(d, "link.yaml")))
+        with open(prior) as f:
+            self.assertEqual(yaml.safe_load(f)["calibration"]["method"], "step")
+        with open(prior + ".bak", "rb") as f:
+            self.assertEqual(f.read(), prior_bytes)
+        # A method the session cannot serve (no plateaus of two rates): refused, nothing replaced.
+        shutil.copy(self.params, prior)
+        os.remove(prior + ".bak")
+        code, stdout, err = hrg_bag("calibrate", bag, "--method", "dual_rate", "--params", prior, "--out", prior)
+        self.assertEqual(code, 1, stdout + err)
+        with open(prior, "rb") as f:
+            self.assertEqual(f.read(), prior_bytes)
+        self.assertEqual(sorted(os.listdir(d)), ["link.yaml", "prior.yaml", "steps.bag"])
+
     def test_allan_reads_the_angle_random_walk(self):
         bag, out_csv = self.path("static.bag"), self.path("allan.csv")
         self.assertEqual(hrg_bag("simulate", "--scenario", os.path.join(self.pkg, "test/scenarios/static_noise.yaml"),
@@ -406,7 +435,7 @@ class HrgBagCli(unittest.TestCase):
             (["allan", rec, "--csv", os.path.join(d, "a.csv"), "--plot", os.path.join(d, "a.csv")], "same file"),
             (cal + ["--out", rec], "same file"),
             (cal + ["--out", os.path.join(d, "c.yaml"), "--report", rec], "same file"),
-            (cal + ["--out", params], "same file"),
+            (cal + ["--out", os.path.join(d, "c.yaml"), "--report", params], "same file"),
             (["simulate", "--scenario", scenario, "--out", scenario], "same file"),
             (["process", rec, "--params", params, "--out", os.path.join(d, "outdir")], "is a directory"),
             (["process", rec, "--params", params, "--csv", os.path.join(d, "outdir")], "is a directory"),

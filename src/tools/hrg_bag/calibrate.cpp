@@ -26,7 +26,11 @@ struct CalibrateOptions {
 int runCalibrate(const CalibrateOptions& o) {
   using namespace bag_tools;
   checkProcessorConfig(o.processor);
-  checkOutputPaths({o.bag, o.params, o.config}, {o.out, o.report, o.plot});
+  // --out may be the prior itself (--params X --out X): the prior is read whole before anything
+  // else and replaced only by an accepted calibration, keeping the old file as X.bak, as the live
+  // calibrator refreshes its parameter file. The report and the plot may never replace it.
+  checkOutputPaths({o.bag, o.config}, {o.out, o.report, o.plot});
+  checkOutputPaths({o.params}, {o.report, o.plot});
   core::CalibrationSettings settings;
   if (!o.config.empty()) {
     YAML::Node root;
@@ -175,7 +179,8 @@ Command addCalibrateCommand(CLI::App& root) {
       "quality gates on the turntable plateaus. Thermal writes K and D as splines over the resonator\n"
       "frequency (the bag's channels must carry it).\n"
       "Every output replaces its path only when complete; an output that is the same file as an input\n"
-      "or another output is refused before anything runs.\n"
+      "or another output is refused before anything runs, but for --out naming the --params file: the\n"
+      "prior is then refreshed in place when the calibration is accepted (the old file kept as .bak).\n"
       "Exit 0 accepted, 1 refused by a gate, 2 bad usage or unreadable input, 3 an output could not\n"
       "be written (nothing left at its path, an existing file unchanged).");
   return [o] { return runCalibrate(*o); };
