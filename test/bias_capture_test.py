@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """~capture_bias: at rest, D0 is refreshed so that the output averages the vertical Earth rate
-of the model's latitude, the file is rewritten with a backup and the new model is published;
-while the table turns, the capture is refused and nothing changes."""
+of the model's latitude, the file is rewritten with a backup and the new model is published (a
+second capture leaves one note, of the latest, in the file); while the table turns, the capture is
+refused and nothing changes."""
 import math
 import os
 import shutil
@@ -63,6 +64,13 @@ class BiasCapture(unittest.TestCase):
         self.assertTrue(os.path.exists(path + ".bak"))
         with open(path + ".bak") as f:
             self.assertEqual(yaml.safe_load(f)["drift"]["mean"], 0.0)
+        # A second capture (the rest lasts 90 s, this ends near 71 s): the notes name the latest
+        # capture once instead of growing a line per capture.
+        r = capture()
+        self.assertTrue(r.success, r.message)
+        with open(path) as f:
+            notes = yaml.safe_load(f)["calibration"]["notes"]
+        self.assertEqual(notes.count("turn-on bias capture"), 1, notes)
 
         # Now the table turns: the capture is refused and the file stays as it is.
         util.wait_for(lambda: table.msg and abs(table.msg.rate) > 0.04, 60, "the table to turn")

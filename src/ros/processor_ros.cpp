@@ -295,8 +295,7 @@ bool ProcessorRos::onCaptureBias(std_srvs::Trigger::Request&, std_srvs::Trigger:
   }
   auto params = std::make_shared<core::GyroParameters>(result.parameters);
   const std::string when = core::utcNow();
-  params->calibration.notes = "D0 from a turn-on bias capture at " + when +
-                              (params->calibration.notes.empty() ? "" : "; " + params->calibration.notes);
+  params->calibration.notes = core::notesAfterBiasCapture(params->calibration.notes, when);
   std::string saved = " (in memory only: ~bias_capture/save is false)";
   if (bias_capture_save_) {
     try {

@@ -131,5 +131,21 @@ BiasCaptureResult BiasCapture::result() const {
   return r;
 }
 
+std::string notesAfterBiasCapture(const std::string& notes, const std::string& when) {
+  static const std::string kPrefix = "D0 from a turn-on bias capture at ";
+  static const std::string kSeparator = "; ";
+  std::string kept;
+  for (std::size_t begin = 0; begin <= notes.size();) {
+    std::size_t end = notes.find(kSeparator, begin);
+    if (end == std::string::npos) end = notes.size();
+    const std::string part = notes.substr(begin, end - begin);
+    if (!part.empty() && part.compare(0, kPrefix.size(), kPrefix) != 0) {
+      kept += (kept.empty() ? "" : kSeparator) + part;
+    }
+    begin = end + kSeparator.size();
+  }
+  return kPrefix + when + (kept.empty() ? "" : kSeparator + kept);
+}
+
 }  // namespace core
 }  // namespace hrg_gyro

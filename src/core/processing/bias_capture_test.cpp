@@ -150,6 +150,20 @@ TEST(BiasCaptureTest, SettingsAreValidated) {
   }
 }
 
+TEST(BiasCaptureTest, NotesKeepOnlyTheLatestCapture) {
+  const std::string first = notesAfterBiasCapture("dual_rate on bench 3", "2026-11-25T10:00:00Z");
+  EXPECT_EQ(first, "D0 from a turn-on bias capture at 2026-11-25T10:00:00Z; dual_rate on bench 3");
+  const std::string second = notesAfterBiasCapture(first, "2026-11-25T11:00:00Z");
+  EXPECT_EQ(second, "D0 from a turn-on bias capture at 2026-11-25T11:00:00Z; dual_rate on bench 3");
+  std::string many = second;
+  for (int i = 0; i < 50; ++i) many = notesAfterBiasCapture(many, "2026-11-25T12:00:00Z");
+  EXPECT_EQ(many, "D0 from a turn-on bias capture at 2026-11-25T12:00:00Z; dual_rate on bench 3");
+  EXPECT_EQ(notesAfterBiasCapture("", "T"), "D0 from a turn-on bias capture at T");
+  // Notes that merely mention a capture elsewhere are kept.
+  EXPECT_EQ(notesAfterBiasCapture("a; see D0 from a turn-on bias capture at X", "T"),
+            "D0 from a turn-on bias capture at T; a; see D0 from a turn-on bias capture at X");
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace hrg_gyro

@@ -78,5 +78,10 @@ class BiasCapture {
   bool has_block_ = false;
 };
 
+/// The parameter file's `calibration.notes` after a bias capture at `when` (UTC text): the capture's
+/// note first, then the earlier notes without the note of an earlier capture. Only the latest
+/// capture is worth a note (its D0 replaced the earlier one), so repeated captures do not grow it.
+std::string notesAfterBiasCapture(const std::string& notes, const std::string& when);
+
 }  // namespace core
 }  // namespace hrg_gyro
