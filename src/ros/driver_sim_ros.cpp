@@ -3,6 +3,7 @@
 #include <rosgraph_msgs/Clock.h>
 #include <std_msgs/Bool.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -22,7 +23,24 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   // The scenario sections are the core parser's (it refuses unknown keys in them).
   params_.claim({"seed", "start_time", "resonator", "pickoff", "turntable", "generator", "thermal", "channels"}, true);
   time_scale_ = params_.get("time_scale", time_scale_);
-  clock_period_ = params_.get("clock_period", clock_period_);
+  // clock_period: "auto" (the template's value) or unset means: with every output sample, but no
+  // more often than kFinestAutoClockPeriod. A consumer's timer under sim time fires only when /clock
+  // passes its due time, so a clock coarser than the samples throttles it (a 50 Hz filter ran at
+  // 20 Hz behind a 20 Hz clock); at the 10 kHz a bench gyro may run, a clock per sample would cost
+  // every node of the graph a callback per sample for timers that no consumer runs that fast.
+  const double auto_clock_period = std::max(config_->outputPeriod(), kFinestAutoClockPeriod);
+  clock_period_ = auto_clock_period;
+  XmlRpc::XmlRpcValue clock_raw;
+  if (params_.getOptional("clock_period", &clock_raw)) {
+    if (clock_raw.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+      clock_period_ = static_cast<double>(clock_raw);
+    } else if (clock_raw.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+      clock_period_ = static_cast<int>(clock_raw);
+    } else if (clock_raw.getType() != XmlRpc::XmlRpcValue::TypeString ||
+               static_cast<std::string>(clock_raw) != "auto") {
+      throw std::invalid_argument("~clock_period must be a positive number of seconds or auto");
+    }
+  }
   max_lag_ = params_.get("max_lag", max_lag_);
   frame_id_ = params_.get("frame_id", frame_id_);
   ros::param::param("/use_sim_time", use_sim_time_, false);
@@ -44,7 +62,15 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   wait_timeout_ = params_.get("wait_timeout", wait_timeout_);
   const int queue_size = params_.get("queue_size", 20000);
   params_.warnAboutUnknownKeys();
-  if (!(clock_period_ > 0.0)) throw std::invalid_argument("~clock_period must be positive (s)");
+  if (!(clock_period_ > 0.0) || !std::isfinite(clock_period_)) {
+    throw std::invalid_argument("~clock_period must be a positive number of seconds or auto");
+  }
+  if (use_sim_time_ && publish_clock_ && clock_period_ > config_->outputPeriod() * (1.0 + 1e-9)) {
+    ROS_WARN(
+        "driver_sim: ~clock_period %g s is coarser than the output samples (%g s): timers of the nodes under "
+        "sim time fire at most every %g s",
+        clock_period_, config_->outputPeriod(), clock_period_);
+  }
   if (!(max_lag_ > 0.0)) throw std::invalid_argument("~max_lag must be positive (s)");
   // Wall-clock stamps are due times, so a late thread catches up; under sim time the clock is ours.
   // Built here so that a bad ~time_scale is refused at start-up, not thrown in the worker thread.
@@ -133,7 +159,9 @@ void DriverSimRos::run() {
       rosgraph_msgs::Clock c;
       c.clock = stamp;
       clock_pub_.publish(c);
-      next_clock = sim.elapsed() + clock_period_;
+      // Half a sample early: with the period equal to the samples' spacing, rounding of the
+      // elapsed time must not skip every other sample.
+      next_clock = sim.elapsed() + clock_period_ - 0.5 * config_->outputPeriod();
     }
     // The sequence number is the sample's index, so a lost sample leaves a gap in it.
     auto channels = boost::make_shared<ChannelAmplitudes>(

@@ -45,7 +45,10 @@ class DriverSimRos {
   double time_scale_ = 1.0;
   double max_lag_ = 0.25;                           // s, sim time only
   std::optional<core::PlaybackSchedule> schedule_;  // built (and validated) with the parameters
-  double clock_period_ = 0.05;  // every subscriber of /clock (every node under sim time) pays for it
+  // Sim time between /clock messages: every subscriber of /clock (every node under sim time) pays
+  // for each, and every timer under sim time waits for one.
+  double clock_period_ = 0.0;
+  static constexpr double kFinestAutoClockPeriod = 1e-3;  // s: "auto" publishes at most 1 kHz
   std::string frame_id_ = "gyro_link";
   bool use_sim_time_ = false;
   bool publish_clock_ = true;
