@@ -2,6 +2,8 @@
 
 #include <cstring>
 
+#include "hrg_gyro/core/common/double_lanes.h"
+
 namespace hrg_gyro {
 namespace core {
 
@@ -22,7 +24,7 @@ DoubleLanes4 load(const double* four) {
 
 // The lanes go through step()'s operations in its order (the formulas are shared; compensator_test
 // checks the bits against step()).
-__attribute__((target_clones("avx2", "default"))) void Compensator::steps(StepBatch* batch) {
+HRG_GYRO_CLONES_FOR_AVX2 void Compensator::steps(StepBatch* batch) {
   const std::size_t n = batch->size;
   std::size_t i = 0;
   if (stepsInLanes()) {

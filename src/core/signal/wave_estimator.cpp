@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "hrg_gyro/core/common/double_lanes.h"
+
 namespace hrg_gyro {
 namespace core {
 
@@ -43,10 +45,9 @@ WaveStatus estimateWaveGeneral(double ac, double bc, double as, double bs, const
 
 // Built twice, for the x86-64 baseline and for AVX2, the loader picking one by CPU: either way each
 // lane is computed with the operations estimateWave uses, in the same order, so the same bits.
-__attribute__((target_clones("avx2", "default"))) void estimateWaves(const ChannelVector* z, std::size_t z_stride,
-                                                                     const CorrectionMatrix& correction, std::size_t n,
-                                                                     const WaveLimits& limits, WaveState* states,
-                                                                     std::size_t state_stride, WaveStatus* statuses) {
+HRG_GYRO_CLONES_FOR_AVX2 void estimateWaves(const ChannelVector* z, std::size_t z_stride,
+                                            const CorrectionMatrix& correction, std::size_t n, const WaveLimits& limits,
+                                            WaveState* states, std::size_t state_stride, WaveStatus* statuses) {
   const auto channels = [z, z_stride](std::size_t i) -> const ChannelVector& {
     return *reinterpret_cast<const ChannelVector*>(reinterpret_cast<const char*>(z) + i * z_stride);
   };

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "hrg_gyro/core/common/double_lanes.h"
+
 namespace hrg_gyro {
 namespace core {
 
@@ -13,8 +15,7 @@ SignalSynthesizer::SignalSynthesizer(const PickoffDefects& defects, int samples_
 
 // Built for the x86-64 baseline and for AVX2 (chosen at load time): the pickoffs' divisions go four per
 // instruction there, with the same IEEE results.
-__attribute__((target_clones("avx2", "default"))) ChannelVector SignalSynthesizer::period(const WaveParameters& wave,
-                                                                                          double theta_end) {
+HRG_GYRO_CLONES_FOR_AVX2 ChannelVector SignalSynthesizer::period(const WaveParameters& wave, double theta_end) {
   const int n = demodulator_.samplesPerPeriod();
   const double sigma = pickoffs_.channelNoiseSigma();
   // Carrier: cos(2 pi j/N + tau) and sin(...) by rotating the reference table by tau.

@@ -15,6 +15,17 @@
 namespace hrg_gyro {
 namespace core {
 
+/// On a function of the batch paths: compiled twice, for AVX2 and for the baseline, the better one
+/// chosen at load time (the bits are the same: no fused multiply-add either way). Clang 14 emits the
+/// chooser of such a function only in a file that also calls it, which leaves the library's own
+/// clones undefined; a clang build (the fuzzers, built for the machine they run on with -mavx2)
+/// compiles one version instead.
+#if defined(__clang__)
+#define HRG_GYRO_CLONES_FOR_AVX2
+#else
+#define HRG_GYRO_CLONES_FOR_AVX2 __attribute__((target_clones("avx2", "default")))
+#endif
+
 typedef double DoubleLanes2 __attribute__((vector_size(16)));
 typedef double DoubleLanes4 __attribute__((vector_size(32)));
 
