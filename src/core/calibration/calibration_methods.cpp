@@ -91,7 +91,7 @@ DualRateMethod::DualRateMethod(const CalibrationSettings& s, double k0)
       k0_(k0),
       groups_(s.bins, s.window, s.window_span, k0, maxFittedOrder(s.scale_factor_orders, s.drift_orders),
               s.group_tolerance, s.plateau.max_gap),
-      regression_(s.scale_factor_orders, s.drift_orders, s.bins) {}
+      regression_(s.scale_factor_orders, s.drift_orders, s.bins, s.bias_trend_order) {}
 
 double DualRateMethod::windowFor(double table_rate) const {
   // The regression is exact for any window; the window only sets how much of each harmonic the
@@ -204,6 +204,29 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
                     formatShort(e.mean_window) + " s, angle noise " + formatShort(e.angle_noise) + " rad, " +
                     std::to_string(e.increments) + " increments in " + std::to_string(e.blocks) + " blocks");
   o.smoothing_factor = 1.0;  // nothing is smoothed: the increments are fitted through their exact integrals
+  if (e.trend.order > 0) {
+    // A trend the session cannot tell from K0 leaves K0 to the trend's guess. The trend costs K0
+    // precision in any session (how much is the inflation of its standard error); refused only when
+    // it costs much (max_trend_inflation) and leaves K0 poorly known (max_trend_k0_std of |K0|).
+    const BiasTrendFit& t = e.trend;
+    o.bias_trend = t;
+    const double per_hour = 3600.0;
+    const double k0_std = e.k.mean_std / std::abs(e.k.mean);
+    const bool separable = t.k0_inflation <= q.max_trend_inflation || k0_std <= q.max_trend_k0_std;
+    const std::string fitted = "bias trend " + formatShort(t.coefficients.front() * per_hour, 3) + " +- " +
+                               formatShort(t.stds.front() * per_hour, 2) + " rad/s per hour (" +
+                               formatShort(t.coefficients.front() * t.span, 3) + " rad/s over the " +
+                               formatShort(t.span, 4) + " s of data)";
+    const std::string confusion = "K0's standard error x" + formatShort(t.k0_inflation, 3) + " to " +
+                                  formatShort(k0_std * 1e6, 3) + " ppm, correlation " +
+                                  formatShort(t.k0_correlation, 2);
+    o.gate("bias_trend", separable, t.k0_inflation, q.max_trend_inflation,
+           separable ? fitted + ", fitted with K and D (" + confusion + ")"
+                     : "the session cannot separate a bias trend from K0 (" + confusion + ", limits x" +
+                           formatShort(q.max_trend_inflation, 3) + " and " + formatShort(q.max_trend_k0_std * 1e6, 3) +
+                           " ppm): order the plateau rates so that a linear trend cancels (+ - - + - + + -), or set "
+                           "bias_trend_order: 0 if the bias is known to be stable");
+  }
   // The gate judges the table by its effect on K: what the data scatter beyond the white wave-angle
   // noise, all charged to the table angle (or the rate integral) as an upper estimate -- angle random
   // walk and drift the model lacks land there too.

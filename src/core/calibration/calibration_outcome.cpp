@@ -129,6 +129,25 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
   out << YAML::Key << "out_of_order" << YAML::Value << o.turntable_rejected.out_of_order;
   out << YAML::EndMap;
   out << YAML::Key << "restarts" << YAML::Value << o.restarts;
+  if (o.bias_trend.order > 0) {
+    // The bias's polynomial in time fitted with K and D: D0(t) = drift.mean + sum_j b_j (t - t_ref)^j.
+    const BiasTrendFit& t = o.bias_trend;
+    out << YAML::Key << "bias_trend" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "order" << YAML::Value << t.order;
+    out << YAML::Key << "coefficients" << YAML::Value;
+    emitNumbers(out, t.coefficients);
+    out << YAML::Comment("rad/s per s^j, j = 1..order");
+    out << YAML::Key << "coefficients_std" << YAML::Value;
+    emitNumbers(out, t.stds);
+    out << YAML::Key << "reference_stamp" << YAML::Value << formatDouble(toSeconds(t.reference_stamp))
+        << YAML::Comment("s: t_ref, where the bias is drift.mean");
+    out << YAML::Key << "span" << YAML::Value << formatDouble(t.span) << YAML::Comment("s of data fitted");
+    out << YAML::Key << "change_over_span" << YAML::Value << formatDouble(t.coefficients.front() * t.span)
+        << YAML::Comment("rad/s: the linear term over the span");
+    out << YAML::Key << "k0_inflation" << YAML::Value << formatDouble(t.k0_inflation);
+    out << YAML::Key << "k0_correlation" << YAML::Value << formatDouble(t.k0_correlation);
+    out << YAML::EndMap;
+  }
   // Root causes read from the K harmonics (first order, docs/math.md 'Pickoff defects to first
   // order'); see defect_diagnosis.h.
   out << YAML::Key << "diagnosis" << YAML::Value << YAML::BeginSeq;

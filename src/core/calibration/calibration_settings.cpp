@@ -24,12 +24,13 @@ const std::vector<std::string> kGateKeys = {
     "min_coverage",     "min_rate_separation", "max_rate_noise",        "max_table_error",
     "min_samples",      "max_condition",       "max_relative_residual", "max_k0_change",
     "max_harmonic_std", "min_steps",           "min_dwell_time",        "min_pairs",
-    "max_p_condition"};
+    "max_p_condition",  "max_trend_inflation", "max_trend_k0_std"};
 const std::vector<std::string> kThermalKeys = {"frequency_nodes", "node_count", "interpolation", "slice_width",
                                                "max_slices"};
 const std::vector<std::string> kScalarKeys = {
-    "method",      "scale_factor_orders", "drift_orders",     "bins",           "window",
-    "window_span", "group_tolerance",     "auto_finish_idle", "backward_reset", "backward_persist"};
+    "method",         "scale_factor_orders", "drift_orders",    "bins",
+    "window",         "window_span",         "group_tolerance", "auto_finish_idle",
+    "backward_reset", "backward_persist",    "bias_trend_order"};
 
 double positive(const YamlField& parent, const char* key, double fallback) {
   const double v = parent.getDouble(key, fallback);
@@ -63,6 +64,8 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   }
   if (root.has("scale_factor_orders")) s.scale_factor_orders = parseEvenOrders(root["scale_factor_orders"]);
   if (root.has("drift_orders")) s.drift_orders = parseEvenOrders(root["drift_orders"]);
+  s.bias_trend_order = static_cast<int>(root.getInteger("bias_trend_order", s.bias_trend_order));
+  if (s.bias_trend_order < 0 || s.bias_trend_order > 2) root["bias_trend_order"].fail("must be 0, 1 or 2");
   s.bins = static_cast<int>(root.getInteger("bins", s.bins));
   if (s.bins < 8 || s.bins > 4096) root["bins"].fail("must be in [8, 4096]");
   s.window = positive(root, "window", s.window);
@@ -111,6 +114,10 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
     if (min_pairs < 2) g["min_pairs"].fail("must be >= 2");
     q.min_pairs = static_cast<std::uint64_t>(min_pairs);
     q.max_p_condition = positive(g, "max_p_condition", q.max_p_condition);
+    q.max_trend_inflation = g.getDouble("max_trend_inflation", q.max_trend_inflation);
+    if (!(q.max_trend_inflation >= 1.0))
+      g["max_trend_inflation"].fail("must be >= 1 (a factor on K0's standard error)");
+    q.max_trend_k0_std = positive(g, "max_trend_k0_std", q.max_trend_k0_std);
   }
   if (root.has("thermal")) {
     const YamlField t = root["thermal"];

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 
@@ -13,6 +14,7 @@ namespace core {
 namespace {
 
 constexpr std::size_t kMaxBlocks = 64;
+constexpr int kMaxTrendOrder = 2;
 
 Eigen::MatrixXd submatrix(const Eigen::MatrixXd& m, const std::vector<int>& rows, const std::vector<int>& cols) {
   Eigen::MatrixXd out(rows.size(), cols.size());
@@ -35,13 +37,20 @@ int orderStep(const std::vector<int>& orders) {
 
 }  // namespace
 
-IncrementRegression::IncrementRegression(const std::vector<int>& k_orders, const std::vector<int>& d_orders, int bins)
-    : k_orders_(k_orders), d_orders_(d_orders), all_orders_(mergeOrders(k_orders, d_orders)), bins_(bins) {
+IncrementRegression::IncrementRegression(const std::vector<int>& k_orders, const std::vector<int>& d_orders, int bins,
+                                         int bias_trend_order)
+    : k_orders_(k_orders),
+      d_orders_(d_orders),
+      all_orders_(mergeOrders(k_orders, d_orders)),
+      bins_(bins),
+      trend_order_(bias_trend_order) {
   for (int k : all_orders_)
     if (k <= 0) throw std::invalid_argument("increment regression: harmonic orders must be positive");
   if (bins_ <= 0) throw std::invalid_argument("increment regression: bins must be positive");
+  if (trend_order_ < 0 || trend_order_ > kMaxTrendOrder)
+    throw std::invalid_argument("increment regression: the bias trend order must be 0, 1 or 2");
   const int n_k = static_cast<int>(k_orders_.size()), n_all = static_cast<int>(all_orders_.size());
-  m_ = 1 + 2 * n_k + 1 + 2 * n_all;
+  m_ = 1 + 2 * n_k + 1 + 2 * n_all + trend_order_;
   basis_ = HarmonicBasis(orderStep(all_orders_), all_orders_.empty() ? 0 : all_orders_.back());
   cos_prev_ = sin_prev_ = cos_now_ = sin_now_ = Eigen::VectorXd::Zero(n_all);
   for (int k : k_orders_)
@@ -65,13 +74,19 @@ void IncrementRegression::endChain() {
   in_chain_ = has_sample_ = has_mean_ = has_previous_dz_ = false;
   history_ = 0;
   sum_.w.setZero();
-  sum_.t = sum_.theta = sum_.phi = sum_.count = 0.0;
+  sum_.t = sum_.t_session = sum_.theta = sum_.phi = sum_.count = 0.0;
 }
 
 void IncrementRegression::add(Nanoseconds stamp, double theta, double phi) {
   if (!in_chain_) throw std::logic_error("increment regression: add() outside a chain");
   if (!has_sample_) origin_ = stamp;
+  if (!has_origin_) {
+    has_origin_ = true;
+    session_origin_ = stamp;
+  }
   const double t = toSeconds(stamp - origin_);
+  const double t_session = toSeconds(stamp - session_origin_);
+  last_session_time_ = std::max(last_session_time_, t_session);
   basis_.evaluate(theta);
   const int n_k = static_cast<int>(k_orders_.size()), n_all = static_cast<int>(all_orders_.size());
   const int t0 = 1 + 2 * n_k;
@@ -94,6 +109,13 @@ void IncrementRegression::add(Nanoseconds stamp, double theta, double phi) {
     for (int u = 0; u < n_all; ++u) {
       integrals_(t0 + 1 + u) += 0.5 * (c(u) + cos_prev_(u)) * dt;
       integrals_(t0 + 1 + n_all + u) += 0.5 * (s(u) + sin_prev_(u)) * dt;
+    }
+    // The trend's integrals of t^j dt, exact (a polynomial needs no trapezoid).
+    double now_power = t_session, before_power = session_t_prev_;
+    for (int j = 1; j <= trend_order_; ++j) {
+      now_power *= t_session;
+      before_power *= session_t_prev_;
+      integrals_(t0 + 1 + 2 * n_all + j - 1) += (now_power - before_power) / (j + 1);
     }
     // Angle noise: deviation of the previous sample from the line through its neighbours.
     if (history_ >= 2) {
@@ -122,12 +144,14 @@ void IncrementRegression::add(Nanoseconds stamp, double theta, double phi) {
   sum_.w.head(m_) += integrals_;
   sum_.w(m_) += theta - theta_start_;
   sum_.t += t;
+  sum_.t_session += t_session;
   sum_.theta += theta;
   sum_.phi += phi;
   sum_.count += 1.0;
 
   has_sample_ = true;
   t_prev_ = t;
+  session_t_prev_ = t_session;
   phi_prev_ = phi;
   cos_prev_.swap(cos_now_);
   sin_prev_.swap(sin_now_);
@@ -137,6 +161,7 @@ void IncrementRegression::closeWindow() {
   WindowMean mean;
   mean.w = sum_.w / sum_.count;
   mean.t = sum_.t / sum_.count;
+  mean.t_session = sum_.t_session / sum_.count;
   mean.theta = sum_.theta / sum_.count;
   mean.phi = sum_.phi / sum_.count;
   mean.count = sum_.count;
@@ -144,7 +169,7 @@ void IncrementRegression::closeWindow() {
   previous_mean_ = mean;
   has_mean_ = true;
   sum_.w.setZero();
-  sum_.t = sum_.theta = sum_.phi = sum_.count = 0.0;
+  sum_.t = sum_.t_session = sum_.theta = sum_.phi = sum_.count = 0.0;
 }
 
 void IncrementRegression::addIncrement(const WindowMean& a, const WindowMean& b) {
@@ -189,6 +214,72 @@ void IncrementRegression::addIncrement(const WindowMean& a, const WindowMean& b)
   group_time_[group_] += dt;
   ++increments_;
   increment_time_ += dt;
+  increment_time_moment_ += dt * 0.5 * (a.t_session + b.t_session);
+}
+
+Eigen::MatrixXd IncrementRegression::regressorMap(double earth_rate, double reference_time) const {
+  const int n_k = static_cast<int>(k_orders_.size()), n_all = static_cast<int>(all_orders_.size());
+  const int t0 = 1 + 2 * n_k, trend0 = t0 + 1 + 2 * n_all;
+  auto orderIndex = [&](int k) {
+    return static_cast<int>(std::lower_bound(all_orders_.begin(), all_orders_.end(), k) - all_orders_.begin());
+  };
+  Eigen::MatrixXd map = Eigen::MatrixXd::Identity(m_ + 1, m_ + 1);
+  // The Earth rate enters phi as earth_rate * t, so each K regressor gains earth_rate times the T
+  // regressor of the same order.
+  map(0, t0) = earth_rate;
+  for (int j = 0; j < n_k; ++j) {
+    map(1 + j, t0 + 1 + orderIndex(k_orders_[j])) = earth_rate;
+    map(1 + n_k + j, t0 + 1 + n_all + orderIndex(k_orders_[j])) = earth_rate;
+  }
+  // The trend's integrals of t^j dt become those of (t - t_ref)^j dt: the binomial expansion over
+  // the lower powers (power 0 is the T column).
+  for (int j = 1; j <= trend_order_; ++j) {
+    double binomial = 1.0;  // C(j, i), from i = 0
+    for (int i = 0; i < j; ++i) {
+      map(trend0 + j - 1, i == 0 ? t0 : trend0 + i - 1) = binomial * std::pow(-reference_time, j - i);
+      binomial = binomial * (j - i) / (i + 1);
+    }
+  }
+  return map;
+}
+
+IncrementRegression::Solved IncrementRegression::solveColumns(const std::vector<int>& sel, const Eigen::MatrixXd& map,
+                                                              const std::vector<Block>& blocks,
+                                                              const Eigen::MatrixXd& total, double angle_noise,
+                                                              double max_condition) const {
+  Solved out;
+  const Eigen::MatrixXd s = map * total * map.transpose();
+  out.solution =
+      solveNormalEquations(submatrix(s, sel, sel), column(s, sel, m_), ColumnScaling::kUnitNorm, max_condition);
+  if (!out.solution.ok) return out;
+  const Eigen::VectorXd& beta = out.solution.coefficients;
+  const Eigen::MatrixXd& inverse = out.solution.normal_inverse;
+  const int p = static_cast<int>(sel.size());
+  // Block sandwich: the score of each block at the solution. Neighbouring blocks share the window
+  // mean at their boundary (with opposite signs), and that shared term is most of a block's score
+  // for white angle noise, so the products of neighbouring scores are kept as well (a lag-one
+  // block estimate); blocks further apart share nothing.
+  std::vector<Eigen::VectorXd> scores;
+  for (const Block& b : blocks) {
+    const Eigen::MatrixXd sb = map * b.products * map.transpose();
+    scores.push_back(column(sb, sel, m_) - submatrix(sb, sel, sel) * beta);
+  }
+  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(p, p);
+  for (std::size_t c = 0; c < scores.size(); ++c) {
+    meat.noalias() += scores[c] * scores[c].transpose();
+    if (c + 1 < scores.size()) {
+      const Eigen::MatrixXd cross = scores[c] * scores[c + 1].transpose();
+      meat += cross + cross.transpose();
+    }
+  }
+  const double g = static_cast<double>(blocks.size()), n = static_cast<double>(increments_);
+  out.sandwich = (g / (g - 1.0)) * ((n - 1.0) / (n - p)) * inverse * meat * inverse;
+  // What white wave-angle noise alone predicts (a floor: a few blocks can understate by chance).
+  const Eigen::MatrixXd zmap = map.topLeftCorner(m_, m_);
+  const Eigen::MatrixXd white_full =
+      zmap * (white_lag0_ - white_lag1_ - white_lag1_.transpose()) * zmap.transpose() * (angle_noise * angle_noise);
+  out.white = inverse * submatrix(white_full, sel, sel) * inverse;
+  return out;
 }
 
 IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std, double min_bin_time,
@@ -196,16 +287,19 @@ IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std
   IncrementFit fit;
   const int n_k = static_cast<int>(k_orders_.size()), n_d = static_cast<int>(d_orders_.size());
   const int n_all = static_cast<int>(all_orders_.size());
-  const int t0 = 1 + 2 * n_k, n_kterms = 1 + 2 * n_k;
+  const int t0 = 1 + 2 * n_k, n_kterms = 1 + 2 * n_k, trend0 = t0 + 1 + 2 * n_all;
   auto orderIndex = [&](int k) {
     return static_cast<int>(std::lower_bound(all_orders_.begin(), all_orders_.end(), k) - all_orders_.begin());
   };
-  // Fitted columns: the K block, T, and the T harmonics of D's orders (mean, cos..., sin...).
+  // Fitted columns: the K block, T, the T harmonics of D's orders (mean, cos..., sin...), the trend.
   std::vector<int> sel;
   for (int j = 0; j < n_kterms; ++j) sel.push_back(j);
   sel.push_back(t0);
   for (int k : d_orders_) sel.push_back(t0 + 1 + orderIndex(k));
   for (int k : d_orders_) sel.push_back(t0 + 1 + n_all + orderIndex(k));
+  const std::vector<int> sel_without_trend = sel;
+  const int trend_at = static_cast<int>(sel.size());  // the trend's first coefficient
+  for (int j = 0; j < trend_order_; ++j) sel.push_back(trend0 + j);
   const int p = static_cast<int>(sel.size());
 
   std::vector<Block> blocks = blocks_;
@@ -222,60 +316,26 @@ IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std
   Eigen::MatrixXd total = Eigen::MatrixXd::Zero(m_ + 1, m_ + 1);
   for (const Block& b : blocks) total += b.products;
 
-  // The Earth rate enters phi as earth_rate * t, so each K regressor gains earth_rate times the T
-  // regressor of the same order: a linear map of the accumulated sums.
-  auto earthMap = [&](double earth) {
-    Eigen::MatrixXd map = Eigen::MatrixXd::Identity(m_ + 1, m_ + 1);
-    map(0, t0) = earth;
-    for (int j = 0; j < n_k; ++j) {
-      map(1 + j, t0 + 1 + orderIndex(k_orders_[j])) = earth;
-      map(1 + n_k + j, t0 + 1 + n_all + orderIndex(k_orders_[j])) = earth;
-    }
-    return map;
-  };
-  auto solveAt = [&](double earth) {
-    const Eigen::MatrixXd map = earthMap(earth);
-    const Eigen::MatrixXd s = map * total * map.transpose();
-    return solveNormalEquations(submatrix(s, sel, sel), column(s, sel, m_), ColumnScaling::kUnitNorm, max_condition);
-  };
-  const LeastSquaresSolution solution = solveAt(earth_rate);
-  if (!solution.ok) {
-    fit.reason = "increment regression condition number " + std::to_string(solution.condition_number) + " above " +
-                 std::to_string(max_condition);
+  // The trend is centred on the mean time of the increments: D0 is then the session's mean bias.
+  const double reference_time = increment_time_ > 0.0 ? increment_time_moment_ / increment_time_ : 0.0;
+  const Eigen::MatrixXd map = regressorMap(earth_rate, reference_time);
+  const Solved solved = solveColumns(sel, map, blocks, total, fit.angle_noise, max_condition);
+  if (!solved.solution.ok) {
+    fit.reason = "increment regression condition number " + std::to_string(solved.solution.condition_number) +
+                 " above " + std::to_string(max_condition);
     return fit;
   }
+  const LeastSquaresSolution& solution = solved.solution;
   const Eigen::VectorXd& beta = solution.coefficients;
-  const Eigen::MatrixXd& inverse = solution.normal_inverse;
-  const Eigen::MatrixXd map = earthMap(earth_rate);
-
-  // Block sandwich: the score of each block at the solution. Neighbouring blocks share the window
-  // mean at their boundary (with opposite signs), and that shared term is most of a block's score
-  // for white angle noise, so the products of neighbouring scores are kept as well (a lag-one
-  // block estimate); blocks further apart share nothing.
-  std::vector<Eigen::VectorXd> scores;
-  for (const Block& b : blocks) {
-    const Eigen::MatrixXd s = map * b.products * map.transpose();
-    scores.push_back(column(s, sel, m_) - submatrix(s, sel, sel) * beta);
-  }
-  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(p, p);
-  for (std::size_t c = 0; c < scores.size(); ++c) {
-    meat.noalias() += scores[c] * scores[c].transpose();
-    if (c + 1 < scores.size()) {
-      const Eigen::MatrixXd cross = scores[c] * scores[c + 1].transpose();
-      meat += cross + cross.transpose();
-    }
-  }
-  const double g = static_cast<double>(blocks.size()), n = static_cast<double>(increments_);
-  const Eigen::MatrixXd sandwich = (g / (g - 1.0)) * ((n - 1.0) / (n - p)) * inverse * meat * inverse;
-  // What white wave-angle noise alone predicts (a floor: a few blocks can understate by chance).
-  const Eigen::MatrixXd zmap = map.topLeftCorner(m_, m_);
-  const Eigen::MatrixXd white_full = zmap * (white_lag0_ - white_lag1_ - white_lag1_.transpose()) * zmap.transpose() *
-                                     (fit.angle_noise * fit.angle_noise);
-  const Eigen::MatrixXd white = inverse * submatrix(white_full, sel, sel) * inverse;
+  const Eigen::MatrixXd& sandwich = solved.sandwich;
+  const Eigen::MatrixXd& white = solved.white;
   // Earth-rate uncertainty: refit with the rate moved by its standard deviation.
   Eigen::VectorXd earth_shift = Eigen::VectorXd::Zero(p);
   if (earth_rate_std > 0.0) {
-    const LeastSquaresSolution moved = solveAt(earth_rate + earth_rate_std);
+    const Eigen::MatrixXd s = regressorMap(earth_rate + earth_rate_std, reference_time) * total *
+                              regressorMap(earth_rate + earth_rate_std, reference_time).transpose();
+    const LeastSquaresSolution moved =
+        solveNormalEquations(submatrix(s, sel, sel), column(s, sel, m_), ColumnScaling::kUnitNorm, max_condition);
     if (moved.ok) earth_shift = (moved.coefficients - beta).cwiseAbs();
   }
   // Noise of theta inside the basis attenuates order k by exp(-k^2 s^2 / 2); undo it. A tenth of the
@@ -321,6 +381,29 @@ IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std
   };
   fill(&fit.k, k_orders_, 0);
   fill(&fit.d, d_orders_, n_kterms);
+
+  if (trend_order_ > 0) {
+    BiasTrendFit& trend = fit.trend;
+    trend.order = trend_order_;
+    for (int j = 0; j < trend_order_; ++j) {
+      trend.coefficients.push_back(value[trend_at + j]);
+      trend.stds.push_back(total_std[trend_at + j]);
+    }
+    trend.reference_time = reference_time;
+    trend.reference_stamp = session_origin_ + toNanoseconds(reference_time);
+    trend.span = last_session_time_;
+    // How the design confuses the trend with K0, from its geometry alone (the normal inverse): the
+    // same fit without the trend, and the correlation of K0 with the linear term.
+    const Eigen::MatrixXd s = map * total * map.transpose();
+    const LeastSquaresSolution without =
+        solveNormalEquations(submatrix(s, sel_without_trend, sel_without_trend), column(s, sel_without_trend, m_),
+                             ColumnScaling::kUnitNorm, std::numeric_limits<double>::infinity());
+    const Eigen::MatrixXd& inv = solution.normal_inverse;
+    if (without.ok && without.normal_inverse(0, 0) > 0.0) {
+      trend.k0_inflation = std::sqrt(inv(0, 0) / without.normal_inverse(0, 0));
+    }
+    trend.k0_correlation = inv(0, trend_at) / std::sqrt(inv(0, 0) * inv(trend_at, trend_at));
+  }
 
   // Binned curves of the two groups with the most data: the fitted model at the bin centre plus the
   // bin's mean residual rate, separated into K and D by the two groups' rates.

@@ -33,6 +33,10 @@ struct AngleLevelGyro {
   double theta0 = 0.2;
   std::uint64_t seed = 7;
   double angle_random_walk = 0.0;  ///< rad/sqrt(s) of wave angle (runTableSession only)
+  /// The bias wanders (runTableSession only): D0 + bias_trend t + bias_random_walk W(t), t in s from
+  /// the session start, W a standard Wiener process (its own seeded stream), held over each step.
+  double bias_trend = 0.0;        ///< rad/s per s
+  double bias_random_walk = 0.0;  ///< rad/s/sqrt(s)
   /// Resonator frequency (Hz) at t s from the start, where K and D are evaluated and which the
   /// samples report; empty: unknown (NaN).
   std::function<double(double)> frequency;
@@ -91,18 +95,38 @@ struct TableImperfections {
   double log_hz = 0.0;            ///< turntable records per s (0: one per wave sample); divides rate_hz
   bool rate_from_angle = false;   ///< the logged rate is the logged angle differenced between records
   bool angle_logged = true;       ///< false: the controller logs no angle (the field is NaN)
-  double drop_fraction = 0.0;     ///< wave samples dropped at random
-  double gap_period = 0.0;        ///< s: a gap in the wave stream every gap_period s (0: none) ...
-  double gap_length = 0.0;        ///< ... lasting this long
+  /// The controller's own clock: each record stamped at its true time + clock_offset (+ clock_step
+  /// from clock_step_at s on) + clock_jitter x N(0, 1), its own seeded stream; seq counts records.
+  double clock_offset = 0.0;   ///< s, the table's stamps minus the gyro's
+  double clock_jitter = 0.0;   ///< s, white
+  double clock_step_at = 0.0;  ///< s from the start (0: no step) ...
+  double clock_step = 0.0;     ///< ... where the offset changes by this much, s
+  double drop_fraction = 0.0;  ///< wave samples dropped at random
+  double gap_period = 0.0;     ///< s: a gap in the wave stream every gap_period s (0: none) ...
+  double gap_length = 0.0;     ///< ... lasting this long
 };
 
-/// table_sink(stamp, angle, rate) per turntable record, wave_sink(stamp, theta, frequency) per wave
-/// sample, in time order (a record and a sample at the same stamp: the record first).
+/// A turntable record as the controller logs it.
+struct TableRecord {
+  Nanoseconds stamp = 0;  ///< on the controller's clock
+  double angle = 0.0, rate = 0.0;
+  std::uint32_t seq = 0;  ///< the controller's record count
+  double time = 0.0;      ///< true time of the record, s from the start
+};
+
+/// The bias the gyro of runTableSession has at t s from the start, without its random walk.
+inline double biasTrendAt(const AngleLevelGyro& g, double t) { return g.bias_trend * t; }
+
+/// table_sink(record) per turntable record, wave_sink(stamp, theta, frequency) per wave sample, in
+/// true time order (a record and a sample at the same true time: the record first).
 inline void runTableSession(const AngleLevelGyro& g, const TableImperfections& table, const TurntableProfile& profile,
-                            const std::function<void(Nanoseconds, double, double)>& table_sink,
+                            const std::function<void(const TableRecord&)>& table_sink,
                             const std::function<void(Nanoseconds, double, double)>& wave_sink) {
   ModelPairEvaluator models(g.k, g.d);
   GaussianNoise noise(g.seed), table_noise(g.seed ^ 0x9e3779b97f4a7c15ULL), drops(g.seed ^ 0x51ed27a3ULL);
+  GaussianNoise bias_noise(g.seed ^ 0x2545f4914f6cdd1dULL), clock_noise(g.seed ^ 0x6a09e667f3bcc909ULL);
+  double bias_walk = 0.0;
+  std::uint32_t seq = 0;
   const double h = 1.0 / g.rate_hz;
   const long log_every = table.log_hz > 0.0 ? std::max(1L, std::lround(g.rate_hz / table.log_hz)) : 1;
   auto frequency = [&](double t) { return g.frequency ? g.frequency(t) : NAN; };
@@ -114,7 +138,7 @@ inline void runTableSession(const AngleLevelGyro& g, const TableImperfections& t
   auto thetaRate = [&](double t, double th, double table_rate) {
     double k, d;
     models.evaluate(th, frequency(t), &k, &d);
-    return k * (table_rate + g.earth_rate) + d;
+    return k * (table_rate + g.earth_rate) + d + biasTrendAt(g, t) + bias_walk;
   };
   double theta = g.theta0, phi = 0.0, logged_previous = 0.0;
   double unused_angle, rate0;
@@ -130,7 +154,16 @@ inline void runTableSession(const AngleLevelGyro& g, const TableImperfections& t
       if (table.encoder_step > 0.0) logged = table.encoder_step * std::round(logged / table.encoder_step);
       double rate = tableRate(t) + g.rate_noise * table_noise.next();
       if (table.rate_from_angle) rate = first_record ? rate0 : (logged - logged_previous) / (log_every * h);
-      table_sink(stamp, table.angle_logged ? logged : NAN, rate);
+      TableRecord r;
+      r.time = t;
+      r.seq = seq++;
+      double clock = table.clock_offset;
+      if (table.clock_step_at > 0.0 && t >= table.clock_step_at) clock += table.clock_step;
+      if (table.clock_jitter > 0.0) clock += table.clock_jitter * clock_noise.next();
+      r.stamp = stamp + toNanoseconds(clock);
+      r.angle = table.angle_logged ? logged : NAN;
+      r.rate = rate;
+      table_sink(r);
       logged_previous = logged;
       first_record = false;
     }
@@ -146,7 +179,16 @@ inline void runTableSession(const AngleLevelGyro& g, const TableImperfections& t
     theta += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
     phi += h / 6 * (w1 + 4 * w2 + w4);
     if (g.angle_random_walk > 0.0) theta += g.angle_random_walk * std::sqrt(h) * noise.next();
+    if (g.bias_random_walk > 0.0) bias_walk += g.bias_random_walk * std::sqrt(h) * bias_noise.next();
   }
+}
+
+/// The same with table_sink(stamp, angle, rate).
+inline void runTableSession(const AngleLevelGyro& g, const TableImperfections& table, const TurntableProfile& profile,
+                            const std::function<void(Nanoseconds, double, double)>& table_sink,
+                            const std::function<void(Nanoseconds, double, double)>& wave_sink) {
+  runTableSession(
+      g, table, profile, [&](const TableRecord& r) { table_sink(r.stamp, r.angle, r.rate); }, wave_sink);
 }
 
 inline CalibrationOutcome calibrateTableSession(const AngleLevelGyro& g, const TableImperfections& table,
@@ -157,6 +199,23 @@ inline CalibrationOutcome calibrateTableSession(const AngleLevelGyro& g, const T
       g, table, profile, [&](Nanoseconds t, double angle, double rate) { session.addTurntable(t, angle, rate); },
       [&](Nanoseconds t, double theta, double frequency) { session.addWave(t, theta, frequency); });
   return session.finish();
+}
+
+/// A dual-rate profile in the Thue-Morse order of its plateaus (w1 w2 w2 w1 w2 w1 w1 w2 ...): a
+/// linear bias trend cancels over every four plateaus, a quadratic over every eight.
+inline TurntableProfile balancedDualRateProfile(double w1, double w2, double duration, int plateaus) {
+  TurntableProfile p;
+  p.append(5.0, 0.0, 0.0, "start");
+  for (int i = 0; i < plateaus; ++i) {
+    const double w = __builtin_popcount(static_cast<unsigned>(i)) % 2 == 0 ? w1 : w2;
+    const double from = p.finalRate();
+    if (w != from) p.append(std::abs(w - from) / 0.5, from, w > from ? 0.5 : -0.5, "ramp");
+    p.append(duration, w, 0.0, "plateau");
+  }
+  const double from = p.finalRate();
+  p.append(std::abs(from) / 0.5, from, from > 0 ? -0.5 : 0.5, "ramp");
+  p.append(25.0, 0.0, 0.0, "rest");
+  return p;
 }
 
 /// Peak of |K_estimated(theta) - K_true(theta)| / |K0_true| over theta, ppm.

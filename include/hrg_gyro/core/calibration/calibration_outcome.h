@@ -10,6 +10,7 @@
 #include "hrg_gyro/core/estimation/defect_diagnosis.h"
 #include "hrg_gyro/core/estimation/dual_rate_estimator.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
+#include "hrg_gyro/core/estimation/increment_regression.h"
 #include "hrg_gyro/core/model/correction_matrix.h"
 #include "hrg_gyro/core/model/gyro_parameters.h"
 
@@ -68,6 +69,9 @@ struct CalibrationOutcome {
   TurntableRejects turntable_rejected;     ///< of them, dropped as glitches
   std::uint64_t restarts = 0;              ///< times a stream went back for good and the run started over
   std::vector<DefectDiagnosis> diagnosis;  ///< one per scale_factor fit with 2 and 4 theta terms
+  /// dual-rate: the bias's trend fitted with K and D (order 0: none was fitted). The written D0 is
+  /// the bias at bias_trend.reference_stamp, the mean time of the data.
+  BiasTrendFit bias_trend;
 
   /// Appends a gate; the first failing one becomes the reason.
   void gate(const std::string& name, bool passed, double value, double limit, const std::string& message);

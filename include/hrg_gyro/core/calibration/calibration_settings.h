@@ -29,6 +29,11 @@ struct QualityLimits {
   double min_dwell_time = 5.0;          ///< s of static data (step and constant-rate methods)
   std::uint64_t min_pairs = 24;         ///< correction-matrix method: generator samples
   double max_p_condition = 1e3;         ///< correction-matrix method
+  /// dual-rate: a session cannot tell a bias trend from K0 (refused, the plateau order named) when
+  /// fitting the trend multiplies K0's standard error by more than max_trend_inflation and leaves it
+  /// above max_trend_k0_std of |K0|
+  double max_trend_inflation = 3.0;
+  double max_trend_k0_std = 2e-6;
 };
 
 /// The thermal method (K and D as splines over the resonator frequency, thermal_method.h).
@@ -46,6 +51,9 @@ struct CalibrationSettings {
   CalibrationMethodKind method = CalibrationMethodKind::kDualRate;
   std::vector<int> scale_factor_orders{2, 4, 6, 8};
   std::vector<int> drift_orders{2, 4};
+  /// dual-rate: degree of the bias's polynomial in time fitted with K and D (0: constant, 1: linear
+  /// trend, 2: quadratic)
+  int bias_trend_order = 1;
   int bins = 128;                  ///< theta bins over [0, pi)
   double window = 2.0;             ///< s, longest averaging window tau
   double window_span = 0.06;       ///< rad, most wave angle a window may sweep (shortens tau at high rates)

@@ -26,6 +26,16 @@
 // Noise of theta inside cos(k theta) attenuates the regressors by exp(-k^2 s^2 / 2) on average
 // (s the per-sample angle noise, estimated from the samples); the fitted harmonics are corrected by
 // that factor (a tenth of the correction counts as its uncertainty).
+//
+// A bias that wanders through the session (a gyro warming up, a lab whose temperature drifts) is
+// fitted with it as a polynomial in time, D0(t) = D0 + sum_j b_j (t - t_ref)^j, j = 1..trend order:
+// its regressors are the integrals of (t - t_ref)^j dt, centred on the mean time of the increments
+// (so D0 is the session's mean bias). A polynomial rather than an offset per plateau: within a
+// plateau of constant rate an offset is indistinguishable from K0 times the rate, so per-plateau
+// offsets would take K0 with them unless rests between plateaus pinned each one; a slow trend is
+// separated from K by its time signature (the order of the plateau rates and the curvature it gives
+// the wave angle within each plateau). How well the session separates it is measured: the trend's
+// inflation of the K0 standard error, and their correlation.
 #pragma once
 
 #include <Eigen/Core>
@@ -34,6 +44,7 @@
 #include <vector>
 
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/common/weighted_least_squares.h"
 #include "hrg_gyro/core/estimation/dual_rate_estimator.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/model/harmonic_basis.h"
@@ -50,6 +61,20 @@ struct IncrementErrorBudget {
   std::vector<double> basis_noise;   ///< from the uncertainty of the basis-noise correction
 };
 
+/// The bias trend fitted with K and D (bias_trend_order > 0).
+struct BiasTrendFit {
+  int order = 0;
+  std::vector<double> coefficients;  ///< b_j, rad/s per s^j
+  std::vector<double> stds;          ///< their standard errors
+  double reference_time = 0.0;       ///< s from the first sample: t_ref, where D0 is the bias
+  Nanoseconds reference_stamp = 0;   ///< the same as a stamp
+  double span = 0.0;                 ///< s from the first to the last sample fitted
+  /// K0's statistical standard error with the trend fitted over that without it (>= 1), and the
+  /// correlation of K0 with the linear coefficient: how much the session confuses the two.
+  double k0_inflation = 1.0;
+  double k0_correlation = 0.0;
+};
+
 struct IncrementFit {
   bool ok = false;
   std::string reason;
@@ -61,12 +86,15 @@ struct IncrementFit {
   double mean_window = 0.0;              ///< s between consecutive window means
   std::size_t increments = 0;
   std::size_t blocks = 0;  ///< blocks of the sandwich covariance
+  BiasTrendFit trend;      ///< order 0: none fitted
 };
 
 class IncrementRegression {
  public:
   /// Orders must be positive. bins: wave-angle bins over [0, pi) for the binned curves.
-  IncrementRegression(const std::vector<int>& k_orders, const std::vector<int>& d_orders, int bins);
+  /// bias_trend_order: degree of the bias's polynomial in time (0: a constant bias; at most 2).
+  IncrementRegression(const std::vector<int>& k_orders, const std::vector<int>& d_orders, int bins,
+                      int bias_trend_order = 0);
 
   /// Starts a chain of plateau group `group` averaged over windows of `window` s (ends any open chain).
   void startChain(int group, double window);
@@ -95,21 +123,38 @@ class IncrementRegression {
   struct WindowMean {
     Eigen::VectorXd w;  // mean of (z, y)
     double t = 0.0, theta = 0.0, phi = 0.0, count = 0.0;
+    double t_session = 0.0;  // mean time from the session's first sample
+  };
+  /// The normal equations of the fitted columns `sel` solved at the Earth rate, with the block
+  /// sandwich and the white-noise covariance of the coefficients.
+  struct Solved {
+    LeastSquaresSolution solution;
+    Eigen::MatrixXd sandwich, white;
   };
 
   void closeWindow();
   void addIncrement(const WindowMean& a, const WindowMean& b);
+  /// The linear map of the accumulated columns: the Earth rate added to phi, the trend centred on t_ref.
+  Eigen::MatrixXd regressorMap(double earth_rate, double reference_time) const;
+  Solved solveColumns(const std::vector<int>& sel, const Eigen::MatrixXd& map, const std::vector<Block>& blocks,
+                      const Eigen::MatrixXd& total, double angle_noise, double max_condition) const;
 
   std::vector<int> k_orders_, d_orders_, all_orders_;
   int bins_;
-  int m_;  // regressors: K block (1 + 2 nK), then T and the T harmonics of every order
+  int trend_order_;
+  int m_;  // regressors: K block (1 + 2 nK), then T and the T harmonics of every order, then the trend
   HarmonicBasis basis_;
+  // The session's first sample: the trend's time origin.
+  bool has_origin_ = false;
+  Nanoseconds session_origin_ = 0;
+  double last_session_time_ = 0.0;
+  double increment_time_moment_ = 0.0;  // sum of increment dt x mean time: the trend's reference
   // The open chain.
   bool in_chain_ = false, has_sample_ = false, has_mean_ = false;
   int group_ = 0;
   double window_ = 0.0;
   Nanoseconds origin_ = 0;
-  double t_prev_ = 0.0, phi_prev_ = 0.0, theta_start_ = 0.0;
+  double t_prev_ = 0.0, phi_prev_ = 0.0, theta_start_ = 0.0, session_t_prev_ = 0.0;
   std::vector<int> k_in_all_;  // index of each K order in all_orders_
   Eigen::VectorXd cos_prev_, sin_prev_, cos_now_, sin_now_, integrals_;
   long window_index_ = 0;
