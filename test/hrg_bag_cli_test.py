@@ -458,6 +458,45 @@ class HrgBagCli(unittest.TestCase):
             self.assertIn(why, err)
             self.assertEqual(snapshot(d), before)
 
+    def test_fifos_devices_and_directories_are_refused_as_inputs_without_blocking(self):
+        # A FIFO without a writer blocks an ordinary open forever: every input is checked before it is
+        # opened, so each case ends at once (the short timeout turns a regression into a failure).
+        d = self.path("not_files")
+        os.makedirs(os.path.join(d, "a_directory"))
+        fifo = os.path.join(d, "fifo")
+        os.mkfifo(fifo)
+        scenario = os.path.join(self.pkg, "test/scenarios/short_session.yaml")
+        kinds = ((fifo, "is a FIFO"), ("/dev/null", "is a character device"),
+                 (os.path.join(d, "a_directory"), "is a directory"))
+        for bad, why in kinds:
+            cases = [
+                ["info", bad],
+                ["process", bad, "--params", self.params, "--csv", os.path.join(d, "p.csv")],
+                ["calibrate", bad, "--method", "dual_rate", "--out", os.path.join(d, "c.yaml")],
+                ["allan", bad],
+                ["export", bad, "--channels-csv", os.path.join(d, "e.csv")],
+                ["process", self.short, "--params", bad, "--csv", os.path.join(d, "p.csv")],
+                ["calibrate", self.short, "--method", "dual_rate", "--out", os.path.join(d, "c.yaml"), "--config",
+                 bad],
+                ["calibrate", self.short, "--method", "dual_rate", "--out", os.path.join(d, "c.yaml"), "--params",
+                 bad],
+                ["allan", self.short, "--params", bad],
+                ["simulate", "--scenario", bad, "--out", os.path.join(d, "s.bag")],
+            ]
+            for args in cases:
+                code, _, err = hrg_bag(*args, timeout=20)
+                self.assertEqual(code, 2, "%s -> exit %d\n%s" % (args, code, err))
+                self.assertIn(bad, err, args)
+                self.assertIn(why, err, args)
+                self.assertNotIn("terminate called", err, args)
+            for option in ("--calibration", "--verification", "--params"):
+                args = ["--calibration", scenario, "--verification", scenario, "--params", self.params]
+                args[args.index(option) + 1] = bad
+                code, _, err = run(HRG_SESSION, *args, timeout=20)
+                self.assertEqual(code, 2, "%s -> exit %d\n%s" % (args, code, err))
+                self.assertIn(why, err, args)
+        self.assertEqual(sorted(os.listdir(d)), ["a_directory", "fifo"], "nothing written")
+
     def test_outputs_replace_their_files_only_when_complete(self):
         d = self.path("replace")
         os.makedirs(d)

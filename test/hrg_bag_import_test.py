@@ -170,6 +170,22 @@ class HrgBagImport(unittest.TestCase):
             self.assertNotIn("terminate called", err)
             self.assertFalse(os.path.exists(out), args)
 
+    def test_fifos_devices_and_directories_are_refused_without_blocking(self):
+        # A FIFO without a writer would block an ordinary open forever; the log is checked before it
+        # is opened, so the import ends at once (the short timeout turns a regression into a failure).
+        ch = self.write("fifo_case_channels.csv", CHANNELS_HEADER + "1.0,1,0,0,0\n")
+        fifo, directory = self.path("log_fifo"), self.path("log_directory")
+        os.mkfifo(fifo)
+        os.makedirs(directory)
+        out = self.path("fifo_case.bag")
+        for bad, why in ((fifo, "is a FIFO"), ("/dev/null", "is a character device"), (directory, "is a directory")):
+            for args, option in ((["--channels", bad], "--channels"), (["--channels", ch, "--turntable", bad],
+                                                                       "--turntable")):
+                code, _, err = hrg_bag("import", *(args + ["--out", out]), timeout=20)
+                self.assertEqual(code, 2, "%s -> exit %d\n%s" % (args, code, err))
+                self.assertIn(option + ": '" + bad + "' " + why, err)
+                self.assertFalse(os.path.exists(out))
+
     def test_a_full_disk_fails_with_exit_3_and_leaves_nothing(self):
         ch = self.path("disk_channels.csv")
         with open(ch, "w") as f:

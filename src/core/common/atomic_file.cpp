@@ -440,31 +440,47 @@ void checkDistinct(const std::vector<std::string>& inputs, const std::vector<std
   }
 }
 
-std::string readBoundedRegularFile(const std::string& path, std::size_t max_bytes, const std::string& what) {
-  // stat before open: opening a FIFO or some devices blocks or has side effects.
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) fail("cannot read " + what + " '" + path + "'", errno);
+int openRegularFileForReading(const std::string& path, const std::string& what, std::uint64_t* size) {
   auto refuseKind = [&](mode_t mode) {
     if (S_ISDIR(mode)) throw std::runtime_error("'" + path + "' is a directory, not a " + what);
     if (!S_ISREG(mode))
       throw std::runtime_error("'" + path + "' is " + kindOf(mode) + ", not a regular file: refusing to read it as a " +
                                what);
   };
+  // stat before open: opening a FIFO blocks until a writer comes, opening some devices has effects.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) fail("cannot read " + what + " '" + path + "'", errno);
+  refuseKind(st.st_mode);
+  // O_NONBLOCK: should the path have been swapped for a FIFO since the stat, open must not hang.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) fail("cannot read " + what + " '" + path + "'", errno);
+  try {
+    if (::fstat(fd, &st) != 0) fail("cannot read " + what + " '" + path + "'", errno);
+    refuseKind(st.st_mode);
+    const int flags = ::fcntl(fd, F_GETFL);
+    if (flags < 0 || ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+      fail("cannot read " + what + " '" + path + "'", errno);
+    }
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  if (size != nullptr) *size = static_cast<std::uint64_t>(st.st_size);
+  return fd;
+}
+
+std::string readBoundedRegularFile(const std::string& path, std::size_t max_bytes, const std::string& what) {
   auto refuseSize = [&](const std::string& size) {
     throw std::runtime_error("'" + path + "' is " + size + ", above the limit of " + std::to_string(max_bytes) +
                              " bytes for a " + what);
   };
-  refuseKind(st.st_mode);
-  if (static_cast<unsigned long long>(st.st_size) > max_bytes) refuseSize(std::to_string(st.st_size) + " bytes");
-  // O_NONBLOCK: should the path have been swapped for a FIFO since the stat, open must not hang.
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-  if (fd < 0) fail("cannot read " + what + " '" + path + "'", errno);
+  std::uint64_t file_size = 0;
+  const int fd = openRegularFileForReading(path, what, &file_size);
   std::string content;
   try {
-    if (::fstat(fd, &st) != 0) fail("cannot read " + what + " '" + path + "'", errno);
-    refuseKind(st.st_mode);
+    if (file_size > max_bytes) refuseSize(std::to_string(file_size) + " bytes");
     // Sized by the stat, grown (never past one byte more than allowed) should the file have grown.
-    content.resize(std::min<std::size_t>(max_bytes, static_cast<std::size_t>(st.st_size)) + 1);
+    content.resize(static_cast<std::size_t>(std::min<std::uint64_t>(max_bytes, file_size)) + 1);
     std::size_t done = 0;
     while (true) {
       if (done == content.size()) {

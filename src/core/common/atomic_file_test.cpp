@@ -487,6 +487,36 @@ TEST_F(AtomicFileTest, BoundedReaderRefusesFifosDevicesAndDirectoriesAtOnce) {
   EXPECT_NE(missing.find("No such file"), std::string::npos) << missing;
 }
 
+TEST_F(AtomicFileTest, OpeningForReadingRefusesWhatIsNotARegularFileWithoutBlocking) {
+  ASSERT_EQ(::mkfifo(at("fifo").c_str(), 0644), 0);
+  fs::create_directories(at("dir"));
+  auto outcome = [](const std::string& path) -> std::string {
+    try {
+      std::uint64_t size = 0;
+      const int fd = openRegularFileForReading(path, "bag", &size);
+      char first = 0;
+      const bool read_one = ::read(fd, &first, 1) == 1;
+      const int flags = ::fcntl(fd, F_GETFL);
+      ::close(fd);
+      return "opened " + std::to_string(size) + " bytes" + (read_one ? ", first '" + std::string(1, first) + "'" : "") +
+             ((flags & O_NONBLOCK) != 0 ? ", non-blocking" : "");
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+  };
+  const std::chrono::seconds limit(5);
+  const std::string fifo = runWithin(limit, [&] { return outcome(at("fifo")); });
+  EXPECT_NE(fifo.find("is a FIFO (named pipe), not a regular file: refusing to read it as a bag"), std::string::npos)
+      << fifo;
+  const std::string null = runWithin(limit, [&] { return outcome("/dev/null"); });
+  EXPECT_NE(null.find("is a character device"), std::string::npos) << null;
+  EXPECT_NE(outcome(at("dir")).find("is a directory, not a bag"), std::string::npos);
+  EXPECT_NE(outcome(at("missing")).find("cannot read bag '" + at("missing") + "': No such file"), std::string::npos);
+  // A regular file: its size, and a descriptor that reads (and blocks) as an ordinary one.
+  writeText(at("regular"), "xyz");
+  EXPECT_EQ(outcome(at("regular")), "opened 3 bytes, first 'x'");
+}
+
 TEST_F(AtomicFileTest, BoundedReaderEnforcesItsLimit) {
   writeText(at("exact"), std::string(1000, 'x'));
   writeText(at("over"), std::string(1001, 'x'));

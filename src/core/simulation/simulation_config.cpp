@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
@@ -190,10 +191,14 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
 
 SimulationConfig SimulationConfig::load(const std::string& path, const std::vector<std::string>& extra_keys) {
   YAML::Node root;
+  std::string text;
   try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError("", "cannot read scenario file '" + path + "'");
+    text = readBoundedRegularFile(path, kMaxScenarioFileBytes, "scenario file");
+  } catch (const std::runtime_error& e) {
+    throw ConfigError("", e.what());
+  }
+  try {
+    root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     throw ConfigError("",
                       "YAML syntax error in '" + path + "' at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);

@@ -14,7 +14,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 
 #include "../cli_checks.h"
 #include "hrg_gyro/GroundTruth.h"
@@ -141,23 +140,47 @@ void OutputText::commit() {
   }
 }
 
+namespace {
+
+/// `text` with every `from` replaced by `to` (rosbag's messages name the file it opened).
+std::string replaceAll(std::string text, const std::string& from, const std::string& to) {
+  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
+    text.replace(at, from.size(), to);
+  }
+  return text;
+}
+
+}  // namespace
+
 std::unique_ptr<rosbag::Bag> openBag(const std::string& path) {
-  std::ifstream probe(path, std::ios::binary);
-  if (!probe) throw UsageError("cannot read bag '" + path + "' (missing or unreadable)");
-  auto bag = std::make_unique<rosbag::Bag>();
+  int fd = -1;
   try {
-    bag->open(path, rosbag::bagmode::Read);
+    fd = core::openRegularFileForReading(path, "bag");  // a FIFO would block rosbag's open forever
+  } catch (const std::runtime_error& e) {
+    throw UsageError(e.what());
+  }
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  // rosbag opens by name. /proc/self/fd/N names the very file just checked, so a path swapped for a
+  // FIFO since cannot make it block; without /proc the checked path is the next best thing.
+  const std::string checked = "/proc/self/fd/" + std::to_string(fd);
+  const std::string name = ::access(checked.c_str(), R_OK) == 0 ? checked : path;
+  auto bag = std::make_unique<rosbag::Bag>();
+  auto why = [&](const rosbag::BagException& e) { return replaceAll(e.what(), name, path); };
+  try {
+    bag->open(name, rosbag::bagmode::Read);
   } catch (const rosbag::BagUnindexedException&) {
     throw UsageError("bag '" + path + "' is unindexed (recording interrupted?): run `rosbag reindex` on a copy");
   } catch (const rosbag::BagFormatException& e) {
-    throw UsageError("bag '" + path + "' is truncated or corrupt: " + e.what());
+    throw UsageError("bag '" + path + "' is truncated or corrupt: " + why(e));
   } catch (const rosbag::BagIOException& e) {
     // The header points at an index past the end of the file: cut short after it was closed.
     throw UsageError("bag '" + path +
-                     "' is truncated or unindexed (copy cut short?): run `rosbag reindex` on a copy (" + e.what() +
-                     ")");
+                     "' is truncated or unindexed (copy cut short?): run `rosbag reindex` on a copy (" + why(e) + ")");
   } catch (const rosbag::BagException& e) {
-    throw UsageError("cannot open bag '" + path + "': " + e.what());
+    throw UsageError("cannot open bag '" + path + "': " + why(e));
   }
   return bag;
 }

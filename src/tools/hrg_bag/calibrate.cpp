@@ -10,6 +10,7 @@
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/core/calibration/calibration_session.h"
 #include "hrg_gyro/core/calibration/generator_pairing.h"
+#include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
 
@@ -35,8 +36,9 @@ int runCalibrate(const CalibrateOptions& o) {
   if (!o.config.empty()) {
     YAML::Node root;
     try {
-      root = YAML::LoadFile(o.config);
-    } catch (const YAML::Exception& e) {
+      // Bounded like a parameter file, and never a FIFO or a device (which would block or never end).
+      root = YAML::Load(core::readBoundedRegularFile(o.config, core::kMaxParameterFileBytes, "settings file"));
+    } catch (const std::runtime_error& e) {  // also YAML::Exception
       throw UsageError("cannot read --config " + o.config + ": " + e.what());
     }
     try {

@@ -1,8 +1,12 @@
 #include "csv_reader.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <charconv>
+#include <cstring>
 #include <limits>
 
 namespace hrg_gyro {
@@ -148,6 +152,22 @@ core::Nanoseconds parseIso8601(std::string_view s, std::string_view field) {
 
 }  // namespace
 
+DescriptorInputBuffer::DescriptorInputBuffer(int fd) : fd_(fd), buffer_(new char[kBufferBytes]) {}
+
+DescriptorInputBuffer::~DescriptorInputBuffer() { ::close(fd_); }
+
+DescriptorInputBuffer::int_type DescriptorInputBuffer::underflow() {
+  for (;;) {
+    const ssize_t n = ::read(fd_, buffer_.get(), kBufferBytes);
+    if (n > 0) {
+      setg(buffer_.get(), buffer_.get(), buffer_.get() + n);
+      return traits_type::to_int_type(buffer_[0]);
+    }
+    if (n == 0) return traits_type::eof();
+    if (errno != EINTR) throw std::runtime_error(std::string("read error: ") + std::strerror(errno));
+  }
+}
+
 StampFormat parseStampFormat(const std::string& name) {
   if (name == "auto") return StampFormat::kAuto;
   if (name == "s") return StampFormat::kSeconds;
@@ -225,6 +245,8 @@ bool CsvReader::readLine() {
     if (t.empty() || t.front() == '#') continue;
     return true;
   }
+  // A failed read ends getline like the end of the file: never take a cut-off log for a whole one.
+  if (in_.bad()) throw ReadError(name_ + ": read error after line " + std::to_string(line_) + " (an I/O error)");
   return false;
 }
 

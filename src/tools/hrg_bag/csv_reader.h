@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <istream>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -25,6 +26,29 @@ StampFormat parseStampFormat(const std::string& name);
 /// A field that is not what its column holds; the message says why (the caller adds file:line).
 struct FieldError : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
+};
+
+/// The log could not be read to its end (an I/O error); the message names the file.
+struct ReadError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// An input stream buffer over a file descriptor, which it owns (closes): for a log opened with
+/// core::openRegularFileForReading, which an std::ifstream cannot take.
+class DescriptorInputBuffer : public std::streambuf {
+ public:
+  explicit DescriptorInputBuffer(int fd);
+  ~DescriptorInputBuffer() override;
+  DescriptorInputBuffer(const DescriptorInputBuffer&) = delete;
+  DescriptorInputBuffer& operator=(const DescriptorInputBuffer&) = delete;
+
+ protected:
+  int_type underflow() override;
+
+ private:
+  static constexpr std::size_t kBufferBytes = 64 << 10;
+  int fd_;
+  std::unique_ptr<char[]> buffer_;
 };
 
 /// A decimal number, the whole field ("nan" allowed here; the caller decides where NaN may stand).
@@ -51,7 +75,7 @@ class CsvReader {
 
   const std::vector<std::string>& header() const { return header_; }
   char delimiter() const { return delimiter_; }
-  /// Reads the next record; false at the end of the file.
+  /// Reads the next record; false at the end of the file, ReadError when reading failed before it.
   bool next();
   /// The fields of the current record, blanks and surrounding double quotes removed.
   const std::vector<std::string_view>& fields() const { return fields_; }

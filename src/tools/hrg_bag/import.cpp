@@ -1,18 +1,17 @@
 // hrg_bag import: a test bench's delimited text logs (channel amplitudes, turntable) into a gyro
 // bag that `hrg_bag calibrate/process` read like a recorded one. Both logs are streamed record by
 // record and merged by stamp as they are read, so memory stays flat for a log of any size.
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iostream>
+#include <memory>
 #include <optional>
 
 #include "../cli_checks.h"
 #include "bag_tools.h"
 #include "gyro_logs.h"
 #include "hrg_gyro/TurntableState.h"
+#include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/ros/conversions.h"
 
 namespace hrg_gyro {
@@ -71,15 +70,26 @@ void logSettings(const ImportOptions& o, csv::LogSettings* channels, csv::LogSet
   }
 }
 
-/// An input log, open for streaming; unreadable is a UsageError naming the option.
-std::unique_ptr<std::ifstream> openLog(const std::string& path, const char* option, double* bytes) {
-  auto in = std::make_unique<std::ifstream>(path, std::ios::binary);
-  struct stat st {};
-  if (!*in || ::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
-    throw bag_tools::UsageError(std::string("cannot read ") + option + " '" + path + "' (missing or not a file)");
+/// An input log, open for streaming. Only a regular file is read: a FIFO, a device, a socket or a
+/// directory is refused before it is opened for reading (a FIFO would wait for a writer forever);
+/// that and a missing or unreadable file are UsageErrors naming the option.
+struct InputLog {
+  std::unique_ptr<csv::DescriptorInputBuffer> buffer;
+  std::unique_ptr<std::istream> stream;
+};
+InputLog openLog(const std::string& path, const char* option, double* bytes) {
+  std::uint64_t size = 0;
+  int fd = -1;
+  try {
+    fd = core::openRegularFileForReading(path, "log", &size);
+  } catch (const std::runtime_error& e) {
+    throw bag_tools::UsageError(std::string(option) + ": " + e.what());
   }
-  *bytes += static_cast<double>(st.st_size);
-  return in;
+  InputLog log;
+  log.buffer = std::make_unique<csv::DescriptorInputBuffer>(fd);
+  log.stream = std::make_unique<std::istream>(log.buffer.get());
+  *bytes += static_cast<double>(size);
+  return log;
 }
 
 int runImport(const ImportOptions& o) {
@@ -88,14 +98,16 @@ int runImport(const ImportOptions& o) {
   csv::LogSettings channel_settings, turntable_settings;
   logSettings(o, &channel_settings, &turntable_settings);
   double total_bytes = 0;
-  const auto channel_file = openLog(o.channels, "--channels", &total_bytes);
-  const auto turntable_file = o.turntable.empty() ? nullptr : openLog(o.turntable, "--turntable", &total_bytes);
+  const InputLog channel_file = openLog(o.channels, "--channels", &total_bytes);
+  const InputLog turntable_file = o.turntable.empty() ? InputLog() : openLog(o.turntable, "--turntable", &total_bytes);
   csv::BadRowCounts channel_skips, turntable_skips;
   std::optional<csv::ChannelLogReader> channels;
   std::optional<csv::TurntableLogReader> turntable;
   try {
-    channels.emplace(*channel_file, o.channels, channel_settings, &channel_skips);
-    if (turntable_file) turntable.emplace(*turntable_file, o.turntable, turntable_settings, &turntable_skips);
+    channels.emplace(*channel_file.stream, o.channels, channel_settings, &channel_skips);
+    if (turntable_file.stream) {
+      turntable.emplace(*turntable_file.stream, o.turntable, turntable_settings, &turntable_skips);
+    }
   } catch (const std::runtime_error& e) {
     throw UsageError(e.what());  // no header, no delimiter, a missing column: the mapping is wrong
   }
@@ -152,6 +164,9 @@ int runImport(const ImportOptions& o) {
     std::cerr << "hrg_bag import: " << e.what() << "\nhrg_bag import: " << o.out
               << " not written (--skip-bad-rows skips and counts such records)\n";
     return 1;  // `bag` is destroyed uncommitted: nothing is left at --out
+  } catch (const csv::ReadError& e) {
+    std::cerr << "hrg_bag import: " << e.what() << "\nhrg_bag import: " << o.out << " not written\n";
+    return 2;  // an unreadable log, as documented
   } catch (const std::runtime_error& e) {
     std::cerr << "hrg_bag import: " << e.what() << "\nhrg_bag import: " << o.out << " not written\n";
     return 1;

@@ -9,12 +9,14 @@
 // Temporaries that a killed writer left behind are removed by the next write of the same file.
 //
 // readBoundedRegularFile is the matching reader for configuration: regular files only (no FIFO,
-// device or directory), never more than a stated number of bytes.
+// device or directory), never more than a stated number of bytes. openRegularFileForReading is its
+// first half, for inputs read as a stream (logs, bags): a regular file, opened without blocking.
 #pragma once
 
 #include <sys/types.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <ostream>
@@ -104,6 +106,14 @@ std::string resolveOutputTarget(const std::string& path);
 /// same link-resolved absolute path for an output that does not exist yet. Tools call it before
 /// they open anything, so that `--out` can never overwrite the file being read.
 void checkDistinct(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
+
+/// A regular file opened for reading (O_RDONLY, close-on-exec) without ever blocking on what the
+/// path names: a directory, a FIFO, a device or a socket is refused from a stat before the open, and
+/// again from an fstat of the descriptor, which is opened O_NONBLOCK (cleared once it is known to be a
+/// regular file) should the path have been swapped for a FIFO in between. `what` names the file in
+/// messages ("bag"). Returns the descriptor, which the caller closes; `size` (when given) receives
+/// the file's size. Throws std::runtime_error.
+int openRegularFileForReading(const std::string& path, const std::string& what, std::uint64_t* size = nullptr);
 
 /// The content of a regular file of at most `max_bytes`. Refuses without blocking a directory, a
 /// FIFO, a device or a socket, and a file above the limit (also one that grows past it while being

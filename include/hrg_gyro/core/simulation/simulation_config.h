@@ -4,6 +4,7 @@
 // shipped simulated gyro (docs/simulation.md).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -69,8 +70,14 @@ struct SimulationConfig {
   /// Parses a scenario. `extra_keys` are accepted (and ignored) at the top level: the ROS-only
   /// parameters of the driver_sim node. Throws ConfigError naming the key.
   static SimulationConfig parse(const YamlField& root, const std::vector<std::string>& extra_keys = {});
+  /// Reads and parses a scenario file: only a regular file of at most kMaxScenarioFileBytes (a
+  /// FIFO, a device or a directory is refused at once, never opened in a way that could block).
   static SimulationConfig load(const std::string& path, const std::vector<std::string>& extra_keys = {});
 };
+
+/// Largest scenario file read. The scenarios of config/scenarios are below 6 KiB; a turntable
+/// profile of ten thousand pieces is below 1 MiB.
+constexpr std::size_t kMaxScenarioFileBytes = std::size_t{4} << 20;
 
 /// The scenario with its gyro frozen at one temperature: amplitude, pickoff defects and intrinsic K
 /// and D taken at `temperature`, thermal section disabled (the sampling frequency stays f0). The
