@@ -170,6 +170,28 @@ class HrgBagImport(unittest.TestCase):
             self.assertNotIn("terminate called", err)
             self.assertFalse(os.path.exists(out), args)
 
+    def test_a_line_longer_than_the_limit_is_a_bad_record(self):
+        # The reader never holds more than 1 MiB of a line: a longer record is a bad record, a file
+        # without line ends (no header row within the limit) is no log.
+        long_field = "4" * (2 << 20)
+        ch = self.write("long_line.csv", CHANNELS_HEADER + "1.0,1,0,0,0\n2.0,1,0,0," + long_field + "\n3.0,1,0,0,0\n")
+        out = self.path("long_line.bag")
+        code, _, err = hrg_bag("import", "--channels", ch, "--out", out)
+        self.assertEqual(code, 1, err)
+        self.assertIn(ch + ":3: line too long: more than 1048576 bytes (1 MiB), the limit of a line", err)
+        self.assertLess(len(err), 4096, "the line is not echoed")
+        self.assertFalse(os.path.exists(out))
+        code, _, err = hrg_bag("import", "--channels", ch, "--out", out, "--skip-bad-rows", "--quiet")
+        self.assertEqual(code, 0, err)
+        self.assertIn("skipped records in %s: 1 (line too long 1)" % ch, err)
+        with rosbag.Bag(out) as b:
+            self.assertEqual([m.header.stamp.to_sec() for _, m, _ in b.read_messages()], [1.0, 3.0])
+        binary = self.write("no_line_ends.dat", "x" * (3 << 20))
+        code, _, err = hrg_bag("import", "--channels", binary, "--out", self.path("binary.bag"))
+        self.assertEqual(code, 2, err)
+        self.assertIn(binary + ":1: line too long", err)
+        self.assertLess(len(err), 4096)
+
     def test_fifos_devices_and_directories_are_refused_without_blocking(self):
         # A FIFO without a writer would block an ordinary open forever; the log is checked before it
         # is opened, so the import ends at once (the short timeout turns a regression into a failure).

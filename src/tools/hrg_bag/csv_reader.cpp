@@ -208,9 +208,20 @@ core::Nanoseconds parseStamp(std::string_view field, StampFormat format) {
   }
 }
 
+LineTooLongError::LineTooLongError()
+    : std::runtime_error("more than " + std::to_string(kMaxLineBytes) + " bytes (" +
+                         std::to_string(kMaxLineBytes >> 20) + " MiB), the limit of a line") {}
+
 CsvReader::CsvReader(std::istream& in, std::string name, char delimiter, bool has_header)
-    : in_(in), name_(std::move(name)), delimiter_(delimiter) {
-  if (!readLine()) {
+    : in_(in), name_(std::move(name)), delimiter_(delimiter), line_buffer_(new char[kMaxLineBytes + 2]) {
+  bool found = false;
+  try {
+    found = readLine();
+  } catch (const LineTooLongError& e) {
+    throw std::runtime_error(name_ + ":" + std::to_string(line_) + ": line too long: " + e.what() +
+                             (has_header ? " (is this a log? no header row within the limit)" : ""));
+  }
+  if (!found) {
     throw std::runtime_error(name_ + (has_header ? ": no header row" : ": no record") +
                              " (the file is empty or only comments)");
   }
@@ -237,10 +248,32 @@ CsvReader::CsvReader(std::istream& in, std::string name, char delimiter, bool ha
 }
 
 bool CsvReader::readLine() {
-  while (std::getline(in_, text_)) {
+  for (;;) {
+    if (discard_rest_) {
+      discard_rest_ = false;
+      in_.ignore(std::numeric_limits<std::streamsize>::max(), '\n');  // read past, nothing stored
+      bytes_ += static_cast<std::uint64_t>(in_.gcount());
+    }
+    // getline stores at most kMaxLineBytes + 1 bytes; it stops with failbit alone when the buffer is
+    // full before the line ends, with eofbit when the file ends without a line end.
+    in_.getline(line_buffer_.get(), static_cast<std::streamsize>(kMaxLineBytes + 2), '\n');
+    const auto extracted = static_cast<std::size_t>(in_.gcount());
+    if (in_.bad() || (extracted == 0 && !in_.good())) break;  // a read error, or the end of the file
+    const bool cut_short = in_.fail() && !in_.eof();
+    const bool ended = !in_.fail() && !in_.eof();  // the line end was extracted with the line
+    std::size_t length = ended ? extracted - 1 : extracted;
     ++line_;
-    bytes_ += text_.size() + 1;
-    if (line_ == 1 && text_.compare(0, 3, "\xEF\xBB\xBF") == 0) text_.erase(0, 3);  // UTF-8 byte-order mark
+    bytes_ += extracted;
+    if (cut_short) {
+      in_.clear();
+      discard_rest_ = true;
+      throw LineTooLongError();
+    }
+    if (length > kMaxLineBytes && !(length == kMaxLineBytes + 1 && line_buffer_[kMaxLineBytes] == '\r')) {
+      throw LineTooLongError();
+    }
+    text_ = std::string_view(line_buffer_.get(), length);
+    if (line_ == 1 && text_.substr(0, 3) == "\xEF\xBB\xBF") text_.remove_prefix(3);  // UTF-8 byte-order mark
     const std::string_view t = trim(text_);
     if (t.empty() || t.front() == '#') continue;
     return true;

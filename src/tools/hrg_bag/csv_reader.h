@@ -1,7 +1,8 @@
 // A streaming reader of the delimited text logs a test bench writes (one record a line, a header
 // row naming the columns), and the strict field parsers behind `hrg_bag import`. It holds one line
-// at a time, so a log of any size is read in constant memory. Numbers are read whole ("1.5abc" and
-// "1,5" are errors, never 1.5 or 1), stamps exactly as integer nanoseconds. No ROS.
+// at a time in a buffer of fixed size (kMaxLineBytes), so a log of any size, even one without a
+// single line end, is read in constant memory. Numbers are read whole ("1.5abc" and "1,5" are
+// errors, never 1.5 or 1), stamps exactly as integer nanoseconds. No ROS.
 #pragma once
 
 #include <cstdint>
@@ -23,9 +24,18 @@ enum class StampFormat { kAuto, kSeconds, kNanoseconds, kIso8601 };
 /// "auto", "s", "ns", "iso"; std::invalid_argument otherwise.
 StampFormat parseStampFormat(const std::string& name);
 
+/// The longest line a log may hold, in bytes without its line end ("\n" or "\r\n"). A record of
+/// eight numbers takes about 150; the limit only stops a file that is no log (a binary file, one
+/// without line ends) from being held whole.
+constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
+
 /// A field that is not what its column holds; the message says why (the caller adds file:line).
 struct FieldError : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
+};
+/// A line longer than kMaxLineBytes; the message says so (the caller adds file:line).
+struct LineTooLongError : std::runtime_error {
+  LineTooLongError();
 };
 
 /// The log could not be read to its end (an I/O error); the message names the file.
@@ -66,16 +76,19 @@ core::Nanoseconds parseStamp(std::string_view field, StampFormat format);
 /// first) is the header; every following such line is a record. A file without a header row
 /// (`has_header` false) has columns named only by index ("#N"), as many as its first record's.
 /// A UTF-8 byte-order mark (as spreadsheet programs write) before the first line is ignored.
+/// No line may be longer than kMaxLineBytes: the reader never holds more of a line than that.
 class CsvReader {
  public:
   /// `delimiter` 0: taken from the header line (the one of ',' ';' '\t' it holds; a header holding
   /// none or several of them is refused: give it). std::runtime_error (naming `name`) on an empty
-  /// file or an undecidable delimiter.
+  /// file, an undecidable delimiter or a first line longer than kMaxLineBytes.
   CsvReader(std::istream& in, std::string name, char delimiter = 0, bool has_header = true);
 
   const std::vector<std::string>& header() const { return header_; }
   char delimiter() const { return delimiter_; }
   /// Reads the next record; false at the end of the file, ReadError when reading failed before it.
+  /// A line longer than kMaxLineBytes throws LineTooLongError, line() being its number; the next
+  /// call goes on after it (the rest of the line is read past, never stored).
   bool next();
   /// The fields of the current record, blanks and surrounding double quotes removed.
   const std::vector<std::string_view>& fields() const { return fields_; }
@@ -97,7 +110,12 @@ class CsvReader {
   std::istream& in_;
   std::string name_;
   char delimiter_;
-  std::string text_;
+  /// The current line, in a buffer of kMaxLineBytes + 2 bytes (one more to tell a line of the limit
+  /// ended by "\r\n" from a longer one, and getline's terminating zero) allocated once: the pages no
+  /// line reaches are never touched.
+  std::unique_ptr<char[]> line_buffer_;
+  std::string_view text_;
+  bool discard_rest_ = false;  ///< the last line was too long: its rest is still to be read past
   std::vector<std::string_view> fields_;
   std::vector<std::string> header_;
   std::uint64_t line_ = 0;

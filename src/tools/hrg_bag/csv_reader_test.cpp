@@ -137,6 +137,45 @@ TEST(CsvReaderTest, WithoutHeaderTheFirstLineIsARecordAndColumnsGoByIndex) {
   EXPECT_FALSE(reader.next());
 }
 
+TEST(CsvReaderTest, ALineLongerThanTheLimitIsRefusedAndReadPast) {
+  const std::string at_limit(kMaxLineBytes - 2, '1');  // "1.<digits>": a field of exactly the limit
+  const std::string over(kMaxLineBytes + 1, '2'), far_over(kMaxLineBytes + 1000, '2');
+  std::istringstream in("stamp\n1." + at_limit + "\n" + "1." + at_limit + "\r\n" + far_over + "\n3\n" + over);
+  CsvReader reader(in, "long.csv", ',');
+  ASSERT_TRUE(reader.next());
+  EXPECT_EQ(reader.fields()[0].size(), kMaxLineBytes);
+  ASSERT_TRUE(reader.next());  // the limit does not count the "\r" of a "\r\n" line end
+  EXPECT_EQ(reader.line(), 3u);
+  EXPECT_EQ(reader.fields()[0].size(), kMaxLineBytes);
+  try {
+    reader.next();
+    FAIL() << "a line of the limit and one byte more was read";
+  } catch (const LineTooLongError& e) {
+    EXPECT_EQ(reader.line(), 4u);
+    EXPECT_EQ(std::string(e.what()), "more than 1048576 bytes (1 MiB), the limit of a line");
+  }
+  ASSERT_TRUE(reader.next());  // the rest of the long line was read past
+  EXPECT_EQ(reader.line(), 5u);
+  EXPECT_EQ(reader.fields()[0], "3");
+  EXPECT_THROW(reader.next(), LineTooLongError);  // the last line, without a line end
+  EXPECT_EQ(reader.line(), 6u);
+  EXPECT_FALSE(reader.next());
+  EXPECT_EQ(reader.bytesRead(), in.str().size());
+}
+
+TEST(CsvReaderTest, AFileWithoutLineEndsIsRefusedAtItsHeader) {
+  std::istringstream in(std::string(3 * kMaxLineBytes, 'x'));
+  try {
+    CsvReader reader(in, "binary.dat");
+    FAIL() << "a header longer than the limit was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("binary.dat:1: line too long: more than 1048576 bytes"), std::string::npos)
+        << e.what();
+  }
+  // Never more of it read than the limit and the one byte that tells it is longer.
+  EXPECT_EQ(in.tellg(), static_cast<std::streamoff>(kMaxLineBytes + 1));
+}
+
 }  // namespace
 }  // namespace csv
 }  // namespace hrg_gyro

@@ -18,6 +18,8 @@ struct Refusal {
 
 const char* describe(BadRowReason reason) {
   switch (reason) {
+    case BadRowReason::kLineTooLong:
+      return "line too long";
     case BadRowReason::kFieldCount:
       return "wrong field count";
     case BadRowReason::kStamp:
@@ -101,8 +103,13 @@ std::uint32_t RecordSource::count(int column, const char* key) const {
 }
 
 bool RecordSource::nextRecord(const std::function<void(core::Nanoseconds)>& parse) {
-  while (csv_.next()) {
+  for (;;) {
     try {
+      try {
+        if (!csv_.next()) return false;
+      } catch (const LineTooLongError& e) {
+        bad(BadRowReason::kLineTooLong, e.what());  // the reader goes on after it, should it be skipped
+      }
       if (csv_.fields().size() != csv_.header().size()) {
         bad(BadRowReason::kFieldCount,
             std::to_string(csv_.fields().size()) + " fields, the header has " + std::to_string(csv_.header().size()));
@@ -129,7 +136,6 @@ bool RecordSource::nextRecord(const std::function<void(core::Nanoseconds)>& pars
       ++skipped_->by_reason[static_cast<std::size_t>(r.reason)];
     }
   }
-  return false;
 }
 
 ChannelLogReader::ChannelLogReader(std::istream& in, const std::string& name, const LogSettings& settings,

@@ -1,9 +1,10 @@
 // The two logs a test bench keeps beside the gyro, read record by record from delimited text: the
 // channel amplitudes (stamp, Ac, Bc, As, Bs and optionally frequency, temperature, periods) and the
-// turntable (stamp and angle and/or rate). Each reader checks every record (field count, numbers,
-// NaN where none may stand, stamps strictly increasing) and either refuses the first bad one with
-// file:line and the reason, or skips it and counts it by reason. Where the turntable log holds only
-// the angle, the rate is derived from it by the central difference of the neighbouring records.
+// turntable (stamp and angle and/or rate). Each reader checks every record (line length, field
+// count, numbers, NaN where none may stand, stamps strictly increasing) and either refuses the first
+// bad one with file:line and the reason, or skips it and counts it by reason. Where the turntable
+// log holds only the angle, the rate is derived from it by the central difference of the
+// neighbouring records.
 // No ROS: `hrg_bag import` turns the records into messages.
 #pragma once
 
@@ -20,8 +21,8 @@
 namespace hrg_gyro {
 namespace csv {
 
-enum class BadRowReason { kFieldCount, kStamp, kStampOrder, kNumber, kNotANumber };
-constexpr std::size_t kBadRowReasons = 5;
+enum class BadRowReason { kLineTooLong, kFieldCount, kStamp, kStampOrder, kNumber, kNotANumber };
+constexpr std::size_t kBadRowReasons = 6;
 const char* describe(BadRowReason reason);
 
 /// Records skipped by reason (with --skip-bad-rows).

@@ -121,6 +121,23 @@ TEST(GyroLogsTest, EveryBadRowReasonWithItsLineNumber) {
   EXPECT_NE(refusal(periods + "1,1,2,3,4,2.5\n").find("periods"), std::string::npos);
 }
 
+TEST(GyroLogsTest, ALineTooLongIsABadRecord) {
+  const std::string ok = std::string(kHeader) + "1.0,1,2,3,4\n";
+  const std::string long_line = "2.0,1,2,3," + std::string(kMaxLineBytes, '4') + "\n";
+  EXPECT_NE(refusal(ok + long_line)
+                .find("ch.csv:3: line too long: more than 1048576 bytes (1 MiB), the limit of a "
+                      "line"),
+            std::string::npos);
+  LogSettings settings;
+  settings.skip_bad_rows = true;
+  BadRowCounts skipped;
+  const auto records = readChannels(ok + long_line + "3.0,5,6,7,8\n", settings, &skipped);
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_EQ(records[1].stamp, 3000000000LL);
+  EXPECT_EQ(records[1].bs, 8.0);
+  EXPECT_EQ(skipped.summary(), "1 (line too long 1)");
+}
+
 TEST(GyroLogsTest, SkippedRowsAreCountedByReason) {
   LogSettings settings;
   settings.skip_bad_rows = true;
