@@ -170,6 +170,27 @@ class HrgBagImport(unittest.TestCase):
             self.assertNotIn("terminate called", err)
             self.assertFalse(os.path.exists(out), args)
 
+    def test_a_stamp_a_bag_cannot_hold_is_a_bad_record(self):
+        # ros::Time holds [1 ns, 2^32 s - 1 ns]: a stamp outside is the log's fault (exit 1 with
+        # FILE:LINE), never a failure to write the bag (exit 3).
+        tt = self.write("range_turntable.csv", "stamp,rate\n1.0,0.1\n4294967296.0,0.1\n")
+        for stamp, line in (("0", 3), ("4294967296.0", 3), ("99999999999999999999", 3)):
+            ch = self.write("range_channels.csv", CHANNELS_HEADER + "1.0,1,0,0,0\n%s,1,0,0,0\n" % stamp)
+            code, _, err = hrg_bag("import", "--channels", ch, "--out", self.path("range.bag"))
+            self.assertEqual(code, 1, err)
+            self.assertIn("%s:%d: stamp out of range: stamp " % (ch, line), err)
+        code, _, err = hrg_bag("import", "--channels", ch, "--turntable", tt, "--out", self.path("range.bag"),
+                               "--skip-bad-rows", "--quiet")
+        self.assertEqual(code, 0, err)
+        self.assertIn("skipped records in %s: 1 (stamp out of range 1)" % ch, err)
+        self.assertIn("skipped records in %s: 1 (stamp out of range 1)" % tt, err)
+        ch = self.write("range_ends.csv", CHANNELS_HEADER + "0.000000001,1,0,0,0\n4294967295.999999999,1,0,0,0\n")
+        code, _, err = hrg_bag("import", "--channels", ch, "--out", self.path("range.bag"), "--quiet")
+        self.assertEqual(code, 0, err)
+        with rosbag.Bag(self.path("range.bag")) as b:
+            self.assertEqual([m.header.stamp.to_nsec() for _, m, _ in b.read_messages()],
+                             [1, 4294967295999999999])
+
     def test_a_line_longer_than_the_limit_is_a_bad_record(self):
         # The reader never holds more than 1 MiB of a line: a longer record is a bad record, a file
         # without line ends (no header row within the limit) is no log.

@@ -31,7 +31,7 @@ bool allDigits(std::string_view s) {
 std::int64_t digitsValue(std::string_view digits, std::string_view field) {
   std::int64_t value = 0;
   const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-  if (r.ec == std::errc::result_out_of_range) throw FieldError("stamp " + quoted(field) + " is out of range");
+  if (r.ec == std::errc::result_out_of_range) throw OutOfRangeError("stamp " + quoted(field) + " is out of range");
   if (r.ec != std::errc() || r.ptr != digits.data() + digits.size()) {
     throw FieldError("stamp " + quoted(field) + " is not a whole number");
   }
@@ -40,13 +40,13 @@ std::int64_t digitsValue(std::string_view digits, std::string_view field) {
 
 std::int64_t checkedAdd(std::int64_t a, std::int64_t b, std::string_view field) {
   std::int64_t sum = 0;
-  if (__builtin_add_overflow(a, b, &sum)) throw FieldError("stamp " + quoted(field) + " is out of range");
+  if (__builtin_add_overflow(a, b, &sum)) throw OutOfRangeError("stamp " + quoted(field) + " is out of range");
   return sum;
 }
 
 std::int64_t checkedScale(std::int64_t a, std::int64_t b, std::string_view field) {
   std::int64_t product = 0;
-  if (__builtin_mul_overflow(a, b, &product)) throw FieldError("stamp " + quoted(field) + " is out of range");
+  if (__builtin_mul_overflow(a, b, &product)) throw OutOfRangeError("stamp " + quoted(field) + " is out of range");
   return product;
 }
 
@@ -146,7 +146,7 @@ core::Nanoseconds parseIso8601(std::string_view s, std::string_view field) {
   if (at != s.size()) throw bad("trailing " + quoted(s.substr(at)));
   const std::int64_t seconds =
       daysFromCivil(year, month, day) * 86400 + hour * 3600 + minute * 60 + second - offset_seconds + (carry ? 1 : 0);
-  if (seconds < 0) throw bad("before 1970-01-01T00:00:00Z");
+  if (seconds < 0) throw OutOfRangeError("ISO 8601 stamp " + quoted(field) + ": before 1970-01-01T00:00:00Z");
   return checkedAdd(checkedScale(seconds, kNanosecondsPerSecond, field), ns, field);
 }
 
@@ -190,7 +190,7 @@ double parseNumber(std::string_view field) {
 core::Nanoseconds parseStamp(std::string_view field, StampFormat format) {
   const std::string_view s = trim(field);
   if (s.empty()) throw FieldError("empty stamp");
-  if (s.front() == '-') throw FieldError("stamp " + quoted(field) + " is negative");
+  if (s.front() == '-') throw OutOfRangeError("stamp " + quoted(field) + " is negative");
   if (format == StampFormat::kAuto) {
     format = s.find_first_of("Tt") != std::string_view::npos ? StampFormat::kIso8601
              : s.find('.') != std::string_view::npos         ? StampFormat::kSeconds

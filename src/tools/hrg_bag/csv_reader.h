@@ -33,6 +33,11 @@ constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
 struct FieldError : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
+/// A stamp that reads as a number but lies outside what a stamp can be: negative, before 1970, or
+/// beyond the signed 64-bit nanosecond range.
+struct OutOfRangeError : FieldError {
+  using FieldError::FieldError;
+};
 /// A line longer than kMaxLineBytes; the message says so (the caller adds file:line).
 struct LineTooLongError : std::runtime_error {
   LineTooLongError();
@@ -69,7 +74,8 @@ double parseNumber(std::string_view field);
 ///   nanoseconds  "1700000000123456789"
 ///   ISO 8601     "2026-11-23T10:00:00.123456789Z" or with an offset "+01:00", "-0530"; a
 ///                date-time without a zone is refused (local time would be a guess).
-/// Negative stamps and values beyond the signed 64-bit nanosecond range throw FieldError.
+/// Negative stamps, stamps before 1970 and values beyond the signed 64-bit nanosecond range throw
+/// OutOfRangeError, anything else that is not a stamp FieldError.
 core::Nanoseconds parseStamp(std::string_view field, StampFormat format);
 
 /// The reader of one delimited file. The first line that is neither empty nor a comment ('#'

@@ -48,6 +48,20 @@ TEST(CsvReaderTest, BadStampsAreRefusedWithTheReason) {
   EXPECT_NE(why("99999999999999999999", StampFormat::kNanoseconds).find("out of range"), std::string::npos);
   EXPECT_NE(why("9999999999999.0", StampFormat::kSeconds).find("out of range"), std::string::npos);
   EXPECT_NE(why("", StampFormat::kAuto).find("empty"), std::string::npos);
+  // Readable numbers outside what a stamp can be are told apart from unreadable ones.
+  for (const char* out_of_range :
+       {"-1.5", "99999999999999999999", "9999999999999.0", "1969-12-31T23:59:59Z", "9999-12-31T23:59:59Z"}) {
+    EXPECT_THROW(parseStamp(out_of_range, StampFormat::kAuto), OutOfRangeError) << out_of_range;
+  }
+  for (const char* unreadable : {"abc", "1.5e3", "2026-11-23T10:00:00"}) {
+    try {
+      parseStamp(unreadable, StampFormat::kAuto);
+      ADD_FAILURE() << unreadable << " was read";
+    } catch (const OutOfRangeError&) {
+      ADD_FAILURE() << unreadable << " is unreadable, not out of range";
+    } catch (const FieldError&) {
+    }
+  }
 }
 
 TEST(CsvReaderTest, NumbersAreReadWholeOrRefused) {

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace hrg_gyro {
@@ -14,6 +15,15 @@ struct Refusal {
   std::string detail;
 };
 
+/// Nanoseconds as exact decimal seconds: 4294967296000000000 -> "4294967296.000000000".
+std::string secondsText(core::Nanoseconds ns) {
+  const char* sign = ns < 0 ? "-" : "";
+  const auto magnitude = ns < 0 ? -static_cast<std::uint64_t>(ns) : static_cast<std::uint64_t>(ns);
+  char fraction[16];
+  std::snprintf(fraction, sizeof fraction, ".%09llu", static_cast<unsigned long long>(magnitude % 1000000000ULL));
+  return sign + std::to_string(magnitude / 1000000000ULL) + fraction;
+}
+
 }  // namespace
 
 const char* describe(BadRowReason reason) {
@@ -24,6 +34,8 @@ const char* describe(BadRowReason reason) {
       return "wrong field count";
     case BadRowReason::kStamp:
       return "unreadable stamp";
+    case BadRowReason::kStampRange:
+      return "stamp out of range";
     case BadRowReason::kStampOrder:
       return "stamp not increasing";
     case BadRowReason::kNumber:
@@ -117,8 +129,15 @@ bool RecordSource::nextRecord(const std::function<void(core::Nanoseconds)>& pars
       core::Nanoseconds stamp = 0;
       try {
         stamp = parseStamp(csv_.fields()[stamp_column_], settings_.stamp_format);
+      } catch (const OutOfRangeError& e) {
+        bad(BadRowReason::kStampRange, e.what());
       } catch (const FieldError& e) {
         bad(BadRowReason::kStamp, e.what());
+      }
+      if (stamp < settings_.earliest_stamp || stamp > settings_.latest_stamp) {
+        bad(BadRowReason::kStampRange,
+            "stamp " + secondsText(stamp) + " s is outside [" + secondsText(settings_.earliest_stamp) + " s, " +
+                secondsText(settings_.latest_stamp) + " s], the stamps " + settings_.stamp_range_holder + " can hold");
       }
       if (have_last_ && stamp <= last_) {
         bad(BadRowReason::kStampOrder, "stamp " + std::to_string(stamp) + " ns is not after the previous record's " +

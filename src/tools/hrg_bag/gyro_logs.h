@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -21,8 +22,8 @@
 namespace hrg_gyro {
 namespace csv {
 
-enum class BadRowReason { kLineTooLong, kFieldCount, kStamp, kStampOrder, kNumber, kNotANumber };
-constexpr std::size_t kBadRowReasons = 6;
+enum class BadRowReason { kLineTooLong, kFieldCount, kStamp, kStampRange, kStampOrder, kNumber, kNotANumber };
+constexpr std::size_t kBadRowReasons = 7;
 const char* describe(BadRowReason reason);
 
 /// Records skipped by reason (with --skip-bad-rows).
@@ -48,6 +49,11 @@ struct LogSettings {
   double angle_scale = 1.0;  ///< to rad
   double rate_scale = 1.0;   ///< to rad/s
   bool skip_bad_rows = false;
+  /// The stamps the output can hold (a bag: ros::TIME_MIN to ros::TIME_MAX); a stamp outside is a
+  /// bad record, `stamp_range_holder` saying whose range it is in the message.
+  core::Nanoseconds earliest_stamp = 0;
+  core::Nanoseconds latest_stamp = std::numeric_limits<core::Nanoseconds>::max();
+  std::string stamp_range_holder = "the output";
 };
 
 struct ChannelRecord {

@@ -138,6 +138,46 @@ TEST(GyroLogsTest, ALineTooLongIsABadRecord) {
   EXPECT_EQ(skipped.summary(), "1 (line too long 1)");
 }
 
+TEST(GyroLogsTest, AStampOutsideWhatTheOutputHoldsIsABadRecord) {
+  // The range import gives: what a bag's ros::Time holds, [TIME_MIN, TIME_MAX].
+  LogSettings bag;
+  bag.earliest_stamp = 1;
+  bag.latest_stamp = 4294967295999999999LL;
+  bag.stamp_range_holder = "a bag";
+  auto why = [&](const std::string& stamp) -> std::string {
+    try {
+      readChannels(std::string(kHeader) + stamp + ",1,2,3,4\n", bag);
+    } catch (const BadRowError& e) {
+      EXPECT_EQ(e.reason, BadRowReason::kStampRange) << e.what();
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(why("0"),
+            "ch.csv:2: stamp out of range: stamp 0.000000000 s is outside [0.000000001 s, 4294967295.999999999 s], "
+            "the stamps a bag can hold");
+  EXPECT_NE(why("4294967296.0").find("ch.csv:2: stamp out of range: stamp 4294967296.000000000 s is outside"),
+            std::string::npos);
+  EXPECT_NE(why("2106-02-07T06:28:16Z").find("stamp 4294967296.000000000 s is outside"), std::string::npos);
+  EXPECT_NE(why("99999999999999999999")
+                .find("ch.csv:2: stamp out of range: stamp '99999999999999999999' is out of "
+                      "range"),
+            std::string::npos);
+  EXPECT_NE(why("-1.5").find("is negative"), std::string::npos);
+  EXPECT_NE(why("1969-12-31T23:59:59Z").find("before 1970"), std::string::npos);
+  // The two ends themselves are stamps a bag holds.
+  EXPECT_EQ(why("0.000000001"), "");
+  EXPECT_EQ(why("4294967295.999999999"), "");
+  // Skipped and counted like any other bad record; a later good record is read.
+  bag.skip_bad_rows = true;
+  BadRowCounts skipped;
+  const auto records =
+      readChannels(std::string(kHeader) + "0,1,2,3,4\n5000000000000000000,1,2,3,4\n2.5,1,2,3,4\n", bag, &skipped);
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0].stamp, 2500000000LL);
+  EXPECT_EQ(skipped.summary(), "2 (stamp out of range 2)");
+}
+
 TEST(GyroLogsTest, SkippedRowsAreCountedByReason) {
   LogSettings settings;
   settings.skip_bad_rows = true;

@@ -40,6 +40,11 @@ void logSettings(const ImportOptions& o, csv::LogSettings* channels, csv::LogSet
   common.rate_scale = o.rate_unit == "deg/s" ? M_PI / 180.0 : 1.0;
   common.skip_bad_rows = o.skip_bad_rows;
   common.has_header = !o.no_header;
+  // A bag's time is a ros::Time (32-bit seconds), and rosbag writes nothing before TIME_MIN: a stamp
+  // outside is a bad record of the log, not a failure of the output.
+  common.earliest_stamp = static_cast<core::Nanoseconds>(ros::TIME_MIN.toNSec());
+  common.latest_stamp = static_cast<core::Nanoseconds>(ros::TIME_MAX.toNSec());
+  common.stamp_range_holder = "a bag";
   *channels = common;
   *turntable = common;
   auto is = [](const std::vector<std::string>& keys, const std::string& key) {
