@@ -191,6 +191,26 @@ class HrgBagImport(unittest.TestCase):
             self.assertEqual([m.header.stamp.to_nsec() for _, m, _ in b.read_messages()],
                              [1, 4294967295999999999])
 
+    def test_an_infinite_derived_rate_is_a_bad_record(self):
+        # Finite angles whose difference overflows: the rate of the record between them is refused
+        # with its own line (not the line read ahead), or skipped leaving the other rates as they were.
+        ch = self.write("overflow_channels.csv", CHANNELS_HEADER + "".join("%d.0,1,0,0,0\n" % i for i in range(1, 6)))
+        tt = self.write("overflow_turntable.csv", "stamp,angle\n1.0,0\n2.0,1e308\n3.0,2\n4.0,-1e308\n5.0,4\n")
+        out = self.path("overflow.bag")
+        code, _, err = hrg_bag("import", "--channels", ch, "--turntable", tt, "--out", out)
+        self.assertEqual(code, 1, err)
+        self.assertIn(tt + ":4: NaN or infinity not allowed: rate derived from the angle is -inf", err)
+        self.assertFalse(os.path.exists(out))
+        code, _, err = hrg_bag("import", "--channels", ch, "--turntable", tt, "--out", out, "--skip-bad-rows",
+                               "--quiet")
+        self.assertEqual(code, 0, err)
+        self.assertIn("skipped records in %s: 1 (NaN or infinity not allowed 1)" % tt, err)
+        with rosbag.Bag(out) as b:
+            table = [(m.header.stamp.to_sec(), m.rate) for _, m, _ in b.read_messages(topics=["/turntable/state"])]
+        self.assertEqual([t for t, _ in table], [1.0, 2.0, 4.0, 5.0])
+        self.assertEqual(table[2][1], 1.0)  # (4 - 2) / 2: the skipped record's good angle is still a neighbour
+        self.assertTrue(all(math.isfinite(rate) for _, rate in table), table)
+
     def test_a_line_longer_than_the_limit_is_a_bad_record(self):
         # The reader never holds more than 1 MiB of a line: a longer record is a bad record, a file
         # without line ends (no header row within the limit) is no log.

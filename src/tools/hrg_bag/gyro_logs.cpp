@@ -15,6 +15,12 @@ struct Refusal {
   std::string detail;
 };
 
+/// The shortest text that reads back to `value` ("inf", "1e+308").
+std::string shortest(double value) {
+  char text[32];
+  return std::string(text, std::to_chars(text, text + sizeof text, value).ptr);
+}
+
 /// Nanoseconds as exact decimal seconds: 4294967296000000000 -> "4294967296.000000000".
 std::string secondsText(core::Nanoseconds ns) {
   const char* sign = ns < 0 ? "-" : "";
@@ -148,13 +154,16 @@ bool RecordSource::nextRecord(const std::function<void(core::Nanoseconds)>& pars
       last_ = stamp;
       return true;
     } catch (const Refusal& r) {
-      if (!settings_.skip_bad_rows || skipped_ == nullptr) {
-        throw BadRowError(
-            r.reason, csv_.name() + ":" + std::to_string(csv_.line()) + ": " + describe(r.reason) + ": " + r.detail);
-      }
-      ++skipped_->by_reason[static_cast<std::size_t>(r.reason)];
+      refuseOrCount(r.reason, csv_.line(), r.detail);
     }
   }
+}
+
+void RecordSource::refuseOrCount(BadRowReason reason, std::uint64_t line, const std::string& detail) {
+  if (!settings_.skip_bad_rows || skipped_ == nullptr) {
+    throw BadRowError(reason, csv_.name() + ":" + std::to_string(line) + ": " + describe(reason) + ": " + detail);
+  }
+  ++skipped_->by_reason[static_cast<std::size_t>(reason)];
 }
 
 ChannelLogReader::ChannelLogReader(std::istream& in, const std::string& name, const LogSettings& settings,
@@ -205,6 +214,12 @@ bool TurntableLogReader::readRecord(TurntableRecord* r) {
   });
 }
 
+bool TurntableLogReader::readRecord(Reading* reading) {
+  if (!readRecord(&reading->record)) return false;
+  reading->line = source_.csv().line();
+  return true;
+}
+
 bool TurntableLogReader::next(TurntableRecord* record) {
   if (!derivesRate()) return readRecord(record);
   if (!primed_) {
@@ -217,18 +232,32 @@ bool TurntableLogReader::next(TurntableRecord* record) {
                                "angle without a neighbour (log the rate, or more records)");
     }
   }
-  if (!have_current_) return false;
-  // Central difference over the neighbours; one-sided at the two ends of the log.
-  const TurntableRecord& a = have_before_ ? before_ : current_;
-  const TurntableRecord& b = have_after_ ? after_ : current_;
-  *record = current_;
-  record->rate = (b.angle - a.angle) / (static_cast<double>(b.stamp - a.stamp) * 1e-9);
-  before_ = current_;
-  have_before_ = true;
-  current_ = after_;
-  have_current_ = have_after_;
-  have_after_ = have_current_ && readRecord(&after_);
-  return true;
+  while (have_current_) {
+    // Central difference over the neighbours; one-sided at the two ends of the log.
+    const Reading& a = have_before_ ? before_ : current_;
+    const Reading& b = have_after_ ? after_ : current_;
+    const double span = static_cast<double>(b.record.stamp - a.record.stamp) * 1e-9;
+    const double rate = (b.record.angle - a.record.angle) / span;
+    // Finite angles can still differ by more than a double holds (1e308 and -1e308).
+    const bool finite = std::isfinite(rate);
+    if (finite) {
+      *record = current_.record;
+      record->rate = rate;
+    } else {
+      source_.refuseOrCount(BadRowReason::kNotANumber, current_.line,
+                            "rate derived from the angle is " + shortest(rate) + ": the central difference of lines " +
+                                std::to_string(a.line) + " and " + std::to_string(b.line) + " overflows (angles " +
+                                shortest(a.record.angle) + " and " + shortest(b.record.angle) + " rad, " +
+                                shortest(span) + " s apart)");
+    }
+    before_ = current_;
+    have_before_ = true;
+    current_ = after_;
+    have_current_ = have_after_;
+    have_after_ = have_current_ && readRecord(&after_);
+    if (finite) return true;
+  }
+  return false;
 }
 
 }  // namespace csv

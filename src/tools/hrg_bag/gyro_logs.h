@@ -84,6 +84,9 @@ class RecordSource {
   /// A whole number in [0, 2^32 - 1] of the current record.
   std::uint32_t count(int column, const char* key) const;
   const CsvReader& csv() const { return csv_; }
+  /// A record found bad after it was read (a rate derived from its neighbours): BadRowError naming
+  /// `line`, or counted when bad records are skipped.
+  void refuseOrCount(BadRowReason reason, std::uint64_t line, const std::string& detail);
 
  private:
   [[noreturn]] void bad(BadRowReason reason, const std::string& detail) const;
@@ -117,13 +120,21 @@ class TurntableLogReader {
   bool derivesRate() const { return rate_ < 0; }
 
  private:
+  /// A record of the log with its line, for the refusal of a rate derived later.
+  struct Reading {
+    TurntableRecord record;
+    std::uint64_t line = 0;
+  };
   bool readRecord(TurntableRecord* record);
+  bool readRecord(Reading* reading);
 
   RecordSource source_;
   int angle_, rate_;
   double angle_scale_, rate_scale_;
-  // The derivation's window: the record before, the one being returned, the one after.
-  TurntableRecord before_, current_, after_;
+  // The derivation's window: the record before, the one being returned, the one after. Every record
+  // read without fault passes through it, also one whose own rate is then refused (its angle is
+  // good), so that skipping a record never changes the rate of another.
+  Reading before_, current_, after_;
   bool primed_ = false, have_before_ = false, have_current_ = false, have_after_ = false;
 };
 

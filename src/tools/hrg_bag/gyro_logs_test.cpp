@@ -20,9 +20,10 @@ std::vector<ChannelRecord> readChannels(const std::string& text, const LogSettin
   return records;
 }
 
-std::vector<TurntableRecord> readTurntable(const std::string& text, const LogSettings& settings = {}) {
+std::vector<TurntableRecord> readTurntable(const std::string& text, const LogSettings& settings = {},
+                                           BadRowCounts* skipped = nullptr) {
   std::istringstream in(text);
-  TurntableLogReader reader(in, "tt.csv", settings, nullptr);
+  TurntableLogReader reader(in, "tt.csv", settings, skipped);
   std::vector<TurntableRecord> records;
   TurntableRecord r;
   while (reader.next(&r)) records.push_back(r);
@@ -233,6 +234,38 @@ TEST(GyroLogsTest, RateFromAngleIsTheCentralDifference) {
   // A derived rate needs a neighbour; an angle-only log also needs every angle.
   EXPECT_THROW(readTurntable("stamp,angle\n0.0,0\n"), std::runtime_error);
   EXPECT_THROW(readTurntable("stamp,angle\n0.0,0\n1.0,nan\n"), BadRowError);
+}
+
+TEST(GyroLogsTest, ADerivedRateThatOverflowsIsABadRecordOfItsOwnLine) {
+  // Finite angles 1e308 and -1e308 two records apart: their difference is no double. The rate is
+  // that of the record between them (line 4), which is named although the reader is a line ahead.
+  const std::string log = "stamp,angle\n0,0\n1.0,1e308\n2.0,2\n3.0,-1e308\n4.0,4\n";
+  try {
+    readTurntable(log);
+    FAIL() << "an infinite derived rate was accepted";
+  } catch (const BadRowError& e) {
+    EXPECT_EQ(e.reason, BadRowReason::kNotANumber);
+    EXPECT_EQ(std::string(e.what()),
+              "tt.csv:4: NaN or infinity not allowed: rate derived from the angle is -inf: the central difference "
+              "of lines 3 and 5 overflows (angles 1e+308 and -1e+308 rad, 2 s apart)");
+  }
+  // Skipped and counted: the record whose rate overflowed is not written, but its angle, good in
+  // itself, stays the neighbour of the next record, so no kept record's rate changes by the skip.
+  // An unreadable record (line 7) is no neighbour: the rate of line 6 spans lines 5 to 8.
+  LogSettings settings;
+  settings.skip_bad_rows = true;
+  BadRowCounts skipped;
+  const auto records = readTurntable(log + "5.0,x\n6.0,10\n", settings, &skipped);
+  ASSERT_EQ(records.size(), 5u);
+  EXPECT_EQ(skipped.summary(), "2 (unreadable number 1, NaN or infinity not allowed 1)");
+  EXPECT_EQ(records[0].stamp, 0);
+  EXPECT_DOUBLE_EQ(records[0].rate, 1e308);              // (1e308 - 0) / 1, one-sided
+  EXPECT_DOUBLE_EQ(records[1].rate, 1.0);                // (2 - 0) / 2
+  EXPECT_EQ(records[2].stamp, 3000000000LL);             // 2.0 s is the one skipped
+  EXPECT_DOUBLE_EQ(records[2].rate, (4.0 - 2.0) / 2.0);  // from the skipped record's angle: not (4 - 1e308) / 3
+  EXPECT_DOUBLE_EQ(records[3].rate, (10.0 + 1e308) / 3.0);
+  EXPECT_EQ(records[4].stamp, 6000000000LL);
+  EXPECT_DOUBLE_EQ(records[4].rate, (10.0 - 4.0) / 2.0);
 }
 
 TEST(GyroLogsTest, RateOnlyLeavesTheAngleNaN) {
