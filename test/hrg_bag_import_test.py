@@ -170,6 +170,20 @@ class HrgBagImport(unittest.TestCase):
             self.assertNotIn("terminate called", err)
             self.assertFalse(os.path.exists(out), args)
 
+    def test_a_long_field_is_quoted_as_an_excerpt(self):
+        # A 500 kB field (within the line limit) is named by its first 64 bytes and its size.
+        field = "x" + "9" * 500000
+        ch = self.write("long_field.csv", CHANNELS_HEADER + "1.0,%s,0,0,0\n" % field)
+        code, _, err = hrg_bag("import", "--channels", ch, "--out", self.path("long_field.bag"))
+        self.assertEqual(code, 1, err[:500])
+        self.assertIn(ch + ":2: unreadable number: ac: 'x" + "9" * 63 + "... (500001 bytes)' is not a number", err)
+        self.assertLess(len(err), 1000, err[:500])
+        header = self.write("long_header.csv", "stamp," + "h" * 500000 + ",bc,as,bs\n1.0,1,0,0,0\n")
+        code, _, err = hrg_bag("import", "--channels", header, "--out", self.path("long_field.bag"))
+        self.assertEqual(code, 2, err[:500])
+        self.assertIn("no column 'ac' for ac in the header ('stamp', '" + "h" * 64 + "... (500000 bytes)', 'bc'", err)
+        self.assertLess(len(err), 1000, err[:500])
+
     def test_a_stamp_a_bag_cannot_hold_is_a_bad_record(self):
         # ros::Time holds [1 ns, 2^32 s - 1 ns]: a stamp outside is the log's fault (exit 1 with
         # FILE:LINE), never a failure to write the bag (exit 3).

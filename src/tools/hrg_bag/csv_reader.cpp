@@ -21,7 +21,7 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-std::string quoted(std::string_view s) { return "'" + std::string(s) + "'"; }
+std::string quoted(std::string_view s) { return "'" + excerpt(s) + "'"; }
 
 bool allDigits(std::string_view s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
@@ -151,6 +151,26 @@ core::Nanoseconds parseIso8601(std::string_view s, std::string_view field) {
 }
 
 }  // namespace
+
+std::string excerpt(std::string_view text) {
+  std::size_t keep = std::min(text.size(), kQuotedBytes);
+  if (keep < text.size()) {
+    while (keep > 0 && (static_cast<unsigned char>(text[keep]) & 0xC0) == 0x80) --keep;  // a continuation byte
+  }
+  std::string out;
+  out.reserve(keep + 32);
+  for (const char c : text.substr(0, keep)) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte == 0x7F) {
+      static const char kHex[] = "0123456789ABCDEF";
+      out += {'\\', 'x', kHex[byte >> 4], kHex[byte & 0xF]};
+    } else {
+      out += c;
+    }
+  }
+  if (keep < text.size()) out += "... (" + std::to_string(text.size()) + " bytes)";
+  return out;
+}
 
 DescriptorInputBuffer::DescriptorInputBuffer(int fd) : fd_(fd), buffer_(new char[kBufferBytes]) {}
 

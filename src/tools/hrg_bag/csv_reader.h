@@ -2,7 +2,8 @@
 // row naming the columns), and the strict field parsers behind `hrg_bag import`. It holds one line
 // at a time in a buffer of fixed size (kMaxLineBytes), so a log of any size, even one without a
 // single line end, is read in constant memory. Numbers are read whole ("1.5abc" and "1,5" are
-// errors, never 1.5 or 1), stamps exactly as integer nanoseconds. No ROS.
+// errors, never 1.5 or 1), stamps exactly as integer nanoseconds. Messages quote fields and header
+// names cut to an excerpt. No ROS.
 #pragma once
 
 #include <cstdint>
@@ -28,6 +29,13 @@ StampFormat parseStampFormat(const std::string& name);
 /// eight numbers takes about 150; the limit only stops a file that is no log (a binary file, one
 /// without line ends) from being held whole.
 constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
+
+/// At most this many bytes of a field or a header name are quoted in a message (excerpt()).
+constexpr std::size_t kQuotedBytes = 64;
+/// `text` for a message: whole up to kQuotedBytes, else its first kQuotedBytes bytes (never half a
+/// UTF-8 character) and "... (N bytes)"; control characters as \xNN, so that a binary field can
+/// neither flood nor drive the terminal.
+std::string excerpt(std::string_view text);
 
 /// A field that is not what its column holds; the message says why (the caller adds file:line).
 struct FieldError : std::invalid_argument {

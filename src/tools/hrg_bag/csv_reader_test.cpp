@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <sstream>
+#include <vector>
 
 namespace hrg_gyro {
 namespace csv {
@@ -149,6 +151,30 @@ TEST(CsvReaderTest, WithoutHeaderTheFirstLineIsARecordAndColumnsGoByIndex) {
   ASSERT_TRUE(reader.next());
   EXPECT_EQ(reader.fields()[2], "5");
   EXPECT_FALSE(reader.next());
+}
+
+TEST(CsvReaderTest, MessagesQuoteAnExcerptOfAField) {
+  EXPECT_EQ(excerpt("1.5abc"), "1.5abc");
+  EXPECT_EQ(excerpt(std::string(kQuotedBytes, 'x')), std::string(kQuotedBytes, 'x'));
+  EXPECT_EQ(excerpt(std::string(10000000, 'x')), std::string(kQuotedBytes, 'x') + "... (10000000 bytes)");
+  // Never half a UTF-8 character ("\xC3\xA9" is one), control characters escaped.
+  EXPECT_EQ(excerpt(std::string(kQuotedBytes - 1, 'x') + "\xC3\xA9" + std::string(100, 'y')),
+            std::string(kQuotedBytes - 1, 'x') + "... (165 bytes)");
+  EXPECT_EQ(excerpt("a\x1B[2Jb\n"), "a\\x1B[2Jb\\x0A");
+  // Through the parsers: a 10 MB field is refused in a message of a few dozen bytes.
+  const std::string huge = "1" + std::string(10000000, '5') + "x";
+  for (const auto& refuse :
+       std::vector<std::function<void()>>{[&] { parseNumber(huge); }, [&] { parseStamp(huge, StampFormat::kSeconds); },
+                                          [&] { parseStamp(huge, StampFormat::kIso8601); }}) {
+    try {
+      refuse();
+      ADD_FAILURE() << "accepted";
+    } catch (const FieldError& e) {
+      EXPECT_LT(std::string(e.what()).size(), 200u) << std::string(e.what()).substr(0, 200);
+      EXPECT_NE(std::string(e.what()).find("... (10000002 bytes)"), std::string::npos)
+          << std::string(e.what()).substr(0, 200);
+    }
+  }
 }
 
 TEST(CsvReaderTest, ALineLongerThanTheLimitIsRefusedAndReadPast) {

@@ -1,5 +1,6 @@
 #include "gyro_logs.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -85,10 +86,16 @@ int RecordSource::column(const std::string& key, bool required) const {
       throw std::runtime_error(csv_.name() + ": no header row, so " + key + " needs its column by index: --column " +
                                key + "=#N (N from 1 to " + std::to_string(csv_.header().size()) + ")");
     }
+    // The names, each an excerpt, and not more of them than a reader takes in.
+    constexpr std::size_t kListedColumns = 16;
+    const std::vector<std::string>& header = csv_.header();
     std::string names;
-    for (const std::string& h : csv_.header()) names += (names.empty() ? "'" : ", '") + h + "'";
-    throw std::runtime_error(csv_.name() + ":" + std::to_string(csv_.line()) + ": no column '" + wanted + "' for " +
-                             key + " in the header (" + names + "): name it with the column option");
+    for (std::size_t i = 0; i < std::min(header.size(), kListedColumns); ++i) {
+      names += (i == 0 ? "'" : ", '") + excerpt(header[i]) + "'";
+    }
+    if (header.size() > kListedColumns) names += ", ... (" + std::to_string(header.size()) + " columns)";
+    throw std::runtime_error(csv_.name() + ":" + std::to_string(csv_.line()) + ": no column '" + excerpt(wanted) +
+                             "' for " + key + " in the header (" + names + "): name it with the column option");
   }
   return index;
 }
@@ -103,7 +110,7 @@ double RecordSource::number(int column, const char* key, bool nan_allowed) const
     bad(BadRowReason::kNumber, std::string(key) + ": " + e.what());
   }
   if (std::isinf(value) || (std::isnan(value) && !nan_allowed)) {
-    bad(BadRowReason::kNotANumber, std::string(key) + " is " + std::string(csv_.fields()[column]) +
+    bad(BadRowReason::kNotANumber, std::string(key) + " is " + excerpt(csv_.fields()[column]) +
                                        (nan_allowed ? "" : " (a number is required here)"));
   }
   return value;
@@ -114,8 +121,7 @@ std::uint32_t RecordSource::count(int column, const char* key) const {
   std::uint32_t value = 0;
   const auto r = std::from_chars(field.data(), field.data() + field.size(), value);
   if (field.empty() || r.ec != std::errc() || r.ptr != field.data() + field.size()) {
-    bad(BadRowReason::kNumber,
-        std::string(key) + ": '" + std::string(field) + "' is not a whole number in [0, 2^32 - 1]");
+    bad(BadRowReason::kNumber, std::string(key) + ": '" + excerpt(field) + "' is not a whole number in [0, 2^32 - 1]");
   }
   return value;
 }

@@ -179,6 +179,36 @@ TEST(GyroLogsTest, AStampOutsideWhatTheOutputHoldsIsABadRecord) {
   EXPECT_EQ(skipped.summary(), "2 (stamp out of range 2)");
 }
 
+TEST(GyroLogsTest, LongFieldsAndHeadersAreQuotedAsExcerpts) {
+  const std::string field(500000, '7');
+  const std::string ok = std::string(kHeader) + "1.0,1,2,3,4\n";
+  for (const std::string& record :
+       {"2.0," + field + "x,2,3,4\n", "2.0,1,2,3," + field + "nan\n", field + "x,1,2,3,4\n"}) {
+    const std::string why = refusal(ok + record);
+    EXPECT_NE(why.find("ch.csv:3: "), std::string::npos) << why.substr(0, 300);
+    EXPECT_NE(why.find("... (5000"), std::string::npos) << why.substr(0, 300);
+    EXPECT_LT(why.size(), 300u) << why.substr(0, 300);
+  }
+  const std::string periods = refusal("stamp,ac,bc,as,bs,periods\n1,1,2,3,4," + field + "\n");
+  EXPECT_NE(periods.find("periods: '" + std::string(kQuotedBytes, '7') + "... (500000 bytes)'"), std::string::npos)
+      << periods.substr(0, 300);
+  // A header of 5000 long names: the message names a few of them, each cut.
+  std::string header = "stamp";
+  for (int i = 0; i < 5000; ++i) header += "," + std::string(100, 'h') + std::to_string(i);
+  try {
+    readChannels(header + "\n");
+    FAIL() << "a header without ac was accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string why = e.what();
+    EXPECT_NE(why.find("no column 'ac' for ac in the header ('stamp', '" + std::string(kQuotedBytes, 'h') +
+                       "... (101 bytes)'"),
+              std::string::npos)
+        << why.substr(0, 300);
+    EXPECT_NE(why.find(", ... (5001 columns))"), std::string::npos) << why.substr(0, 300);
+    EXPECT_LT(why.size(), 2000u);
+  }
+}
+
 TEST(GyroLogsTest, SkippedRowsAreCountedByReason) {
   LogSettings settings;
   settings.skip_bad_rows = true;
