@@ -329,6 +329,8 @@ class HrgBagCli(unittest.TestCase):
             (common["info"] + ["--channels-topic", ""], "--channels-topic", "empty"),
             (["info"], "BAG", "required"),
             (common["process"] + ["--frame-id", ""], "--frame-id", "empty"),
+            (common["process"] + ["--frame-id", "gyro\nlink"], "--frame-id", "control characters"),
+            (common["simulate"] + ["--frame-id", "/gyro_link"], "--frame-id", "tf2"),
             (["process", bag], "--params", "required"),
             (common["calibrate"] + ["--method", "bogus"], "--method", "unknown method"),
             (common["calibrate"] + ["--plot", self.path("x.png")], "--plot", "--report"),

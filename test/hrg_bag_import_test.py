@@ -162,6 +162,20 @@ class HrgBagImport(unittest.TestCase):
             (["--channels", ch, "--out", ch], "refused"),
             (["--channels", ch, "--turntable", self.write("no_rate.csv", "stamp,speed\n1,2\n"), "--out", out],
              "needs an angle or a rate column"),
+            (["--channels", ch, "--out", out, "--channels-topic", "channels"], "--channels-topic: must be a global"),
+            (["--channels", ch, "--out", out, "--channels-topic", "/gyro channels"], "is not a ROS topic name"),
+            (["--channels", ch, "--out", out, "--channels-topic", "/gyro/\nchannels"], "is not a ROS topic name"),
+            (["--channels", ch, "--out", out, "--channels-topic", "/gyro-1"], "is not a ROS topic name"),
+            (["--channels", ch, "--out", out, "--channels-topic", "/gyro//channels"], "'//'"),
+            (["--channels", ch, "--out", out, "--turntable-topic", "/turntable/"], "--turntable-topic: must not"),
+            (["--channels", ch, "--out", out, "--turntable-topic", "~state"], "--turntable-topic: must be a global"),
+            (["--channels", ch, "--out", out, "--channels-topic", "/"], "--channels-topic: must not"),
+            (["--channels", ch, "--turntable", self.write("rate.csv", "stamp,rate\n1.0,0.1\n"), "--out", out,
+              "--channels-topic", "/gyro", "--turntable-topic", "/gyro"],
+             "--channels-topic and --turntable-topic are both /gyro"),
+            (["--channels", ch, "--out", out, "--frame-id", "gyro\nlink"], "--frame-id: must not hold blanks"),
+            (["--channels", ch, "--out", out, "--frame-id", "gyro link"], "--frame-id: must not hold blanks"),
+            (["--channels", ch, "--out", out, "--frame-id", "/gyro_link"], "--frame-id: must not start with '/'"),
         ]
         for args, fragment in cases:
             code, _, err = hrg_bag("import", *args)
@@ -169,6 +183,12 @@ class HrgBagImport(unittest.TestCase):
             self.assertIn(fragment, err, args)
             self.assertNotIn("terminate called", err)
             self.assertFalse(os.path.exists(out), args)
+        # The two topics may be equal when only one is written; names and frames of other forms are taken.
+        for extra in (["--channels-topic", "/turntable/state"], ["--channels-topic", "/bench_7/gyro_2/channels"],
+                      ["--frame-id", "bench.gyro-2_link"]):
+            code, _, err = hrg_bag("import", "--channels", ch, "--out", out, "--quiet", *extra)
+            self.assertEqual(code, 0, "%s\n%s" % (extra, err))
+            os.remove(out)
 
     def test_a_long_field_is_quoted_as_an_excerpt(self):
         # A 500 kB field (within the line limit) is named by its first 64 bytes and its size.

@@ -95,6 +95,23 @@ inline CLI::Validator notEmpty() {
       "");
 }
 
+/// A frame_id for the written messages: not empty, no blank or control character (a newline would
+/// split the CSV row or the log line it is written into), and no leading '/' (tf2 refuses such a
+/// frame id in every lookup).
+inline CLI::Validator frameId() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        if (text.empty()) return "must not be empty";
+        for (const char c : text) {
+          const auto byte = static_cast<unsigned char>(c);
+          if (byte <= 0x20 || byte == 0x7F) return "must not hold blanks or control characters (a newline, a tab)";
+        }
+        if (text.front() == '/') return "must not start with '/' (tf2 refuses such a frame id)";
+        return "";
+      },
+      "");
+}
+
 /// Parses argv; --help prints the help on stdout and gives 0, a refused argument prints
 /// "<tool>: <option>: <reason>" on stderr and gives 2. Otherwise -1: go on.
 inline int parseCommandLine(CLI::App& app, int argc, char** argv) {

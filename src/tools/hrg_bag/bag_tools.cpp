@@ -1,5 +1,6 @@
 #include "bag_tools.h"
 
+#include <ros/names.h>
 #include <ros/package.h>
 #include <rosbag/exceptions.h>
 #include <sys/stat.h>
@@ -183,6 +184,21 @@ std::unique_ptr<rosbag::Bag> openBag(const std::string& path) {
     throw UsageError("cannot open bag '" + path + "': " + why(e));
   }
   return bag;
+}
+
+CLI::Validator topicName() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::string why;
+        if (text.empty()) return "must not be empty";
+        if (!ros::names::validate(text, why)) {
+          return "is not a ROS topic name: a letter or '/' first, then only letters, digits, '_' and '/'";
+        }
+        if (text.front() != '/') return "must be a global name, starting with '/' (as rosbag record writes topics)";
+        if (text.size() == 1 || ros::names::clean(text) != text) return "must not hold '//' or end with '/'";
+        return "";
+      },
+      "");
 }
 
 void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_truth) {

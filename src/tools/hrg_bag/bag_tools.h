@@ -61,6 +61,10 @@ std::unique_ptr<rosbag::Bag> openBag(const std::string& path);
 struct GyroTopics {
   std::string channels, turntable, truth;
 };
+/// A topic to write: a valid ROS graph resource name (ros::names::validate: a letter or '/' first,
+/// then letters, digits, '_' and '/'), global ('/' first, as rosbag record writes topics), without
+/// '//' or a trailing '/'.
+CLI::Validator topicName();
 /// Adds --channels-topic and, when asked, --turntable-topic and --truth-topic.
 void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_truth);
 /// Explicit topics win; otherwise the single topic of the right type is taken. Throws UsageError

@@ -99,6 +99,10 @@ InputLog openLog(const std::string& path, const char* option, double* bytes) {
 
 int runImport(const ImportOptions& o) {
   using namespace bag_tools;
+  if (!o.turntable.empty() && o.channels_topic == o.turntable_topic) {
+    throw UsageError("--channels-topic and --turntable-topic are both " + o.channels_topic +
+                     ": one topic cannot carry both message types");
+  }
   checkOutputPaths({o.channels, o.turntable}, {o.out});
   csv::LogSettings channel_settings, turntable_settings;
   logSettings(o, &channel_settings, &turntable_settings);
@@ -227,13 +231,13 @@ Command addImportCommand(CLI::App& root) {
   cmd->add_flag("--skip-bad-rows", o->skip_bad_rows, "skip bad records and count them by reason (default: refuse)");
   cmd->add_flag("--quiet", o->quiet, "no progress on stderr (the summary and notes stay)");
   cmd->add_option("--channels-topic", o->channels_topic, "topic of the channel amplitudes")
-      ->check(tools::notEmpty())
+      ->check(topicName())
       ->capture_default_str();
-  cmd->add_option("--turntable-topic", o->turntable_topic, "topic of the turntable states")
-      ->check(tools::notEmpty())
+  cmd->add_option("--turntable-topic", o->turntable_topic, "topic of the turntable states (not the channels')")
+      ->check(topicName())
       ->capture_default_str();
   cmd->add_option("--frame-id", o->frame_id, "frame_id of the written messages")
-      ->check(tools::notEmpty())
+      ->check(tools::frameId())
       ->capture_default_str();
   addCompressionOption(*cmd, &o->compression);
   cmd->footer(

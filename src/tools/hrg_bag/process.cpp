@@ -323,7 +323,7 @@ Command addProcessCommand(CLI::App& root) {
       ->check(tools::notEmpty());
   cmd->add_option("--csv", o->csv, "output CSV: one row per input sample with its verdict")->check(tools::notEmpty());
   cmd->add_option("--frame-id", o->frame_id, "frame_id of the written messages")
-      ->check(tools::notEmpty())
+      ->check(tools::frameId())
       ->capture_default_str();
   addCompressionOption(*cmd, &o->compression);
   addTopicOptions(*cmd, &o->topics, false);

@@ -59,7 +59,7 @@ Command addSimulateCommand(CLI::App& root) {
   o->seed_option = cmd->add_option("--seed", o->seed, "noise seed, a whole number >= 0 (default: the scenario's)")
                        ->transform(tools::unsignedWholeNumber());
   cmd->add_option("--frame-id", o->frame_id, "frame_id of the written messages")
-      ->check(tools::notEmpty())
+      ->check(tools::frameId())
       ->capture_default_str();
   cmd->add_flag("--no-truth", o->no_truth, "do not write /truth");
   addCompressionOption(*cmd, &o->compression);
