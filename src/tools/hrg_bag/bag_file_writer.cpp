@@ -85,7 +85,7 @@ BagFileWriter::BagFileWriter(const std::string& path, Compression compression, s
   chunk_ = takeChunk();
   writeFile(kMagic, sizeof kMagic - 1);
   writeFileHeader(0);  // rewritten by close() with the index position
-  worker_ = std::make_unique<SerialWorker>();
+  worker_ = std::make_unique<SerialWorker>(kChunksWaiting);
 }
 
 BagFileWriter::~BagFileWriter() {
@@ -170,22 +170,25 @@ std::shared_ptr<BagFileWriter::Chunk> BagFileWriter::takeChunk() {
   }
   auto chunk = std::make_shared<Chunk>();
   chunk->bytes.reserve(chunk_threshold_ + (64u << 10));
+  ++chunks_allocated_;
   return chunk;
 }
 
 void BagFileWriter::flushChunk() {
   if (chunk_->bytes.empty()) return;
   // The full chunk goes to the worker, which returns it to the spares once written; a spare (or,
-  // while the worker holds them all, a new one) takes the next messages.
-  std::shared_ptr<Chunk> full = std::move(chunk_);
-  chunk_ = takeChunk();
-  worker_->submit([this, full] {
+  // while the worker holds them all, a new one) takes the next messages. Submitted first: submit
+  // waits while kChunksWaiting chunks wait, so a new chunk is made only while at most that many wait
+  // and one is written, which bounds the chunks ever made by kMaxChunksAlive. (Taken first, the
+  // next chunk would be one more, made while the full one still waits to be queued.)
+  worker_->submit([this, full = chunk_] {
     writeChunk(*full);
     full->bytes.clear();
     for (ChunkIndex& index : full->index) index.entries.clear();
     std::lock_guard<std::mutex> lock(spare_mutex_);
     spare_chunks_.push_back(full);
   });
+  chunk_ = takeChunk();
 }
 
 void BagFileWriter::writeChunk(Chunk& chunk) {

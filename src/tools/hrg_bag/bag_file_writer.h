@@ -5,7 +5,8 @@
 // message is serialised straight into the chunk in memory, and the file sees one large write per
 // chunk plus the index at the end. A full chunk is compressed and written by a background thread
 // (SerialWorker) while the next one fills; written chunks come back to be filled again, so memory is
-// allocated once.
+// allocated once, and never more than kMaxChunksAlive chunks, however far the background thread
+// falls behind (a loaded machine): the thread filling chunks then waits for it.
 // Layout written: the file header record (padded to 4 KiB like rosbag's, rewritten on close), then
 // per chunk a chunk record (connection records of the connections it introduces, then the message
 // data records; none, LZ4 or BZ2 compressed) followed by its index data records (by connection id, as
@@ -40,6 +41,16 @@ class BagFileWriter {
  public:
   enum class Compression { kNone, kLz4, kBz2 };
 
+  /// Full chunks that may wait for the background thread besides the one it writes. One keeps both
+  /// threads busy; each more would only cost memory while the thread is behind.
+  static constexpr std::size_t kChunksWaiting = 1;
+  /// The most chunks in memory at once, whatever the load: the one filling, the waiting ones and the
+  /// one being written. A chunk holds up to `chunk_threshold` bytes plus its last message, and 12
+  /// bytes of index a message. With the compression buffer (a chunk's size) and the 4 MiB file stage,
+  /// the writer's worst case at the default threshold is about 3 x (4.06 + 0.4) + 4.1 + 4 = 21.5 MiB
+  /// for messages of about 120 bytes (docs/importing_logs.md).
+  static constexpr std::size_t kMaxChunksAlive = kChunksWaiting + 2;
+
   /// Creates (truncates) `path`. Chunks close once they hold more than `chunk_threshold` bytes.
   BagFileWriter(const std::string& path, Compression compression, std::uint32_t chunk_threshold = 4u << 20);
   ~BagFileWriter();
@@ -61,6 +72,9 @@ class BagFileWriter {
 
   /// Writes the last chunk, the index and the final file header, and closes the file.
   void close();
+
+  /// The chunks allocated so far: at most kMaxChunksAlive (the tests check the bound).
+  std::size_t chunksAllocated() const { return chunks_allocated_; }
 
  private:
   struct Connection {
@@ -118,6 +132,7 @@ class BagFileWriter {
   std::shared_ptr<Chunk> chunk_;     // the open chunk, filled by write()
   std::mutex spare_mutex_;           // guards spare_chunks_, which the worker refills
   std::vector<std::shared_ptr<Chunk>> spare_chunks_;
+  std::size_t chunks_allocated_ = 0;  // by takeChunk, on the thread that writes
   // Used by the worker while it runs, by close() once it has finished.
   std::vector<std::uint8_t> compressed_, scratch_;
   std::vector<ChunkInfo> chunks_;

@@ -93,6 +93,26 @@ TEST_P(BagFileWriterTest, TheSameSessionGivesTheSameBytes) {
   std::remove(second.c_str());
 }
 
+TEST(BagFileWriterMemoryTest, NoMoreChunksThanTheBoundHoweverFarTheWriterThreadFallsBehind) {
+  // bzip2 on 32 KiB chunks: compressing one takes some milliseconds, tens of times longer than
+  // filling it, so the filling thread is ahead of the writing one, as on a loaded machine. It must
+  // then wait rather than make more chunks.
+  const std::string path = temporaryPath("bounded");
+  BagFileWriter writer(path, Compression::kBz2, 32 << 10);
+  for (int i = 0; i < 40000; ++i) {
+    std_msgs::Float64 value;
+    value.data = i;
+    writer.write("/value", ros::Time(100, 0) + ros::Duration(1e-3 * i), value);
+    ASSERT_LE(writer.chunksAllocated(), BagFileWriter::kMaxChunksAlive) << "after message " << i;
+  }
+  writer.close();
+  RecordProperty("chunks_allocated", static_cast<int>(writer.chunksAllocated()));
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  EXPECT_EQ(rosbag::View(bag).size(), 40000u);
+  bag.close();
+  std::remove(path.c_str());
+}
+
 INSTANTIATE_TEST_SUITE_P(Compressions, BagFileWriterTest,
                          ::testing::Values(Compression::kNone, Compression::kLz4, Compression::kBz2));
 
