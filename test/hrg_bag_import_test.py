@@ -63,7 +63,8 @@ class HrgBagImport(unittest.TestCase):
         code, out, _ = hrg_bag("import", "--help")
         self.assertEqual(code, 0)
         for fragment in ("usage: hrg_bag import", "--column", "--angle-unit", "--rate-unit", "--stamp-format",
-                         "--delimiter", "--skip-bad-rows", "central difference", "ISO 8601"):
+                         "--delimiter", "--skip-bad-rows", "central difference", "ISO 8601", "a line over 1 MiB",
+                         "from 2^32 s", "derived rate", "a FIFO"):
             self.assertIn(fragment, out)
         code, out, _ = hrg_bag("export", "--help")
         self.assertEqual(code, 0)

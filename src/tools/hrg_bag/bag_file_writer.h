@@ -46,9 +46,10 @@ class BagFileWriter {
   static constexpr std::size_t kChunksWaiting = 1;
   /// The most chunks in memory at once, whatever the load: the one filling, the waiting ones and the
   /// one being written. A chunk holds up to `chunk_threshold` bytes plus its last message, and 12
-  /// bytes of index a message. With the compression buffer (a chunk's size) and the 4 MiB file stage,
-  /// the writer's worst case at the default threshold is about 3 x (4.06 + 0.4) + 4.1 + 4 = 21.5 MiB
-  /// for messages of about 120 bytes (docs/importing_logs.md).
+  /// bytes of index a message (up to twice that touched, as the index grows). With the compression
+  /// buffer (a chunk's size), LZ4's own (1.1 MiB), the index records and the 4 MiB file stage, the
+  /// writer's worst case at the default threshold is about 3 x (4.06 + 0.8) + 4.1 + 1.1 + 0.4 + 4 =
+  /// 24 MiB for messages of about 120 bytes (docs/importing_logs.md).
   static constexpr std::size_t kMaxChunksAlive = kChunksWaiting + 2;
 
   /// Creates (truncates) `path`. Chunks close once they hold more than `chunk_threshold` bytes.

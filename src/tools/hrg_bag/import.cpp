@@ -233,7 +233,7 @@ Command addImportCommand(CLI::App& root) {
   cmd->add_option("--channels-topic", o->channels_topic, "topic of the channel amplitudes")
       ->check(topicName())
       ->capture_default_str();
-  cmd->add_option("--turntable-topic", o->turntable_topic, "topic of the turntable states (not the channels')")
+  cmd->add_option("--turntable-topic", o->turntable_topic, "topic of the turntable states (not --channels-topic)")
       ->check(topicName())
       ->capture_default_str();
   cmd->add_option("--frame-id", o->frame_id, "frame_id of the written messages")
@@ -249,11 +249,15 @@ Command addImportCommand(CLI::App& root) {
       "Turntable with only an angle: the rate is the central difference of the neighbouring records,\n"
       "(angle[i+1] - angle[i-1]) / (t[i+1] - t[i-1]), one-sided at the ends; its noise is the angle's\n"
       "noise / (sqrt(2) x record spacing). With only a rate, the angle is written as NaN.\n"
-      "A bad record (field count, unreadable stamp or number, NaN where a number is required, stamp\n"
-      "not increasing) is refused with file:line and the reason, or skipped and counted with\n"
-      "--skip-bad-rows. The bag is written to a temporary and renamed over --out when complete.\n"
-      "Exit 0 success, 1 a bad record or no usable record (nothing written), 2 bad usage, an unreadable\n"
-      "log or a header without the columns, 3 the bag could not be written.");
+      "A bad record (a line over 1 MiB, field count, unreadable stamp or number, a stamp a bag cannot\n"
+      "hold: before 1 ns or from 2^32 s, NaN or infinity where a number is required, also a derived rate\n"
+      "that overflows, stamp not increasing) is refused with file:line and the reason, or skipped and\n"
+      "counted with --skip-bad-rows. Messages quote at most 64 bytes of a field. Topics are global ROS\n"
+      "names; a frame id has no blank, control character or leading '/'.\n"
+      "The bag is written to a temporary and renamed over --out when complete.\n"
+      "Exit 0 success, 1 a bad record or no usable record (nothing written), 2 bad usage, a log that is\n"
+      "no regular file (a FIFO, a device, a directory: refused before it is opened), unreadable, without\n"
+      "a header row within 1 MiB or without the columns, 3 the bag could not be written.");
   return [o] { return runImport(*o); };
 }
 
