@@ -28,7 +28,7 @@ def documented_programs():
     found = set()
     for path in [os.path.join(ROOT, "README.md")] + sorted(glob.glob(os.path.join(ROOT, "docs", "*.md"))):
         with open(path) as f:
-            found.update(re.findall(r"rosrun hrg_gyro ([A-Za-z0-9_.]+)", f.read()))
+            found.update(re.findall(r"rosrun hrg_gyro ([a-z][a-z0-9_.]*)", f.read()))
     return sorted(found)
 
 
