@@ -56,7 +56,7 @@ bool RateGroups::add(Nanoseconds stamp, double theta, double y, std::uint64_t pl
                      double reported_rate, double frequency) {
   RateGroup* group = nullptr;
   for (RateGroup& g : groups_) {
-    if (std::abs(g.meanRate() - plateau_rate) <= tolerance_) {
+    if (std::abs(g.meanPlateauRate() - plateau_rate) <= tolerance_) {
       group = &g;
       break;
     }
@@ -93,6 +93,7 @@ bool RateGroups::add(Nanoseconds stamp, double theta, double y, std::uint64_t pl
   group->last_stamp = stamp;
   it->second.add(stamp, theta, y, frequency);
   group->rate_sum += reported_rate;
+  group->plateau_rate_sum += plateau_rate;
   group->rate_sq_sum += reported_rate * reported_rate;
   ++group->rate_count;
   return true;

@@ -34,6 +34,9 @@ struct RateGroup {
   double window = 0.0;                       ///< s, averaging window of this group's rates
   double rate_sum = 0.0, rate_sq_sum = 0.0;  ///< of the reported rate, for its mean and noise
   std::uint64_t rate_count = 0;
+  /// The plateaus' own rates (the slope of the table angle), by which samples are grouped: a noisy
+  /// reported rate must not start a new group with every sample.
+  double plateau_rate_sum = 0.0;
   std::uint64_t last_plateau = 0;
   Nanoseconds last_stamp = 0;
   bool in_slice = false;
@@ -41,6 +44,7 @@ struct RateGroup {
   std::map<long, ThetaBinnedRates> slices;  ///< by slice index (slice i covers [i w, (i + 1) w) Hz)
 
   double meanRate() const { return rate_count ? rate_sum / rate_count : 0.0; }
+  double meanPlateauRate() const { return rate_count ? plateau_rate_sum / rate_count : 0.0; }
   double rateStd() const;
   double totalTime() const;
   std::uint64_t samples() const;
