@@ -122,17 +122,23 @@ void DualRateMethod::addSample(const PlateauSample& s) {
     in_chain_ = true;
     chain_plateau_ = s.plateau.id;
     unwrap_ = 0.0;
+    rate_integral_ = 0.0;
   } else {
+    rate_integral_ += 0.5 * (s.table_rate + last_table_rate_) * toSeconds(s.stamp - last_stamp_);
     // A controller may log its angle modulo 2 pi: unwrap it.
     const double step = s.table_angle + unwrap_ - last_table_angle_;
     if (step > kPi) unwrap_ -= 2.0 * kPi;
     if (step < -kPi) unwrap_ += 2.0 * kPi;
   }
   const double angle = s.table_angle + unwrap_;
-  regression_.add(s.stamp, s.theta, angle);
+  regression_.setAngleSmoothError(s.angle_smooth_error);
+  // The logged rate's integral too, where the angle is logged: the regression weighs the two by
+  // their noise (without an angle, the angle is that integral already).
+  regression_.add(s.stamp, s.theta, angle, s.angle_logged ? rate_integral_ : NAN);
   angle_logged_ = s.angle_logged;
   last_stamp_ = s.stamp;
   last_table_angle_ = angle;
+  last_table_rate_ = s.table_rate;
 }
 
 bool DualRateMethod::complete() const { return progress().fraction >= 1.0; }
@@ -200,9 +206,13 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
                     largest(e.budget.statistical) + " (white wave-angle noise alone " + largest(e.budget.angle_noise) +
                     ", beyond it " + largest(e.budget.beyond_noise) + "), Earth rate " + largest(e.budget.earth_rate) +
                     ", basis-noise correction " + largest(e.budget.basis_noise) + "; phi from the " +
-                    (angle_logged_ ? "logged table angle" : "integrated table rate") + ", window " +
-                    formatShort(e.mean_window) + " s, angle noise " + formatShort(e.angle_noise) + " rad, " +
-                    std::to_string(e.increments) + " increments in " + std::to_string(e.blocks) + " blocks");
+                    (angle_logged_
+                         ? (e.angle_weight >= 1.0 ? std::string("logged table angle")
+                                                  : "logged table angle weighted " + formatShort(e.angle_weight, 2) +
+                                                        " against the logged rate's integral")
+                         : std::string("integrated table rate")) +
+                    ", window " + formatShort(e.mean_window) + " s, angle noise " + formatShort(e.angle_noise) +
+                    " rad, " + std::to_string(e.increments) + " increments in " + std::to_string(e.blocks) + " blocks");
   o.smoothing_factor = 1.0;  // nothing is smoothed: the increments are fitted through their exact integrals
   if (e.trend.order > 0) {
     // A trend the session cannot tell from K0 leaves K0 to the trend's guess. The trend costs K0

@@ -129,6 +129,42 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
   out << YAML::Key << "out_of_order" << YAML::Value << o.turntable_rejected.out_of_order;
   out << YAML::EndMap;
   out << YAML::Key << "restarts" << YAML::Value << o.restarts;
+  if (o.table_clock.measured) {
+    // The table's clock against the gyro's: stamps regularised from the record count, the offset
+    // measured at every change of rate (table stamps minus gyro stamps, after the configured offset).
+    const TableClockReport& c = o.table_clock;
+    out << YAML::Key << "table_clock" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "configured_offset" << YAML::Value << formatDouble(c.configured_offset) << YAML::Comment("s");
+    out << YAML::Key << "regularised" << YAML::Value << c.stamps.fixed_rate;
+    if (!c.stamps.note.empty())
+      out << YAML::Key << "regularisation_note" << YAML::Value << YAML::DoubleQuoted << c.stamps.note;
+    out << YAML::Key << "records" << YAML::Value << c.stamps.records;
+    out << YAML::Key << "regularised_records" << YAML::Value << c.stamps.regularised;
+    out << YAML::Key << "off_line_records" << YAML::Value << c.stamps.off_line;
+    out << YAML::Key << "clock_steps" << YAML::Value << c.stamps.clock_steps;
+    out << YAML::Key << "counted_by" << YAML::Value << (c.stamps.used_sequence ? "sequence" : "spacing");
+    out << YAML::Key << "log_period" << YAML::Value << formatDouble(c.stamps.period) << YAML::Comment("s");
+    out << YAML::Key << "jitter" << YAML::Value << formatDouble(c.stamps.jitter)
+        << YAML::Comment("s, rms of the stamps about their line");
+    out << YAML::Key << "offset_estimated" << YAML::Value << c.offset.estimated;
+    out << YAML::Key << "offset" << YAML::Value << formatDouble(c.offset.offset) << YAML::Comment("s");
+    out << YAML::Key << "offset_std" << YAML::Value << formatDouble(c.offset.offset_std) << YAML::Comment("s");
+    out << YAML::Key << "offset_spread" << YAML::Value << formatDouble(c.offset.spread) << YAML::Comment("s");
+    out << YAML::Key << "offset_changed" << YAML::Value << c.offset.changed;
+    out << YAML::Key << "offset_note" << YAML::Value << YAML::DoubleQuoted << c.offset.note;
+    out << YAML::Key << "transitions" << YAML::Value << YAML::BeginSeq;
+    for (const TableClockTransition& t : c.offset.transitions) {
+      out << YAML::Flow << YAML::BeginMap;
+      out << YAML::Key << "stamp" << YAML::Value << formatDouble(toSeconds(t.stamp));
+      out << YAML::Key << "rate_before" << YAML::Value << formatDouble(t.rate_before);
+      out << YAML::Key << "rate_after" << YAML::Value << formatDouble(t.rate_after);
+      out << YAML::Key << "offset" << YAML::Value << formatDouble(t.offset);
+      out << YAML::Key << "offset_noise" << YAML::Value << formatDouble(t.offset_noise);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+    out << YAML::EndMap;
+  }
   if (o.bias_trend.order > 0) {
     // The bias's polynomial in time fitted with K and D: D0(t) = drift.mean + sum_j b_j (t - t_ref)^j.
     const BiasTrendFit& t = o.bias_trend;

@@ -36,6 +36,20 @@ bool refusedForLackOfPlateaus(const CalibrationOutcome& o, bool with_coverage) {
 }
 
 std::string percent(double fraction) { return formatShort(100.0 * fraction, 2) + " %"; }
+
+TableClockOffsetSettings offsetSettings(const TableClockSettings& c) {
+  TableClockOffsetSettings s;
+  s.guard = c.max_offset;  // an offset up to the largest accepted is measured without bias
+  return s;
+}
+
+StampRegulariserSettings stampSettings(const TableClockSettings& c) {
+  StampRegulariserSettings s;
+  s.enabled = c.regularise;
+  s.window = c.window;
+  s.max_jitter = c.max_jitter;
+  return s;
+}
 std::string seconds(double s) { return formatShort(s, 3) + " s"; }
 
 }  // namespace
@@ -47,6 +61,8 @@ CalibrationSession::CalibrationSession(const CalibrationSettings& settings, cons
       detector_(settings.plateau),
       turntable_(kMaxHistory + 1),
       pending_(kMaxPending + 1),
+      regulariser_(stampSettings(settings.table_clock)),
+      clock_offset_(offsetSettings(settings.table_clock)),
       turntable_timeline_(settings.backward_reset, settings.backward_persist),
       wave_timeline_(settings.backward_reset, settings.backward_persist) {}
 
@@ -74,9 +90,15 @@ bool CalibrationSession::plausible(Nanoseconds stamp, double angle, double rate)
   return true;
 }
 
-bool CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double rate) {
+bool CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double rate, std::uint64_t sequence) {
   ++counters_.turntable;
   ++counters_.turntable_total;
+  // The table's clock first: a known offset, then the line through a fixed-rate log's stamps (a
+  // glitched stamp comes back as it was, and is dropped below like any other).
+  if (stamp > 0) {
+    stamp -= toNanoseconds(settings_.table_clock.offset);
+    stamp = regulariser_.regularise(stamp, sequence);
+  }
   // Values first: a glitched record must not move the stamp reference either.
   if (stamp > 0 && !plausible(stamp, angle, rate)) return false;
   switch (turntable_timeline_.check(stamp)) {
@@ -100,6 +122,7 @@ bool CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double ra
   has_last_good_ = true;
   last_good_stamp_ = stamp;
   if (std::isfinite(angle)) last_good_angle_ = angle;
+
   judged_.clear();
   detector_.add(stamp, angle, rate, &judged_);
   for (const PlateauRecord& r : judged_) turntable_.push_back(r);
@@ -121,6 +144,8 @@ void CalibrationSession::restart() {
   const std::uint64_t turntable_total = counters_.turntable_total;
   method_ = makeCalibrationMethod(settings_, prior_);
   detector_ = PlateauDetector(settings_.plateau);
+  regulariser_ = TableStampRegulariser(stampSettings(settings_.table_clock));
+  clock_offset_ = TableClockOffsetEstimator(offsetSettings(settings_.table_clock));
   turntable_.clear();
   pending_.clear();
   counters_ = SessionCounters();
@@ -196,10 +221,6 @@ void CalibrationSession::classify(const WaveRecord& w) {
     ++counters_.unsynchronized;
     return;
   }
-  if (a.plateau.id != b.plateau.id || !a.plateau.settled) {
-    ++counters_.unsettled;
-    return;
-  }
   PlateauSample s;
   s.stamp = w.stamp;
   s.theta = w.theta;
@@ -210,6 +231,14 @@ void CalibrationSession::classify(const WaveRecord& w) {
   s.table_angle = a.angle + f * (b.angle - a.angle);
   s.table_rate = a.rate + f * (b.rate - a.rate);
   s.angle_logged = a.angle_logged && b.angle_logged;
+  s.angle_smooth_error = regularisedAngleError(s.table_rate);
+  const bool settled = a.plateau.id == b.plateau.id && a.plateau.settled;
+  // Every sample with the table around it, ramps included: the changes of rate show the clocks' offset.
+  clock_offset_.add(w.stamp, w.theta, s.table_angle, s.table_rate, b.plateau.id, b.plateau.rate, settled);
+  if (!settled) {
+    ++counters_.unsettled;
+    return;
+  }
   method_->addSample(s);
   ++counters_.used;
 }
@@ -279,6 +308,52 @@ std::string CalibrationSession::plateauDiagnosis(bool* names_a_cause) const {
          std::to_string(st.plateaus) + " plateaus started)";
 }
 
+double CalibrationSession::regularisedAngleError(double rate) const {
+  // A line through N stamps of jitter J is off by about 2 J / sqrt(N) at its newest end: that times
+  // the rate is what the regularised stamps leave on the angle, smooth over the line's window.
+  const TableStampStatistics& st = regulariser_.statistics();
+  if (!st.fixed_rate) return 0.0;
+  const double records = std::max<double>(1.0, static_cast<double>(regulariser_.lineRecords()));
+  return rate * rate * st.jitter * st.jitter * 4.0 / records;
+}
+
+void CalibrationSession::reportTableClock(CalibrationOutcome* o) const {
+  TableClockReport& c = o->table_clock;
+  c.measured = true;
+  c.configured_offset = settings_.table_clock.offset;
+  c.stamps = regulariser_.statistics();
+  // The offset is measured with the model the run found (the prior's where it found none).
+  const bool fitted = !o->scale_factor.empty() && o->scale_factor[0].ok && !o->drift.empty() && o->drift[0].ok &&
+                      o->frequency_nodes.empty();
+  const HarmonicModel k = fitted ? toModel(o->scale_factor[0]) : prior_.scale_factor;
+  const HarmonicModel d = fitted ? toModel(o->drift[0]) : prior_.drift;
+  c.offset = clock_offset_.estimate(k, d, prior_.earth_rate.verticalRate());
+  if (!c.stamps.note.empty()) o->notes.push_back("table stamps used as logged: " + c.stamps.note);
+  if (c.stamps.clock_steps > 0) {
+    o->notes.push_back("the table's clock stepped " + std::to_string(c.stamps.clock_steps) +
+                       " time(s): its stamps were put on a new line after each step");
+  }
+  if (!c.offset.estimated) {
+    o->notes.push_back("table clock offset not measured: " + c.offset.note);
+    return;
+  }
+  const TableClockSettings& ts = settings_.table_clock;
+  const double worst = std::abs(c.offset.offset) + 3.0 * c.offset.offset_std;
+  const std::string measured = "the table's stamps are " + formatShort(1e3 * c.offset.offset, 3) + " +- " +
+                               formatShort(1e3 * c.offset.offset_std, 2) + " ms " +
+                               (c.offset.offset >= 0.0 ? "behind" : "ahead of") + " the gyro's (" + c.offset.note + ")";
+  // Samples are judged settled by the table's stamps: an offset near the settling time would let a
+  // sample of a ramp count on a plateau.
+  const bool passed = worst <= ts.max_offset;
+  o->gate("table_clock", passed, worst, ts.max_offset,
+          passed ? measured
+                 : measured +
+                       "; beyond table_clock/max_offset the plateaus are judged on a shifted timeline: put "
+                       "both on one clock, or set table_clock/offset to " +
+                       formatShort(c.configured_offset + c.offset.offset, 4) + " s and calibrate again");
+  o->decide();
+}
+
 CalibrationOutcome CalibrationSession::finish() const {
   CalibrationOutcome o = method_->finish(prior_);
   bool names_a_cause = false;
@@ -292,6 +367,7 @@ CalibrationOutcome CalibrationSession::finish() const {
     o.reason = "plateaus: " + cause + " (" + o.reason + ")";
   }
   o.quadrature_ratio = quadrature_count_ > 0 ? quadrature_sum_ / quadrature_count_ : 0.0;
+  if (!traitsOf(settings_.method).uses_generator_pairs && counters_.turntable_total > 0) reportTableClock(&o);
   diagnose(&o, prior_.correction);
   o.turntable_records = counters_.turntable_total;
   o.turntable_rejected = counters_.rejected;

@@ -1,5 +1,6 @@
 #include "hrg_gyro/core/calibration/calibration_settings.h"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace hrg_gyro {
@@ -25,6 +26,7 @@ const std::vector<std::string> kGateKeys = {
     "min_samples",      "max_condition",       "max_relative_residual", "max_k0_change",
     "max_harmonic_std", "min_steps",           "min_dwell_time",        "min_pairs",
     "max_p_condition",  "max_trend_inflation", "max_trend_k0_std"};
+const std::vector<std::string> kTableClockKeys = {"offset", "regularise", "window", "max_jitter", "max_offset"};
 const std::vector<std::string> kThermalKeys = {"frequency_nodes", "node_count", "interpolation", "slice_width",
                                                "max_slices"};
 const std::vector<std::string> kScalarKeys = {
@@ -45,6 +47,7 @@ std::vector<std::string> CalibrationSettings::keyPaths() {
   for (const std::string& k : kPlateauKeys) keys.push_back("plateau/" + k);
   for (const std::string& k : kGateKeys) keys.push_back("gates/" + k);
   for (const std::string& k : kThermalKeys) keys.push_back("thermal/" + k);
+  for (const std::string& k : kTableClockKeys) keys.push_back("table_clock/" + k);
   return keys;
 }
 
@@ -52,7 +55,7 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   CalibrationSettings s;
   root.requireMap();
   std::vector<std::string> allowed = kScalarKeys;
-  allowed.insert(allowed.end(), {"plateau", "gates", "thermal"});
+  allowed.insert(allowed.end(), {"plateau", "gates", "thermal", "table_clock"});
   allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
   root.rejectUnknownKeys(allowed);
   if (root.has("method")) {
@@ -118,6 +121,18 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
     if (!(q.max_trend_inflation >= 1.0))
       g["max_trend_inflation"].fail("must be >= 1 (a factor on K0's standard error)");
     q.max_trend_k0_std = positive(g, "max_trend_k0_std", q.max_trend_k0_std);
+  }
+  if (root.has("table_clock")) {
+    const YamlField c = root["table_clock"];
+    c.rejectUnknownKeys(kTableClockKeys);
+    TableClockSettings& tc = s.table_clock;
+    tc.offset = c.getDouble("offset", tc.offset);
+    if (!(std::abs(tc.offset) <= 3600.0)) c["offset"].fail("must be a finite number of seconds, |offset| <= 3600");
+    tc.regularise = c.getBool("regularise", tc.regularise);
+    tc.window = c.getDouble("window", tc.window);
+    if (!(tc.window >= 1.0 && tc.window <= 3600.0)) c["window"].fail("must be in [1, 600] s");
+    tc.max_jitter = positive(c, "max_jitter", tc.max_jitter);
+    tc.max_offset = positive(c, "max_offset", tc.max_offset);
   }
   if (root.has("thermal")) {
     const YamlField t = root["thermal"];

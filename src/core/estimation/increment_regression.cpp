@@ -15,6 +15,8 @@ namespace {
 
 constexpr std::size_t kMaxBlocks = 64;
 constexpr int kMaxTrendOrder = 2;
+// Window increments seen before the two table sources are weighed (until then, the angle alone).
+constexpr std::size_t kMinSourceIncrements = 16;
 
 Eigen::MatrixXd submatrix(const Eigen::MatrixXd& m, const std::vector<int>& rows, const std::vector<int>& cols) {
   Eigen::MatrixXd out(rows.size(), cols.size());
@@ -51,13 +53,24 @@ IncrementRegression::IncrementRegression(const std::vector<int>& k_orders, const
     throw std::invalid_argument("increment regression: the bias trend order must be 0, 1 or 2");
   const int n_k = static_cast<int>(k_orders_.size()), n_all = static_cast<int>(all_orders_.size());
   m_ = 1 + 2 * n_k + 1 + 2 * n_all + trend_order_;
+  // Accumulated per sample: the regression's columns with the K block taken along the table angle,
+  // then the same K block along the rate integral, then y.
+  k_terms_ = 1 + 2 * n_k;
+  rate_k0_ = m_;
+  raw_y_ = m_ + k_terms_;
   basis_ = HarmonicBasis(orderStep(all_orders_), all_orders_.empty() ? 0 : all_orders_.back());
   cos_prev_ = sin_prev_ = cos_now_ = sin_now_ = Eigen::VectorXd::Zero(n_all);
   for (int k : k_orders_)
     k_in_all_.push_back(
         static_cast<int>(std::lower_bound(all_orders_.begin(), all_orders_.end(), k) - all_orders_.begin()));
-  integrals_ = Eigen::VectorXd::Zero(m_);
-  sum_.w = previous_mean_.w = Eigen::VectorXd::Zero(m_ + 1);
+  // The T column of each K column's order (K0: T itself): b dt of the chain's slope correction.
+  const int t0 = 1 + 2 * n_k;
+  time_column_of_k_.push_back(t0);
+  for (int j = 0; j < n_k; ++j) time_column_of_k_.push_back(t0 + 1 + k_in_all_[j]);
+  for (int j = 0; j < n_k; ++j) time_column_of_k_.push_back(t0 + 1 + n_all + k_in_all_[j]);
+  integrals_ = Eigen::VectorXd::Zero(raw_y_);
+  sum_.w = Eigen::VectorXd::Zero(raw_y_ + 1);
+  previous_mean_.w = Eigen::VectorXd::Zero(m_ + 1);
   open_block_.products = Eigen::MatrixXd::Zero(m_ + 1, m_ + 1);
   white_lag0_ = white_lag1_ = Eigen::MatrixXd::Zero(m_, m_);
 }
@@ -71,13 +84,76 @@ void IncrementRegression::startChain(int group, double window) {
 }
 
 void IncrementRegression::endChain() {
+  if (in_chain_) flushChain();
   in_chain_ = has_sample_ = has_mean_ = has_previous_dz_ = false;
   history_ = 0;
   sum_.w.setZero();
-  sum_.t = sum_.t_session = sum_.theta = sum_.phi = sum_.count = 0.0;
+  sum_.t = sum_.t_session = sum_.theta = sum_.phi = sum_.phi_rate = sum_.count = 0.0;
+  chain_means_.clear();
+  line_ = LineSums();
+  chain_has_rate_ = true;
 }
 
-void IncrementRegression::add(Nanoseconds stamp, double theta, double phi) {
+void IncrementRegression::flushChain() {
+  if (chain_means_.empty()) return;
+  // The table's slope on this chain, from the angle: the rate integral keeps only its shape.
+  double slope = 0.0;
+  const double stt = line_.tt - line_.t * line_.t / line_.n, stx = line_.tx - line_.t * line_.x / line_.n;
+  if (line_.n >= 2.0 && stt > 0.0) slope = stx / stt;
+  // What the session says of the two sources: on consecutive window means, the angle minus the rate
+  // integral (the chain's slope removed) moves by the angle's white noise (differences
+  // anti-correlated at lag one) and by the integral's wander (uncorrelated differences: rate noise,
+  // ripple the logged rate misses). An increment's error from the angle is twice its noise per window
+  // mean (plus what regularised stamps leave, smooth and so not in the scatter); from the integral,
+  // the wander. The weighted sum with the least variance; both clean (a rate differenced from the
+  // angle is the angle again, smoothed): the angle, as without a rate.
+  double previous_difference = 0.0;
+  for (std::size_t i = 1; chain_has_rate_ && i < chain_means_.size(); ++i) {
+    const WindowMean& a = chain_means_[i - 1];
+    const WindowMean& b = chain_means_[i];
+    const double difference = (b.x - a.x) - slope * (b.t - a.t);
+    source_squares_ += difference * difference;
+    ++source_count_;
+    if (i >= 2) {
+      source_lag_ += difference * previous_difference;
+      ++source_lag_count_;
+    }
+    previous_difference = difference;
+  }
+  double weight = 1.0;  // of the angle
+  if (chain_has_rate_ && source_count_ >= kMinSourceIncrements && source_lag_count_ >= kMinSourceIncrements / 2) {
+    const double variance = source_squares_ / source_count_, lag = source_lag_ / source_lag_count_;
+    // Each part only where the data show it beyond their own scatter (a lag-one covariance of N
+    // differences scatters by about variance / sqrt(N)): a clean source is not blamed for chance.
+    const double resolution = 2.0 * variance / std::sqrt(static_cast<double>(source_lag_count_));
+    const double angle_noise = -lag > resolution ? -lag : 0.0;
+    const double remainder = variance - 2.0 * angle_noise;
+    const double wander = remainder > resolution ? remainder : 0.0;
+    const double angle = 2.0 * (angle_noise + angle_smooth_error_);
+    if (angle + wander > 0.0) weight = wander / (angle + wander);
+  }
+  const double chain_time = chain_means_.back().t - chain_means_.front().t;
+  angle_weight_time_ += weight * chain_time;
+  weighted_chain_time_ += chain_time;
+  for (WindowMean& m : chain_means_) {
+    Eigen::VectorXd final_w(m_ + 1);
+    final_w.head(m_) = m.w.head(m_);
+    if (weight < 1.0) {
+      for (int j = 0; j < k_terms_; ++j) {
+        final_w(j) = weight * m.w(j) + (1.0 - weight) * (m.w(rate_k0_ + j) + slope * m.w(time_column_of_k_[j]));
+      }
+      m.phi = weight * m.phi + (1.0 - weight) * (m.phi_rate + slope * m.t);
+    }
+    final_w(m_) = m.w(raw_y_);
+    m.w.swap(final_w);
+    if (has_mean_) addIncrement(previous_mean_, m);
+    previous_mean_ = m;
+    has_mean_ = true;
+  }
+  chain_means_.clear();
+}
+
+void IncrementRegression::add(Nanoseconds stamp, double theta, double phi, double phi_rate) {
   if (!in_chain_) throw std::logic_error("increment regression: add() outside a chain");
   if (!has_sample_) origin_ = stamp;
   if (!has_origin_) {
@@ -96,6 +172,7 @@ void IncrementRegression::add(Nanoseconds stamp, double theta, double phi) {
     c(u) = basis_.cosOf(all_orders_[u]);
     s(u) = basis_.sinOf(all_orders_[u]);
   }
+  if (!std::isfinite(phi_rate)) chain_has_rate_ = false;
   if (has_sample_) {
     // Trapezoid of each integrand between the previous sample and this one.
     const double dt = t - t_prev_, dphi = phi - phi_prev_;
@@ -104,6 +181,15 @@ void IncrementRegression::add(Nanoseconds stamp, double theta, double phi) {
       const int u = k_in_all_[j];
       integrals_(1 + j) += 0.5 * (c(u) + cos_prev_(u)) * dphi;
       integrals_(1 + n_k + j) += 0.5 * (s(u) + sin_prev_(u)) * dphi;
+    }
+    if (chain_has_rate_) {
+      const double drate = phi_rate - phi_rate_prev_;
+      integrals_(rate_k0_) += drate;
+      for (int j = 0; j < n_k; ++j) {
+        const int u = k_in_all_[j];
+        integrals_(rate_k0_ + 1 + j) += 0.5 * (c(u) + cos_prev_(u)) * drate;
+        integrals_(rate_k0_ + 1 + n_k + j) += 0.5 * (s(u) + sin_prev_(u)) * drate;
+      }
     }
     integrals_(t0) += dt;
     for (int u = 0; u < n_all; ++u) {
@@ -141,35 +227,47 @@ void IncrementRegression::add(Nanoseconds stamp, double theta, double phi) {
   const long index = static_cast<long>(std::floor(t / window_));
   if (index != window_index_ && sum_.count > 0.0) closeWindow();
   window_index_ = index;
-  sum_.w.head(m_) += integrals_;
-  sum_.w(m_) += theta - theta_start_;
+  sum_.w.head(raw_y_) += integrals_;
+  sum_.w(raw_y_) += theta - theta_start_;
   sum_.t += t;
   sum_.t_session += t_session;
   sum_.theta += theta;
   sum_.phi += phi;
+  if (chain_has_rate_) {
+    sum_.phi_rate += phi_rate;
+    const double x = phi - phi_rate;
+    line_.n += 1.0;
+    line_.t += t;
+    line_.tt += t * t;
+    line_.x += x;
+    line_.tx += t * x;
+  }
   sum_.count += 1.0;
 
   has_sample_ = true;
   t_prev_ = t;
   session_t_prev_ = t_session;
   phi_prev_ = phi;
+  phi_rate_prev_ = phi_rate;
   cos_prev_.swap(cos_now_);
   sin_prev_.swap(sin_now_);
 }
 
 void IncrementRegression::closeWindow() {
+  // Held until the chain ends: the table's slope on the chain and the two sources' weights are
+  // known only then.
   WindowMean mean;
   mean.w = sum_.w / sum_.count;
   mean.t = sum_.t / sum_.count;
   mean.t_session = sum_.t_session / sum_.count;
   mean.theta = sum_.theta / sum_.count;
   mean.phi = sum_.phi / sum_.count;
+  mean.phi_rate = sum_.phi_rate / sum_.count;
+  mean.x = mean.phi - mean.phi_rate;
   mean.count = sum_.count;
-  if (has_mean_) addIncrement(previous_mean_, mean);
-  previous_mean_ = mean;
-  has_mean_ = true;
+  chain_means_.push_back(std::move(mean));
   sum_.w.setZero();
-  sum_.t = sum_.t_session = sum_.theta = sum_.phi = sum_.count = 0.0;
+  sum_.t = sum_.t_session = sum_.theta = sum_.phi = sum_.phi_rate = sum_.count = 0.0;
 }
 
 void IncrementRegression::addIncrement(const WindowMean& a, const WindowMean& b) {
@@ -284,7 +382,14 @@ IncrementRegression::Solved IncrementRegression::solveColumns(const std::vector<
 
 IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std, double min_bin_time,
                                         double max_condition) const {
+  if (in_chain_ && !chain_means_.empty()) {
+    // The open chain's window means wait for its end: close it on a copy.
+    IncrementRegression closed = *this;
+    closed.endChain();
+    return closed.solve(earth_rate, earth_rate_std, min_bin_time, max_condition);
+  }
   IncrementFit fit;
+  fit.angle_weight = weighted_chain_time_ > 0.0 ? angle_weight_time_ / weighted_chain_time_ : 1.0;
   const int n_k = static_cast<int>(k_orders_.size()), n_d = static_cast<int>(d_orders_.size());
   const int n_all = static_cast<int>(all_orders_.size());
   const int t0 = 1 + 2 * n_k, n_kterms = 1 + 2 * n_k, trend0 = t0 + 1 + 2 * n_all;

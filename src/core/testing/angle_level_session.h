@@ -196,7 +196,7 @@ inline CalibrationOutcome calibrateTableSession(const AngleLevelGyro& g, const T
                                                 const GyroParameters& prior) {
   CalibrationSession session(settings, prior);
   runTableSession(
-      g, table, profile, [&](Nanoseconds t, double angle, double rate) { session.addTurntable(t, angle, rate); },
+      g, table, profile, [&](const TableRecord& r) { session.addTurntable(r.stamp, r.angle, r.rate, r.seq); },
       [&](Nanoseconds t, double theta, double frequency) { session.addWave(t, theta, frequency); });
   return session.finish();
 }

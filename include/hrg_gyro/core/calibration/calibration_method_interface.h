@@ -28,6 +28,9 @@ struct PlateauSample {
   double table_angle = 0.0;
   double table_rate = 0.0;    ///< rad/s, as reported, interpolated at the stamp
   bool angle_logged = false;  ///< the turntable stream logs the table angle
+  /// rad^2: the variance the regularised stamps (table_stamp_regulariser.h) leave on table_angle, an
+  /// error smooth in time that the angle's own scatter does not show (0: stamps as logged).
+  double angle_smooth_error = 0.0;
 };
 
 struct CalibrationProgress {

@@ -38,13 +38,16 @@ class DualRateMethod : public CalibrationMethod {
   RateGroups groups_;  // coverage, progress and the plateau summaries
   // The estimate, with phi the session's table angle: the logged angle, or the integral of the
   // logged rate for a controller that logs none (the session decides, PlateauSample::angle_logged).
+  // Where both are logged, the regression weighs the angle against the rate's integral (its slope
+  // from the angle) by their measured noise: jittered stamps spoil the angle, not the integral.
   IncrementRegression regression_;
   std::vector<double> group_rates_;  // plateau rate of each regression group
   bool in_chain_ = false;
   std::uint64_t chain_plateau_ = 0;
   Nanoseconds last_stamp_ = 0;
   double last_table_angle_ = 0.0, unwrap_ = 0.0;
-  bool angle_logged_ = true;  // of the last sample: named in the report
+  double rate_integral_ = 0.0, last_table_rate_ = 0.0;  // of the logged rate over the open chain
+  bool angle_logged_ = true;                            // of the last sample: named in the report
   std::uint64_t samples_ = 0;
 };
 

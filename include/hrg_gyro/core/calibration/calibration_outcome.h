@@ -11,6 +11,8 @@
 #include "hrg_gyro/core/estimation/dual_rate_estimator.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/estimation/increment_regression.h"
+#include "hrg_gyro/core/estimation/table_clock_offset.h"
+#include "hrg_gyro/core/estimation/table_stamp_regulariser.h"
 #include "hrg_gyro/core/model/correction_matrix.h"
 #include "hrg_gyro/core/model/gyro_parameters.h"
 
@@ -25,6 +27,14 @@ struct TurntableRejects {
   std::uint64_t duplicate = 0;     ///< the stamp of the last good record
   std::uint64_t out_of_order = 0;  ///< behind the last good stamp (not, or not yet, a new timeline)
   std::uint64_t total() const { return bad_rate + bad_angle + bad_stamp + duplicate + out_of_order; }
+};
+
+/// What the session measured of the table's clock against the gyro's.
+struct TableClockReport {
+  bool measured = false;           ///< a turntable stream was read
+  double configured_offset = 0.0;  ///< s, subtracted from the table's stamps (table_clock/offset)
+  TableStampStatistics stamps;     ///< the regularisation of a fixed-rate log: jitter, steps
+  TableClockOffsetResult offset;   ///< the offset left after the configured one, from the changes of rate
 };
 
 struct GroupSummary {
@@ -72,6 +82,7 @@ struct CalibrationOutcome {
   /// dual-rate: the bias's trend fitted with K and D (order 0: none was fitted). The written D0 is
   /// the bias at bias_trend.reference_stamp, the mean time of the data.
   BiasTrendFit bias_trend;
+  TableClockReport table_clock;
 
   /// Appends a gate; the first failing one becomes the reason.
   void gate(const std::string& name, bool passed, double value, double limit, const std::string& message);

@@ -12,6 +12,12 @@
 // judges each record over a span centred on it, so records (and the wave samples between them) are
 // classified half a smoothing span after they arrive.
 //
+// The table's records may be stamped by another computer (table_clock settings): a known offset is
+// subtracted first, a fixed-rate log's stamps are put on the line through them against the record
+// count (TableStampRegulariser) before anything else reads them, and every wave sample around a change
+// of rate is kept to measure the offset that is left (TableClockOffsetEstimator), reported with the
+// outcome and gated (table_clock/max_offset).
+//
 // A glitched turntable record (a non-finite or impossible rate, an infinite angle, a NaN angle or one
 // the rate bound cannot reach in an angle-logging stream, a zero, duplicate or backward stamp) is
 // dropped and counted by reason before the plateau detector sees it, so it cannot end a plateau. A stream whose stamps
@@ -28,6 +34,8 @@
 #include "hrg_gyro/core/calibration/calibration_method_interface.h"
 #include "hrg_gyro/core/common/ring_buffer.h"
 #include "hrg_gyro/core/common/stamp_timeline.h"
+#include "hrg_gyro/core/estimation/table_clock_offset.h"
+#include "hrg_gyro/core/estimation/table_stamp_regulariser.h"
 #include "hrg_gyro/core/model/gyro_parameters.h"
 
 namespace hrg_gyro {
@@ -49,8 +57,11 @@ class CalibrationSession {
  public:
   CalibrationSession(const CalibrationSettings& settings, const GyroParameters& prior);
 
-  /// Returns false when the record was dropped (counted in counters().rejected).
-  bool addTurntable(Nanoseconds stamp, double angle, double rate);
+  /// Returns false when the record was dropped (counted in counters().rejected). `sequence`: the
+  /// record's header sequence number (TableStampRegulariser::kNoSequence when there is none); the
+  /// stamps of a fixed-rate log are regularised with it (table_clock settings).
+  bool addTurntable(Nanoseconds stamp, double angle, double rate,
+                    std::uint64_t sequence = TableStampRegulariser::kNoSequence);
   /// quadrature_ratio: B/A of the wave (NaN if unknown), averaged for the defect diagnosis.
   void addWave(Nanoseconds stamp, double theta, double frequency, double quadrature_ratio = NAN);
   void addGeneratorPair(Nanoseconds stamp, const ChannelVector& raw, const ChannelVector& reference);
@@ -86,6 +97,10 @@ class CalibrationSession {
   /// The stream went back for good: drop what the run gathered, start over from the prior.
   void restart();
   void classify(const WaveRecord& w);
+  /// The table clock's report and gate, from the regulariser and the changes of rate.
+  void reportTableClock(CalibrationOutcome* outcome) const;
+  /// Variance (rad^2) the regularised stamps leave on the table angle at this rate, smooth in time.
+  double regularisedAngleError(double rate) const;
 
   CalibrationSettings settings_;
   GyroParameters prior_;
@@ -94,6 +109,8 @@ class CalibrationSession {
   RingBuffer<PlateauRecord> turntable_;  // judged records
   std::vector<PlateauRecord> judged_;    // scratch: records the detector has just judged
   RingBuffer<WaveRecord> pending_;
+  TableStampRegulariser regulariser_;
+  TableClockOffsetEstimator clock_offset_;
   SessionCounters counters_;
   StampTimeline turntable_timeline_;
   StampTimeline wave_timeline_;

@@ -47,6 +47,16 @@ struct ThermalSettings {
   std::size_t nodeCount() const { return frequency_nodes.empty() ? node_count : frequency_nodes.size(); }
 };
 
+/// The table's clock (table_clock section): its stamps may come from another computer than the
+/// gyro's, offset and with jitter. See table_stamp_regulariser.h and table_clock_offset.h.
+struct TableClockSettings {
+  double offset = 0.0;       ///< s, a known offset of the table's stamps, subtracted before anything
+  bool regularise = true;    ///< a fixed-rate log's stamps put on the line through them
+  double window = 600.0;     ///< s of records the line is fitted over
+  double max_jitter = 5e-3;  ///< s: a log whose stamps scatter more about their line is not fixed-rate
+  double max_offset = 0.5;   ///< s: an estimated offset beyond this (3 sigma included) is refused
+};
+
 struct CalibrationSettings {
   CalibrationMethodKind method = CalibrationMethodKind::kDualRate;
   std::vector<int> scale_factor_orders{2, 4, 6, 8};
@@ -66,6 +76,7 @@ struct CalibrationSettings {
   PlateauSettings plateau;
   QualityLimits gates;
   ThermalSettings thermal;
+  TableClockSettings table_clock;
 
   /// Parses the calibrator settings map. Throws ConfigError naming the key.
   static CalibrationSettings parse(const YamlField& root, const std::vector<std::string>& extra_keys = {});

@@ -39,6 +39,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -87,6 +88,9 @@ struct IncrementFit {
   std::size_t increments = 0;
   std::size_t blocks = 0;  ///< blocks of the sandwich covariance
   BiasTrendFit trend;      ///< order 0: none fitted
+  /// Weight of the logged table angle against the integral of the logged rate (with the angle's
+  /// slope per chain), time-weighted over the chains: 1 the angle alone, 0 the rate's shape alone.
+  double angle_weight = 1.0;
 };
 
 class IncrementRegression {
@@ -99,10 +103,14 @@ class IncrementRegression {
   /// Starts a chain of plateau group `group` averaged over windows of `window` s (ends any open chain).
   void startChain(int group, double window);
   /// Adds a sample of the open chain: theta the measured wave angle, phi the table angle (without the
-  /// Earth rate, which solve() adds); stamps increasing.
-  void add(Nanoseconds stamp, double theta, double phi);
+  /// Earth rate, which solve() adds), phi_rate the integral of the table's logged rate from the chain's
+  /// start (NaN: none); stamps increasing.
+  void add(Nanoseconds stamp, double theta, double phi, double phi_rate = NAN);
   /// Closes the open chain (its last, partial window is left out).
   void endChain();
+  /// rad^2: an error of the angle that is smooth in time (regularised stamps), which the window
+  /// means' scatter does not show; counted against the angle when the two sources are weighed.
+  void setAngleSmoothError(double variance) { angle_smooth_error_ = variance; }
   bool inChain() const { return in_chain_; }
 
   std::size_t increments() const { return increments_; }
@@ -121,9 +129,14 @@ class IncrementRegression {
     double dt = 0.0, dphi = 0.0;
   };
   struct WindowMean {
-    Eigen::VectorXd w;  // mean of (z, y)
+    Eigen::VectorXd w;  // mean of (z, y): the raw columns until the chain ends, then the regression's
     double t = 0.0, theta = 0.0, phi = 0.0, count = 0.0;
     double t_session = 0.0;  // mean time from the session's first sample
+    double phi_rate = 0.0;   // mean rate integral
+    double x = 0.0;          // phi - phi_rate
+  };
+  struct LineSums {
+    double n = 0.0, t = 0.0, tt = 0.0, x = 0.0, tx = 0.0;
   };
   /// The normal equations of the fitted columns `sel` solved at the Earth rate, with the block
   /// sandwich and the white-noise covariance of the coefficients.
@@ -133,6 +146,9 @@ class IncrementRegression {
   };
 
   void closeWindow();
+  /// The chain's window means into increments, the table angle taken as the weighted sum of the
+  /// logged angle and the rate integral (with the chain's slope from the angle).
+  void flushChain();
   void addIncrement(const WindowMean& a, const WindowMean& b);
   /// The linear map of the accumulated columns: the Earth rate added to phi, the trend centred on t_ref.
   Eigen::MatrixXd regressorMap(double earth_rate, double reference_time) const;
@@ -143,6 +159,8 @@ class IncrementRegression {
   int bins_;
   int trend_order_;
   int m_;  // regressors: K block (1 + 2 nK), then T and the T harmonics of every order, then the trend
+  int k_terms_ = 0, rate_k0_ = 0, raw_y_ = 0;  // the accumulated columns: K block along the rate integral, y
+  std::vector<int> time_column_of_k_;
   HarmonicBasis basis_;
   // The session's first sample: the trend's time origin.
   bool has_origin_ = false;
@@ -154,7 +172,15 @@ class IncrementRegression {
   int group_ = 0;
   double window_ = 0.0;
   Nanoseconds origin_ = 0;
-  double t_prev_ = 0.0, phi_prev_ = 0.0, theta_start_ = 0.0, session_t_prev_ = 0.0;
+  double t_prev_ = 0.0, phi_prev_ = 0.0, theta_start_ = 0.0, session_t_prev_ = 0.0, phi_rate_prev_ = 0.0;
+  std::vector<WindowMean> chain_means_;  // the open chain's, held until it ends
+  LineSums line_;                        // of phi - phi_rate against t over the open chain
+  bool chain_has_rate_ = true;
+  // The two table sources, judged over the session: consecutive differences of (angle - integral).
+  double source_squares_ = 0.0, source_lag_ = 0.0;
+  std::size_t source_count_ = 0, source_lag_count_ = 0;
+  double angle_smooth_error_ = 0.0;
+  double angle_weight_time_ = 0.0, weighted_chain_time_ = 0.0;
   std::vector<int> k_in_all_;  // index of each K order in all_orders_
   Eigen::VectorXd cos_prev_, sin_prev_, cos_now_, sin_now_, integrals_;
   long window_index_ = 0;
