@@ -11,6 +11,7 @@ GyroSimulator::GyroSimulator(const SimulationConfig& config)
     : config_(config),
       synth_(config_.pickoff, config_.resonator.samples_per_period, config_.seed),
       rate_noise_(config_.seed ^ 0x5deece66dULL),
+      bias_walk_draws_(config_.seed ^ 0x1f83d9abfb41bd6bULL),
       intrinsic_(config_.resonator.scale_factor, config_.resonator.drift),
       frequency_(config_.resonator.frequency),
       amplitude_(config_.resonator.amplitude),
@@ -76,7 +77,15 @@ double GyroSimulator::thetaRate(double t, double theta) {
   double angle, rate, k, d;
   config_.profile.evaluate(t - generatorDuration(), &angle, &rate);
   intrinsic_.evaluate(theta, config_.resonator.frequency, &k, &d);
+  const BiasDriftConfig& drift = config_.resonator.bias_drift;
+  // Only with a drift: adding a zero could still flip the sign of a zero rate.
+  if (drift.enabled()) return k * (rate + earth_rate_) + d + (drift.trendAt(t) + bias_walk_);
   return k * (rate + earth_rate_) + d;
+}
+
+double GyroSimulator::injectedBias(double t) const {
+  const HarmonicModel& d = config_.thermal.enabled ? thermal_d_ : config_.resonator.drift;
+  return d.meanAt(config_.resonator.frequency) + config_.resonator.bias_drift.trendAt(t) + bias_walk_;
 }
 
 void GyroSimulator::stamp(double t_center, SimulationSample* out) const {
@@ -85,12 +94,16 @@ void GyroSimulator::stamp(double t_center, SimulationSample* out) const {
 
 bool GyroSimulator::next(SimulationSample* out) {
   if (done()) return false;
+  const double t_start = t_;
   if (config_.generator.enabled && t_ < generatorDuration() - 1e-9) {
     nextGenerator(out);
   } else {
     nextDynamic(out);
   }
   out->index = index_++;
+  const double walk = config_.resonator.bias_drift.random_walk;
+  // The Wiener increment over the window just simulated, held over the next one.
+  if (walk > 0.0) bias_walk_ += walk * std::sqrt(t_ - t_start) * bias_walk_draws_.next();
   return true;
 }
 
@@ -148,6 +161,7 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
   truth.phase = rc.phase;
   truth.frequency = frequency_;
   truth.temperature = temperature_;
+  truth.bias = injectedBias(t_center);
   truth.generator = false;
   logTurntable(t_center, out);
 }
@@ -183,6 +197,7 @@ void GyroSimulator::nextGenerator(SimulationSample* out) {
   truth.phase = wave.phase;
   truth.frequency = frequency_;
   truth.temperature = temperature_;
+  truth.bias = injectedBias(0.5 * (t_start + t_));
   truth.inertial_rate = earth_rate_;
   truth.inertial_angle = earth_rate_ * 0.5 * (t_start + t_);
   truth.generator = true;

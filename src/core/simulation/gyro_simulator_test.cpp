@@ -3,7 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include "hrg_gyro/core/processing/gyro_processor.h"
+#include "hrg_gyro/core/simulation/injected_model.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -131,6 +134,250 @@ TEST(GyroSimulatorTest, GeneratorSweepsKnownWaves) {
   }
   ASSERT_EQ(thetas.size(), 4u * 2u * 2u);
   EXPECT_NEAR(thetas.back(), 3 * kPi / 4, 1e-15);
+}
+
+/// A gyro at rest whose wave angle still sweeps: a large D0 (0.05 rad/s, about 2 rad in 40 s) so
+/// that D(theta) and K(theta) are met at many angles, at 1/T = 200 Hz with 8 samples per period.
+SimulationConfig restingGyro(double duration) {
+  SimulationConfig c;
+  c.resonator.samples_per_period = 8;
+  c.resonator.periods_per_output = 25;
+  c.resonator.scale_factor = HarmonicModel({2, 4}, -0.56, {-2e-4, 1e-4}, {1.5e-4, 0.0});
+  c.resonator.drift = HarmonicModel({2}, 0.05, {2e-3}, {-1e-3});
+  c.latitude = 0.9;
+  c.profile.append(duration, 0.0, 0.0, "rest");
+  return c;
+}
+
+YamlField parseYaml(const std::string& text) { return YamlField(YAML::Load(text), ""); }
+
+TEST(GyroSimulatorTest, BiasDriftKeysAreParsedAndBadOnesNamed) {
+  const std::string profile = "turntable: {profile: [{type: dwell, duration: 1}]}\n";
+  const SimulationConfig c =
+      SimulationConfig::parse(parseYaml("resonator: {bias_drift: {rate: -5.0e-10, random_walk: 2.0e-8}}\n" + profile));
+  EXPECT_EQ(c.resonator.bias_drift.rate, -5e-10);
+  EXPECT_EQ(c.resonator.bias_drift.random_walk, 2e-8);
+  EXPECT_TRUE(c.resonator.bias_drift.enabled());
+  EXPECT_FALSE(SimulationConfig::parse(parseYaml(profile)).resonator.bias_drift.enabled());
+  auto key = [&](const std::string& section) {
+    try {
+      SimulationConfig::parse(parseYaml("resonator: {bias_drift: " + section + "}\n" + profile));
+    } catch (const ConfigError& e) {
+      return e.key();
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(key("{rate: .nan}"), "resonator.bias_drift.rate");
+  EXPECT_EQ(key("{rate: .inf}"), "resonator.bias_drift.rate");
+  EXPECT_EQ(key("{rate: fast}"), "resonator.bias_drift.rate");
+  EXPECT_EQ(key("{random_walk: -1.0e-8}"), "resonator.bias_drift.random_walk");
+  EXPECT_EQ(key("{random_walk: .inf}"), "resonator.bias_drift.random_walk");
+  EXPECT_EQ(key("{trend: 1.0e-9}"), "resonator.bias_drift.trend");
+  EXPECT_EQ(key("[1.0e-9, 0]"), "resonator.bias_drift");
+  EXPECT_EQ(key("{rate: 0, random_walk: 0}"), "accepted");
+}
+
+// A section of zeros is the scenario without one, bit for bit (and the fingerprint test below
+// holds the scenario without one to its bits from before the section existed).
+TEST(GyroSimulatorTest, BiasDriftOfZerosIsTheRunWithout) {
+  const std::string scenario =
+      "pickoff: {noise: 2.0e-4, amplitude_to_gap: 0.05}\n"
+      "turntable: {latitude: 0.9, profile: [{type: dwell, duration: 0.5}, {type: rate, rate: 0.3, duration: 2}]}\n"
+      "resonator: {samples_per_period: 8, rate_noise: 1.0e-5";
+  GyroSimulator a(SimulationConfig::parse(parseYaml(scenario + "}\n")));
+  GyroSimulator b(SimulationConfig::parse(parseYaml(scenario + ", bias_drift: {rate: 0.0, random_walk: 0.0}}\n")));
+  SimulationSample sa, sb;
+  int n = 0;
+  while (a.next(&sa)) {
+    ASSERT_TRUE(b.next(&sb));
+    for (int i = 0; i < 4; ++i) ASSERT_EQ(sa.z[i], sb.z[i]) << n;
+    ASSERT_EQ(sa.truth.theta, sb.truth.theta) << n;
+    EXPECT_EQ(sa.truth.bias, 0.0);  // the default intrinsic D is zero
+    EXPECT_EQ(sb.truth.bias, 0.0);
+    ++n;
+  }
+  EXPECT_FALSE(b.next(&sb));
+  EXPECT_GT(n, 2000);
+}
+
+// Constant K and D: theta(t) = theta0 + (K Omega_E + D0) t + R t^2 / 2 in closed form, which RK4
+// integrates exactly (a polynomial of t of degree 2); the truth reports D0 + R t.
+TEST(GyroSimulatorTest, BiasTrendAddsItsExactIntegralToTheta) {
+  SimulationConfig c = restingGyro(20.0);
+  c.resonator.scale_factor = HarmonicModel(-0.56);
+  c.resonator.drift = HarmonicModel(1e-5);
+  c.resonator.bias_drift.rate = 3e-8;  // rad/s per s: D0 moves by 6e-7 rad/s, theta by 6e-6 rad
+  GyroSimulator sim(c);
+  const double slope = -0.56 * verticalEarthRate(0.9) + 1e-5;
+  SimulationSample s;
+  double worst = 0.0;
+  int n = 0;
+  while (sim.next(&s)) {
+    const double t = toSeconds(s.stamp) - c.start_time;
+    const double expected = c.resonator.initial_theta + slope * t + 0.5 * 3e-8 * t * t;
+    // Round-off of 100000 RK4 steps on theta ~ 1e-2 rad: ~1e-15 rad each, 1e-12 in all.
+    ASSERT_NEAR(s.truth.theta, expected, 1e-12) << t;
+    EXPECT_NEAR(s.truth.bias, 1e-5 + 3e-8 * t, 1e-18) << t;
+    EXPECT_NEAR(s.truth.bias, injectedBiasTrend(c, t), 1e-18) << t;
+    worst = std::max(worst, std::abs(s.truth.theta - (c.resonator.initial_theta + slope * t)));
+    ++n;
+  }
+  EXPECT_EQ(n, 4000);
+  EXPECT_NEAR(worst, 0.5 * 3e-8 * 20.0 * 20.0, 1e-7);  // the trend's angle really is in theta
+}
+
+// Harmonic K and D, a trend and a random walk: theta is the integral of
+//   K(theta) Omega_E + D(theta) + R t + w_k
+// with w_k the random walk held over window k, read back from the truth (bias - D0 - R t). An
+// independent RK4 at a quarter of the simulator's step agrees with the truth's theta.
+TEST(GyroSimulatorTest, BiasDriftEntersThetaAsItsExactIntegral) {
+  SimulationConfig c = restingGyro(40.0);
+  c.resonator.bias_drift.rate = 2e-8;         // D0 moves by 8e-7 rad/s in 40 s: 1.6e-5 rad of theta
+  c.resonator.bias_drift.random_walk = 2e-6;  // ~1.3e-5 rad/s after 40 s, ~3e-4 rad of theta
+  GyroSimulator sim(c);
+  const ResonatorConfig& rc = c.resonator;
+  const double earth = verticalEarthRate(0.9), d0 = rc.drift.meanAt(NAN), h = 0.25 / rc.frequency;
+  const int steps_per_window = 4 * rc.periods_per_output;  // the centre is at step 50 of 100
+  auto rate = [&](double t, double theta, double walk) {
+    return rc.scale_factor(theta) * earth + rc.drift(theta) + rc.bias_drift.rate * t + walk;
+  };
+  double theta = rc.initial_theta, worst = 0.0, walk_angle = 0.0;
+  SimulationSample s;
+  int k = 0;
+  while (sim.next(&s)) {
+    const double window_start = k * c.outputPeriod();
+    const double walk = s.truth.bias - d0 - rc.bias_drift.rate * (window_start + 0.5 * c.outputPeriod());
+    double centre = NAN;
+    for (int j = 0; j < steps_per_window; ++j) {
+      if (j == steps_per_window / 2) centre = theta;
+      const double t = window_start + j * h;
+      const double k1 = rate(t, theta, walk), k2 = rate(t + h / 2, theta + h / 2 * k1, walk);
+      const double k3 = rate(t + h / 2, theta + h / 2 * k2, walk), k4 = rate(t + h, theta + h * k3, walk);
+      theta += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    }
+    walk_angle += walk * c.outputPeriod();
+    // Two RK4 integrations of one smooth equation agree to ~1e-12 rad; the truth's linear
+    // interpolation at the window centre adds theta'' h^2 / 8 ~ 1e-12 rad. The drift's own angle
+    // is ~3e-4 rad: 1e-9 would catch any error of the drift's integral above 3 ppm.
+    ASSERT_NEAR(s.truth.theta, centre, 1e-9) << k;
+    worst = std::max(worst, std::abs(s.truth.theta - centre));
+    ++k;
+  }
+  std::printf(
+      "[ measured ] theta with the drifting bias vs an independent RK4: %.3g rad at worst; the random "
+      "walk's angle %.3g rad, the trend's %.3g rad\n",
+      worst, walk_angle, 0.5 * rc.bias_drift.rate * 40.0 * 40.0);
+  EXPECT_EQ(k, 8000);
+  EXPECT_GT(std::abs(walk_angle), 1e-5);  // the walk moved theta by far more than the tolerance
+}
+
+// The random walk's increments between samples are W sqrt(T) N(0, 1): independent, zero mean, variance
+// W^2 T. Three seeds of 20000 increments each: the normalised variance is 1 within 5 sigma of its
+// estimate (sqrt(2 / 60000) = 0.6 % each), the mean 0 and the lag-1 correlation 0 within 5 / sqrt(60000).
+TEST(GyroSimulatorTest, BiasRandomWalkIncrementsHaveTheStatedVariance) {
+  SimulationConfig c = restingGyro(20.0);
+  c.resonator.periods_per_output = 5;  // T = 1 ms
+  c.resonator.bias_drift.random_walk = 3e-7;
+  c.turntable_log.angle_noise = 1e-6;  // encoder draws: the walk must not move them
+  const double scale = 3e-7 * std::sqrt(c.outputPeriod());
+  std::vector<double> z;
+  std::vector<std::vector<TurntableLogRecord>> logs;
+  for (const std::uint64_t seed : {1, 2, 3}) {
+    c.seed = seed;
+    GyroSimulator sim(c);
+    SimulationSample s;
+    double previous = NAN;
+    std::vector<TurntableLogRecord> log;
+    while (sim.next(&s)) {
+      if (!std::isnan(previous)) z.push_back((s.truth.bias - previous) / scale);
+      previous = s.truth.bias;
+      log.insert(log.end(), s.turntable.begin(), s.turntable.end());
+    }
+    logs.push_back(log);
+  }
+  const double n = static_cast<double>(z.size());
+  double mean = 0.0, var = 0.0, lag1 = 0.0;
+  for (const double v : z) mean += v / n;
+  for (std::size_t i = 0; i < z.size(); ++i) {
+    var += (z[i] - mean) * (z[i] - mean) / n;
+    if (i > 0) lag1 += (z[i] - mean) * (z[i - 1] - mean) / n;
+  }
+  std::printf(
+      "[ measured ] bias random walk: %.0f increments, variance %.4f of W^2 T, mean %.4f, lag-1 "
+      "correlation %.4f\n",
+      n, var, mean, lag1 / var);
+  EXPECT_EQ(z.size(), 3u * 19999u);
+  EXPECT_NEAR(var, 1.0, 5.0 * std::sqrt(2.0 / n));
+  EXPECT_NEAR(mean, 0.0, 5.0 / std::sqrt(n));
+  EXPECT_NEAR(lag1 / var, 0.0, 5.0 / std::sqrt(n));
+  // The same seed without the walk logs the same encoder noise: the walk draws from its own stream.
+  c.resonator.bias_drift.random_walk = 0.0;
+  GyroSimulator still(c);
+  SimulationSample s;
+  std::size_t r = 0;
+  while (still.next(&s)) {
+    for (const TurntableLogRecord& record : s.turntable) ASSERT_EQ(record.angle, logs.back()[r++].angle);
+  }
+  EXPECT_EQ(r, logs.back().size());
+  EXPECT_NE(logs[0][5].angle, logs[1][5].angle);  // the seeds differ
+}
+
+/// FNV-1a over the bits of every simulated value a consumer sees: samples, truth and table records.
+class Fingerprint {
+ public:
+  template <typename T>
+  void add(const T& value) {
+    unsigned char bytes[sizeof(T)];
+    std::memcpy(bytes, &value, sizeof(T));
+    for (const unsigned char b : bytes) hash_ = (hash_ ^ b) * 0x100000001b3ULL;
+  }
+  void add(const SimulationSample& s) {
+    add(s.index), add(s.stamp), add(s.channels_delivered), add(s.frequency), add(s.temperature);
+    for (int i = 0; i < 4; ++i) add(s.z[i]);
+    add(s.truth.theta), add(s.truth.table_angle), add(s.truth.table_rate), add(s.truth.inertial_angle);
+    for (const TurntableLogRecord& r : s.turntable) {
+      add(r.index), add(r.time), add(r.stamp), add(r.angle), add(r.rate), add(static_cast<int>(r.glitch));
+    }
+  }
+  std::uint64_t value() const { return hash_; }
+
+ private:
+  std::uint64_t hash_ = 0xcbf29ce484222325ULL;
+};
+
+// The bits of a noisy scenario with every random effect of the table log on, as they were before
+// the bias drift and the table clock existed: scenarios without those sections must not change by
+// one bit. The hash is of this compiler and C library (Debian bookworm's gcc and glibc); another
+// libm may round a logarithm or a sine differently, and then the value printed here is the new one.
+TEST(GyroSimulatorTest, ScenarioWithoutNewSectionsKeepsItsFingerprint) {
+  const std::string scenario =
+      "seed: 7\n"
+      "resonator: {periods_per_output: 25, samples_per_period: 8, rate_noise: 1.0e-5, initial_theta: 0.2,\n"
+      "  scale_factor: {orders: [2, 4], mean: -0.56, cos: [-2.0e-4, 1.0e-4], sin: [1.5e-4, 0.0]},\n"
+      "  drift: {orders: [2], mean: 1.0e-5, cos: [2.0e-5], sin: [-1.0e-5]}}\n"
+      "pickoff: {misplacement: [1.0e-3, 0, 0, -0.5e-3, 0, 0, 0, -1.0e-3], amplitude_to_gap: 0.05, noise: 2.0e-4}\n"
+      "channels: {drop_probability: 0.01}\n"
+      "turntable:\n"
+      "  latitude: 0.9\n"
+      "  ripple: {amplitude: 0.002, frequency: 0.37}\n"
+      "  profile: [{type: dwell, duration: 1.0}, {type: dual_rate, rates: [0.2, -0.2], duration: 2.0, settle: 0.5}]\n";
+  const std::string logs[] = {
+      "  log: {angle_noise: 2.0e-6, angle_resolution: 1.0e-7, drop_probability: 0.01,\n"
+      "        glitches: {nan_rate: 0.01, absurd_rate: 0.01, infinite_angle: 0.01, zero_stamp: 0.01, "
+      "backward_stamp: 0.01}}\n",
+      "  log: {rate: 130, angle_noise: 2.0e-6, logged_rate: differenced_angle, drop_probability: 0.01,\n"
+      "        glitches: {zero_stamp: 0.01, backward_stamp: 0.01}}\n"};
+  std::vector<std::uint64_t> hashes;
+  for (const std::string& log : logs) {
+    GyroSimulator sim(SimulationConfig::parse(YamlField(YAML::Load(scenario + log), "")));
+    Fingerprint f;
+    SimulationSample s;
+    while (sim.next(&s)) f.add(s);
+    std::printf("[ measured ] fingerprint 0x%016llx\n", static_cast<unsigned long long>(f.value()));
+    hashes.push_back(f.value());
+  }
+  EXPECT_EQ(hashes[0], 0x8b7804bd5bd67e64ULL);
+  EXPECT_EQ(hashes[1], 0x98ff87d26350b089ULL);
 }
 
 }  // namespace

@@ -10,6 +10,16 @@
 
 namespace hrg_gyro {
 namespace core {
+
+double injectedBiasTrend(const SimulationConfig& config, double t) {
+  const ResonatorConfig& rc = config.resonator;
+  double d0 = rc.drift.meanAt(rc.frequency);
+  if (config.thermal.enabled) {
+    d0 = atTemperature(config, config.thermal.profile.evaluate(t)).resonator.drift.meanAt(rc.frequency);
+  }
+  return d0 + rc.bias_drift.trendAt(t);
+}
+
 EffectiveModel computeEffectiveModel(const SimulationConfig& config, const CorrectionMatrix& correction,
                                      const std::vector<int>& k_orders, const std::vector<int>& d_orders) {
   PickoffDefects noiseless = config.pickoff;

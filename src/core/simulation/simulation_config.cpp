@@ -55,6 +55,19 @@ void checkThermalLimits(const SimulationConfig& c, const YamlField& section) {
   }
 }
 
+BiasDriftConfig parseBiasDrift(const YamlField& section) {
+  section.requireMap();
+  section.rejectUnknownKeys({"rate", "random_walk"});
+  BiasDriftConfig c;
+  c.rate = section.getDouble("rate", 0.0);
+  if (!std::isfinite(c.rate)) section["rate"].fail("must be finite (rad/s per s)");
+  c.random_walk = section.getDouble("random_walk", 0.0);
+  if (!(std::isfinite(c.random_walk) && c.random_walk >= 0.0)) {
+    section["random_walk"].fail("must be >= 0 (rad/s/sqrt(s))");
+  }
+  return c;
+}
+
 }  // namespace
 
 SimulationConfig atTemperature(const SimulationConfig& config, double temperature) {
@@ -87,7 +100,7 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
   if (root.has("resonator")) {
     const YamlField r = root["resonator"];
     r.rejectUnknownKeys({"frequency", "samples_per_period", "periods_per_output", "amplitude", "quadrature", "phase",
-                         "initial_theta", "scale_factor", "drift", "rate_noise"});
+                         "initial_theta", "scale_factor", "drift", "rate_noise", "bias_drift"});
     ResonatorConfig& rc = c.resonator;
     rc.frequency = r.getDouble("frequency", rc.frequency);
     if (!(rc.frequency > 0.0)) r["frequency"].fail("must be positive (Hz)");
@@ -107,6 +120,7 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
     if (r.has("drift")) rc.drift = parseDriftModel(r["drift"]);
     rc.rate_noise = r.getDouble("rate_noise", 0.0);
     if (rc.rate_noise < 0.0) r["rate_noise"].fail("must be >= 0 (rad/sqrt(s))");
+    if (r.has("bias_drift")) rc.bias_drift = parseBiasDrift(r["bias_drift"]);
   }
 
   if (root.has("pickoff")) {

@@ -10,6 +10,11 @@
 // session starts with a known sweep of (theta, B, tau) at rest (for the correction-matrix fit), and
 // the turntable profile, if any, follows it.
 //
+// A wandering bias (ResonatorConfig::bias_drift) adds rate t + W B(t) to d theta/dt, t from the
+// scenario start. The trend is inside the RK4 stages (linear in t, so integrated exactly); the random
+// walk is held over each output window (its value at the window's start, stepped by W sqrt(T) N(0, 1)
+// from a stream of its own between windows), a constant the RK4 stages integrate exactly too.
+//
 // The turntable records are those the table controller logs (TurntableLogger): by default one per
 // output sample with its stamp and the exact table state, otherwise at the log rate with encoder
 // noise, quantisation, a differenced rate, losses and glitches. Channel samples may be lost too
@@ -48,6 +53,9 @@ struct TruthState {
   double phase = 0.0;
   double frequency = 0.0;    ///< Hz
   double temperature = NAN;  ///< degC
+  /// The injected turn-on bias D0(t) at the sample, rad/s: the mean of the intrinsic D (at the
+  /// sample's temperature) plus the bias drift's trend and random walk (as held over the window).
+  double bias = 0.0;
   bool generator = false;
   const std::string* segment = nullptr;  ///< profile label (owned by the simulator)
 };
@@ -93,6 +101,8 @@ class GyroSimulator {
   double generatorDuration() const;
   std::uint64_t generatorOutputsPerState() const;
   void stamp(double t_center, SimulationSample* out) const;
+  /// The injected D0 at t s from the start, within the current window (TruthState::bias).
+  double injectedBias(double t) const;
   /// Thermal scenarios: moves the gyro to the temperature at time t (s from the start).
   void updateTemperature(double t);
   /// Fills out->turntable with the records logged up to the sample's centre time t_center.
@@ -100,7 +110,9 @@ class GyroSimulator {
 
   SimulationConfig config_;
   SignalSynthesizer synth_;
-  GaussianNoise rate_noise_;  // separate stream: switching it on leaves the pickoff noise unchanged
+  GaussianNoise rate_noise_;       // separate stream: switching it on leaves the pickoff noise unchanged
+  GaussianNoise bias_walk_draws_;  // the bias random walk's own stream, for the same reason
+  double bias_walk_ = 0.0;         // W B(t) at the current window's start, held over the window, rad/s
   // Intrinsic K and D: the resonator's own models, or (thermal) those of the current temperature.
   HarmonicModel thermal_k_{0.0}, thermal_d_{0.0};
   ModelPairEvaluator intrinsic_;

@@ -22,6 +22,11 @@ struct EffectiveModel {
   double nonlinearity_ppm = 0.0;   ///< peak |K_eff - K0| / |K0| including every order up to 16
 };
 
+/// The injected turn-on bias D0(t) of a scenario at t s from its start, rad/s, without the random
+/// walk: the mean of the intrinsic D (at the temperature of time t) plus the bias drift's trend. The
+/// random walk's realisation is a draw of the run: the ground truth carries it (TruthState::bias).
+double injectedBiasTrend(const SimulationConfig& config, double t);
+
 EffectiveModel computeEffectiveModel(const SimulationConfig& config, const CorrectionMatrix& correction,
                                      const std::vector<int>& k_orders, const std::vector<int>& d_orders);
 

@@ -20,6 +20,19 @@
 namespace hrg_gyro {
 namespace core {
 
+/// A turn-on bias that wanders through the session, as a warming gyro's does:
+///   D0(t) = D0 + rate t + random_walk B(t),
+/// t s since the scenario start (generator sweep included), B a standard Wiener process. The wander
+/// adds to d theta/dt like D does (it is not scaled by K). Off (zeros) by default.
+struct BiasDriftConfig {
+  double rate = 0.0;         ///< rad/s per s: the linear trend of D0
+  double random_walk = 0.0;  ///< rad/s/sqrt(s): D0's random walk, its std grows as random_walk sqrt(t)
+
+  bool enabled() const { return rate != 0.0 || random_walk != 0.0; }
+  /// The trend's part of the wander at t s from the scenario start, rad/s.
+  double trendAt(double t) const { return rate * t; }
+};
+
 struct ResonatorConfig {
   double frequency = 5000.0;          ///< Hz
   int samples_per_period = 32;        ///< N >= 8
@@ -33,6 +46,7 @@ struct ResonatorConfig {
   /// White noise of the body rate the resonator senses (angle random walk), rad/sqrt(s); the
   /// pickoff noise gives white *angle* noise instead. 0: none.
   double rate_noise = 0.0;
+  BiasDriftConfig bias_drift;  ///< a wandering D0 (default: none)
 };
 
 struct GeneratorConfig {
