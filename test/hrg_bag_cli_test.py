@@ -131,6 +131,41 @@ class HrgBagCli(unittest.TestCase):
         self.assertFails(hrg_bag("simulate", "--scenario", self.path("nope.yaml"), "--out", self.path("n.bag")), 2,
                          "nope.yaml")
 
+    def test_simulate_writes_the_controller_count_and_clock(self):
+        # The table logged at 100 Hz on its own clock (0.1 s ahead, 2 ms of jitter), 5 % of its
+        # records and of the channel samples lost: header.seq is the controller's count (the sample
+        # index for /channels), so each loss leaves a gap; the bag time is when the record was made.
+        with open(os.path.join(self.pkg, "test/scenarios/short_session.yaml")) as f:
+            scenario = f.read()
+        scenario += ("  log: {rate: 100.0, drop_probability: 0.05, clock: {offset: 0.1, jitter: 0.002}}\n"
+                     "channels: {drop_probability: 0.05}\n")
+        path, bag_path = self.path("clock.yaml"), self.path("clock.bag")
+        with open(path, "w") as f:
+            f.write(scenario)
+        code, _, err = hrg_bag("simulate", "--scenario", path, "--out", bag_path, "--no-truth")
+        self.assertEqual(code, 0, err)
+        seqs = {"/channels": [], "/turntable/state": []}
+        offsets = []
+        with rosbag.Bag(bag_path) as bag:
+            for topic, msg, t in bag.read_messages(topics=list(seqs)):
+                seqs[topic].append(msg.header.seq)
+                if topic == "/turntable/state":
+                    offsets.append(msg.header.stamp.to_sec() - t.to_sec())
+        for topic, seq in seqs.items():
+            steps = [b - a for a, b in zip(seq, seq[1:])]
+            self.assertTrue(all(s >= 1 for s in steps), topic)
+            lost = sum(s - 1 for s in steps)
+            # 5 % of ~3700 records and ~7400 samples: 5 sigma below the expected losses is still > 100.
+            self.assertGreater(lost, 100, topic)
+            self.assertEqual(seq[0] + len(seq) + lost - 1, seq[-1], topic)
+        n = len(offsets)
+        mean = sum(offsets) / n
+        std = math.sqrt(sum((o - mean) ** 2 for o in offsets) / n)
+        # The record's bag time is its true time (rounded to the ns, as its stamp is): the stamps lead
+        # by the offset with the jitter's spread, within 5 sigma of their estimates over n records.
+        self.assertAlmostEqual(mean, 0.1, delta=5 * 0.002 / math.sqrt(n))
+        self.assertAlmostEqual(std, 0.002, delta=5 * 0.002 / math.sqrt(2 * n))
+
     def test_info_reports_rates_and_validates(self):
         code, out, err = hrg_bag("info", self.short)
         self.assertEqual(code, 0, err)

@@ -64,10 +64,10 @@ ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::
   return m;
 }
 
-TurntableState toTurntableMessage(const core::TurntableLogRecord& r, core::Nanoseconds origin, std::uint32_t seq,
+TurntableState toTurntableMessage(const core::TurntableLogRecord& r, core::Nanoseconds origin,
                                   const std::string& frame_id) {
   TurntableState m;
-  m.header.seq = seq;
+  m.header.seq = static_cast<std::uint32_t>(r.index);
   // A zero stamp is what a glitched controller sends, whatever the clock's origin.
   m.header.stamp = r.stamp == 0 ? ros::Time() : toRosTime(origin + r.stamp);
   m.header.frame_id = frame_id;

@@ -167,9 +167,10 @@ void DriverSimRos::run() {
     auto channels = boost::make_shared<ChannelAmplitudes>(
         toChannelsMessage(s, stamp, static_cast<std::uint32_t>(s.index), frame_id_));
     if (s.channels_delivered) channels_pub_.publish(channels);
+    // A record's sequence number is the controller's count, its stamp on the controller's clock.
+    // (roscpp renumbers header.seq on a TCP connection; a nodelet in this process sees these.)
     for (const core::TurntableLogRecord& r : s.turntable) {
-      turntable_pub_.publish(boost::make_shared<TurntableState>(
-          toTurntableMessage(r, origin, static_cast<std::uint32_t>(r.index), frame_id_)));
+      turntable_pub_.publish(boost::make_shared<TurntableState>(toTurntableMessage(r, origin, frame_id_)));
     }
     if (truth_pub_.getNumSubscribers() > 0) {
       truth_pub_.publish(boost::make_shared<GroundTruth>(toTruthMessage(s, channels->header)));

@@ -37,9 +37,9 @@ GyroOutput toOutputMessage(const std_msgs::Header& header, const core::Processor
 // The messages of one simulated sample (driver_sim and `hrg_bag simulate`).
 ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::Time& stamp, std::uint32_t seq,
                                     const std::string& frame_id);
-/// A turntable record as the simulated table controller logged it; `origin` shifts its stamp (wall-clock playback), a
-/// zero stamp stays 0.
-TurntableState toTurntableMessage(const core::TurntableLogRecord& r, core::Nanoseconds origin, std::uint32_t seq,
+/// A turntable record as the simulated table controller logged it: header.seq its record count (a lost record leaves a
+/// gap), the stamp on the controller's clock; `origin` shifts the stamp (wall-clock playback), a zero stamp stays 0.
+TurntableState toTurntableMessage(const core::TurntableLogRecord& r, core::Nanoseconds origin,
                                   const std::string& frame_id);
 GroundTruth toTruthMessage(const core::SimulationSample& s, const std_msgs::Header& header);
 

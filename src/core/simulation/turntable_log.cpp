@@ -15,12 +15,45 @@ const char* const kGlitchKeys[kTurntableGlitchKinds] = {"nan_rate", "absurd_rate
 
 }  // namespace
 
+double TableClockConfig::errorAt(double t) const {
+  double error = offset + rate_error * t;
+  for (const TableClockStep& step : steps) {
+    if (step.at <= t) error += step.size;
+  }
+  return error;
+}
+
+TableClockConfig TableClockConfig::parse(const YamlField& clock) {
+  clock.requireMap();
+  clock.rejectUnknownKeys({"offset", "jitter", "rate_error", "steps"});
+  TableClockConfig c;
+  c.offset = clock.getDouble("offset", 0.0);
+  if (!std::isfinite(c.offset)) clock["offset"].fail("must be finite (s, the controller's clock minus the gyro's)");
+  c.jitter = clock.getDouble("jitter", 0.0);
+  if (!(std::isfinite(c.jitter) && c.jitter >= 0.0)) clock["jitter"].fail("must be >= 0 (s, standard deviation)");
+  c.rate_error = clock.getDouble("rate_error", 0.0);
+  if (!(std::isfinite(c.rate_error) && std::abs(c.rate_error) < 1.0)) {
+    clock["rate_error"].fail("must be in (-1, 1) (s per s; a real clock is off by parts per million)");
+  }
+  if (clock.has("steps")) {
+    const YamlField steps = clock["steps"];
+    steps.requireSequence();
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+      const std::vector<double> step = steps.at(i).asDoubles(2);
+      if (!(std::isfinite(step[0]) && step[0] >= 0.0)) steps.at(i).fail("the time must be >= 0 s (from the start)");
+      if (!std::isfinite(step[1])) steps.at(i).fail("the size must be finite (s)");
+      c.steps.push_back({step[0], step[1]});
+    }
+  }
+  return c;
+}
+
 double TurntableGlitchRates::total() const { return std::accumulate(per_record.begin(), per_record.end(), 0.0); }
 
 TurntableLogConfig TurntableLogConfig::parse(const YamlField& log) {
   log.requireMap();
   log.rejectUnknownKeys(
-      {"rate", "angle_noise", "angle_resolution", "logged_rate", "drop_probability", "gaps", "glitches"});
+      {"rate", "angle_noise", "angle_resolution", "logged_rate", "drop_probability", "gaps", "glitches", "clock"});
   TurntableLogConfig c;
   c.rate = log.getDouble("rate", 0.0);
   if (!(std::isfinite(c.rate) && c.rate >= 0.0)) {
@@ -52,6 +85,7 @@ TurntableLogConfig TurntableLogConfig::parse(const YamlField& log) {
     }
     if (!(c.glitches.total() <= 1.0)) g.fail("the glitch rates add up to more than 1 per record");
   }
+  if (log.has("clock")) c.clock = TableClockConfig::parse(log["clock"]);
   return c;
 }
 
@@ -59,6 +93,7 @@ TurntableLogger::TurntableLogger(const TurntableLogConfig& config, std::uint64_t
     : config_(config),
       encoder_noise_(seed ^ 0x3c6ef372fe94f82bULL),
       glitch_draws_(seed ^ 0xa54ff53a5f1d36f1ULL),
+      clock_jitter_(seed ^ 0xcbbb9d5dc1059ed8ULL),
       delivery_(config.delivery, seed ^ 0x510e527fade682d1ULL) {}
 
 void TurntableLogger::log(double t, Nanoseconds stamp, double angle, double rate,
@@ -67,6 +102,12 @@ void TurntableLogger::log(double t, Nanoseconds stamp, double angle, double rate
   r.index = counters_.logged;
   r.time = t;
   r.stamp = stamp;
+  if (config_.clock.enabled()) {
+    double error = config_.clock.errorAt(t);
+    if (config_.clock.jitter > 0.0) error += config_.clock.jitter * clock_jitter_.next();
+    // ROS time 0 means unset: a clock far behind still stamps after it.
+    r.stamp = std::max<Nanoseconds>(1, stamp + toNanoseconds(error));
+  }
   r.angle = angle;
   if (config_.angle_noise > 0.0) r.angle += config_.angle_noise * encoder_noise_.next();
   if (config_.angle_resolution > 0.0)
@@ -110,7 +151,7 @@ void TurntableLogger::log(double t, Nanoseconds stamp, double angle, double rate
       r.stamp = 0;
       break;
     case TurntableGlitch::kBackwardStamp:
-      r.stamp = std::max<Nanoseconds>(1, stamp - toNanoseconds(kBackwardStampJump));
+      r.stamp = std::max<Nanoseconds>(1, r.stamp - toNanoseconds(kBackwardStampJump));  // on the controller's clock
       break;
     case TurntableGlitch::kNone:
       break;

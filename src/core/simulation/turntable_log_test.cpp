@@ -1,6 +1,7 @@
 // The turntable side of a real session, generated: drive ripple in the true motion, what the
-// controller logs (encoder noise and counts, a differenced rate, its own log rate), lost messages,
-// gaps and glitched records, each checked against what was asked and reproducible by seed.
+// controller logs (encoder noise and counts, a differenced rate, its own log rate, its own clock),
+// lost messages, gaps and glitched records, each checked against what was asked and reproducible by
+// seed.
 #include "hrg_gyro/core/simulation/turntable_log.h"
 
 #include <gtest/gtest.h>
@@ -274,13 +275,205 @@ TEST(TurntableLogTest, LostChannelSamplesAreFlaggedAndStillCounted) {
   EXPECT_NEAR(static_cast<double>(lost - in_gap), expected, 5 * std::sqrt(expected));
 }
 
+// Without jitter the controller's stamps are exact: the true time plus the offset, the rate error
+// times the true time and every step taken at or before it (to the nanosecond the stamps round to).
+TEST(TurntableLogTest, ClockOffsetRateErrorAndStepsMoveTheStamps) {
+  SimulationConfig c = plateauScenario(0.1, 4.0);
+  c.turntable_log.rate = 100.0;
+  c.turntable_log.clock.offset = 0.05;
+  c.turntable_log.clock.rate_error = 2e-5;
+  c.turntable_log.clock.steps = {{2.0, 0.01}, {3.505, -0.02}};
+  GyroSimulator sim(c);
+  SimulationSample s;
+  std::vector<TurntableLogRecord> records;
+  while (sim.next(&s)) records.insert(records.end(), s.turntable.begin(), s.turntable.end());
+  ASSERT_GT(records.size(), 500u);
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    const TurntableLogRecord& r = records[k];
+    EXPECT_EQ(r.index, k);
+    EXPECT_EQ(r.time, k / 100.0);  // taken at the table's own rate, whatever its clock
+    const double t = r.time;
+    const double error = 0.05 + 2e-5 * t + (t >= 2.0 ? 0.01 : 0.0) + (t >= 3.505 ? -0.02 : 0.0);
+    const double ns = static_cast<double>(r.stamp - toNanoseconds(c.start_time + t));
+    ASSERT_NEAR(ns, 1e9 * error, 1.0) << k;  // each of the two roundings to whole ns is within 0.5
+  }
+  // The steps at the records where they fall: record 200 is taken at 2.0 s exactly, 351 first after 3.505 s.
+  auto error = [&](std::size_t k) { return toSeconds(records[k].stamp - toNanoseconds(c.start_time + k / 100.0)); };
+  EXPECT_NEAR(error(200) - error(199), 0.01 + 2e-5 * 0.01, 2e-9);
+  EXPECT_NEAR(error(351) - error(350), -0.02 + 2e-5 * 0.01, 2e-9);
+  EXPECT_NEAR(error(350) - error(349), 2e-5 * 0.01, 2e-9);
+}
+
+// One record with every sample (log rate 0): the stamp is the sample's plus the offset, exactly.
+TEST(TurntableLogTest, ClockOffsetOfTheRecordsLoggedWithEverySample) {
+  SimulationConfig c = plateauScenario(0.1, 2.0);
+  c.turntable_log.clock.offset = -0.025;
+  GyroSimulator sim(c);
+  SimulationSample s;
+  int n = 0;
+  while (sim.next(&s)) {
+    ASSERT_EQ(s.turntable.size(), 1u);
+    EXPECT_EQ(s.turntable[0].stamp - s.stamp, toNanoseconds(-0.025));
+    EXPECT_NEAR(s.turntable[0].time, toSeconds(s.stamp) - c.start_time, 1e-9);  // the sample's centre time
+    EXPECT_EQ(s.turntable[0].angle, s.truth.table_angle);                       // the clock moves stamps only
+    ++n;
+  }
+  EXPECT_GT(n, 600);
+}
+
+// White jitter: the stamps' deviations from the exact clock have the asked standard deviation. 100000
+// records: the estimated std is within 5 sigma = 5 J / sqrt(2 N) (1.1 %) of J, the mean within 5 J / sqrt(N)
+// (the rounding to whole ns adds 0.3 ns of spread, 3e-7 of J). The jitter draws from its own stream.
+TEST(TurntableLogTest, ClockJitterHasTheAskedSpreadFromItsOwnStream) {
+  TurntableLogConfig jittery;
+  jittery.angle_noise = 2e-6;
+  jittery.clock.offset = 0.03;
+  jittery.clock.jitter = 1e-3;
+  TurntableLogConfig steady = jittery;
+  steady.clock.jitter = 0.0;
+  TurntableLogger a(jittery, 5), b(steady, 5), again(jittery, 5), other(jittery, 6);
+  std::vector<TurntableLogRecord> ra, rb, rc, ro;
+  const int n = 100000;
+  for (int k = 0; k < n; ++k) {
+    const double t = k * 0.01;
+    a.log(t, toNanoseconds(1.0 + t), 0.05 * t, 0.05, &ra);
+    b.log(t, toNanoseconds(1.0 + t), 0.05 * t, 0.05, &rb);
+    again.log(t, toNanoseconds(1.0 + t), 0.05 * t, 0.05, &rc);
+    other.log(t, toNanoseconds(1.0 + t), 0.05 * t, 0.05, &ro);
+  }
+  double sum = 0.0, sum2 = 0.0;
+  int out_of_order = 0;
+  for (int k = 0; k < n; ++k) {
+    const double deviation = toSeconds(ra[k].stamp - toNanoseconds(1.0 + k * 0.01)) - 0.03;
+    sum += deviation;
+    sum2 += deviation * deviation;
+    EXPECT_EQ(ra[k].angle, rb[k].angle);  // the encoder's draws are the same with or without jitter
+    EXPECT_EQ(rb[k].stamp, toNanoseconds(1.0 + k * 0.01) + toNanoseconds(0.03));
+    EXPECT_EQ(ra[k].stamp, rc[k].stamp);
+    if (k > 0 && ra[k].stamp < ra[k - 1].stamp) ++out_of_order;
+  }
+  const double mean = sum / n, std_measured = std::sqrt(sum2 / n - mean * mean);
+  std::printf(
+      "[ measured ] stamp jitter std %.5g s (asked 1e-3), mean %.3g s; %d of %d stamps before their "
+      "predecessor's\n",
+      std_measured, mean, out_of_order, n);
+  EXPECT_NEAR(std_measured, 1e-3, 5 * 1e-3 / std::sqrt(2.0 * n));
+  EXPECT_NEAR(mean, 0.0, 5 * 1e-3 / std::sqrt(n));
+  EXPECT_EQ(out_of_order, 0);  // 10 ms apart, 1 ms of jitter: 7 sigma
+  bool differs = false;
+  for (int k = 0; k < n && !differs; ++k) differs = ra[k].stamp != ro[k].stamp;
+  EXPECT_TRUE(differs);
+}
+
+// A table logged faster or slower than the gyro's 200 Hz, its stamps jittered by more than its record
+// spacing at 1 kHz: the records come in the order they were taken (index and true time increasing),
+// their stamps out of order where the jitter says so, and none is lost or repeated.
+TEST(TurntableLogTest, TableClockAtHigherAndLowerLogRatesThanTheGyro) {
+  for (const double log_rate : {1000.0, 50.0}) {
+    SimulationConfig c = plateauScenario(0.1, 3.0);
+    c.turntable_log.rate = log_rate;
+    c.turntable_log.clock.offset = 0.1;
+    c.turntable_log.clock.jitter = 2e-3;
+    GyroSimulator sim(c);
+    SimulationSample s;
+    std::vector<TurntableLogRecord> records;
+    while (sim.next(&s)) {
+      for (const TurntableLogRecord& r : s.turntable) {
+        EXPECT_LE(r.time, toSeconds(s.stamp) - c.start_time + 1e-12);  // carried by the sample after it
+        records.push_back(r);
+      }
+    }
+    // Every record up to the last sample's centre, half an output period before the end.
+    const double last_centre = sim.elapsed() - 0.5 * c.outputPeriod();
+    ASSERT_EQ(records.size(), static_cast<std::size_t>(std::floor(last_centre * log_rate + 1e-9)) + 1);
+    int out_of_order = 0;
+    for (std::size_t k = 1; k < records.size(); ++k) {
+      EXPECT_EQ(records[k].index, records[k - 1].index + 1);
+      EXPECT_GT(records[k].time, records[k - 1].time);
+      if (records[k].stamp < records[k - 1].stamp) ++out_of_order;
+    }
+    std::printf(
+        "[ measured ] table logged at %.0f Hz with 2 ms of jitter: %d of %zu stamps before their "
+        "predecessor's\n",
+        log_rate, out_of_order, records.size());
+    // 1 ms apart, two jitters differing by 2.8 ms (std): P(N < -1 / 2.83) = 36 % of the stamps go
+    // back (within 0.05: ~7 binomial sigmas of 0.0074, room for neighbours sharing a draw); 20 ms apart
+    // is 7 sigmas: none.
+    if (log_rate == 1000.0) {
+      EXPECT_NEAR(static_cast<double>(out_of_order) / records.size(), 0.362, 0.05);
+    } else {
+      EXPECT_EQ(out_of_order, 0);
+    }
+  }
+}
+
+// The controller's count runs on whatever happens to the stamps: a lost record leaves a gap in it,
+// nothing else does.
+TEST(TurntableLogTest, RecordIndexIsContiguousExceptWhereRecordsWereLost) {
+  SimulationConfig c = plateauScenario(0.1, 6.0);
+  c.turntable_log.rate = 100.0;
+  c.turntable_log.delivery.drop_probability = 0.05;
+  c.turntable_log.delivery.gaps = {{3.0, 0.5}};
+  c.turntable_log.clock.offset = 0.02;
+  c.turntable_log.clock.jitter = 1e-3;
+  c.turntable_log.clock.steps = {{4.0, -0.3}};
+  GyroSimulator sim(c);
+  SimulationSample s;
+  std::vector<std::uint64_t> indices;
+  while (sim.next(&s)) {
+    for (const TurntableLogRecord& r : s.turntable) indices.push_back(r.index);
+  }
+  const TurntableLogCounters& counters = sim.turntableLogCounters();
+  std::uint64_t skipped = indices.front();
+  for (std::size_t k = 1; k < indices.size(); ++k) {
+    ASSERT_GT(indices[k], indices[k - 1]);
+    skipped += indices[k] - indices[k - 1] - 1;
+  }
+  skipped += counters.logged - 1 - indices.back();
+  EXPECT_EQ(skipped, counters.lost);
+  EXPECT_EQ(indices.size() + counters.lost, counters.logged);
+  EXPECT_GE(counters.lost, 50u);  // the 0.5 s gap alone
+}
+
+// Stamp glitches spoil the controller's stamp: a zero stamp is 0, a backward one 0.5 s before the
+// stamp its clock gave.
+TEST(TurntableLogTest, StampGlitchesApplyAfterTheClock) {
+  TurntableLogConfig c;
+  c.clock.offset = 0.2;
+  c.clock.rate_error = 1e-4;
+  c.glitches.per_record[static_cast<int>(TurntableGlitch::kZeroStamp)] = 0.1;
+  c.glitches.per_record[static_cast<int>(TurntableGlitch::kBackwardStamp)] = 0.1;
+  TurntableLogger logger(c, 3);
+  std::vector<TurntableLogRecord> records;
+  for (int k = 0; k < 2000; ++k) logger.log(k * 0.01, toNanoseconds(1.0 + k * 0.01), 0.0, 0.0, &records);
+  int zero = 0, backward = 0;
+  for (const TurntableLogRecord& r : records) {
+    const Nanoseconds clock = toNanoseconds(1.0 + r.time) + toNanoseconds(0.2 + 1e-4 * r.time);
+    switch (r.glitch) {
+      case TurntableGlitch::kZeroStamp:
+        EXPECT_EQ(r.stamp, 0);
+        ++zero;
+        break;
+      case TurntableGlitch::kBackwardStamp:
+        EXPECT_EQ(r.stamp, clock - toNanoseconds(kBackwardStampJump));
+        ++backward;
+        break;
+      default:
+        EXPECT_EQ(r.stamp, clock);
+    }
+  }
+  EXPECT_GT(zero, 100);
+  EXPECT_GT(backward, 100);
+}
+
 TEST(TurntableLogTest, ScenarioKeysAreParsedAndBadOnesNamed) {
   const std::string base = "turntable:\n  profile:\n    - {type: rate, rate: 0.1, duration: 2}\n";
   const SimulationConfig c = SimulationConfig::parse(
       parse(base +
             "  ripple: {amplitude: 0.002, frequency: 0.37}\n"
             "  log: {rate: 100, angle_noise: 2.0e-6, angle_resolution: 1.0e-7, logged_rate: differenced_angle,\n"
-            "        drop_probability: 0.001, gaps: [[10, 2]], glitches: {nan_rate: 0.001, backward_stamp: 0.002}}\n"
+            "        drop_probability: 0.001, gaps: [[10, 2]], glitches: {nan_rate: 0.001, backward_stamp: 0.002},\n"
+            "        clock: {offset: 0.1, jitter: 0.002, rate_error: -3.0e-6, steps: [[600, 0.05], [900, -0.01]]}}\n"
             "channels: {drop_probability: 0.01, gaps: [[3, 1], [5, 0.5]]}\n"));
   EXPECT_EQ(c.ripple.amplitude, 0.002);
   EXPECT_EQ(c.ripple.frequency, 0.37);
@@ -294,6 +487,15 @@ TEST(TurntableLogTest, ScenarioKeysAreParsedAndBadOnesNamed) {
   EXPECT_EQ(c.turntable_log.glitches.per_record[static_cast<int>(TurntableGlitch::kBackwardStamp)], 0.002);
   EXPECT_EQ(c.channels.drop_probability, 0.01);
   EXPECT_EQ(c.channels.gaps.size(), 2u);
+  const TableClockConfig& clock = c.turntable_log.clock;
+  EXPECT_EQ(clock.offset, 0.1);
+  EXPECT_EQ(clock.jitter, 0.002);
+  EXPECT_EQ(clock.rate_error, -3e-6);
+  ASSERT_EQ(clock.steps.size(), 2u);
+  EXPECT_EQ(clock.steps[1].at, 900.0);
+  EXPECT_EQ(clock.steps[1].size, -0.01);
+  EXPECT_DOUBLE_EQ(clock.errorAt(700.0), 0.1 - 3e-6 * 700.0 + 0.05);
+  EXPECT_FALSE(SimulationConfig::parse(parse(base)).turntable_log.clock.enabled());
 
   auto key = [&](const std::string& extra) {
     try {
@@ -315,6 +517,20 @@ TEST(TurntableLogTest, ScenarioKeysAreParsedAndBadOnesNamed) {
   EXPECT_EQ(key("  log: {glitches: {nan_rate: 2}}\n"), "turntable.log.glitches.nan_rate");
   EXPECT_EQ(key("  log: {glitches: {nan_rate: 0.6, zero_stamp: 0.6}}\n"), "turntable.log.glitches");
   EXPECT_EQ(key("  log: {glitches: {nan: 0.1}}\n"), "turntable.log.glitches.nan");
+  EXPECT_EQ(key("  log: {clock: {offset: .nan}}\n"), "turntable.log.clock.offset");
+  EXPECT_EQ(key("  log: {clock: {jitter: -0.001}}\n"), "turntable.log.clock.jitter");
+  EXPECT_EQ(key("  log: {clock: {jitter: .inf}}\n"), "turntable.log.clock.jitter");
+  EXPECT_EQ(key("  log: {clock: {rate_error: 1.5}}\n"), "turntable.log.clock.rate_error");
+  EXPECT_EQ(key("  log: {clock: {rate_error: .nan}}\n"), "turntable.log.clock.rate_error");
+  EXPECT_EQ(key("  log: {clock: {steps: 0.1}}\n"), "turntable.log.clock.steps");
+  EXPECT_EQ(key("  log: {clock: {steps: [0.1, 0.2]}}\n"), "turntable.log.clock.steps[0]");
+  EXPECT_EQ(key("  log: {clock: {steps: [[10, 0.1], [20]]}}\n"), "turntable.log.clock.steps[1]");
+  EXPECT_EQ(key("  log: {clock: {steps: [[10, 0.1, 3]]}}\n"), "turntable.log.clock.steps[0]");
+  EXPECT_EQ(key("  log: {clock: {steps: [[-1, 0.1]]}}\n"), "turntable.log.clock.steps[0]");
+  EXPECT_EQ(key("  log: {clock: {steps: [[1, .inf]]}}\n"), "turntable.log.clock.steps[0][1]");
+  EXPECT_EQ(key("  log: {clock: {ofset: 0.1}}\n"), "turntable.log.clock.ofset");
+  EXPECT_EQ(key("  log: {clock: 0.1}\n"), "turntable.log.clock");
+  EXPECT_EQ(key("  log: {clock: {offset: -0.05, steps: []}}\n"), "accepted");
   EXPECT_EQ(key("channels: {drop_probability: -0.1}\n"), "channels.drop_probability");
   EXPECT_EQ(key("channels: {gaps: [[-1, 1]]}\n"), "channels.gaps[0]");
   EXPECT_EQ(key("channels: {gap: []}\n"), "channels.gap");

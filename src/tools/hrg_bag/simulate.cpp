@@ -33,10 +33,12 @@ int runSimulate(const SimulateOptions& o) {
     // The channel sequence number is the sample's index, so a lost sample leaves a gap in it.
     const ChannelAmplitudes ch = toChannelsMessage(s, stamp, static_cast<std::uint32_t>(s.index), o.frame_id);
     if (s.channels_delivered) bag.write("/channels", stamp, ch);
-    // The table's records, recorded when they were made (a glitched stamp does not move them).
+    // The table's records, recorded when they were made (neither a glitched stamp nor the
+    // controller's clock moves them), their sequence number the controller's count: a lost record
+    // leaves a gap in it.
     for (const core::TurntableLogRecord& r : s.turntable) {
       bag.write("/turntable/state", toRosTime(core::toNanoseconds(config.start_time + r.time)),
-                toTurntableMessage(r, 0, static_cast<std::uint32_t>(r.index), o.frame_id));
+                toTurntableMessage(r, 0, o.frame_id));
     }
     if (truth) bag.write("/truth", stamp, toTruthMessage(s, ch.header));
     progress.update(sim.elapsed(), ++seq);

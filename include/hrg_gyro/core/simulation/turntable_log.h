@@ -3,9 +3,13 @@
 // angle read through an encoder (white noise, quantisation to whole counts), the rate either the
 // drive's (true) rate or the logged angle differenced at the log rate, lost records (StreamDelivery),
 // and glitched records (a NaN or absurd rate, an infinite angle, a zero or backward stamp) at a
-// given rate per record. Each random effect draws from its own seeded stream, so a scenario gives
-// the same log run after run and switching one effect on leaves the others' draws unchanged.
-// Defaults: the exact table state, nothing lost, nothing glitched.
+// given rate per record. The controller may stamp on its own computer's clock (TableClockConfig):
+// an offset from the gyro's clock, a rate error, steps and white jitter; the records are still
+// taken at their true times, only their stamps move (out of order when the jitter exceeds the
+// spacing: they are left so, as a real log would hold them). Each random effect draws from its own
+// seeded stream, so a scenario gives the same log run after run and switching one effect on leaves
+// the others' draws unchanged. Defaults: the exact table state and stamps, nothing lost, nothing
+// glitched.
 #pragma once
 
 #include <array>
@@ -41,6 +45,29 @@ struct TurntableGlitchRates {
 constexpr double kAbsurdTableRate = 1000.0;  // rad/s
 constexpr double kBackwardStampJump = 0.5;   // s
 
+/// A step of the controller's clock (an NTP correction, a manual reset): from true time `at` on, its
+/// stamps are `size` later.
+struct TableClockStep {
+  double at = 0.0;    ///< s from the scenario start
+  double size = 0.0;  ///< s (negative: the clock steps back)
+};
+
+/// The controller's own clock: a record taken at true time t (s from the scenario start) is stamped
+///   exact stamp + offset + rate_error t + (the steps at or before t) + jitter N(0, 1).
+/// Default: the gyro's clock, exactly.
+struct TableClockConfig {
+  double offset = 0.0;      ///< s, the controller's clock minus the gyro's
+  double jitter = 0.0;      ///< s, standard deviation of white stamp jitter
+  double rate_error = 0.0;  ///< s per s: the controller's clock runs 1 + rate_error times as fast
+  std::vector<TableClockStep> steps;
+
+  bool enabled() const { return offset != 0.0 || jitter != 0.0 || rate_error != 0.0 || !steps.empty(); }
+  /// The clock's error at true time t without its jitter, s.
+  double errorAt(double t) const;
+  /// Parses turntable.log.clock. Throws ConfigError naming the key.
+  static TableClockConfig parse(const YamlField& clock);
+};
+
 struct TurntableLogConfig {
   double rate = 0.0;              ///< Hz; 0: one record with every output sample, at its stamp
   double angle_noise = 0.0;       ///< rad, white noise of the logged angle
@@ -48,6 +75,7 @@ struct TurntableLogConfig {
   LoggedRate logged_rate = LoggedRate::kTable;
   DeliveryConfig delivery;  ///< lost records
   TurntableGlitchRates glitches;
+  TableClockConfig clock;  ///< the controller's clock (default: the gyro's)
 
   /// Parses turntable.log. Throws ConfigError naming the key.
   static TurntableLogConfig parse(const YamlField& log);
@@ -56,7 +84,7 @@ struct TurntableLogConfig {
 struct TurntableLogRecord {
   std::uint64_t index = 0;  ///< the controller's record count (a lost record leaves a gap in it)
   double time = 0.0;        ///< true time of the record, s from the scenario start
-  Nanoseconds stamp = 0;    ///< as logged (a stamp glitch spoils it)
+  Nanoseconds stamp = 0;    ///< as logged: on the controller's clock (a stamp glitch spoils it)
   double angle = 0.0;       ///< rad, as logged
   double rate = 0.0;        ///< rad/s, as logged
   TurntableGlitch glitch = TurntableGlitch::kNone;
@@ -76,13 +104,15 @@ class TurntableLogger {
   const TurntableLogCounters& counters() const { return counters_; }
 
   /// Logs the true table state (angle rad, rate rad/s) of true time t (s from the scenario start,
-  /// stamp `stamp`): appends the record to `out` unless it is lost.
+  /// `stamp` its exact stamp on the gyro's clock): appends the record, stamped on the controller's
+  /// clock, to `out` unless it is lost.
   void log(double t, Nanoseconds stamp, double angle, double rate, std::vector<TurntableLogRecord>* out);
 
  private:
   TurntableLogConfig config_;
   GaussianNoise encoder_noise_;
   GaussianNoise glitch_draws_;
+  GaussianNoise clock_jitter_;
   StreamDelivery delivery_;
   bool has_previous_ = false;
   double previous_time_ = 0.0;
