@@ -1,10 +1,13 @@
 // Turntable profiles and scenario files.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/simulation/injected_model.h"
 #include "hrg_gyro/core/simulation/simulation_config.h"
 
 namespace hrg_gyro {
@@ -51,6 +54,77 @@ TEST(TurntableProfile, RateAndDualRateRampAtTheAccelerationLimit) {
   EXPECT_NEAR(angle, 0.0, 1e-12);
 }
 
+/// The plateaus of a dual_rate segment labelled `label`: [start, end) and rate.
+struct Plateau {
+  double start, end, rate;
+};
+std::vector<Plateau> plateausOf(const TurntableProfile& p, const std::string& label) {
+  std::vector<Plateau> out;
+  for (const TurntableProfile::Piece& piece : p.pieces()) {
+    if (piece.label == label + "/rate1" || piece.label == label + "/rate2") {
+      out.push_back({piece.start, piece.start + piece.duration, piece.rate0});
+    }
+  }
+  return out;
+}
+
+/// The integral of t^power over the plateaus of `rate` minus that over the others: what a bias
+/// trend of that power leaves in the difference of the two rates' mean readings (times a duration).
+double imbalance(const std::vector<Plateau>& plateaus, double rate, int power, std::size_t count) {
+  double sum = 0.0;
+  for (std::size_t n = 0; n < count; ++n) {
+    const Plateau& q = plateaus[n];
+    const double integral = (std::pow(q.end, power + 1) - std::pow(q.start, power + 1)) / (power + 1);
+    sum += q.rate == rate ? integral : -integral;
+  }
+  return sum;
+}
+
+TEST(TurntableProfile, DualRateBalancedOrderCancelsLinearAndQuadraticTrends) {
+  const std::string segment = "{type: dual_rate, rates: [0.05, -0.05], duration: 20.0, settle: 1.0, repeat: 4";
+  auto parseProfile = [&](const std::string& order) {
+    return TurntableProfile::parse(
+        parse("profile: [{type: dwell, duration: 5}, " + segment + order + ", label: cal}]")["profile"], 0.5);
+  };
+  const TurntableProfile balanced = parseProfile(", order: balanced");
+  const TurntableProfile alternating = parseProfile("");
+  const std::vector<Plateau> b = plateausOf(balanced, "cal"), a = plateausOf(alternating, "cal");
+  ASSERT_EQ(b.size(), 8u);
+  ASSERT_EQ(a.size(), 8u);
+  const double order[8] = {0.05, -0.05, -0.05, 0.05, -0.05, 0.05, 0.05, -0.05};  // + - - + - + + -
+  // Evenly spaced as the alternating plateaus are: the reversal's 0.2 s, the settle, the plateau.
+  for (std::size_t n = 0; n < 8; ++n) {
+    EXPECT_EQ(b[n].rate, order[n]) << n;
+    EXPECT_EQ(a[n].rate, n % 2 == 0 ? 0.05 : -0.05) << n;
+    EXPECT_NEAR(b[n].start, a[n].start, 1e-12) << n;
+    EXPECT_NEAR(b[n].end - b[n].start, 20.0, 1e-12) << n;
+  }
+  EXPECT_NEAR(balanced.duration(), alternating.duration(), 1e-12);
+  // The table really holds the rate between two plateaus of the same rate (no stop, no ramp).
+  double angle, rate;
+  balanced.evaluate(0.5 * (b[1].end + b[2].start), &angle, &rate);
+  EXPECT_EQ(rate, -0.05);
+  // A trend t (t^2) integrates to the same over both rates' plateaus: over the first 4 (all 8).
+  // Relative to the integral over one rate's plateaus, to the round-off of the sums.
+  const double scale1 = 4 * 20.0 * b[7].end, scale2 = scale1 * b[7].end;
+  EXPECT_NEAR(imbalance(b, 0.05, 1, 4) / scale1, 0.0, 1e-14);
+  EXPECT_NEAR(imbalance(b, 0.05, 1, 8) / scale1, 0.0, 1e-14);
+  EXPECT_NEAR(imbalance(b, 0.05, 2, 8) / scale2, 0.0, 1e-14);
+  // The alternating order leaves a trend's share: each + plateau comes one slot (21.2 s) before its -.
+  EXPECT_NEAR(imbalance(a, 0.05, 1, 8), -4 * 20.0 * 21.2, 1e-9);
+  // The default is today's profile, piece by piece.
+  const TurntableProfile explicit_alternating = parseProfile(", order: alternating");
+  ASSERT_EQ(explicit_alternating.pieces().size(), alternating.pieces().size());
+  for (std::size_t i = 0; i < alternating.pieces().size(); ++i) {
+    const TurntableProfile::Piece &x = explicit_alternating.pieces()[i], &y = alternating.pieces()[i];
+    EXPECT_EQ(x.start, y.start);
+    EXPECT_EQ(x.duration, y.duration);
+    EXPECT_EQ(x.rate0, y.rate0);
+    EXPECT_EQ(x.accel, y.accel);
+    EXPECT_EQ(x.label, y.label);
+  }
+}
+
 TEST(TurntableProfile, PiecewiseIsLinearInRate) {
   const TurntableProfile p = TurntableProfile::parse(
       parse("profile: [{type: piecewise, points: [[0, 0.0], [10, 0.2], [20, 0.2]]}]")["profile"], 0.5);
@@ -75,6 +149,8 @@ TEST(TurntableProfile, BadSegmentsNameTheirKey) {
   expectError("profile: [{type: dual_rate, rates: [0.1, 0.1], duration: 5}]", "profile[0].rates");
   expectError("profile: [{type: piecewise, points: [[1, 0], [2, 1]]}]", "profile[0].points[0]");
   expectError("profile: [{type: dwell, duration: 1, speed: 2}]", "profile[0].speed");
+  expectError("profile: [{type: dual_rate, rates: [0.1, -0.1], duration: 5, order: random}]", "profile[0].order");
+  expectError("profile: [{type: dual_rate, rates: [0.1, -0.1], duration: 5, order: [balanced]}]", "profile[0].order");
 }
 
 std::string readFile(const std::string& path) {
@@ -84,24 +160,79 @@ std::string readFile(const std::string& path) {
   return ss.str();
 }
 
+/// The text without its lines that start with `prefix`.
+std::string withoutLines(const std::string& text, const std::string& prefix) {
+  std::istringstream in(text);
+  std::string line, out;
+  while (std::getline(in, line)) {
+    if (line.compare(0, prefix.size(), prefix) != 0) out += line + "\n";
+  }
+  return out;
+}
+
 TEST(Scenarios, ShippedScenariosParseAndDescribeTheSameGyro) {
   const std::string dir = std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/";
+  const std::set<std::string> shipped = {"dual_rate.yaml",
+                                         "constant_rate.yaml",
+                                         "steps.yaml",
+                                         "verification.yaml",
+                                         "generator.yaml",
+                                         "demo.yaml",
+                                         "two_stage.yaml",
+                                         "thermal_ramp.yaml",
+                                         "dual_rate_drifting.yaml",
+                                         "dual_rate_table_clock.yaml"};
+  // Every scenario file is checked here, but diagnosis.yaml (its isotropic resonator differs).
+  std::set<std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) files.insert(entry.path().filename().string());
+  files.erase("diagnosis.yaml");
+  EXPECT_EQ(files, shipped);
   std::string reference_gyro;
-  for (const char* name : {"dual_rate.yaml", "constant_rate.yaml", "steps.yaml", "verification.yaml", "generator.yaml",
-                           "demo.yaml", "two_stage.yaml", "thermal_ramp.yaml"}) {
+  for (const std::string& name : shipped) {
     SCOPED_TRACE(name);
     const SimulationConfig c = SimulationConfig::load(dir + name, nodeOnlyScenarioKeys());
     EXPECT_EQ(c.resonator.samples_per_period, 32);
     EXPECT_DOUBLE_EQ(c.pickoff.gap, 20.0);
-    // The gyro block (everything after the seed line up to the session part) is identical.
+    // The gyro block (everything after the seed line up to the session part) is identical; a warming
+    // gyro's bias drift is a line of its own there, a property of the session rather than of the gyro.
     const std::string text = readFile(dir + name);
     const std::size_t from = text.find("start_time:"), to = text.find("# ---- The session");
     ASSERT_NE(from, std::string::npos);
     ASSERT_NE(to, std::string::npos);
-    const std::string gyro = text.substr(from, to - from);
+    const std::string gyro = withoutLines(text.substr(from, to - from), "  bias_drift:");
     if (reference_gyro.empty()) reference_gyro = gyro;
     EXPECT_EQ(gyro, reference_gyro);
   }
+}
+
+// dual_rate_drifting.yaml: D0 moves by 1.0e-6 rad/s over the whole session, the plateaus in the
+// balanced order; dual_rate_table_clock.yaml: the table at 100 Hz on its own clock.
+TEST(Scenarios, DriftingAndTableClockScenariosAreWhatTheySay) {
+  const std::string dir = std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/";
+  const SimulationConfig drifting = SimulationConfig::load(dir + "dual_rate_drifting.yaml", nodeOnlyScenarioKeys());
+  const SimulationConfig plain = SimulationConfig::load(dir + "dual_rate.yaml", nodeOnlyScenarioKeys());
+  const double duration = drifting.profile.duration();
+  EXPECT_NEAR(duration, 1868.6, 1e-9);
+  EXPECT_NEAR(duration, plain.profile.duration(), 1e-9);
+  // The rate is given to 5 digits: 1e-6 rad/s within 1e-5 of it.
+  EXPECT_NEAR(injectedBiasTrend(drifting, duration) - injectedBiasTrend(drifting, 0.0), 1e-6, 1e-11);
+  EXPECT_EQ(drifting.resonator.bias_drift.random_walk, 0.0);
+  EXPECT_FALSE(plain.resonator.bias_drift.enabled());
+  const std::vector<Plateau> plateaus = plateausOf(drifting.profile, "calibration");
+  ASSERT_EQ(plateaus.size(), 8u);
+  const double order[8] = {0.05, -0.05, -0.05, 0.05, -0.05, 0.05, 0.05, -0.05};
+  for (std::size_t n = 0; n < 8; ++n) EXPECT_EQ(plateaus[n].rate, order[n]) << n;
+
+  const SimulationConfig clock = SimulationConfig::load(dir + "dual_rate_table_clock.yaml", nodeOnlyScenarioKeys());
+  const TurntableLogConfig& log = clock.turntable_log;
+  EXPECT_EQ(log.rate, 100.0);
+  EXPECT_EQ(log.angle_noise, 2e-6);
+  EXPECT_NEAR(log.angle_resolution, kTwoPi / (1 << 23), 1e-10);
+  EXPECT_EQ(log.clock.offset, 0.1);
+  EXPECT_EQ(log.clock.jitter, 0.002);
+  EXPECT_EQ(log.clock.rate_error, 0.0);
+  EXPECT_TRUE(log.clock.steps.empty());
+  EXPECT_NEAR(clock.profile.duration(), plain.profile.duration(), 1e-9);
 }
 
 TEST(Scenarios, RejectsBadValuesByKey) {

@@ -8,6 +8,18 @@
 namespace hrg_gyro {
 namespace core {
 
+namespace {
+
+/// The Thue-Morse sequence: 0 1 1 0 1 0 0 1 ..., the parity of the number of ones in n. Its first 2^m
+/// terms split 0..2^m - 1 into two sets with equal sums of every power below m.
+int thueMorse(long n) {
+  int parity = 0;
+  for (unsigned long v = static_cast<unsigned long>(n); v != 0; v &= v - 1) parity ^= 1;
+  return parity;
+}
+
+}  // namespace
+
 void TurntableProfile::append(double duration, double rate0, double accel, const std::string& label) {
   if (duration <= 0.0) return;
   Piece p;
@@ -107,19 +119,29 @@ TurntableProfile TurntableProfile::parse(const YamlField& profile, double accele
       tp.append(seg.getDouble("settle", 0.0), rate, 0.0, label + "/settle");
       tp.append(positive("duration"), rate, 0.0, label);
     } else if (type == "dual_rate") {
-      seg.rejectUnknownKeys({"type", "label", "rates", "duration", "settle", "repeat"});
+      seg.rejectUnknownKeys({"type", "label", "rates", "duration", "settle", "repeat", "order"});
       const std::vector<double> rates = seg["rates"].asDoubles(2);
       if (rates[0] == rates[1]) seg["rates"].fail("the two plateau rates must differ");
       const long repeat = seg.getInteger("repeat", 1);
       if (repeat < 1) seg["repeat"].fail("must be >= 1");
+      const std::string order = seg.getString("order", "alternating");
+      if (order != "alternating" && order != "balanced") {
+        seg["order"].fail("must be 'alternating' or 'balanced', not '" + order + "'");
+      }
       const double duration = positive("duration"), settle = seg.getDouble("settle", 0.0);
-      for (long r = 0; r < repeat; ++r) {
-        for (int k = 0; k < 2; ++k) {
-          const std::string sub = label + "/rate" + std::to_string(k + 1);
+      const double reversal = std::abs(rates[1] - rates[0]) / acceleration;  // s
+      for (long n = 0; n < 2 * repeat; ++n) {
+        const int k = order == "balanced" ? thueMorse(n) : static_cast<int>(n % 2);
+        const std::string sub = label + "/rate" + std::to_string(k + 1);
+        if (n > 0 && tp.finalRate() == rates[k]) {
+          // The same rate again: hold it for as long as a reversal takes, so the plateaus stay
+          // evenly spaced and the balanced order cancels a bias trend exactly.
+          tp.append(reversal + settle, rates[k], 0.0, sub + "/settle");
+        } else {
           tp.rampTo(rates[k], acceleration, sub);
           tp.append(settle, rates[k], 0.0, sub + "/settle");
-          tp.append(duration, rates[k], 0.0, sub);
         }
+        tp.append(duration, rates[k], 0.0, sub);
       }
     } else if (type == "steps") {
       seg.rejectUnknownKeys({"type", "label", "angle", "rate", "dwell", "count"});

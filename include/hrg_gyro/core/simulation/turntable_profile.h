@@ -6,7 +6,11 @@
 //   rate       {rate, duration[, settle]}      change to `rate` rad/s, hold settle + duration s
 //   steps      {angle, rate, dwell, count}     `count` moves of `angle` rad (trapezoidal, cruise
 //                                              `rate`), each followed by a `dwell` s rest
-//   dual_rate  {rates: [w1, w2], duration[, settle, repeat]}  plateaus at w1 then w2, repeated
+//   dual_rate  {rates: [w1, w2], duration[, settle, repeat, order]}  2 x repeat plateaus at w1 and w2;
+//              order `alternating` (default): w1 w2 w1 w2 ...; `balanced`: the Thue-Morse order
+//              w1 w2 w2 w1 w2 w1 w1 w2 ..., which cancels a linear bias trend between the two rates
+//              over every 4 plateaus and a quadratic one over every 8 (two plateaus of one rate in a
+//              row hold it through the time a reversal takes, keeping the plateaus evenly spaced)
 //   piecewise  {points: [[t, rate], ...]}      rate linear between points (t from segment start)
 // Every segment may carry a `label` (ground truth reports it). Rate changes use
 // turntable.acceleration (rad/s^2).
