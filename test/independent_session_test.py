@@ -6,7 +6,8 @@ the nominal prior, and the fitted K is compared with the injected one: the peak 
 
 Cases: the shipped gyro's magnitudes with an encoder-logged angle, a slow drive (40 s ramps), a
 strong nonlinearity (3 % cos 4theta, 0.3 % cos 8theta) and a real table log (strong nonlinearity,
-0.2 % drive ripple, the rate logged as the differenced encoder angle)."""
+0.2 % drive ripple, the rate logged as the differenced encoder angle). One more reads back what the
+generator's options for a wandering bias, the plateau order and the table's clock write."""
 import math
 import os
 import shutil
@@ -14,6 +15,7 @@ import subprocess
 import sys
 import unittest
 
+import rosbag
 import rospy
 import rostest
 import yaml
@@ -93,6 +95,63 @@ class IndependentSession(unittest.TestCase):
                                             "--encoder-noise", "2e-6", "--encoder-bits", "23", "--differenced-rate")
         self.assertLessEqual(residual, 1.0)
         self.assertLessEqual(abs(k0_error), 1.0)
+
+
+    def test_generator_table_clock_plateau_order_and_bias_drift(self):
+        # What the generator's own options write, read back from its bag and truth (no calibration):
+        # the table at 50 Hz on a clock 0.05 s ahead with 1 ms of jitter and two steps, header.seq the
+        # record count, the balanced order over 2 pairs (+ - - +: the two - plateaus one run), the drift's
+        # parameters and its realisation in the truth.
+        bag_path = os.path.join(self.work, "options.bag")
+        truth_path = os.path.join(self.work, "options.truth.yaml")
+        subprocess.run([sys.executable, GENERATOR, "--out", bag_path, "--truth", truth_path, "--pairs", "2",
+                        "--order", "balanced", "--bias-trend", "5e-9", "--bias-random-walk", "2e-8",
+                        "--table-log-rate", "50", "--table-clock-offset", "0.05", "--table-clock-jitter", "0.001",
+                        "--table-clock-step", "20", "0.02", "--table-clock-step", "60", "-0.03"],
+                       check=True, timeout=600)
+        with open(truth_path) as f:
+            truth = yaml.safe_load(f)
+        seqs, times, deviations, rates = [], [], [], []
+        with rosbag.Bag(bag_path) as bag:
+            for _, m, t in bag.read_messages(topics=["/turntable/state"]):
+                true_time = t.to_sec() - 1.0  # written at its true time (the session starts at 1 s)
+                clock = 0.05 + (0.02 if true_time >= 20.0 else 0.0) + (-0.03 if true_time >= 60.0 else 0.0)
+                seqs.append(m.header.seq)
+                times.append(true_time)
+                deviations.append(m.header.stamp.to_sec() - t.to_sec() - clock)
+                rates.append(m.rate)
+        n = len(seqs)
+        self.assertEqual(seqs, list(range(n)))
+        self.assertTrue(all(abs(b - a - 0.02) < 1e-6 for a, b in zip(times, times[1:])), "one record per 20 ms")
+        mean = sum(deviations) / n
+        std = math.sqrt(sum((d - mean) ** 2 for d in deviations) / n)
+        print("[ measured ] generator's table clock: %d records, jitter std %.4g s (asked 1e-3), mean %.3g s"
+              % (n, std, mean))
+        # Within 5 sigma of the estimates over n records (the stamps' rounding to 1 ns is negligible).
+        self.assertAlmostEqual(mean, 0.0, delta=5 * 1e-3 / math.sqrt(n))
+        self.assertAlmostEqual(std, 1e-3, delta=5 * 1e-3 / math.sqrt(2 * n))
+        # Runs of the plateau rates: + then - (two plateaus and a reversal's time) then +.
+        runs = []
+        for t, r in zip(times, rates):
+            sign = 1 if r == 0.4 else -1 if r == -0.4 else 0
+            if sign and (not runs or runs[-1][0] != sign or t - runs[-1][2] > 0.03):
+                runs.append([sign, t, t])
+            elif sign:
+                runs[-1][2] = t
+        plateau = 3.0 + 2.0 * math.pi / (0.56 * 0.4)
+        self.assertEqual([r[0] for r in runs], [1, -1, 1])
+        self.assertAlmostEqual(runs[0][2] - runs[0][1], plateau, delta=0.03)
+        self.assertAlmostEqual(runs[1][2] - runs[1][1], 2 * plateau + 1.6, delta=0.03)
+        self.assertEqual(truth["plateau_order"], "balanced")
+        drift = truth["bias_drift"]
+        self.assertEqual((drift["rate"], drift["random_walk"]), (5e-9, 2e-8))
+        (t0, d_start), (t_mid, _), (t_end, d_end) = drift["realised"]
+        self.assertEqual((t0, d_start), (0.0, truth["drift"]["mean"]))
+        self.assertAlmostEqual(t_end, truth["session_seconds"])
+        # The walk's part of D0 at the end, 2e-8 sqrt(t_end) = 2.8e-7 rad/s (1 sigma): within 6 sigma.
+        self.assertLess(abs(d_end - d_start - 5e-9 * t_end), 6 * 2e-8 * math.sqrt(t_end))
+        self.assertEqual(truth["table_clock"], {"log_rate": 50.0, "offset": 0.05, "jitter": 0.001, "rate_error": 0.0,
+                                                "steps": [[20.0, 0.02], [60.0, -0.03]]})
 
 
 if __name__ == "__main__":
