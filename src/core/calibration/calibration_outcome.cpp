@@ -151,6 +151,12 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
     out << YAML::Key << "offset_std" << YAML::Value << formatDouble(c.offset.offset_std) << YAML::Comment("s");
     out << YAML::Key << "offset_spread" << YAML::Value << formatDouble(c.offset.spread) << YAML::Comment("s");
     out << YAML::Key << "offset_changed" << YAML::Value << c.offset.changed;
+    out << YAML::Key << "rate_error_estimated" << YAML::Value << c.offset.rate_estimated;
+    out << YAML::Key << "rate_error" << YAML::Value << formatDouble(c.offset.rate_error)
+        << YAML::Comment("s per s: the table's clock against the gyro's, from the offsets' drift");
+    out << YAML::Key << "rate_error_std" << YAML::Value << formatDouble(c.offset.rate_error_std);
+    out << YAML::Key << "k_scaled" << YAML::Value << formatDouble(c.k_scaled)
+        << YAML::Comment("K was multiplied by this for the clocks' rate difference");
     out << YAML::Key << "offset_note" << YAML::Value << YAML::DoubleQuoted << c.offset.note;
     out << YAML::Key << "transitions" << YAML::Value << YAML::BeginSeq;
     for (const TableClockTransition& t : c.offset.transitions) {

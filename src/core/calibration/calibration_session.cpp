@@ -337,6 +337,21 @@ void CalibrationSession::reportTableClock(CalibrationOutcome* o) const {
     o->notes.push_back("table clock offset not measured: " + c.offset.note);
     return;
   }
+  // A table clock running at another rate than the gyro's stretches the table angle against the
+  // gyro's time, and K with it (K measured = K (1 + rate error)): undone, its uncertainty added to K0's.
+  if (fitted && c.offset.rate_estimated && !c.offset.changed && c.stamps.clock_steps == 0) {
+    const double scale = 1.0 / (1.0 + c.offset.rate_error);
+    HarmonicFitResult& kf = o->scale_factor[0];
+    kf.mean *= scale;
+    for (double& v : kf.cos) v *= scale;
+    for (double& v : kf.sin) v *= scale;
+    kf.mean_std = std::hypot(kf.mean_std * scale, kf.mean * c.offset.rate_error_std);
+    o->parameters.scale_factor = toModel(kf);
+    c.k_scaled = scale;
+    o->notes.push_back("K divided by 1 + " + formatShort(c.offset.rate_error, 3) +
+                       " for the table clock's rate against the gyro's (measured from the offsets' drift, +- " +
+                       formatShort(c.offset.rate_error_std, 2) + ")");
+  }
   const TableClockSettings& ts = settings_.table_clock;
   const double worst = std::abs(c.offset.offset) + 3.0 * c.offset.offset_std;
   const std::string measured = "the table's stamps are " + formatShort(1e3 * c.offset.offset, 3) + " +- " +

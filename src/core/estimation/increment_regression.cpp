@@ -15,6 +15,8 @@ namespace {
 
 constexpr std::size_t kMaxBlocks = 64;
 constexpr int kMaxTrendOrder = 2;
+// rad^2: table errors below a nanoradian are rounding, not noise (two exact logs stay on the angle).
+constexpr double kNegligibleTableNoise = 1e-18;
 // Window increments seen before the two table sources are weighed (until then, the angle alone).
 constexpr std::size_t kMinSourceIncrements = 16;
 
@@ -125,7 +127,8 @@ void IncrementRegression::flushChain() {
     const double variance = source_squares_ / source_count_, lag = source_lag_ / source_lag_count_;
     // Each part only where the data show it beyond their own scatter (a lag-one covariance of N
     // differences scatters by about variance / sqrt(N)): a clean source is not blamed for chance.
-    const double resolution = 2.0 * variance / std::sqrt(static_cast<double>(source_lag_count_));
+    const double resolution =
+        std::max(kNegligibleTableNoise, 2.0 * variance / std::sqrt(static_cast<double>(source_lag_count_)));
     const double angle_noise = -lag > resolution ? -lag : 0.0;
     const double remainder = variance - 2.0 * angle_noise;
     const double wander = remainder > resolution ? remainder : 0.0;

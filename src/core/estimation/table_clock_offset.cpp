@@ -14,6 +14,8 @@ namespace {
 // spread a millisecond): the offset itself moved during the session.
 constexpr double kChangedChiSquare = 25.0;
 constexpr double kChangedSpread = 1e-3;
+// s the changes of rate must span for the offset's drift (the clocks' rate difference) to be fitted.
+constexpr double kMinDriftSpan = 60.0;
 
 std::string milliseconds(double s) {
   char buf[32];
@@ -168,32 +170,56 @@ TableClockOffsetResult TableClockOffsetEstimator::estimate(const HarmonicModel& 
                            : "the changes of rate seen had too few samples on their plateaus";
     return r;
   }
-  double sum = 0.0, noise = 0.0, lo = r.transitions.front().offset, hi = lo;
+  double noise = 0.0, lo = r.transitions.front().offset, hi = lo, mean_t = 0.0, mean_offset = 0.0;
+  const Nanoseconds t0 = r.transitions.front().stamp;
   for (const TableClockTransition& t : r.transitions) {
-    sum += t.offset;
     noise += t.offset_noise * t.offset_noise;
     lo = std::min(lo, t.offset);
     hi = std::max(hi, t.offset);
+    mean_t += toSeconds(t.stamp - t0) / n;
+    mean_offset += t.offset / n;
   }
-  r.offset = sum / n;
+  // offset = a + rate_error (t - mean t), by least squares where the changes span a minute or more.
+  double stt = 0.0, sto = 0.0;
+  for (const TableClockTransition& t : r.transitions) {
+    const double dt = toSeconds(t.stamp - t0) - mean_t;
+    stt += dt * dt;
+    sto += dt * (t.offset - mean_offset);
+  }
+  const double span = toSeconds(r.transitions.back().stamp - t0);
+  r.rate_estimated = n >= 3.0 && span >= kMinDriftSpan && stt > 0.0;
+  if (r.rate_estimated) r.rate_error = sto / stt;
   double scatter = 0.0, chi = 0.0;
   for (const TableClockTransition& t : r.transitions) {
-    scatter += (t.offset - r.offset) * (t.offset - r.offset);
-    if (t.offset_noise > 0.0) chi += std::pow((t.offset - r.offset) / t.offset_noise, 2);
+    const double residual = t.offset - mean_offset - r.rate_error * (toSeconds(t.stamp - t0) - mean_t);
+    scatter += residual * residual;
+    if (t.offset_noise > 0.0) chi += std::pow(residual / t.offset_noise, 2);
   }
-  // The noise of the mean, or, where the transitions disagree more than that, their scatter.
-  const double from_noise = std::sqrt(noise) / n;
-  const double from_scatter = n >= 3.0 ? std::sqrt(scatter / (n - 1.0) / n) : 0.0;
-  r.offset_std = std::max(from_noise, from_scatter);
+  const double fitted = r.rate_estimated ? 2.0 : 1.0;
+  // The noise of the mean (and of the slope), or, where the offsets disagree more than that, their
+  // scatter about the line.
+  const double residual_variance = n > fitted ? scatter / (n - fitted) : 0.0;
+  const double noise_variance = noise / n;
+  r.offset = mean_offset;
+  r.offset_std = std::sqrt(std::max(noise_variance, n >= 3.0 ? residual_variance : 0.0) / n);
+  if (r.rate_estimated) {
+    r.rate_error_std = std::sqrt(std::max(noise_variance, residual_variance) / stt);
+  }
   r.spread = hi - lo;
-  r.changed = n >= 3.0 && chi / (n - 1.0) > kChangedChiSquare && r.spread > kChangedSpread;
+  r.changed =
+      n > fitted + 1.0 && chi / (n - fitted) > kChangedChiSquare && std::sqrt(residual_variance) > kChangedSpread / 3;
   r.estimated = true;
   r.note = std::to_string(r.transitions.size()) + " changes of rate, offsets " + milliseconds(lo) + " to " +
            milliseconds(hi);
+  if (r.rate_estimated && std::abs(r.rate_error) > 3.0 * r.rate_error_std) {
+    char drift[96];
+    std::snprintf(drift, sizeof drift, "%.3g +- %.2g", 1e6 * r.rate_error, 1e6 * r.rate_error_std);
+    r.note += std::string("; the table's clock runs ") + drift + " ppm " + (r.rate_error > 0.0 ? "fast" : "slow") +
+              " against the gyro's";
+  }
   if (r.changed) {
     r.note +=
-        ": they disagree far beyond their noise, so the offset moved during the session (a clock step, or a "
-        "clock running at another rate): from " +
+        ": they disagree far beyond their noise and a steady drift, so the offset stepped during the session: from " +
         milliseconds(r.transitions.front().offset) + " at the first change to " +
         milliseconds(r.transitions.back().offset) + " at the last";
   }

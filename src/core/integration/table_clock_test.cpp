@@ -91,7 +91,7 @@ TEST(TableClockTest, AClockStepIsFollowedAndShowsInTheOffsets) {
   const AngleLevelGyro g = gyro(22);
   TableImperfections table = ownClock(0.05, 1e-3);
   table.clock_step_at = 480.0;  // between the second and the third plateau
-  table.clock_step = 0.025;  // two and a half records: a whole number would look like lost records
+  table.clock_step = 0.025;     // two and a half records: a whole number would look like lost records
   const CalibrationOutcome o = testing::calibrateTableSession(g, table, profile, settings(), prior());
   ASSERT_TRUE(o.accepted) << o.reason;
   const TableClockReport& c = o.table_clock;
@@ -104,6 +104,29 @@ TEST(TableClockTest, AClockStepIsFollowedAndShowsInTheOffsets) {
   EXPECT_NEAR(c.offset.transitions.front().offset, 0.05, 1e-3);
   EXPECT_NEAR(c.offset.transitions.back().offset, 0.075, 1e-3);
   EXPECT_LE(testing::peakErrorPpm(toModel(o.scale_factor[0]), g.k), 1.0);
+}
+
+TEST(TableClockTest, AClockRunningAtAnotherRateIsMeasuredAndKUndoneOfIt) {
+  // A table computer whose clock runs 10 ppm fast: the table angle is stretched by 10 ppm against the
+  // gyro's time, and K with it. The offsets' drift over the session measures it.
+  const TurntableProfile profile = testing::dualRateProfile(0.05, -0.05, 226.0, 2);
+  const AngleLevelGyro g = gyro(24);
+  TableImperfections table = ownClock(0.05, 1e-3);
+  table.clock_rate_error = 1e-5;
+  const CalibrationOutcome o = testing::calibrateTableSession(g, table, profile, settings(), prior());
+  ASSERT_TRUE(o.accepted) << o.reason;
+  const TableClockReport& c = o.table_clock;
+  const double k0_error = 1e6 * (o.scale_factor[0].mean - g.k.meanAt(NAN)) / 0.56;
+  std::printf(
+      "table clock 10 ppm fast: rate error %.3f +- %.3f ppm measured, K scaled by %.8f; K0 error %.3f ppm "
+      "(sigma %.3f), peak %.2f ppm\n",
+      1e6 * c.offset.rate_error, 1e6 * c.offset.rate_error_std, c.k_scaled, k0_error,
+      1e6 * o.scale_factor[0].mean_std / 0.56, testing::peakErrorPpm(toModel(o.scale_factor[0]), g.k));
+  ASSERT_TRUE(c.offset.rate_estimated);
+  EXPECT_NEAR(c.offset.rate_error, 1e-5, 3.0 * c.offset.rate_error_std + 1e-7);
+  EXPECT_LE(std::abs(k0_error), 3.0 * 1e6 * o.scale_factor[0].mean_std / 0.56);
+  EXPECT_LE(testing::peakErrorPpm(toModel(o.scale_factor[0]), g.k), 1.0);
+  EXPECT_FALSE(c.offset.changed);
 }
 
 TEST(TableClockTest, AnOffsetBeyondTheLimitIsRefusedWithTheValueToSet) {

@@ -97,13 +97,14 @@ struct TableImperfections {
   bool angle_logged = true;       ///< false: the controller logs no angle (the field is NaN)
   /// The controller's own clock: each record stamped at its true time + clock_offset (+ clock_step
   /// from clock_step_at s on) + clock_jitter x N(0, 1), its own seeded stream; seq counts records.
-  double clock_offset = 0.0;   ///< s, the table's stamps minus the gyro's
-  double clock_jitter = 0.0;   ///< s, white
-  double clock_step_at = 0.0;  ///< s from the start (0: no step) ...
-  double clock_step = 0.0;     ///< ... where the offset changes by this much, s
-  double drop_fraction = 0.0;  ///< wave samples dropped at random
-  double gap_period = 0.0;     ///< s: a gap in the wave stream every gap_period s (0: none) ...
-  double gap_length = 0.0;     ///< ... lasting this long
+  double clock_offset = 0.0;      ///< s, the table's stamps minus the gyro's
+  double clock_jitter = 0.0;      ///< s, white
+  double clock_step_at = 0.0;     ///< s from the start (0: no step) ...
+  double clock_step = 0.0;        ///< ... where the offset changes by this much, s
+  double clock_rate_error = 0.0;  ///< s per s: the controller's clock runs 1 + this times as fast
+  double drop_fraction = 0.0;     ///< wave samples dropped at random
+  double gap_period = 0.0;        ///< s: a gap in the wave stream every gap_period s (0: none) ...
+  double gap_length = 0.0;        ///< ... lasting this long
 };
 
 /// A turntable record as the controller logs it.
@@ -157,7 +158,7 @@ inline void runTableSession(const AngleLevelGyro& g, const TableImperfections& t
       TableRecord r;
       r.time = t;
       r.seq = seq++;
-      double clock = table.clock_offset;
+      double clock = table.clock_offset + table.clock_rate_error * t;
       if (table.clock_step_at > 0.0 && t >= table.clock_step_at) clock += table.clock_step;
       if (table.clock_jitter > 0.0) clock += table.clock_jitter * clock_noise.next();
       r.stamp = stamp + toNanoseconds(clock);

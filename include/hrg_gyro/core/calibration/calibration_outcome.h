@@ -35,6 +35,7 @@ struct TableClockReport {
   double configured_offset = 0.0;  ///< s, subtracted from the table's stamps (table_clock/offset)
   TableStampStatistics stamps;     ///< the regularisation of a fixed-rate log: jitter, steps
   TableClockOffsetResult offset;   ///< the offset left after the configured one, from the changes of rate
+  double k_scaled = 1.0;           ///< K was multiplied by this for the clocks' rate difference
 };
 
 struct GroupSummary {

@@ -10,11 +10,11 @@
 //
 // I the model's integral along the path, int K(theta) (dphi + Omega_E dt) + D(theta) dt, with the
 // measured theta and the logged phi; the means are over the last `window` s of settled plateau
-// before the change and the first after it, K the model's over the change. The K(theta) and D(theta) are those the calibration
-// found, so the transitions are kept (thinned to at most `max_rate` samples per s) and measured at
-// the end. Each transition gives one offset; their scatter is the estimate's uncertainty, and a
-// scatter far beyond what the wave-angle noise explains says the offset changed during the session
-// (a clock step, a clock running at another rate). No ROS.
+// before the change and the first after it, K the model's over the change. The K(theta) and D(theta) are those the
+// calibration found, so the transitions are kept (thinned to at most `max_rate` samples per s) and measured at the end.
+// Each transition gives one offset; a straight line through them in time gives the offset and its drift (the table's
+// clock running at another rate than the gyro's, which scales K), their scatter about it the uncertainty, and a scatter
+// far beyond what the wave-angle noise explains says the offset stepped during the session. No ROS.
 #pragma once
 
 #include <cstdint>
@@ -54,7 +54,12 @@ struct TableClockOffsetResult {
   double offset = 0.0;      ///< s, mean of the transitions
   double offset_std = 0.0;  ///< s, its standard error
   double spread = 0.0;      ///< s, largest minus smallest transition offset
-  bool changed = false;     ///< the transitions disagree beyond their noise: the offset moved
+  /// The offset's steady drift over the session: the table's clock runs 1 + rate_error times as fast
+  /// as the gyro's. It scales the table angle against the gyro's time, so K by 1 + rate_error.
+  bool rate_estimated = false;  ///< at least 3 changes over at least a minute
+  double rate_error = 0.0;      ///< s per s
+  double rate_error_std = 0.0;
+  bool changed = false;  ///< the offsets disagree beyond their noise and a steady drift: the offset stepped
   std::vector<TableClockTransition> transitions;
 };
 
