@@ -239,7 +239,7 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
     if (!session()) return;
   }
   const std::uint64_t restarts = session()->counters().restarts;
-  session()->addTurntable(toNanoseconds(msg->header.stamp), msg->angle, msg->rate);
+  session()->addTurntable(toNanoseconds(msg->header.stamp), msg->angle, msg->rate, msg->header.seq);
   noteRestart(restarts);
   if (session()->shouldFinish()) {
     bool written = false;

@@ -23,7 +23,8 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
       continue;
     }
     // What the table controller logged, not the truth.
-    for (const TurntableLogRecord& record : s.turntable) session.addTurntable(record.stamp, record.angle, record.rate);
+    for (const TurntableLogRecord& record : s.turntable)
+      session.addTurntable(record.stamp, record.angle, record.rate, record.index);
     if (!s.channels_delivered) continue;
     const ProcessorResult r = proc.process({s.stamp, s.z, s.frequency, s.temperature});
     if (r.has_wave)

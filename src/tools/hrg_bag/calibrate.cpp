@@ -89,7 +89,7 @@ int runCalibrate(const CalibrateOptions& o) {
         }
       } else if (m.getTopic() == topics.turntable) {
         const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
-        if (t) session.addTurntable(toNanoseconds(t->header.stamp), t->angle, t->rate);
+        if (t) session.addTurntable(toNanoseconds(t->header.stamp), t->angle, t->rate, t->header.seq);
       } else {
         const GroundTruth::ConstPtr g = m.instantiate<GroundTruth>();
         if (!g || !g->generator) continue;
