@@ -6,7 +6,8 @@ the nominal prior, and the fitted K is compared with the injected one: the peak 
 
 Cases: the shipped gyro's magnitudes with an encoder-logged angle, a slow drive (40 s ramps), a
 strong nonlinearity (3 % cos 4theta, 0.3 % cos 8theta) and a real table log (strong nonlinearity,
-0.2 % drive ripple, the rate logged as the differenced encoder angle). One more reads back what the
+0.2 % drive ripple, the rate logged as the differenced encoder angle), a bias that wanders (its trend
+found) and a table logged on its own clock (its offset and jitter found). One more reads back what the
 generator's options for a wandering bias, the plateau order and the table's clock write."""
 import math
 import os
@@ -40,14 +41,20 @@ class IndependentSession(unittest.TestCase):
         cls.params = os.path.join(rospy.get_param("~package_dir"), "config", "params_uncalibrated.yaml")
 
     def calibrate(self, name, *generator_args):
-        """Generates the session and calibrates it; returns (residual nonlinearity, K0 error), ppm of |K0|."""
+        """Generates the session and calibrates it; returns (residual nonlinearity, K0 error), ppm of |K0|.
+        The calibration report and the generator's truth are kept in self.report and self.truth."""
         bag, truth = os.path.join(self.work, name + ".bag"), os.path.join(self.work, name + ".truth.yaml")
-        out = os.path.join(self.work, name + ".yaml")
+        out, report = os.path.join(self.work, name + ".yaml"), os.path.join(self.work, name + ".report.yaml")
         subprocess.run([sys.executable, GENERATOR, "--out", bag, "--truth", truth] + list(generator_args),
                        check=True, timeout=600)
         p = subprocess.run([HRG_BAG, "calibrate", bag, "--method", "dual_rate", "--params", self.params,
-                            "--out", out], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            "--out", out, "--report", report], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                            universal_newlines=True, timeout=600)
+        if os.path.exists(report):
+            with open(report) as f:
+                self.report = yaml.safe_load(f)
+        with open(truth) as f:
+            self.truth = yaml.safe_load(f)
         if p.returncode != 0:
             why = [line for line in (p.stdout + p.stderr).splitlines() if "REFUSED" in line or "error" in line.lower()]
             print("[ measured ] %s: refused (exit %d): %s" % (name, p.returncode, "; ".join(why)))
@@ -96,6 +103,32 @@ class IndependentSession(unittest.TestCase):
         self.assertLessEqual(residual, 1.0)
         self.assertLessEqual(abs(k0_error), 1.0)
 
+    def test_a_bias_that_wanders(self):
+        # D0 moving by 1e-6 rad/s over the session (about 400 s), plateaus in the alternating order: the
+        # calibration fits the trend with K, and finds the injected one.
+        residual, k0_error = self.calibrate("wandering_bias", "--cos4", "2e-3", "--cos8", "0", "--encoder-noise",
+                                            "2e-6", "--encoder-bits", "23", "--bias-trend", "2.5e-9")
+        trend = self.report["bias_trend"]
+        print("[ measured ] wandering bias: trend %.4g +- %.2g rad/s per s (injected %.4g)"
+              % (trend["coefficients"][0], trend["coefficients_std"][0], self.truth["bias_drift"]["rate"]))
+        self.assertLessEqual(residual, 1.0)
+        self.assertLessEqual(abs(k0_error), 1.0)
+        self.assertAlmostEqual(trend["coefficients"][0], 2.5e-9, delta=3 * trend["coefficients_std"][0])
+
+    def test_the_table_on_its_own_clock(self):
+        # The table logged at 100 Hz on a clock 100 ms late with 2 ms of jitter: the stamps regularised,
+        # the offset measured at the changes of rate, K within 1 ppm.
+        residual, k0_error = self.calibrate("own_clock", "--cos4", "2e-3", "--cos8", "0", "--encoder-noise", "2e-6",
+                                            "--encoder-bits", "23", "--table-log-rate", "100",
+                                            "--table-clock-offset", "0.1", "--table-clock-jitter", "0.002")
+        clock = self.report["table_clock"]
+        print("[ measured ] own clock: offset %.4f +- %.4f ms, jitter %.3f ms, regularised %s"
+              % (1e3 * clock["offset"], 1e3 * clock["offset_std"], 1e3 * clock["jitter"], clock["regularised"]))
+        self.assertLessEqual(residual, 1.0)
+        self.assertLessEqual(abs(k0_error), 1.0)
+        self.assertTrue(clock["regularised"])
+        self.assertAlmostEqual(clock["offset"], 0.1, delta=3 * clock["offset_std"] + 2e-5)
+        self.assertAlmostEqual(clock["jitter"], 0.002, delta=0.0002)
 
     def test_generator_table_clock_plateau_order_and_bias_drift(self):
         # What the generator's own options write, read back from its bag and truth (no calibration):

@@ -177,6 +177,62 @@ TEST(RealSessionImperfectionsTest, StrongPickoffNonlinearity) {
   expectWithinOnePpm(calibrate("A/d0 = 0.2", c, settings));
 }
 
+/// A shipped scenario, loaded as the node loads it.
+SimulationConfig shipped(const std::string& name) {
+  return SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/" + name, nodeOnlyScenarioKeys());
+}
+
+// A bias that wanders by 1e-6 rad/s over the session, in the shipped order that cancels a linear
+// trend (+ - - + ...) and in the alternating order that would let a constant-bias fit take it for
+// K0: the trend is fitted with K, and measured against the injected one.
+TEST(RealSessionImperfectionsTest, ABiasThatWandersThroughTheSession) {
+  for (const char* order : {"balanced", "alternating"}) {
+    SimulationConfig c = shipped("dual_rate_drifting.yaml");
+    if (std::string(order) == "alternating") {
+      const SimulationConfig plain = shipped("dual_rate.yaml");
+      c.profile = plain.profile;  // + - + - ..., the same plateaus
+      c.resonator.bias_drift.rate = 1e-6 / c.profile.duration();
+    }
+    const Measured m = calibrate(std::string("D0 drifting 1e-6 rad/s, ") + order, c);
+    expectWithinOnePpm(m);
+    EXPECT_LE(std::abs(m.k0_ppm), 3.0 * m.k0_sigma_ppm + 0.05);
+    const BiasTrendFit& t = m.run.outcome.bias_trend;
+    ASSERT_EQ(t.order, 1);
+    std::printf("[ measured ] %s: trend %.4e +- %.1e rad/s per s (injected %.4e), K0 sigma x%.2f\n", order,
+                t.coefficients[0], t.stds[0], c.resonator.bias_drift.rate, t.k0_inflation);
+    EXPECT_NEAR(t.coefficients[0], c.resonator.bias_drift.rate, 3.0 * t.stds[0] + 0.01 * c.resonator.bias_drift.rate);
+  }
+}
+
+// The table logged at 100 Hz on its own clock: 100 ms late, 2 ms of jitter, a 2 urad encoder; and
+// the same clock running 10 ppm fast, which stretches the table angle (and K) by 10 ppm.
+TEST(RealSessionImperfectionsTest, TheTableOnItsOwnClock) {
+  for (double rate_error : {0.0, 1e-5}) {
+    SimulationConfig c = shipped("dual_rate_table_clock.yaml");
+    c.turntable_log.clock.rate_error = rate_error;
+    const Measured m = calibrate("table at 100 Hz, 100 ms late, 2 ms jitter, rate error " +
+                                     std::to_string(static_cast<int>(rate_error * 1e6)) + " ppm",
+                                 c);
+    expectWithinOnePpm(m);
+    EXPECT_LE(std::abs(m.k0_ppm), 3.0 * m.k0_sigma_ppm + 0.05);
+    const TableClockReport& clock = m.run.outcome.table_clock;
+    std::printf(
+        "[ measured ] table clock: offset %.4f +- %.4f ms (injected %.1f ms at the start), jitter %.3f ms (injected "
+        "%.1f ms), rate error %.3f +- %.3f ppm (injected %.1f)\n",
+        1e3 * clock.offset.offset, 1e3 * clock.offset.offset_std, 1e3 * c.turntable_log.clock.offset,
+        1e3 * clock.stamps.jitter, 1e3 * c.turntable_log.clock.jitter, 1e6 * clock.offset.rate_error,
+        1e6 * clock.offset.rate_error_std, 1e6 * rate_error);
+    ASSERT_TRUE(clock.offset.estimated) << clock.offset.note;
+    ASSERT_TRUE(clock.offset.rate_estimated);
+    EXPECT_NEAR(clock.offset.rate_error, rate_error, 3.0 * clock.offset.rate_error_std + 1e-8);
+    if (rate_error == 0.0) {
+      EXPECT_NEAR(clock.offset.offset, c.turntable_log.clock.offset, 3.0 * clock.offset.offset_std + 2e-5);
+    }
+    EXPECT_TRUE(clock.stamps.fixed_rate) << clock.stamps.note;
+    EXPECT_NEAR(clock.stamps.jitter, c.turntable_log.clock.jitter, 0.1 * c.turntable_log.clock.jitter);
+  }
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace hrg_gyro
