@@ -341,6 +341,27 @@ def validate_report(report, path):
             f.fail("turntable_rejected", "a map of reasons (text) to counts", key)
         f.count(rejected, key, "turntable_rejected")
     f.count(report, "restarts")
+    if "bias_trend" in report:  # dual-rate: the bias's trend fitted with K and D
+        trend = f.mapping(report, "bias_trend")
+        order = f.count(trend, "order", "bias_trend", minimum=1)
+        for key in ("coefficients", "coefficients_std"):
+            f.numbers(trend, key, "bias_trend", length=(order, "bias_trend.order"), finite=True)
+        for key in ("reference_stamp", "span", "change_over_span", "k0_inflation", "k0_correlation"):
+            f.number(trend, key, "bias_trend", finite=True)
+    if "table_clock" in report:  # the table's clock against the gyro's
+        clock = f.mapping(report, "table_clock")
+        for key in ("regularised", "offset_estimated", "offset_changed", "rate_error_estimated"):
+            f.boolean(clock, key, "table_clock")
+        for key in ("records", "regularised_records", "off_line_records", "clock_steps"):
+            f.count(clock, key, "table_clock")
+        for key in ("configured_offset", "log_period", "jitter", "offset", "offset_std", "offset_spread", "rate_error",
+                    "rate_error_std", "k_scaled"):
+            f.number(clock, key, "table_clock", finite=True)
+        f.text(clock, "counted_by", "table_clock")
+        f.text(clock, "offset_note", "table_clock")
+        for here, t in f.items(clock, "transitions", "table_clock"):
+            for key in ("stamp", "rate_before", "rate_after", "offset", "offset_noise"):
+                f.number(t, key, here, finite=True)
     for here, plateau in f.items(report, "plateaus"):
         for key in ("rate", "rate_std", "duration", "coverage", "turns"):
             f.number(plateau, key, here)

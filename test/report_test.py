@@ -208,7 +208,8 @@ class ReportTest(unittest.TestCase):
         self.assertGreaterEqual(checked, 4 * len(k["orders"]) * 2 + 2 * len(report["gates"]) + 6 * len(
             report["plateaus"]), sorted(page.by_q))
         for key in ("scale_factor.0.cos_std.0", "drift.0.sin.0", "gates.8.value", "diagnosis.0.recommended_p.3",
-                    "nonlinearity_ppm"):
+                    "nonlinearity_ppm", "bias_trend.coefficients.0", "bias_trend.k0_inflation", "table_clock.offset",
+                    "table_clock.jitter"):
             self.assertIn(key, page.by_q)
         self.assertEqual(page.by_id["verification-before"], "3425.067")
         self.assertEqual(page.by_id["verification-after"], "0.540")
