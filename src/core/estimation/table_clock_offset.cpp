@@ -44,6 +44,19 @@ void TableClockOffsetEstimator::add(Nanoseconds stamp, double theta, double tabl
                                     std::uint64_t plateau, double plateau_rate, bool settled) {
   (void)table_rate;
   if (!std::isfinite(theta) || !std::isfinite(table_angle)) return;
+  // A gap in the samples (lost samples, a table outage) breaks the path the model is integrated
+  // along: a change of rate with one in it is not measured, and a plateau's tail starts anew.
+  const bool gap = last_added_ != 0 && toSeconds(stamp - last_added_) > settings_.max_sample_gap;
+  last_added_ = stamp;
+  if (gap) {
+    if (in_transition_) {
+      in_transition_ = false;
+      open_samples_.clear();
+      ++broken_;
+    }
+    on_plateau_ = false;
+    tail_.clear();
+  }
   if (in_transition_) {
     const double t = toSeconds(stamp - open_origin_);
     int side = 0;
@@ -168,6 +181,7 @@ TableClockOffsetResult TableClockOffsetEstimator::estimate(const HarmonicModel& 
   if (n < 1.0) {
     r.note = done_.empty() ? "no change of the table's rate was seen settled on both sides by both streams"
                            : "the changes of rate seen had too few samples on their plateaus";
+    if (broken_ > 0) r.note += " (" + std::to_string(broken_) + " left out: a gap in the samples)";
     return r;
   }
   double noise = 0.0, lo = r.transitions.front().offset, hi = lo, mean_t = 0.0, mean_offset = 0.0;
@@ -211,6 +225,7 @@ TableClockOffsetResult TableClockOffsetEstimator::estimate(const HarmonicModel& 
   r.estimated = true;
   r.note = std::to_string(r.transitions.size()) + " changes of rate, offsets " + milliseconds(lo) + " to " +
            milliseconds(hi);
+  if (broken_ > 0) r.note += " (" + std::to_string(broken_) + " more left out: a gap in the samples)";
   if (r.rate_estimated && std::abs(r.rate_error) > 3.0 * r.rate_error_std) {
     char drift[96];
     std::snprintf(drift, sizeof drift, "%.3g +- %.2g", 1e6 * r.rate_error, 1e6 * r.rate_error_std);

@@ -37,6 +37,7 @@ struct TableClockOffsetSettings {
   double min_rate_change = 0.005;  ///< rad/s: smaller changes of rate are not measured
   double max_transition = 30.0;    ///< s from leaving one settled plateau to settling on the next
   std::size_t max_transitions = 64;
+  double max_sample_gap = 0.1;  ///< s between two samples beyond which a change of rate is left out
 };
 
 /// One change of rate seen by both streams.
@@ -94,7 +95,8 @@ class TableClockOffsetEstimator {
   void keep(std::deque<Sample>* into, Nanoseconds origin, Nanoseconds stamp, double theta, double phi, int side);
 
   TableClockOffsetSettings settings_;
-  Nanoseconds last_kept_ = 0;
+  Nanoseconds last_kept_ = 0, last_added_ = 0;
+  std::size_t broken_ = 0;  // changes of rate left out for a gap in the samples
   // The settled plateau the table is on and its last `window` s: the "before" side of a change.
   bool on_plateau_ = false;
   std::uint64_t plateau_ = 0;
