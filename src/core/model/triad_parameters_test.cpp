@@ -1,0 +1,106 @@
+#include "hrg_gyro/core/model/triad_parameters.h"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include "hrg_gyro/core/common/yaml_field.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+TriadParameters sample() {
+  TriadParameters t;
+  t.frame_id = "imu_body";
+  t.axes = {{"gx", "gy", "gz"}};
+  t.axis_to_body << 1.000002, -3e-5, 1.2e-5, 4e-5, 0.999998, -2e-5, -1e-5, 2.5e-5, 1.0000001;
+  t.bias << 1e-7, -2e-7, 3e-8;
+  t.axis_to_body_std.setConstant(1.5e-6);
+  t.bias_std << 1e-8, 1e-8, 2e-8;
+  t.calibration.method = ParameterOrigin::manual();
+  t.calibration.time = "2026-11-25T12:00:00Z";
+  t.calibration.source = "bench 3";
+  return t;
+}
+
+std::string refusedKey(const std::string& yaml) {
+  try {
+    parseTriadParameters(YAML::Load(yaml));
+  } catch (const ConfigError& e) {
+    return e.key();
+  }
+  return "";
+}
+
+const char* kValid =
+    "frame_id: imu_link\naxes: [x, y, z]\naxis_to_body: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\nbias: [0, 0, 0]\n";
+
+TEST(TriadParametersTest, EmitsTheEquationAndReadsBackExactly) {
+  const TriadParameters t = sample();
+  const std::string text = emitTriadParameters(t);
+  EXPECT_NE(text.find("omega_body = M omega_axis - bias"), std::string::npos) << text;
+  EXPECT_NE(text.find("misalignment A_ij"), std::string::npos) << text;
+  EXPECT_EQ(parseTriadParameters(YAML::Load(text)), t);
+  // A = M^-1 is the axes' directions: M A = I.
+  EXPECT_LT((t.axis_to_body * t.bodyToAxis() - Eigen::Matrix3d::Identity()).norm(), 1e-15);
+}
+
+TEST(TriadParametersTest, TheMinimalFileIsTheNominalTriad) {
+  const TriadParameters t = parseTriadParameters(YAML::Load(kValid));
+  EXPECT_EQ(t.axis_to_body, Eigen::Matrix3d::Identity());
+  EXPECT_EQ(t.bias, Eigen::Vector3d::Zero());
+  EXPECT_TRUE(t.calibration.method.isNone());
+}
+
+TEST(TriadParametersTest, EveryBadKeyIsNamed) {
+  const std::string v = kValid;
+  auto with = [&](const std::string& key, const std::string& value) {
+    YAML::Node n = YAML::Load(v);
+    n[key] = YAML::Load(value);
+    YAML::Emitter e;
+    e << n;
+    return std::string(e.c_str());
+  };
+  EXPECT_EQ(refusedKey(v + "axis_to_bdy: 1\n"), "axis_to_bdy");  // a typo
+  EXPECT_EQ(refusedKey(with("frame_id", "\"/imu\"")), "frame_id");
+  EXPECT_EQ(refusedKey(with("frame_id", "\"imu link\"")), "frame_id");
+  EXPECT_EQ(refusedKey(with("axes", "[x, y]")), "axes");
+  EXPECT_EQ(refusedKey(with("axes", "[x, x, z]")), "axes[1]");
+  EXPECT_EQ(refusedKey(with("axis_to_body", "[[1, 0, 0], [0, 1, 0]]")), "axis_to_body");
+  EXPECT_EQ(refusedKey(with("axis_to_body", "[[1, 0, 0], [0, 1, 0], [0, .nan, 1]]")), "axis_to_body[2][1]");
+  // Axes swapped (y and x): far from the identity.
+  EXPECT_EQ(refusedKey(with("axis_to_body", "[[0, 1, 0], [1, 0, 0], [0, 0, 1]]")), "axis_to_body");
+  EXPECT_EQ(refusedKey(with("bias", "[0, 0]")), "bias");
+  EXPECT_EQ(refusedKey(with("bias", "[0, 0, 1]")), "bias");  // 1 rad/s: deg/s taken for rad/s?
+  EXPECT_EQ(refusedKey(with("bias_std", "[0, -1, 0]")), "bias_std");
+  EXPECT_EQ(refusedKey(with("calibration", "{method: magic}")), "calibration.method");
+}
+
+TEST(TriadParametersTest, SavedAtomicallyAndLoadedBack) {
+  const std::string dir = ::testing::TempDir();
+  const std::string path = dir + "/triad_parameters_test.yaml";
+  std::remove(path.c_str());
+  std::remove((path + ".bak").c_str());
+  const TriadParameters t = sample();
+  saveTriadFile(path, t);
+  EXPECT_EQ(loadTriadFile(path), t);
+  TriadParameters u = t;
+  u.bias(2) = 5e-8;
+  saveTriadFile(path, u);
+  EXPECT_EQ(loadTriadFile(path), u);
+  EXPECT_EQ(loadTriadFile(path + ".bak"), t);
+  TriadParameters bad = t;
+  bad.axis_to_body(0, 1) = 0.5;
+  EXPECT_THROW(saveTriadFile(path, bad), std::runtime_error);
+  EXPECT_EQ(loadTriadFile(path), u);  // untouched
+  std::remove(path.c_str());
+  std::remove((path + ".bak").c_str());
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro
