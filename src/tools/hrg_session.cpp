@@ -41,7 +41,12 @@ CalibrationSettings checkedSettings(const std::string& method, const std::vector
   n["bins"] = bins;
   n["window"] = window;
   try {
-    return CalibrationSettings::parse(YamlField(n, ""));
+    CalibrationSettings s = CalibrationSettings::parse(YamlField(n, ""));
+    if (traitsOf(s.method).three_axes) {
+      throw ArgumentError("--method " + method +
+                          ": hrg_session simulates one axis; calibrate a triad with hrg_bag calibrate --method triad");
+    }
+    return s;
   } catch (const ConfigError& e) {
     static const std::pair<const char*, const char*> kOptions[] = {{"method", "--method"},
                                                                    {"scale_factor_orders", "--orders"},
@@ -89,7 +94,7 @@ int main(int argc, char** argv) {
   app.add_option("--params", params, "parameter file of the gyro before calibration")->required();
   app.add_option("--out", out, "calibrated parameter file, written atomically when the gates accept")
       ->check(hrg_gyro::tools::notEmpty());
-  app.add_option("--method", method, calibrationMethodNames("|"))->capture_default_str();
+  app.add_option("--method", method, singleAxisMethodNames("|"))->capture_default_str();
   auto orders_option = [&](const char* name, std::vector<int>* target, const char* meaning) {
     app.add_option(name, *target, meaning)->delimiter(',')->transform(wholeNumber(2, 64))->capture_default_str();
   };

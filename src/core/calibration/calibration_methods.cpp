@@ -77,6 +77,10 @@ std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettin
       return std::make_unique<StepMethod>(s);
     case CalibrationMethodKind::kCorrectionMatrix:
       return std::make_unique<CorrectionMatrixMethod>(s);
+    case CalibrationMethodKind::kTriad:
+      throw std::invalid_argument(
+          "the triad method calibrates three axes at once: give it a triad session (hrg_bag calibrate --method triad "
+          "on a bag with the three axes' channels and the fixture's positions, or the calibrator in triad mode)");
     case CalibrationMethodKind::kThermal:
       return std::make_unique<ThermalMethod>(s, k0);
   }

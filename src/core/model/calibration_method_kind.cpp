@@ -12,21 +12,26 @@ struct Entry {
 };
 
 // The methods, listed once. Columns: name, description, generator pairs, turntable, K and D, P,
-// frequency dependent.
+// frequency dependent, three axes.
 const Entry kMethods[] = {
     {CalibrationMethodKind::kDualRate,
      {"dual_rate", "two opposite table rates: K(theta) and D(theta), the drift cancels", false, true, true, false,
-      false}},
+      false, false}},
     {CalibrationMethodKind::kConstantRate,
-     {"constant_rate", "a dwell then one table rate: K(theta) and D", false, true, true, false, false}},
+     {"constant_rate", "a dwell then one table rate: K(theta) and D", false, true, true, false, false, false}},
     {CalibrationMethodKind::kStep,
-     {"step", "table steps between dwells: K(theta) from the steps, D from the dwells", false, true, true, false,
+     {"step", "table steps between dwells: K(theta) from the steps, D from the dwells", false, true, true, false, false,
       false}},
     {CalibrationMethodKind::kCorrectionMatrix,
-     {"correction_matrix", "generator sweep at rest: the correction matrix P", true, false, false, true, false}},
+     {"correction_matrix", "generator sweep at rest: the correction matrix P", true, false, false, true, false, false}},
     {CalibrationMethodKind::kThermal,
      {"thermal", "dual rate across temperature: K and D as splines over the resonator frequency", false, true, true,
-      false, true}},
+      false, true, false}},
+    {CalibrationMethodKind::kTriad,
+     {"triad",
+      "three axes in a fixture turned through positions: each axis's K(theta) and D(theta), the triad's matrix and "
+      "bias",
+      false, true, true, false, false, true}},
 };
 
 const Entry& entryOf(CalibrationMethodKind method) {
@@ -54,6 +59,14 @@ std::string nameOf(CalibrationMethodKind method) { return traitsOf(method).name;
 std::string calibrationMethodNames(const std::string& separator) {
   std::string out;
   for (const Entry& e : kMethods) out += (out.empty() ? "" : separator) + std::string(e.traits.name);
+  return out;
+}
+
+std::string singleAxisMethodNames(const std::string& separator) {
+  std::string out;
+  for (const Entry& e : kMethods) {
+    if (!e.traits.three_axes) out += (out.empty() ? "" : separator) + std::string(e.traits.name);
+  }
   return out;
 }
 

@@ -24,6 +24,7 @@ enum class CalibrationMethodKind {
   kStep,              ///< table steps between dwells: K from the steps, D from the dwells
   kCorrectionMatrix,  ///< generator sweep at rest: the correction matrix P
   kThermal,           ///< dual-rate across temperature: K and D as splines over the frequency
+  kTriad,             ///< three axes in a fixture turned through positions: each axis's K and D, the triad's M and bias
 };
 
 /// What a method needs from a session and what it estimates.
@@ -36,6 +37,7 @@ struct CalibrationMethodTraits {
   bool estimates_k_and_d;     ///< writes K(theta) and D(theta)
   bool estimates_correction;  ///< writes the correction matrix P
   bool frequency_dependent;   ///< K and D over the resonator frequency (the input must carry it)
+  bool three_axes;            ///< calibrates a triad (three axes' streams and the fixture's position)
 };
 
 /// Every method, in the order help texts list them; the first is the default.
@@ -45,6 +47,8 @@ const CalibrationMethodTraits& traitsOf(CalibrationMethodKind method);
 std::string nameOf(CalibrationMethodKind method);
 /// The names of every method joined by `separator`, e.g. "dual_rate, constant_rate, ...".
 std::string calibrationMethodNames(const std::string& separator = ", ");
+/// The same for the methods of one axis (those that are not three_axes).
+std::string singleAxisMethodNames(const std::string& separator = ", ");
 /// The method named `name`; nullopt for an unknown name.
 std::optional<CalibrationMethodKind> findCalibrationMethod(const std::string& name);
 /// The method named `name`; throws std::invalid_argument "unknown method 'x' (dual_rate, ...)".

@@ -1,0 +1,110 @@
+// A triad calibrated on a single-axis rate table, the multi-position way: the three gyros sit in a
+// fixture that the operator turns through positions (which body axis points along the table axis, up
+// or down, and tilted ones), each with its table profile, and the bench logs the fixture's position.
+//
+// Three stages, all from one session:
+//  1. Each axis's K(theta) and D(theta): today's dual-rate method, fed with the axis's wave angle and
+//     the table while the axis points along the table axis (up, or down with the table angle's sign
+//     turned and the Earth's vertical rate with it), one single-axis CalibrationSession per axis.
+//  2. The axes' directions A in the body frame: in every fixture position, each axis's compensated
+//     increments (stage 1's K and D applied to its wave angle) against the table angle, over window
+//     increments on the position's moving plateaus, give its response c_i,p = A_i . u_p to the table's
+//     rate (u_p: the table axis in the body frame, from the position's logged orientation); the fit
+//     also takes a constant rate (the axis's residual bias) and the Earth's horizontal rate, which turns
+//     with the table as a sinusoid of the table angle. A_i is then the least-squares solution over the
+//     positions: at least three independent table-axis directions are needed (refused otherwise, the
+//     missing body axes named). M = A^-1.
+//  3. The body bias: in every rest of a locked position, the axes' mean compensated rates through M
+//     against the Earth's 3-D rate in the body frame (latitude from the axes' parameter files, the
+//     table's azimuth from the settings, the table angle at rest from the log).
+//
+// A fixture position off by a small rotation makes u_p, and so the responses of that position, off by
+// it: the error enters A as the least-squares image of the positions' errors (docs/triad.md).
+//
+// Memory: stage 1 is streamed (the sessions' sums); stage 2 keeps each axis's wave angle and the
+// table's angle thinned to `store_rate`, and the fixture's timeline. No ROS.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "hrg_gyro/core/calibration/calibration_session.h"
+#include "hrg_gyro/core/calibration/triad_outcome.h"
+
+namespace hrg_gyro {
+namespace core {
+
+struct TriadCalibrationSettings {
+  double azimuth = 0.0;                             ///< rad: the table's zero mark from North towards East
+  double window = 1.0;                              ///< s: window of the cross-axis response fit
+  double store_rate = 20.0;                         ///< Hz: wave and table samples kept per axis for stages 2 and 3
+  double vertical_tolerance = 0.02;                 ///< an axis is along the table axis when |u . e_i| >= 1 - this
+  double min_rest = 20.0;                           ///< s of settled rest for a bias estimate
+  double min_position_time = 60.0;                  ///< s of moving plateaus for a position's responses
+  double max_misalignment = kMaxTriadMisalignment;  ///< largest |A - I| accepted
+
+  /// Parses the `triad` section of the calibrator settings. Throws ConfigError naming the key.
+  static TriadCalibrationSettings parse(const YamlField& section);
+  static std::vector<std::string> keys();
+};
+
+/// The fixture's position as the bench logs it (hrg_gyro/FixturePosition).
+struct FixtureRecord {
+  Nanoseconds stamp = 0;
+  std::uint32_t index = 0;
+  std::string name;
+  Eigen::Quaterniond body_to_table = Eigen::Quaterniond::Identity();
+  bool locked = false;
+};
+
+class TriadCalibration {
+ public:
+  /// `axis_settings`: the dual-rate settings of stage 1 (method is forced to dual_rate); `priors`:
+  /// each axis's parameter file in the triad's axis order (their P is kept; their latitude is the
+  /// site's); `prior_triad`: the triad file whose frame_id and axis names the result keeps.
+  TriadCalibration(const CalibrationSettings& axis_settings, const TriadCalibrationSettings& settings,
+                   const std::array<GyroParameters, 3>& priors, const TriadParameters& prior_triad);
+
+  void addFixture(const FixtureRecord& record);
+  /// The table's records (one stream for the whole fixture); sequence as in CalibrationSession.
+  void addTurntable(Nanoseconds stamp, double angle, double rate,
+                    std::uint64_t sequence = TableStampRegulariser::kNoSequence);
+  /// Axis `axis` (0..2, the triad's order)'s wave angle from its processor (prior P applied).
+  void addWave(int axis, Nanoseconds stamp, double theta, double frequency = NAN);
+
+  /// Runs the three stages; writes nothing.
+  TriadOutcome finish() const;
+
+ private:
+  struct StoredSample {
+    Nanoseconds stamp;
+    double value;  // the wave angle, or the table angle
+  };
+  struct Interval {  // a locked fixture position
+    Nanoseconds from = 0, to = 0;
+    FixtureRecord fixture;
+  };
+  /// The fixture record in force at `stamp` (nullptr: none yet).
+  const FixtureRecord* fixtureAt(Nanoseconds stamp) const;
+  /// +1 or -1 when axis `axis` points up or down the table axis in `fixture`, 0 otherwise.
+  int verticalSign(const FixtureRecord& fixture, int axis) const;
+  std::vector<Interval> lockedIntervals() const;
+
+  CalibrationSettings axis_settings_;
+  TriadCalibrationSettings settings_;
+  std::array<GyroParameters, 3> priors_;
+  TriadParameters prior_triad_;
+  std::array<std::unique_ptr<CalibrationSession>, 3> sessions_;
+  std::vector<FixtureRecord> fixtures_;  // every change of the fixture's state, in order
+  std::array<std::vector<StoredSample>, 3> waves_;
+  std::vector<StoredSample> table_;  // the table angle, thinned
+  std::vector<double> table_rates_;  // the reported rate of each stored table sample
+  std::array<Nanoseconds, 3> last_wave_kept_{{0, 0, 0}};
+  Nanoseconds last_table_kept_ = 0;
+  Nanoseconds origin_ = 0;  // first stamp seen: the Earth-rate term's time origin
+};
+
+}  // namespace core
+}  // namespace hrg_gyro
