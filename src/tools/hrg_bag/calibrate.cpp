@@ -13,6 +13,7 @@
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "triad_calibrate.h"
 
 namespace hrg_gyro {
 
@@ -22,10 +23,55 @@ struct CalibrateOptions {
   std::string bag, method, params, out, report, plot, config;
   bag_tools::GyroTopics topics;
   core::ProcessorConfig processor;
+  bag_tools::TriadCalibrateOptions triad;  // --method triad: its own inputs
 };
+
+/// The method asked for: --method, else --config's, else the default.
+core::CalibrationMethodKind chosenMethod(const CalibrateOptions& o) {
+  if (!o.method.empty()) return core::parseCalibrationMethod(o.method);
+  if (o.config.empty()) return core::CalibrationSettings().method;
+  try {
+    const YAML::Node root =
+        YAML::Load(core::readBoundedRegularFile(o.config, core::kMaxParameterFileBytes, "settings file"));
+    if (root.IsMap() && root["method"] && root["method"].IsScalar())
+      return core::parseCalibrationMethod(root["method"].as<std::string>());
+  } catch (const std::exception&) {
+    // read and reported with the rest of the settings below
+  }
+  return core::CalibrationSettings().method;
+}
+
+int runTriad(const CalibrateOptions& o) {
+  using namespace bag_tools;
+  if (!o.params.empty()) {
+    throw UsageError("--method triad takes each axis's prior with --axis-params NAME=FILE, not --params");
+  }
+  if (!o.topics.channels.empty() || !o.topics.truth.empty()) {
+    throw UsageError(
+        "--method triad: each axis's channels are /NAME/channels (--axis-channels NAME=TOPIC), "
+        "and no generator reference is used");
+  }
+  if (!o.plot.empty()) {
+    throw UsageError("--plot draws a single axis's report; the triad's report is drawn by hrg_bag report");
+  }
+  TriadCalibrateOptions t = o.triad;
+  t.bag = o.bag;
+  t.out = o.out;
+  t.report = o.report;
+  t.config = o.config;
+  t.turntable_topic = o.topics.turntable;
+  t.processor = o.processor;
+  return runTriadCalibrate(t);
+}
 
 int runCalibrate(const CalibrateOptions& o) {
   using namespace bag_tools;
+  if (chosenMethod(o) == core::CalibrationMethodKind::kTriad) return runTriad(o);
+  const bool triad_options = !o.triad.triad.empty() || !o.triad.axis_params.empty() || !o.triad.axis_out.empty() ||
+                             !o.triad.axis_channels.empty() || !o.triad.fixture_topic.empty();
+  if (triad_options) {
+    throw UsageError("--triad, --axis-params, --axis-out, --axis-channels and --fixture-topic are for --method triad");
+  }
   checkProcessorConfig(o.processor);
   // --out may be the prior itself (--params X --out X): the prior is read whole before anything
   // else and replaced only by an accepted calibration, keeping the old file as X.bak, as the live
@@ -163,7 +209,8 @@ Command addCalibrateCommand(CLI::App& root) {
                   core::calibrationMethodNames("|") + " (default: --config's, else " +
                       core::nameOf(core::CalibrationSettings().method) + ")")
       ->check(knownMethod());
-  cmd->add_option("--out", o->out, "calibrated parameter file, written atomically only when every gate passes")
+  cmd->add_option("--out", o->out,
+                  "calibrated parameter file (triad: the triad file), written atomically only when every gate passes")
       ->required()
       ->check(tools::notEmpty());
   cmd->add_option("--params", o->params, "prior parameter file (default: the nominal model at latitude 0)")
@@ -176,10 +223,24 @@ Command addCalibrateCommand(CLI::App& root) {
   cmd->add_option("--plot", o->plot, "PNG drawn from the report")->needs(report)->check(tools::notEmpty());
   addTopicOptions(*cmd, &o->topics, true);
   addProcessorOptions(*cmd, &o->processor);
+  cmd->add_option("--triad", o->triad.triad,
+                  "triad: prior triad file (axis names and order, frame_id; default nominal)")
+      ->check(tools::notEmpty());
+  cmd->add_option("--axis-params", o->triad.axis_params,
+                  "triad: NAME=FILE, each axis's prior parameter file (all three)");
+  cmd->add_option("--axis-out", o->triad.axis_out,
+                  "triad: NAME=FILE, each axis's calibrated parameter file (default: NAME.yaml beside --out)");
+  cmd->add_option("--axis-channels", o->triad.axis_channels,
+                  "triad: NAME=TOPIC, an axis's channels (default /NAME/channels)");
+  cmd->add_option("--fixture-topic", o->triad.fixture_topic,
+                  "triad: the fixture's positions (hrg_gyro/FixturePosition; default: the bag's single one)")
+      ->check(topicName());
   cmd->footer(
       "Processes the bag's channels with the prior parameters and runs the calibrator's method with its\n"
       "quality gates on the turntable plateaus. Thermal writes K and D as splines over the resonator\n"
       "frequency (the bag's channels must carry it).\n"
+      "Triad (docs/triad.md): each axis's channels through its own processor, the table and the fixture's\n"
+      "positions; writes each axis's parameter file and the triad file, all or none checked before the first.\n"
       "Every output replaces its path only when complete; an output that is the same file as an input\n"
       "or another output is refused before anything runs, but for --out naming the --params file: the\n"
       "prior is then refreshed in place when the calibration is accepted (the old file kept as .bak).\n"
