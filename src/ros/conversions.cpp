@@ -215,4 +215,15 @@ core::CalibrationOutcome fromMessage(const CalibrationResult& m) {
   return o;
 }
 
+core::FixtureRecord fromMessage(const FixturePosition& msg) {
+  core::FixtureRecord r;
+  r.stamp = toNanoseconds(msg.header.stamp);
+  r.index = msg.index;
+  r.name = msg.name;
+  r.body_to_table =
+      Eigen::Quaterniond(msg.body_to_table.w, msg.body_to_table.x, msg.body_to_table.y, msg.body_to_table.z);
+  r.locked = msg.locked;
+  return r;
+}
+
 }  // namespace hrg_gyro

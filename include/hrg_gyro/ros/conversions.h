@@ -7,11 +7,13 @@
 
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/ChannelAmplitudes.h"
+#include "hrg_gyro/FixturePosition.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/GyroOutput.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
 #include "hrg_gyro/core/calibration/calibration_outcome.h"
+#include "hrg_gyro/core/calibration/triad_calibration.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/simulation/gyro_simulator.h"
@@ -51,5 +53,9 @@ CalibrationResult toMessage(const core::CalibrationOutcome& outcome, bool writte
                             const ros::Time& stamp);
 /// The parts of an outcome a message carries (for summaries built from a received result).
 core::CalibrationOutcome fromMessage(const CalibrationResult& msg);
+
+/// The fixture's position as logged, its quaternion as is: core::acceptFixtureOrientation decides
+/// whether it is a rotation (the live calibrator and `hrg_bag calibrate --method triad` alike).
+core::FixtureRecord fromMessage(const FixturePosition& msg);
 
 }  // namespace hrg_gyro
