@@ -5,7 +5,9 @@
                 [--verification SUMMARY.yaml] [--rest FROM TO] [--title TEXT]
 
 REPORT.yaml is the calibration report (`hrg_bag calibrate --report`, or the calibrator node's
-<parameter file>.<method>.report.yaml). With --bag, the session's turntable profile and temperature
+<parameter file>.<method>.report.yaml). A triad's report (method triad) gets a page of its own: the
+axis matrix with its misalignment angles, the positions' responses, the body bias against the Earth's
+rate and each axis's K(theta); it is drawn from the YAML alone (no --bag, --params, --verification). With --bag, the session's turntable profile and temperature
 are drawn from the bag, and the Allan deviation of the compensated rate is computed over the bag's
 longest rest (or --rest FROM TO, channel stamps in s) by `hrg_bag allan`, which runs the package's
 processor with the calibrated parameters (--params, else the parameters in the report, else the
@@ -68,6 +70,13 @@ SPEC_KEYS = {
     "max_bias_instability_deg_per_h": ("bias_instability", RAD_S_TO_DEG_H),
     "max_rrw_rad_per_s_per_sqrt_s": ("rate_random_walk", 1.0),
     "max_rrw_deg_per_h_per_sqrt_h": ("rate_random_walk", RAD_S_SQRT_S_TO_DEG_H_SQRT_H),
+}
+# A triad's own figures (a triad report only; on a single axis they are "not measured").
+TRIAD_SPEC_KEYS = {
+    "max_misalignment_urad": ("misalignment", 1e6),
+    "max_misalignment_std_urad": ("misalignment_std", 1e6),
+    "max_body_bias_std_rad_per_s": ("body_bias_std", 1.0),
+    "max_body_bias_std_deg_per_h": ("body_bias_std", RAD_S_TO_DEG_H),
 }
 SPEC_OTHER_KEYS = {"name", "require_accepted"}
 
@@ -186,10 +195,11 @@ def positive_number(value):
 def load_spec(path):
     spec = load_yaml(path, "--spec")
     for key, value in spec.items():
-        if key not in SPEC_KEYS and key not in SPEC_OTHER_KEYS:
+        if key not in SPEC_KEYS and key not in TRIAD_SPEC_KEYS and key not in SPEC_OTHER_KEYS:
             raise ReportError("--spec %s: unknown key %s (known: %s)" %
-                              (path, shown(key), ", ".join(sorted(list(SPEC_KEYS) + list(SPEC_OTHER_KEYS)))))
-        if key in SPEC_KEYS and not positive_number(value):
+                              (path, shown(key), ", ".join(sorted(list(SPEC_KEYS) + list(TRIAD_SPEC_KEYS) +
+                                                                  list(SPEC_OTHER_KEYS)))))
+        if (key in SPEC_KEYS or key in TRIAD_SPEC_KEYS) and not positive_number(value):
             raise ReportError("--spec %s: '%s' must be a positive number, not %s" % (path, key, shown(value)))
         if key == "require_accepted" and not isinstance(value, bool):
             raise ReportError("--spec %s: 'require_accepted' must be true or false, not %s" % (path, shown(value)))
@@ -394,11 +404,73 @@ def validate_report(report, path):
     return report
 
 
+def validate_triad_report(report, path):
+    """Refuses (ReportError naming the key path) a triad calibration report the page cannot show;
+    each axis's own report inside it is checked as a single-axis one."""
+    f = Fields("triad calibration report %s" % path)
+    f.text(report, "method")
+    f.boolean(report, "accepted")
+    f.text(report, "reason")
+    f.text(report, "frame_id")
+    axes = f.get(report, "axes", "")
+    if not (isinstance(axes, list) and len(axes) == 3 and all(isinstance(a, str) and a for a in axes)
+            and len(set(axes)) == 3):
+        f.fail("axes", "a list of three distinct axis names", axes)
+
+    def vector(m, key, prefix="", **rule):
+        return f.numbers(m, key, prefix, length=(3, "axes"), **rule)
+
+    for key in ("axis_to_body", "axis_to_body_std", "body_to_axis", "body_to_axis_std"):
+        rows = f.get(report, key, "")
+        if not isinstance(rows, list) or len(rows) != 3:
+            f.fail(key, "a 3x3 matrix (three rows of three numbers)", rows)
+        for i in range(3):
+            vector(rows, i, key, **({"minimum": 0.0} if key.endswith("_std") else {"finite": True}))
+    vector(report, "fit_chi_square")
+    f.count(report, "positions_fitted")
+    f.boolean(report, "bias_estimated")
+    vector(report, "bias", finite=True)
+    vector(report, "bias_std", minimum=0.0)
+    for here, p in f.items(report, "positions"):
+        f.count(p, "position", here)
+        f.text(p, "name", here)
+        vector(p, "table_axis", here, finite=True)
+        vector(p, "response", here, finite=True)
+        vector(p, "response_std", here, minimum=0.0)
+        f.number(p, "duration", here, minimum=0.0)
+        f.count(p, "increments", here)
+    for here, r in f.items(report, "rests"):
+        f.count(r, "position", here)
+        f.text(r, "name", here)
+        f.number(r, "table_angle", here, finite=True)
+        for key in ("axis_rates", "earth_body", "bias"):
+            vector(r, key, here, finite=True)
+        vector(r, "axis_rates_std", here, minimum=0.0)
+        f.number(r, "duration", here, minimum=0.0)
+    for here, gate in f.items(report, "gates"):
+        f.text(gate, "name", here)
+        f.boolean(gate, "passed", here)
+        f.number(gate, "value", here)
+        f.number(gate, "limit", here)
+        f.text(gate, "message", here)
+    notes = f.get(report, "notes", "")
+    if not isinstance(notes, list) or not all(isinstance(n, str) for n in notes):
+        f.fail("notes", "a list of text", notes)
+    axis_reports = f.mapping(report, "axis_reports")
+    for name in axes:
+        f.mapping(axis_reports, name, "axis_reports")
+        validate_report(axis_reports[name], "%s, axis_reports.%s" % (path, name))
+    f.text(report, "triad_file")
+    return report
+
+
 def load_report(path):
     report = load_yaml(path, "calibration report")
     for key in ("method", "accepted"):
         if key not in report:
             raise ReportError("%s is not a calibration report: no '%s' key" % (path, key))
+    if report["method"] == "triad":
+        return validate_triad_report(report, path)
     return validate_report(report, path)
 
 
@@ -682,11 +754,102 @@ def render(template_name, **context):
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(find_template_dir()), autoescape=True,
                              undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True)
     env.filters["num"] = fmt
+    # A direction's or an angle's components: rounding noise (1e-16 of a rotation) shown as 0.
+    env.filters["axis"] = lambda v: fmt(0.0 if abs(v) < 1e-12 else v, 4)
     return env.get_template(template_name).render(**context)
+
+
+def triad_axis_figures(report, name, band_sigma):
+    """One axis of a triad: its K(theta) figure and summary, from its own report."""
+    r = report["axis_reports"][name]
+    k_est = (r.get("scale_factor") or [None])[0]
+    binned = r.get("binned") or {}
+    axis = {"name": name, "r": r, "k_figure": None, "after_rms": None}
+    if k_est:
+        axis["k_figure"] = model_figure(binned.get("theta") or [], binned.get("k"), k_est, k_est["mean"], None,
+                                        "K / K0 - 1 (ppm)", band_sigma)
+        axis["after_rms"] = 1e6 * k_est["residual_rms"] / abs(k_est["mean"])
+    return axis
+
+
+def build_triad(args, report):
+    """The context of the triad page (templates/triad_report.html.j2)."""
+    for option in ("bag", "params", "verification", "rest"):
+        if getattr(args, option):
+            raise ReportError("--%s: a triad report is drawn from its YAML alone (the single-axis page reads "
+                              "a bag, parameters and a verification summary; run it per axis)" % option)
+    spec = load_spec(args.spec) if args.spec else None
+    band_sigma = 1.96
+    a = report["body_to_axis"]
+    a_std = report["body_to_axis_std"]
+    names = report["axes"]
+    misalignment = []  # the off-diagonal entries of A: axis i tilted towards body axis j, in urad
+    for i in range(3):
+        for j in range(3):
+            if i != j:
+                misalignment.append({"axis": names[i], "towards": "xyz"[j], "i": i, "j": j,
+                                     "urad": 1e6 * a[i][j], "std_urad": 1e6 * a_std[i][j]})
+    scales = [{"axis": names[i], "i": i, "ppm": 1e6 * (a[i][i] - 1.0), "std_ppm": 1e6 * a_std[i][i]}
+              for i in range(3)]
+    ctx = {"title": args.title or "Triad calibration report: " + os.path.basename(args.report),
+           "generated": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+           "report_path": os.path.basename(args.report), "r": report, "band_sigma": band_sigma,
+           "misalignment": misalignment, "scales": scales, "rad_s_to_deg_h": RAD_S_TO_DEG_H,
+           "axes": [triad_axis_figures(report, n, band_sigma) for n in names],
+           "spec": None, "spec_rows": [], "overall": None}
+    if spec is not None:
+        ctx["spec"] = spec
+        ctx["spec_rows"] = triad_spec_rows(spec, report, ctx)
+        ctx["overall"] = all(row["passed"] for row in ctx["spec_rows"])
+    return ctx
+
+
+def triad_spec_rows(spec, report, ctx):
+    rows = []
+    if spec.get("require_accepted", True):
+        rows.append({"key": "require_accepted", "limit": "true", "value": "accepted" if report["accepted"] else
+                     "refused", "basis": "every quality gate of the triad and of its three axes",
+                     "passed": bool(report["accepted"])})
+    for key in sorted(k for k in spec if k in SPEC_KEYS or k in TRIAD_SPEC_KEYS):
+        quantity, factor = SPEC_KEYS.get(key) or TRIAD_SPEC_KEYS[key]
+        limit = float(spec[key])
+        value, basis = None, ""
+        if quantity == "nonlinearity":
+            values = [x["after_rms"] for x in ctx["axes"] if x["after_rms"] is not None]
+            if len(values) == 3:
+                value, basis = max(values), "worst axis: rms residual of its binned K about the fit"
+        elif quantity == "harmonic_std":
+            worst = None
+            for x in ctx["axes"]:
+                k_est = (x["r"].get("scale_factor") or [None])[0]
+                stds = list(k_est["cos_std"]) + list(k_est["sin_std"]) if k_est else []
+                if stds:
+                    ppm = 1e6 * max(stds) / abs(k_est["mean"])
+                    worst = ppm if worst is None else max(worst, ppm)
+            if worst is not None:
+                value, basis = worst, "worst axis: largest K harmonic standard error"
+        elif report["positions_fitted"] > 0 and quantity == "misalignment":
+            value = max(abs(m["urad"]) for m in ctx["misalignment"]) / 1e6 * factor
+            basis = "largest off-diagonal entry of A = M^-1 (an axis's tilt towards another body axis)"
+        elif report["positions_fitted"] > 0 and quantity == "misalignment_std":
+            value = max(m["std_urad"] for m in ctx["misalignment"]) / 1e6 * factor
+            basis = "largest standard error of the off-diagonal entries of A"
+        elif report["bias_estimated"] and quantity == "body_bias_std":
+            value, basis = max(report["bias_std"]) * factor, "largest standard error of the body bias"
+        if value is None:
+            rows.append({"key": key, "limit": fmt(limit, 4), "value": "not measured",
+                         "basis": "not in a triad report" if key in SPEC_KEYS and quantity not in
+                         ("nonlinearity", "harmonic_std") else "the report has no data for it", "passed": False})
+        else:
+            rows.append({"key": key, "limit": fmt(limit, 4), "value": fmt(value, 4), "basis": basis,
+                         "passed": value <= limit})
+    return rows
 
 
 def build(args):
     report = load_report(args.report)
+    if report["method"] == "triad":
+        return build_triad(args, report)
     spec = load_spec(args.spec) if args.spec else None
     verification = load_verification(args.verification) if args.verification else None
     if args.rest and not args.rest[0] < args.rest[1]:
@@ -768,8 +931,8 @@ def spec_rows(spec, report, ctx):
     if spec.get("require_accepted", True):
         rows.append({"key": "require_accepted", "limit": "true", "value": "accepted" if report["accepted"] else
                      "refused", "basis": "every quality gate of the calibration", "passed": bool(report["accepted"])})
-    for key in sorted(k for k in spec if k in SPEC_KEYS):
-        quantity, factor = SPEC_KEYS[key]
+    for key in sorted(k for k in spec if k in SPEC_KEYS or k in TRIAD_SPEC_KEYS):
+        quantity, factor = SPEC_KEYS.get(key) or TRIAD_SPEC_KEYS[key]
         limit = float(spec[key])
         value, basis, bound = None, "", False
         if quantity == "nonlinearity":
@@ -783,6 +946,10 @@ def spec_rows(spec, report, ctx):
             stds = list(k_est["cos_std"]) + list(k_est["sin_std"]) if k_est else []
             if stds:  # a K0-only fit has no harmonic to compare: not measured
                 value, basis = 1e6 * max(stds) / abs(k_est["mean"]), "largest K harmonic standard error"
+        elif quantity in ("misalignment", "misalignment_std", "body_bias_std"):
+            rows.append({"key": key, "limit": fmt(limit, 4), "value": "not measured",
+                         "basis": "a triad's figure: this is a single axis's report", "passed": False})
+            continue
         elif quantity in terms:
             t = terms[quantity]
             if t["identified"]:
@@ -801,9 +968,10 @@ def spec_rows(spec, report, ctx):
 
 def main(argv):
     parser = argparse.ArgumentParser(prog="hrg_report.py", description=__doc__.split("\n\n")[0],
-                                     epilog="Specification YAML keys: %s. Unknown keys are refused. Exit 0 the "
+                                     epilog="Specification YAML keys: %s (the max_misalignment and max_body_bias keys for a triad's "
+                                     "report). Unknown keys are refused. Exit 0 the "
                                      "page was written, 2 bad usage or input (nothing written), 3 the page could "
-                                     "not be written." % ", ".join(sorted(list(SPEC_KEYS) + list(SPEC_OTHER_KEYS))))
+                                     "not be written." % ", ".join(sorted(list(SPEC_KEYS) + list(TRIAD_SPEC_KEYS) + list(SPEC_OTHER_KEYS))))
     parser.add_argument("report", help="calibration report YAML")
     parser.add_argument("--out", required=True, help="HTML file to write")
     parser.add_argument("--bag", help="the session's bag: profile, temperature, Allan deviation at rest")
@@ -853,7 +1021,7 @@ def run(args):
         return 2
     try:
         ctx = build(args)
-        html = render("report.html.j2", **ctx)
+        html = render("triad_report.html.j2" if ctx["r"]["method"] == "triad" else "report.html.j2", **ctx)
     except ReportError as e:
         sys.stderr.write("hrg_report: %s\n" % e)
         return 2

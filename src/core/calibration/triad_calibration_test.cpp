@@ -5,6 +5,7 @@
 #include "hrg_gyro/core/calibration/triad_calibration.h"
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cstdio>
 
@@ -88,6 +89,23 @@ TEST(TriadCalibrationTest, TheAxesDirectionsEachAxisKAndTheBiasAgainstTheExactTr
   ASSERT_TRUE(o.bias_estimated);
   EXPECT_EQ(o.rests.size(), 6u);
   for (int j = 0; j < 3; ++j) EXPECT_LE(std::abs(o.triad.bias(j)), 3.0 * o.triad.bias_std(j) + 1e-9) << j;
+
+  // The report holds the same numbers (full precision), each axis's own report and the file to write.
+  const YAML::Node report = YAML::Load(emitTriadReport(o));
+  EXPECT_EQ(report["method"].as<std::string>(), "triad");
+  EXPECT_TRUE(report["accepted"].as<bool>());
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_EQ(report["axis_to_body"][i][j].as<double>(), o.triad.axis_to_body(i, j));
+      EXPECT_EQ(report["body_to_axis_std"][i][j].as<double>(), o.body_to_axis_std(i, j));
+    }
+    EXPECT_EQ(report["bias"][i].as<double>(), o.triad.bias(i));
+    const std::string axis = o.axis_names[i];
+    EXPECT_EQ(report["axis_reports"][axis]["nonlinearity_ppm"].as<double>(), o.axes[i].nonlinearity_ppm) << axis;
+  }
+  EXPECT_EQ(report["positions"].size(), o.positions.size());
+  EXPECT_EQ(report["rests"].size(), o.rests.size());
+  EXPECT_EQ(parseTriadParameters(YAML::Load(report["triad_file"].as<std::string>())), o.triad);
 }
 
 TEST(TriadCalibrationTest, AFixtureOffByMicroradiansGivesTheErrorItExplains) {
