@@ -71,7 +71,7 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   std::vector<std::string> triad_keys;
   for (const std::string& k : core::TriadCalibrationSettings::keys()) triad_keys.push_back("triad/" + k);
   params_.claim(triad_keys);
-  params_.claim({"triad"}, true);  // the core's parser refuses what it does not know in the section
+  params_.claim({"triad"}, true);        // the core's parser refuses what it does not know in the section
   params_.claim({"diagnostic_period"});  // read by diagnostic_updater itself
 
   // Keys of the single-axis methods: accepted in the shared template, not used here (and said so).
@@ -194,6 +194,10 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 
   result_pub_ = pnh_.advertise<TriadCalibrationResult>("result", 1, true);
   ros::NodeHandle in = input_.handle(nh_);
+  // The table last: a driver that waits for its turntable listener (driver_sim's
+  // wait_for_subscribers) then finds the fixture's and the waves' subscriptions already asked for.
+  fixture_sub_ =
+      in.subscribe("fixture/position", 100, &TriadCalibratorRos::onFixture, this, ros::TransportHints().tcpNoDelay());
   for (int i = 0; i < 3; ++i) {
     wave_subs_[i] = in.subscribe<WaveState>(
         axes_[i] + "/wave", queue_size, [this, i](const WaveState::ConstPtr& m) { onWave(i, m); }, ros::VoidConstPtr(),
@@ -201,8 +205,6 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   }
   turntable_sub_ = in.subscribe("turntable/state", queue_size, &TriadCalibratorRos::onTurntable, this,
                                 ros::TransportHints().tcpNoDelay());
-  fixture_sub_ =
-      in.subscribe("fixture/position", 100, &TriadCalibratorRos::onFixture, this, ros::TransportHints().tcpNoDelay());
   start_srv_ = pnh_.advertiseService("start", &TriadCalibratorRos::onStart, this);
   finish_srv_ = pnh_.advertiseService("finish", &TriadCalibratorRos::onFinish, this);
   abort_srv_ = pnh_.advertiseService("abort", &TriadCalibratorRos::onAbort, this);
