@@ -1,6 +1,7 @@
 #include "hrg_gyro/ros/triad_calibrator_ros.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
 #include <stdexcept>
 
@@ -46,8 +47,13 @@ void toArray(const Eigen::Vector3d& v, boost::array<double, 3>* out) {
   for (int i = 0; i < 3; ++i) (*out)[i] = v(i);
 }
 
+/// A stamp as sec.nsec, exactly (the tests compare it with the last stamp of a bag); "none" for 0.
 std::string stampText(core::Nanoseconds t) {
-  return t == 0 ? std::string("none") : core::formatShort(core::toSeconds(t), 12);
+  if (t == 0) return "none";
+  char text[32];
+  std::snprintf(text, sizeof(text), "%lld.%09lld", static_cast<long long>(t / 1000000000),
+                static_cast<long long>(t % 1000000000));
+  return text;
 }
 
 }  // namespace
