@@ -126,11 +126,9 @@ Eigen::Matrix3d parseOrientation(const YamlField& p) {
                                   finite(b, "yaw", 0.0, "rad"));
 }
 
-std::vector<FixturePositionConfig> parsePositions(const YamlField& list, double acceleration, double error_std,
-                                                  std::uint64_t seed) {
+std::vector<FixturePositionConfig> parsePositions(const YamlField& list, double acceleration) {
   list.requireSequence();
   if (list.size() == 0) list.fail("the session needs at least one position");
-  GaussianNoise error_draws(seed ^ kFixtureErrorStream);
   std::set<std::string> names;
   std::vector<FixturePositionConfig> positions;
   for (std::size_t k = 0; k < list.size(); ++k) {
@@ -142,8 +140,6 @@ std::vector<FixturePositionConfig> parsePositions(const YamlField& list, double 
     if (c.name.empty()) p["name"].fail("must not be empty");
     if (!names.insert(c.name).second) p["name"].fail("position '" + c.name + "' is named twice");
     c.nominal = parseOrientation(p);
-    // Three draws for every position, given or not: giving one position's error changes no other's.
-    const Eigen::Vector3d drawn(error_draws.next(), error_draws.next(), error_draws.next());
     if (p.has("error")) {
       const std::vector<double> e = p["error"].asDoubles(3);
       for (std::size_t j = 0; j < 3; ++j) {
@@ -153,8 +149,7 @@ std::vector<FixturePositionConfig> parsePositions(const YamlField& list, double 
         }
         c.error[static_cast<Eigen::Index>(j)] = e[j];
       }
-    } else {
-      c.error = error_std * drawn;
+      c.error_given = true;
     }
     c.profile = TurntableProfile::parse(p["profile"], acceleration);
     if (k == 0) {
@@ -222,6 +217,17 @@ Eigen::Matrix3d TriadSimulationConfig::bodyToAxis() const {
   return a;
 }
 
+void TriadSimulationConfig::setSeed(std::uint64_t new_seed) {
+  seed = new_seed;
+  GaussianNoise draws(seed ^ kFixtureErrorStream);
+  for (FixturePositionConfig& p : positions) {
+    // Three draws for every position, given or not: giving one position's error changes no other's.
+    Eigen::Vector3d drawn;
+    for (int j = 0; j < 3; ++j) drawn[j] = draws.next();  // in order (arguments' order is unspecified)
+    if (!p.error_given) p.error = fixture_error_std * drawn;
+  }
+}
+
 TriadParameters TriadSimulationConfig::injectedTriad() const {
   TriadParameters t;
   for (int i = 0; i < 3; ++i) t.axes[i] = axes[i].name;
@@ -286,7 +292,8 @@ TriadSimulationConfig TriadSimulationConfig::parse(const YamlField& root, const 
   if (!(c.fixture_error_std >= 0.0 && c.fixture_error_std <= kMaxFixtureErrorStd)) {
     t["fixture_error_std"].fail("must be in [0, " + formatDouble(kMaxFixtureErrorStd) + "] rad");
   }
-  c.positions = parsePositions(t["positions"], c.turntable.acceleration, c.fixture_error_std, c.seed);
+  c.positions = parsePositions(t["positions"], c.turntable.acceleration);
+  c.setSeed(c.seed);
 
   // The session: each position's profile after its move, the table at rest during the move.
   for (FixturePositionConfig& p : c.positions) {

@@ -164,6 +164,13 @@ TEST(TriadSimulationConfigTest, FixtureErrorsAreGivenOrDrawnFromTheirOwnStream) 
   EXPECT_EQ(mixed.positions[1].error, Eigen::Vector3d(1.0e-4, -2.0e-4, 3.0e-4));
   EXPECT_EQ(mixed.positions[0].error, drawn.positions[0].error);
   EXPECT_EQ(mixed.positions[2].error, drawn.positions[2].error);
+  // Another seed draws the drawn errors again and keeps the given one.
+  TriadSimulationConfig reseeded = mixed;
+  reseeded.setSeed(4);
+  EXPECT_EQ(reseeded.seed, 4u);
+  EXPECT_EQ(reseeded.positions[1].error, mixed.positions[1].error);
+  EXPECT_NE(reseeded.positions[0].error, mixed.positions[0].error);
+  EXPECT_LT(reseeded.positions[0].error.cwiseAbs().maxCoeff(), 5e-3);
   EXPECT_LT((mixed.positions[1].bodyToPlatter() -
              rotationFromVector(Eigen::Vector3d(1.0e-4, -2.0e-4, 3.0e-4)) * mixed.positions[1].nominal)
                 .cwiseAbs()

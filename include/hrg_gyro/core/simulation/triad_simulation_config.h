@@ -83,8 +83,9 @@ struct FixturePositionConfig {
   std::string name;
   Eigen::Matrix3d nominal = Eigen::Matrix3d::Identity();  ///< body_to_table as planned (FixturePosition)
   Eigen::Vector3d error = Eigen::Vector3d::Zero();        ///< rad, rotation vector in the platter's frame
-  TurntableProfile profile;                               ///< the table's motion in this position
-  double move = 0.0;                                      ///< s unclamped before it (0: the first position)
+  bool error_given = false;  ///< false: `error` is drawn (TriadSimulationConfig::fixture_error_std)
+  TurntableProfile profile;  ///< the table's motion in this position
+  double move = 0.0;         ///< s unclamped before it (0: the first position)
   // The session's times of this position, s from the scenario start (set by the parser).
   double move_start = 0.0;  ///< the fixture is unclamped (= start for the first position)
   double start = 0.0;       ///< clamped in this position
@@ -110,6 +111,8 @@ struct TriadSimulationConfig {
   double outputPeriod() const { return axes[0].resonator.periods_per_output / axes[0].resonator.frequency; }
   /// Simulated duration, s.
   double duration() const { return table_profile.duration(); }
+  /// Sets the seed and draws again the fixture errors that are not given (a --seed option).
+  void setSeed(std::uint64_t new_seed);
   /// A: row i = axis i's sensitive direction in the body frame times (1 + scale_i).
   Eigen::Matrix3d bodyToAxis() const;
   /// What a perfect calibration on this fixture finds: M = A^-1, no body bias (each axis's own D is
