@@ -166,6 +166,53 @@ class HrgBagCli(unittest.TestCase):
         self.assertAlmostEqual(mean, 0.1, delta=5 * 0.002 / math.sqrt(n))
         self.assertAlmostEqual(std, 0.002, delta=5 * 0.002 / math.sqrt(2 * n))
 
+    def test_simulate_writes_a_triads_topics(self):
+        # A triad scenario: exactly each axis's channels and truth under its name, the table, the
+        # fixture's log and the body's truth; --no-truth drops the truths; --seed draws the noise and
+        # the fixture errors anew; --frame-id names the body frame.
+        scenario = self.path("triad.yaml")
+        with open(scenario, "w") as f:
+            f.write("seed: 3\n"
+                    "triad:\n"
+                    "  frame_id: fixture\n"
+                    "  fixture_error_std: 1.0e-4\n"
+                    "  axes:\n"
+                    "    - {name: gx, misalignment: [1.0e-4, 0.0], pickoff: {noise: 2.0e-4}}\n"
+                    "    - {name: gy, misalignment: [0.0, 0.0], pickoff: {noise: 2.0e-4}}\n"
+                    "    - {name: gz, misalignment: [0.0, -1.0e-4], pickoff: {noise: 2.0e-4}}\n"
+                    "  positions:\n"
+                    "    - {name: z up, up: '+z', profile: [{type: rate, rate: 0.2, duration: 1.0}]}\n"
+                    "    - {name: x up, up: '+x', move: 1.0, profile: [{type: dwell, duration: 1.0}]}\n")
+        runs = {"truth": [], "no_truth": ["--no-truth"], "seed": ["--seed", "9"], "frame": ["--frame-id", "jig"]}
+        topics = {}
+        for name, extra in runs.items():
+            code, _, err = hrg_bag("simulate", "--scenario", scenario, "--out", self.path("triad_%s.bag" % name),
+                                   *extra)
+            self.assertEqual(code, 0, err)
+            with rosbag.Bag(self.path("triad_%s.bag" % name)) as bag:
+                topics[name] = {t: i.msg_type for t, i in bag.get_type_and_topic_info().topics.items()}
+        axes = {"/g%s/channels" % a: "hrg_gyro/ChannelAmplitudes" for a in "xyz"}
+        common = dict(axes, **{"/turntable/state": "hrg_gyro/TurntableState",
+                               "/fixture/position": "hrg_gyro/FixturePosition"})
+        self.assertEqual(topics["no_truth"], common)
+        with_truth = dict(common, **{"/g%s/truth" % a: "hrg_gyro/GroundTruth" for a in "xyz"})
+        with_truth["/truth"] = "hrg_gyro/BodyTruth"
+        self.assertEqual(topics["truth"], with_truth)
+
+        def first(bag_name, topic):
+            with rosbag.Bag(self.path(bag_name)) as bag:
+                return [m for _, m, _ in bag.read_messages(topics=[topic])]
+        body, body_seed = first("triad_truth.bag", "/truth"), first("triad_seed.bag", "/truth")
+        self.assertEqual({m.header.frame_id for m in body}, {"fixture"})
+        self.assertEqual({m.header.frame_id for m in first("triad_frame.bag", "/fixture/position")}, {"jig"})
+        self.assertEqual({m.header.frame_id for m in first("triad_truth.bag", "/gy/channels")}, {"gy"})
+        # Another seed: other fixture errors (the body's true orientation) and other noise.
+        self.assertNotEqual(body[0].body_to_table, body_seed[0].body_to_table)
+        self.assertNotEqual(first("triad_truth.bag", "/gx/channels")[0].c_in,
+                            first("triad_seed.bag", "/gx/channels")[0].c_in)
+        self.assertEqual(hrg_bag("simulate", "--scenario", scenario, "--out", self.path("triad_again.bag"))[0], 0)
+        self.assertTrue(filecmp.cmp(self.path("triad_truth.bag"), self.path("triad_again.bag"), shallow=False))
+
     def test_info_reports_rates_and_validates(self):
         code, out, err = hrg_bag("info", self.short)
         self.assertEqual(code, 0, err)

@@ -63,6 +63,14 @@ TEST(ParameterTemplateTest, DriverSimTemplateIsComplete) {
   EXPECT_EQ(node.parameters().unknownKeys(), Keys{});
 }
 
+// The same template serves a triad scenario: the node reads it whole and the triad section is the
+// core parser's.
+TEST(ParameterTemplateTest, DriverSimTemplateIsCompleteForATriad) {
+  DriverSimRos node(ros::NodeHandle("triad_template"), ros::NodeHandle("triad_template/driver_sim"), false);
+  EXPECT_EQ(node.parameters().defaultedKeys(), Keys{}) << "keys config/driver_sim.yaml lacks";
+  EXPECT_EQ(node.parameters().unknownKeys(), Keys{});
+}
+
 TEST(ParameterTemplateTest, TyposAreUnknownKeys) {
   ProcessorRos node(ros::NodeHandle("typo"), ros::NodeHandle("typo/processor"));
   EXPECT_EQ(node.parameters().unknownKeys(), (Keys{"bias_capture/durration", "max_gapp"}));

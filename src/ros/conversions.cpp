@@ -94,6 +94,44 @@ GroundTruth toTruthMessage(const core::SimulationSample& s, const std_msgs::Head
   return t;
 }
 
+namespace {
+
+geometry_msgs::Quaternion toQuaternionMessage(const Eigen::Quaterniond& q) {
+  geometry_msgs::Quaternion m;
+  m.w = q.w();
+  m.x = q.x();
+  m.y = q.y();
+  m.z = q.z();
+  return m;
+}
+
+}  // namespace
+
+FixturePosition toFixtureMessage(const core::TriadSample& s, const ros::Time& stamp, const std::string& frame_id) {
+  FixturePosition m;
+  m.header.seq = static_cast<std::uint32_t>(s.index);
+  m.header.stamp = stamp;
+  m.header.frame_id = frame_id;
+  m.index = s.fixture.index;
+  m.name = s.fixture.name ? *s.fixture.name : std::string();
+  m.body_to_table = toQuaternionMessage(s.fixture.body_to_table);
+  m.locked = s.fixture.locked;
+  return m;
+}
+
+BodyTruth toBodyTruthMessage(const core::TriadSample& s, const ros::Time& stamp, const std::string& frame_id) {
+  BodyTruth m;
+  m.header.seq = static_cast<std::uint32_t>(s.index);
+  m.header.stamp = stamp;
+  m.header.frame_id = frame_id;
+  m.angular_velocity.x = s.body.angular_velocity.x();
+  m.angular_velocity.y = s.body.angular_velocity.y();
+  m.angular_velocity.z = s.body.angular_velocity.z();
+  m.body_to_table = toQuaternionMessage(s.body.body_to_table);
+  m.position = s.body.position;
+  return m;
+}
+
 HarmonicEstimate toMessage(const core::HarmonicFitResult& fit, double frequency) {
   HarmonicEstimate m;
   m.orders.assign(fit.orders.begin(), fit.orders.end());

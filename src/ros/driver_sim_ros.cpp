@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstdio>
 
+#include "hrg_gyro/BodyTruth.h"
 #include "hrg_gyro/ChannelAmplitudes.h"
+#include "hrg_gyro/FixturePosition.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/ros/conversions.h"
@@ -18,17 +20,27 @@ namespace hrg_gyro {
 DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_process)
     : nh_(nh), pnh_(pnh), params_(pnh, "driver_sim"), owns_process_(owns_process) {
   const YAML::Node params = privateParameters(pnh_);
-  config_ = std::make_unique<core::SimulationConfig>(
-      core::SimulationConfig::parse(core::YamlField(params, ""), core::nodeOnlyScenarioKeys()));
+  if (core::isTriadScenario(params)) {
+    triad_config_ = std::make_unique<core::TriadSimulationConfig>(
+        core::TriadSimulationConfig::parse(core::YamlField(params, ""), core::nodeOnlyScenarioKeys()));
+    output_period_ = triad_config_->outputPeriod();
+    start_time_ = triad_config_->start_time;
+  } else {
+    config_ = std::make_unique<core::SimulationConfig>(
+        core::SimulationConfig::parse(core::YamlField(params, ""), core::nodeOnlyScenarioKeys()));
+    output_period_ = config_->outputPeriod();
+    start_time_ = config_->start_time;
+  }
   // The scenario sections are the core parser's (it refuses unknown keys in them).
-  params_.claim({"seed", "start_time", "resonator", "pickoff", "turntable", "generator", "thermal", "channels"}, true);
+  params_.claim(
+      {"seed", "start_time", "resonator", "pickoff", "turntable", "generator", "thermal", "channels", "triad"}, true);
   time_scale_ = params_.get("time_scale", time_scale_);
   // clock_period: "auto" (the template's value) or unset means: with every output sample, but no
   // more often than kFinestAutoClockPeriod. A consumer's timer under sim time fires only when /clock
   // passes its due time, so a clock coarser than the samples throttles it (a 50 Hz filter ran at
   // 20 Hz behind a 20 Hz clock); at the 10 kHz a bench gyro may run, a clock per sample would cost
   // every node of the graph a callback per sample for timers that no consumer runs that fast.
-  const double auto_clock_period = std::max(config_->outputPeriod(), kFinestAutoClockPeriod);
+  const double auto_clock_period = std::max(output_period_, kFinestAutoClockPeriod);
   clock_period_ = auto_clock_period;
   XmlRpc::XmlRpcValue clock_raw;
   if (params_.getOptional("clock_period", &clock_raw)) {
@@ -65,11 +77,11 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   if (!(clock_period_ > 0.0) || !std::isfinite(clock_period_)) {
     throw std::invalid_argument("~clock_period must be a positive number of seconds or auto");
   }
-  if (use_sim_time_ && publish_clock_ && clock_period_ > config_->outputPeriod() * (1.0 + 1e-9)) {
+  if (use_sim_time_ && publish_clock_ && clock_period_ > output_period_ * (1.0 + 1e-9)) {
     ROS_WARN(
         "driver_sim: ~clock_period %g s is coarser than the output samples (%g s): timers of the nodes under "
         "sim time fire at most every %g s",
-        clock_period_, config_->outputPeriod(), clock_period_);
+        clock_period_, output_period_, clock_period_);
   }
   if (!(max_lag_ > 0.0)) throw std::invalid_argument("~max_lag must be positive (s)");
   // Wall-clock stamps are due times, so a late thread catches up; under sim time the clock is ours.
@@ -79,18 +91,34 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
     ROS_WARN("driver_sim: ~time_scale = %g without /use_sim_time: stamps will run ahead of the wall clock",
              time_scale_);
   }
-  channels_pub_ = nh_.advertise<ChannelAmplitudes>("channels", queue_size);
   turntable_pub_ = nh_.advertise<TurntableState>("turntable/state", queue_size);
-  truth_pub_ = nh_.advertise<GroundTruth>("truth", queue_size);
+  if (triad_config_) {
+    for (int i = 0; i < 3; ++i) {
+      const std::string& axis = triad_config_->axes[i].name;
+      axis_channels_pub_[i] = nh_.advertise<ChannelAmplitudes>(triadAxisTopic(axis, "channels"), queue_size);
+      axis_truth_pub_[i] = nh_.advertise<GroundTruth>(triadAxisTopic(axis, "truth"), queue_size);
+    }
+    fixture_pub_ = nh_.advertise<FixturePosition>("fixture/position", queue_size);
+    truth_pub_ = nh_.advertise<BodyTruth>("truth", queue_size);
+  } else {
+    channels_pub_ = nh_.advertise<ChannelAmplitudes>("channels", queue_size);
+    truth_pub_ = nh_.advertise<GroundTruth>("truth", queue_size);
+  }
   done_pub_ = pnh_.advertise<std_msgs::Bool>("done", 1, true);
   if (use_sim_time_ && publish_clock_) clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 100);
   std_msgs::Bool done;
   done.data = false;
   done_pub_.publish(done);
-  core::GyroSimulator probe(*config_);
-  ROS_INFO("driver_sim: %.1f s scenario at %.0f Hz output (%s), time scale %s", probe.duration(),
-           1.0 / config_->outputPeriod(), config_->generator.enabled ? "generator sweep first" : "turntable profile",
-           time_scale_ > 0.0 ? std::to_string(time_scale_).c_str() : "as fast as possible");
+  if (triad_config_) {
+    ROS_INFO("driver_sim: %.1f s triad session (%zu fixture positions) at %.0f Hz output, time scale %s",
+             triad_config_->duration(), triad_config_->positions.size(), 1.0 / output_period_,
+             time_scale_ > 0.0 ? std::to_string(time_scale_).c_str() : "as fast as possible");
+  } else {
+    core::GyroSimulator probe(*config_);
+    ROS_INFO("driver_sim: %.1f s scenario at %.0f Hz output (%s), time scale %s", probe.duration(),
+             1.0 / output_period_, config_->generator.enabled ? "generator sweep first" : "turntable profile",
+             time_scale_ > 0.0 ? std::to_string(time_scale_).c_str() : "as fast as possible");
+  }
   worker_ = std::thread(&DriverSimRos::run, this);
 }
 
@@ -99,10 +127,17 @@ DriverSimRos::~DriverSimRos() {
   if (worker_.joinable()) worker_.join();
 }
 
+std::uint32_t DriverSimRos::channelSubscribers() const {
+  if (!triad_config_) return channels_pub_.getNumSubscribers();
+  std::uint32_t fewest = axis_channels_pub_[0].getNumSubscribers();
+  for (const ros::Publisher& p : axis_channels_pub_) fewest = std::min(fewest, p.getNumSubscribers());
+  return fewest;
+}
+
 bool DriverSimRos::waitForSubscribers() {
   const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(wait_timeout_);
   while (!stop_ && ros::ok()) {
-    if (static_cast<int>(channels_pub_.getNumSubscribers()) >= wait_channels_ &&
+    if (static_cast<int>(channelSubscribers()) >= wait_channels_ &&
         static_cast<int>(turntable_pub_.getNumSubscribers()) >= wait_turntable_ &&
         static_cast<int>(truth_pub_.getNumSubscribers()) >= wait_truth_) {
       return true;
@@ -111,8 +146,8 @@ bool DriverSimRos::waitForSubscribers() {
       ROS_WARN(
           "driver_sim: starting after %.1f s without all expected subscribers (channels %u/%d, "
           "turntable %u/%d, truth %u/%d)",
-          wait_timeout_, channels_pub_.getNumSubscribers(), wait_channels_, turntable_pub_.getNumSubscribers(),
-          wait_turntable_, truth_pub_.getNumSubscribers(), wait_truth_);
+          wait_timeout_, channelSubscribers(), wait_channels_, turntable_pub_.getNumSubscribers(), wait_turntable_,
+          truth_pub_.getNumSubscribers(), wait_truth_);
       return true;
     }
     ros::WallDuration(0.01).sleep();
@@ -120,22 +155,58 @@ bool DriverSimRos::waitForSubscribers() {
   return false;
 }
 
-void DriverSimRos::run() {
-  core::GyroSimulator sim(*config_);
+void DriverSimRos::publishSingle(const core::SimulationSample& s, const ros::Time& stamp, core::Nanoseconds origin) {
+  // The sequence number is the sample's index, so a lost sample leaves a gap in it.
+  auto channels = boost::make_shared<ChannelAmplitudes>(
+      toChannelsMessage(s, stamp, static_cast<std::uint32_t>(s.index), frame_id_));
+  if (s.channels_delivered) channels_pub_.publish(channels);
+  // A record's sequence number is the controller's count, its stamp on the controller's clock.
+  // (roscpp renumbers header.seq on a TCP connection; a nodelet in this process sees these.)
+  for (const core::TurntableLogRecord& r : s.turntable) {
+    turntable_pub_.publish(boost::make_shared<TurntableState>(toTurntableMessage(r, origin, frame_id_)));
+  }
+  if (truth_pub_.getNumSubscribers() > 0) {
+    truth_pub_.publish(boost::make_shared<GroundTruth>(toTruthMessage(s, channels->header)));
+  }
+}
+
+void DriverSimRos::publishTriad(const core::TriadSample& s, const ros::Time& stamp, core::Nanoseconds origin) {
+  const core::TriadSimulationConfig& c = *triad_config_;
+  for (int i = 0; i < 3; ++i) {
+    const core::SimulationSample& axis = s.axes[i];
+    auto channels = boost::make_shared<ChannelAmplitudes>(
+        toChannelsMessage(axis, stamp, static_cast<std::uint32_t>(axis.index), c.axes[i].name));
+    if (axis.channels_delivered) axis_channels_pub_[i].publish(channels);
+    if (axis_truth_pub_[i].getNumSubscribers() > 0) {
+      axis_truth_pub_[i].publish(boost::make_shared<GroundTruth>(toTruthMessage(axis, channels->header)));
+    }
+  }
+  for (const core::TurntableLogRecord& r : s.turntable) {
+    turntable_pub_.publish(boost::make_shared<TurntableState>(toTurntableMessage(r, origin, c.frame_id)));
+  }
+  if (s.fixture_logged)
+    fixture_pub_.publish(boost::make_shared<FixturePosition>(toFixtureMessage(s, stamp, c.frame_id)));
+  if (truth_pub_.getNumSubscribers() > 0) {
+    truth_pub_.publish(boost::make_shared<BodyTruth>(toBodyTruthMessage(s, stamp, c.frame_id)));
+  }
+}
+
+template <class Simulator, class Sample, class Publish>
+void DriverSimRos::play(Simulator& sim, Sample* sample, const Publish& publish) {
   // Under sim time the clock must run before anyone waits for subscribers' time to pass.
   if (!clock_pub_.getTopic().empty()) {
     rosgraph_msgs::Clock c;
-    c.clock = toRosTime(core::toNanoseconds(config_->start_time));
+    c.clock = toRosTime(core::toNanoseconds(start_time_));
     clock_pub_.publish(c);
   }
   if (!waitForSubscribers()) return;
   // In wall time the stamps start now, after the wait, so they say when each sample was taken.
   const core::Nanoseconds origin =
-      use_sim_time_ ? 0 : toNanoseconds(ros::Time::now()) - core::toNanoseconds(config_->start_time);
+      use_sim_time_ ? 0 : toNanoseconds(ros::Time::now()) - core::toNanoseconds(start_time_);
   const ros::WallTime wall_start = ros::WallTime::now();
   core::PlaybackSchedule& schedule = *schedule_;
   schedule.start(wall_start.toSec());
-  core::SimulationSample s;
+  Sample& s = *sample;
   double next_clock = 0.0;
   std::uint32_t seq = 0;
   while (!stop_ && ros::ok() && sim.next(&s)) {
@@ -161,20 +232,9 @@ void DriverSimRos::run() {
       clock_pub_.publish(c);
       // Half a sample early: with the period equal to the samples' spacing, rounding of the
       // elapsed time must not skip every other sample.
-      next_clock = sim.elapsed() + clock_period_ - 0.5 * config_->outputPeriod();
+      next_clock = sim.elapsed() + clock_period_ - 0.5 * output_period_;
     }
-    // The sequence number is the sample's index, so a lost sample leaves a gap in it.
-    auto channels = boost::make_shared<ChannelAmplitudes>(
-        toChannelsMessage(s, stamp, static_cast<std::uint32_t>(s.index), frame_id_));
-    if (s.channels_delivered) channels_pub_.publish(channels);
-    // A record's sequence number is the controller's count, its stamp on the controller's clock.
-    // (roscpp renumbers header.seq on a TCP connection; a nodelet in this process sees these.)
-    for (const core::TurntableLogRecord& r : s.turntable) {
-      turntable_pub_.publish(boost::make_shared<TurntableState>(toTurntableMessage(r, origin, frame_id_)));
-    }
-    if (truth_pub_.getNumSubscribers() > 0) {
-      truth_pub_.publish(boost::make_shared<GroundTruth>(toTruthMessage(s, channels->header)));
-    }
+    publish(s, stamp, origin);
     ++seq;
   }
   if (stop_ || !ros::ok()) return;
@@ -194,6 +254,22 @@ void DriverSimRos::run() {
   if (shutdown_when_done_ && owns_process_) {
     ros::WallDuration(0.5).sleep();  // let the last messages and the latched flag go out
     ros::requestShutdown();
+  }
+}
+
+void DriverSimRos::run() {
+  if (triad_config_) {
+    core::TriadSimulator sim(*triad_config_);
+    core::TriadSample s;
+    play(sim, &s, [this](const core::TriadSample& x, const ros::Time& stamp, core::Nanoseconds origin) {
+      publishTriad(x, stamp, origin);
+    });
+  } else {
+    core::GyroSimulator sim(*config_);
+    core::SimulationSample s;
+    play(sim, &s, [this](const core::SimulationSample& x, const ros::Time& stamp, core::Nanoseconds origin) {
+      publishSingle(x, stamp, origin);
+    });
   }
 }
 

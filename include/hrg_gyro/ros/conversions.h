@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "hrg_gyro/BodyTruth.h"
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/ChannelAmplitudes.h"
 #include "hrg_gyro/FixturePosition.h"
@@ -17,6 +18,7 @@
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/simulation/gyro_simulator.h"
+#include "hrg_gyro/core/simulation/triad_simulator.h"
 
 namespace hrg_gyro {
 
@@ -44,6 +46,14 @@ ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::
 TurntableState toTurntableMessage(const core::TurntableLogRecord& r, core::Nanoseconds origin,
                                   const std::string& frame_id);
 GroundTruth toTruthMessage(const core::SimulationSample& s, const std_msgs::Header& header);
+
+// The messages of one simulated triad sample (driver_sim and `hrg_bag simulate` on a triad scenario):
+// the fixture's position (fixture/position) and the body's truth (truth), stamped with the sample,
+// frame_id the triad's body frame; header.seq the sample's index.
+FixturePosition toFixtureMessage(const core::TriadSample& s, const ros::Time& stamp, const std::string& frame_id);
+BodyTruth toBodyTruthMessage(const core::TriadSample& s, const ros::Time& stamp, const std::string& frame_id);
+/// The topic (relative) of one axis's stream of a triad: "<axis>/<stream>", e.g. "x/channels".
+inline std::string triadAxisTopic(const std::string& axis, const std::string& stream) { return axis + "/" + stream; }
 
 HarmonicEstimate toMessage(const core::HarmonicFitResult& fit, double frequency);
 core::HarmonicFitResult fromMessage(const HarmonicEstimate& msg);

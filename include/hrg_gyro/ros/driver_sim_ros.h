@@ -8,10 +8,17 @@
 // core::PlaybackSchedule); without it, stamps follow the wall clock from the start and a late
 // thread catches up. `~done` (std_msgs/Bool, latched)
 // turns true when the scenario is over.
+//
+// A triad scenario (a `triad` section: core::TriadSimulationConfig) runs core::TriadSimulator instead
+// and publishes, per output sample, `<axis>/channels` and `<axis>/truth` for each of its three axes
+// (frame_id the axis's name), `turntable/state`, `fixture/position` (hrg_gyro/FixturePosition, on a
+// change of position or lock and every second) and `truth` (hrg_gyro/BodyTruth), the last two with
+// the triad's frame_id (its triad.frame_id; ~frame_id is the single gyro's).
 #pragma once
 
 #include <ros/ros.h>
 
+#include <array>
 #include <atomic>
 #include <memory>
 #include <optional>
@@ -20,6 +27,7 @@
 
 #include "hrg_gyro/core/simulation/gyro_simulator.h"
 #include "hrg_gyro/core/simulation/playback_schedule.h"
+#include "hrg_gyro/core/simulation/triad_simulator.h"
 #include "hrg_gyro/ros/parameter_reader.h"
 
 namespace hrg_gyro {
@@ -35,13 +43,26 @@ class DriverSimRos {
 
  private:
   void run();
+  /// Plays `sim` (a GyroSimulator or a TriadSimulator) on the schedule; `publish(sample, stamp,
+  /// origin)` publishes one sample's messages.
+  template <class Simulator, class Sample, class Publish>
+  void play(Simulator& sim, Sample* sample, const Publish& publish);
+  void publishSingle(const core::SimulationSample& s, const ros::Time& stamp, core::Nanoseconds origin);
+  void publishTriad(const core::TriadSample& s, const ros::Time& stamp, core::Nanoseconds origin);
   bool waitForSubscribers();
+  /// The fewest subscribers of the channels: of the one topic, or of the triad's three axes.
+  std::uint32_t channelSubscribers() const;
 
   ros::NodeHandle nh_, pnh_;
   ParameterReader params_;
-  bool owns_process_;  // a node may shut itself down when done; a nodelet must not
-  std::unique_ptr<core::SimulationConfig> config_;
+  bool owns_process_;                               // a node may shut itself down when done; a nodelet must not
+  std::unique_ptr<core::SimulationConfig> config_;  // a single gyro's scenario, or
+  std::unique_ptr<core::TriadSimulationConfig> triad_config_;  // a triad's
+  double output_period_ = 0.0;                                 // s, of either
+  double start_time_ = 0.0;                                    // s, of either
   ros::Publisher channels_pub_, turntable_pub_, truth_pub_, clock_pub_, done_pub_;
+  std::array<ros::Publisher, 3> axis_channels_pub_, axis_truth_pub_;  // a triad's; truth_pub_ its body truth
+  ros::Publisher fixture_pub_;
   double time_scale_ = 1.0;
   double max_lag_ = 0.25;                           // s, sim time only
   std::optional<core::PlaybackSchedule> schedule_;  // built (and validated) with the parameters

@@ -155,7 +155,7 @@ CalibrationProgress DualRateMethod::progress() const {
   double worst = order.size() >= 2 ? 1.0 : 0.0;
   for (std::size_t i = 0; i < order.size() && i < 2; ++i) {
     const RateGroup& g = groups_.groups()[order[i]];
-    const double cov = g.rates().coverage(minBinTime());
+    const double cov = g.rates().coverage(minBinTime(g.meanRate()));
     worst = std::min(worst, cov);
     s << ", " << formatShort(g.meanRate()) << " rad/s: coverage " << formatShort(100 * cov) << " %";
   }
@@ -169,7 +169,10 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
   o.method = kind();
   const QualityLimits& q = settings_.gates;
   const auto order = groups_.byDuration();
-  for (std::size_t i : order) o.plateaus.push_back(summarize(groups_.groups()[i], minBinTime()));
+  for (std::size_t i : order) {
+    const RateGroup& g = groups_.groups()[i];
+    o.plateaus.push_back(summarize(g, minBinTime(g.meanRate())));
+  }
   o.samples = samples_;
   o.gate("samples", samples_ >= q.min_samples, static_cast<double>(samples_), static_cast<double>(q.min_samples),
          std::to_string(samples_) + " wave samples on moving plateaus");
@@ -183,7 +186,7 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
   const RateGroup& g2 = groups_.groups()[order[1]];
   const double w1 = g1.meanRate(), w2 = g2.meanRate();
   o.duration = g1.rates().totalTime() + g2.rates().totalTime();
-  o.coverage = std::min(g1.rates().coverage(minBinTime()), g2.rates().coverage(minBinTime()));
+  o.coverage = std::min(g1.rates().coverage(minBinTime(w1)), g2.rates().coverage(minBinTime(w2)));
   o.gate("coverage", o.coverage >= q.min_coverage, o.coverage, q.min_coverage,
          "theta bins covered by both plateaus: " + formatShort(100 * o.coverage) + " %");
   o.gate("rate_separation", std::abs(w1 - w2) >= q.min_rate_separation, std::abs(w1 - w2), q.min_rate_separation,
@@ -193,7 +196,8 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
   const double earth_std = prior.earth_rate.enabled
                                ? kEarthRotationRate * std::abs(std::cos(prior.earth_rate.latitude)) * 0.01 * kPi / 180
                                : 0.0;
-  const IncrementFit e = regression_.solve(earth, earth_std, minBinTime(), q.max_condition);
+  // One threshold for the bins of both groups: the longer of their windows' quarters.
+  const IncrementFit e = regression_.solve(earth, earth_std, std::max(minBinTime(w1), minBinTime(w2)), q.max_condition);
   if (!e.ok) {
     o.gate("fit", false, 0.0, 0.0, e.reason);
     o.decide();

@@ -51,6 +51,18 @@ TEST(DualRateTest, RecoversKAndDAndCancelsTheDrift) {
   EXPECT_GT(o.error_bound, 0.0);
 }
 
+TEST(DualRateTest, AFastShortPlateauCoversThetaWithItsOwnWindow) {
+  // At 0.4 rad/s the wave crosses a theta bin in 0.11 s: 30 s plateaus sweep each bin about 0.45 s
+  // in all, less than a quarter of the 2 s `window` but many times the 0.27 s window these rates use.
+  // Coverage and the fit's bins are judged against the window in use.
+  const AngleLevelGyro g = referenceGyro();
+  const CalibrationOutcome o =
+      calibrateAngleLevel(g, dualRateProfile(0.4, -0.4, 30.0), settings("dual_rate"), priorFor(g));
+  ASSERT_TRUE(o.accepted) << o.reason;
+  EXPECT_GE(o.coverage, 0.95);
+  EXPECT_LE(testing::peakErrorPpm(o.parameters.scale_factor, g.k), 1.0);
+}
+
 TEST(DualRateTest, NonFiniteWaveAnglesAreSkipped) {
   const AngleLevelGyro g = referenceGyro();
   CalibrationSession session(settings("dual_rate"), priorFor(g));

@@ -16,7 +16,7 @@
 
 namespace {
 
-const std::vector<std::string> kFolders = {"common",     "model",       "signal",     "estimation",
+const std::vector<std::string> kFolders = {"common",     "model",       "resonator",  "signal",    "estimation",
                                            "processing", "calibration", "simulation", "evaluation"};
 
 std::vector<std::string> entries(const std::string& dir, bool directories) {

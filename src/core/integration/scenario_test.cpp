@@ -1,6 +1,7 @@
 // Turntable profiles and scenario files.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -9,6 +10,7 @@
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/simulation/injected_model.h"
 #include "hrg_gyro/core/simulation/simulation_config.h"
+#include "hrg_gyro/core/simulation/triad_simulation_config.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -182,10 +184,13 @@ TEST(Scenarios, ShippedScenariosParseAndDescribeTheSameGyro) {
                                          "thermal_ramp.yaml",
                                          "dual_rate_drifting.yaml",
                                          "dual_rate_table_clock.yaml"};
-  // Every scenario file is checked here, but diagnosis.yaml (its isotropic resonator differs).
+  // Every scenario file is checked here, but diagnosis.yaml (its isotropic resonator differs) and the
+  // triad's (TriadScenariosAreWhatTheySay).
   std::set<std::string> files;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) files.insert(entry.path().filename().string());
   files.erase("diagnosis.yaml");
+  files.erase("triad.yaml");
+  files.erase("triad_verification.yaml");
   EXPECT_EQ(files, shipped);
   std::string reference_gyro;
   for (const std::string& name : shipped) {
@@ -233,6 +238,141 @@ TEST(Scenarios, DriftingAndTableClockScenariosAreWhatTheySay) {
   EXPECT_EQ(log.clock.rate_error, 0.0);
   EXPECT_TRUE(log.clock.steps.empty());
   EXPECT_NEAR(clock.profile.duration(), plain.profile.duration(), 1e-9);
+}
+
+/// The text between `from` and `to` (both must be there).
+std::string between(const std::string& text, const std::string& from, const std::string& to) {
+  const std::size_t a = text.find(from), b = text.find(to);
+  EXPECT_NE(a, std::string::npos) << from;
+  EXPECT_NE(b, std::string::npos) << to;
+  return a == std::string::npos || b == std::string::npos ? std::string() : text.substr(a, b - a);
+}
+
+/// The plateaus (rate != 0, constant) of a position's profile, and its longest rest.
+void plateausAndRest(const TurntableProfile& p, std::vector<Plateau>* plateaus, double* rest) {
+  *rest = 0.0;
+  for (const TurntableProfile::Piece& piece : p.pieces()) {
+    if (piece.accel != 0.0) continue;
+    if (piece.rate0 == 0.0) *rest = std::max(*rest, piece.duration);
+    if (piece.rate0 != 0.0 && piece.label.find("/settle") == std::string::npos) {
+      plateaus->push_back({piece.start, piece.start + piece.duration, piece.rate0});
+    }
+  }
+}
+
+// config/scenarios/triad.yaml is the documented calibration session: the shipped gyro on each axis
+// (varied a little), misalignments of tens to hundreds of microradians, a perfect fixture in the six
+// positions +-z, +-x, +-y, each with a rest of 60 s and plateaus at +-0.05 rad/s that sweep the up
+// axis's theta by 2 pi, moves of 10 s; triad_verification.yaml the same triad in tilted positions
+// (the table's axis along a body diagonal) at +-0.08 rad/s; test/scenarios/triad_short.yaml its short
+// form for the tests.
+TEST(Scenarios, TriadScenariosAreWhatTheySay) {
+  const std::string dir = std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/";
+  const TriadSimulationConfig cal = TriadSimulationConfig::load(dir + "triad.yaml", nodeOnlyScenarioKeys());
+  const TriadSimulationConfig ver =
+      TriadSimulationConfig::load(dir + "triad_verification.yaml", nodeOnlyScenarioKeys());
+  const TriadSimulationConfig brief = TriadSimulationConfig::load(
+      std::string(HRG_GYRO_SOURCE_DIR) + "/test/scenarios/triad_short.yaml", nodeOnlyScenarioKeys());
+  // One triad in the three files, word for word.
+  const std::string axes = between(readFile(dir + "triad.yaml"), "  axes:", "  # ---- The session");
+  EXPECT_EQ(between(readFile(dir + "triad_verification.yaml"), "  axes:", "  # ---- The session"), axes);
+  EXPECT_EQ(between(readFile(std::string(HRG_GYRO_SOURCE_DIR) + "/test/scenarios/triad_short.yaml"),
+                    "  axes:", "  # ---- The session"),
+            axes);
+  // The shipped gyro on each axis, a little different on each.
+  const SimulationConfig shipped = SimulationConfig::load(dir + "dual_rate.yaml", nodeOnlyScenarioKeys());
+  for (int i = 0; i < 3; ++i) {
+    SCOPED_TRACE(i);
+    const TriadAxisConfig& a = cal.axes[i];
+    EXPECT_EQ(a.name, std::string(1, static_cast<char>('x' + i)));
+    EXPECT_EQ(a.resonator.frequency, shipped.resonator.frequency);
+    EXPECT_EQ(a.resonator.periods_per_output, shipped.resonator.periods_per_output);
+    EXPECT_EQ(a.pickoff.gap, shipped.pickoff.gap);
+    EXPECT_EQ(a.pickoff.noise, shipped.pickoff.noise);
+    EXPECT_NEAR(a.resonator.scale_factor.meanAt(NAN), -0.56, 0.005);
+    EXPECT_EQ(a.resonator.scale_factor.orders(), shipped.resonator.scale_factor.orders());
+    if (i > 0) {
+      EXPECT_NE(a.resonator.scale_factor, cal.axes[0].resonator.scale_factor);
+      EXPECT_NE(a.pickoff.misplacement, cal.axes[0].pickoff.misplacement);
+    }
+    for (const double m : a.misalignment) {
+      EXPECT_GE(std::abs(m), 1e-5);
+      EXPECT_LE(std::abs(m), 1e-3);
+    }
+  }
+  EXPECT_EQ(cal.axes[0].resonator.scale_factor, shipped.resonator.scale_factor);
+  EXPECT_EQ(cal.axes[0].pickoff.misplacement, shipped.pickoff.misplacement);
+
+  // The calibration session: six positions, each axis up and down, a perfect fixture.
+  const std::vector<std::string> ups = {"+z", "-z", "+x", "-x", "+y", "-y"};
+  ASSERT_EQ(cal.positions.size(), ups.size());
+  EXPECT_EQ(cal.fixture_error_std, 0.0);
+  EXPECT_EQ(cal.turntable.wobble.amplitude, 0.0);
+  for (std::size_t k = 0; k < ups.size(); ++k) {
+    SCOPED_TRACE(ups[k]);
+    const FixturePositionConfig& p = cal.positions[k];
+    Eigen::Matrix3d r;
+    ASSERT_TRUE(rotationForUp(ups[k], &r));
+    EXPECT_EQ(p.nominal, r);
+    EXPECT_EQ(p.error, Eigen::Vector3d::Zero());
+    EXPECT_EQ(p.move, k == 0 ? 0.0 : 10.0);
+    std::vector<Plateau> plateaus;
+    double rest;
+    plateausAndRest(p.profile, &plateaus, &rest);
+    EXPECT_GE(rest, 60.0);
+    ASSERT_EQ(plateaus.size(), 4u);
+    const int up = ups[k][1] - 'x';
+    for (const Plateau& q : plateaus) {
+      EXPECT_EQ(std::abs(q.rate), 0.05);
+      // The up axis's theta sweeps at least 2 pi on each plateau (today's dual-rate coverage).
+      EXPECT_GE(std::abs(cal.axes[up].resonator.scale_factor.meanAt(NAN) * q.rate) * (q.end - q.start), kTwoPi);
+    }
+  }
+  EXPECT_NEAR(cal.duration(), 5910.8, 1e-6);
+
+  // The verification session: every axis senses 1/sqrt(3) of the table's rate, +-0.08 rad/s, and each
+  // plateau sweeps every axis's theta by at least 2 pi.
+  EXPECT_GE(ver.positions.size(), 4u);
+  for (const FixturePositionConfig& p : ver.positions) {
+    SCOPED_TRACE(p.name);
+    const Eigen::Vector3d table_axis = p.nominal.transpose() * Eigen::Vector3d::UnitZ();
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(std::abs(table_axis[i]), 1.0 / std::sqrt(3.0), 1e-12);
+    EXPECT_EQ(p.error, Eigen::Vector3d::Zero());
+    std::vector<Plateau> plateaus;
+    double rest;
+    plateausAndRest(p.profile, &plateaus, &rest);
+    EXPECT_GE(rest, 60.0);
+    ASSERT_EQ(plateaus.size(), 2u);
+    for (const Plateau& q : plateaus) {
+      EXPECT_EQ(std::abs(q.rate), 0.08);
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_GE(
+            std::abs(ver.axes[i].resonator.scale_factor.meanAt(NAN) * q.rate) / std::sqrt(3.0) * (q.end - q.start),
+            kTwoPi);
+      }
+    }
+  }
+  // The diagonals of the four positions span the body frame (the body rate is checked about each axis
+  // with both signs of the others).
+  Eigen::MatrixXd diagonals(3, static_cast<Eigen::Index>(ver.positions.size()));
+  for (std::size_t k = 0; k < ver.positions.size(); ++k) {
+    diagonals.col(static_cast<Eigen::Index>(k)) = ver.positions[k].nominal.transpose() * Eigen::Vector3d::UnitZ();
+  }
+  EXPECT_EQ(Eigen::FullPivLU<Eigen::MatrixXd>(diagonals).rank(), 3);
+
+  // The tests' short session: the calibration's positions at +-0.4 rad/s, one plateau of each, ten minutes.
+  ASSERT_EQ(brief.positions.size(), ups.size());
+  for (std::size_t k = 0; k < ups.size(); ++k) {
+    Eigen::Matrix3d r;
+    rotationForUp(ups[k], &r);
+    EXPECT_EQ(brief.positions[k].nominal, r) << ups[k];
+    std::vector<Plateau> plateaus;
+    double rest;
+    plateausAndRest(brief.positions[k].profile, &plateaus, &rest);
+    ASSERT_EQ(plateaus.size(), 2u);
+    for (const Plateau& q : plateaus) EXPECT_GE(0.56 * std::abs(q.rate) * (q.end - q.start), kTwoPi);
+  }
+  EXPECT_LT(brief.duration(), 600.0);
 }
 
 TEST(Scenarios, RejectsBadValuesByKey) {

@@ -7,7 +7,7 @@
 namespace hrg_gyro {
 namespace core {
 
-GyroSimulator::GyroSimulator(const SimulationConfig& config)
+GyroSimulator::GyroSimulator(const SimulationConfig& config, const AxisRateInput* input)
     : config_(config),
       synth_(config_.pickoff, config_.resonator.samples_per_period, config_.seed),
       rate_noise_(config_.seed ^ 0x5deece66dULL),
@@ -16,6 +16,7 @@ GyroSimulator::GyroSimulator(const SimulationConfig& config)
       frequency_(config_.resonator.frequency),
       amplitude_(config_.resonator.amplitude),
       earth_rate_(verticalEarthRate(config_.latitude)),
+      input_(input),
       theta_(config_.resonator.initial_theta),
       logger_(config_.turntable_log, config_.seed),
       channel_delivery_(config_.channels, config_.seed ^ 0x9b05688c2b3e6c1fULL) {
@@ -28,6 +29,7 @@ GyroSimulator::GyroSimulator(const SimulationConfig& config)
 void GyroSimulator::logTurntable(double t_center, SimulationSample* out) {
   out->turntable.clear();
   out->channels_delivered = channel_delivery_.delivered(t_center);
+  if (input_) return;  // one axis of a triad: the triad logs the table
   const double log_rate = config_.turntable_log.rate;
   if (log_rate == 0.0) {
     // One record with the sample, stamped like it, from the sample's own truth.
@@ -73,14 +75,20 @@ double GyroSimulator::duration() const { return generatorDuration() + config_.pr
 
 bool GyroSimulator::done() const { return t_ >= duration() - 1e-9; }
 
-double GyroSimulator::thetaRate(double t, double theta) {
-  double angle, rate, k, d;
+double GyroSimulator::sensedRate(double t) const {
+  if (input_) return input_->rateAt(t);
+  double angle, rate;
   config_.profile.evaluate(t - generatorDuration(), &angle, &rate);
+  return rate + earth_rate_;
+}
+
+double GyroSimulator::thetaRate(double t, double theta, double sensed) {
+  double k, d;
   intrinsic_.evaluate(theta, config_.resonator.frequency, &k, &d);
   const BiasDriftConfig& drift = config_.resonator.bias_drift;
   // Only with a drift: adding a zero could still flip the sign of a zero rate.
-  if (drift.enabled()) return k * (rate + earth_rate_) + d + (drift.trendAt(t) + bias_walk_);
-  return k * (rate + earth_rate_) + d;
+  if (drift.enabled()) return k * sensed + d + (drift.trendAt(t) + bias_walk_);
+  return k * sensed + d;
 }
 
 double GyroSimulator::injectedBias(double t) const {
@@ -111,8 +119,9 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
   const ResonatorConfig& rc = config_.resonator;
   const int m = rc.periods_per_output;
   const double period = 1.0 / rc.frequency;
-  std::vector<double> boundary_theta(m + 1);
+  std::vector<double> boundary_theta(m + 1), boundary_input_angle(m + 1);
   boundary_theta[0] = theta_;
+  boundary_input_angle[0] = input_angle_;
   const double t_start = t_;
   if (config_.thermal.enabled) updateTemperature(t_start + 0.5 * m * period);
   ChannelVector sum = ChannelVector::Zero();
@@ -120,11 +129,21 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
   for (int p = 0; p < m; ++p) {
     // RK4 over one period: the rate changes by < 1e-5 relative within it.
     const double h = period, t = t_;
-    const double k1 = thetaRate(t, theta_);
-    const double k2 = thetaRate(t + h / 2, theta_ + h / 2 * k1);
-    const double k3 = thetaRate(t + h / 2, theta_ + h / 2 * k2);
-    const double k4 = thetaRate(t + h, theta_ + h * k3);
+    // The sensed rate depends on time only: one evaluation per stage time.
+    const double sensed0 = sensedRate(t), sensed_mid = sensedRate(t + h / 2), sensed1 = sensedRate(t + h);
+    const double k1 = thetaRate(t, theta_, sensed0);
+    const double k2 = thetaRate(t + h / 2, theta_ + h / 2 * k1, sensed_mid);
+    const double k3 = thetaRate(t + h / 2, theta_ + h / 2 * k2, sensed_mid);
+    const double k4 = thetaRate(t + h, theta_ + h * k3, sensed1);
     double theta_end = theta_ + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    // The input's angle by Simpson's rule on the same stages (RK4 of a function of time alone).
+    if (input_) {
+      // Kahan-compensated like the time: hours of small increments stay exact to the last bits.
+      const double y = h / 6 * (sensed0 + 4 * sensed_mid + sensed1) - input_angle_compensation_;
+      const double sum = input_angle_ + y;
+      input_angle_compensation_ = (sum - input_angle_) - y;
+      input_angle_ = sum;
+    }
     if (rc.rate_noise > 0.0) {
       // A white body-rate noise, seen through the scale factor like any rotation.
       double k, d;
@@ -135,6 +154,7 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
     sum += synth_.period(wave, theta_end);
     theta_ = theta_end;
     boundary_theta[p + 1] = theta_;
+    boundary_input_angle[p + 1] = input_angle_;
     // Kahan summation keeps 24 h of 200 us steps exact to the nanosecond.
     const double y = h - t_compensation_;
     const double sum_t = t_ + y;
@@ -154,8 +174,20 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
   TruthState& truth = out->truth;
   truth.theta = boundary_theta[lo] + frac * (boundary_theta[lo + 1] - boundary_theta[lo]);
   config_.profile.evaluate(t_center - generatorDuration(), &truth.table_angle, &truth.table_rate, &truth.segment);
-  truth.inertial_rate = truth.table_rate + earth_rate_;
-  truth.inertial_angle = truth.table_angle + earth_rate_ * t_center;
+  if (input_) {
+    // The input's rate at the centre and its angle: Simpson from the period boundary before it.
+    const double t_lo = t_start + lo * period;
+    truth.inertial_rate = input_->rateAt(t_center);
+    truth.inertial_angle = boundary_input_angle[lo];
+    if (t_center > t_lo) {
+      truth.inertial_angle +=
+          (t_center - t_lo) / 6 *
+          (input_->rateAt(t_lo) + 4 * input_->rateAt(0.5 * (t_lo + t_center)) + truth.inertial_rate);
+    }
+  } else {
+    truth.inertial_rate = truth.table_rate + earth_rate_;
+    truth.inertial_angle = truth.table_angle + earth_rate_ * t_center;
+  }
   truth.amplitude = amplitude_;
   truth.quadrature = rc.quadrature;
   truth.phase = rc.phase;

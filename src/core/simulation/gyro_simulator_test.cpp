@@ -345,6 +345,48 @@ class Fingerprint {
   std::uint64_t hash_ = 0xcbf29ce484222325ULL;
 };
 
+/// The single-axis table's own rate as an input: Omega_table(t) + Omega_E, computed as the simulator does.
+class TableRateInput : public AxisRateInput {
+ public:
+  explicit TableRateInput(const SimulationConfig& c) : profile_(c.profile), earth_(verticalEarthRate(c.latitude)) {}
+  double rateAt(double t) const override {
+    double angle, rate;
+    profile_.evaluate(t, &angle, &rate);
+    return rate + earth_;
+  }
+
+ private:
+  TurntableProfile profile_;
+  double earth_;
+};
+
+// The hook a triad's axis uses senses what it is given: given the table's rate it is the single-axis
+// gyro bit for bit (channels, theta, stamps), and the truth's inertial angle is the input's integral.
+TEST(GyroSimulatorTest, AnAxisInputOfTheTableRateGivesTheSingleAxisSamples) {
+  SimulationConfig c = idealConfig();
+  c.pickoff.noise = 2e-4;
+  c.resonator.rate_noise = 1e-5;
+  c.resonator.periods_per_output = 25;
+  const TableRateInput input(c);
+  GyroSimulator single(c), axis(c, &input);
+  SimulationSample a, b;
+  int n = 0;
+  while (single.next(&a)) {
+    ASSERT_TRUE(axis.next(&b));
+    ASSERT_EQ(a.stamp, b.stamp);
+    for (int i = 0; i < 4; ++i) ASSERT_EQ(a.z[i], b.z[i]) << n;
+    ASSERT_EQ(a.truth.theta, b.truth.theta) << n;
+    EXPECT_EQ(a.truth.inertial_rate, b.truth.inertial_rate) << n;
+    // Simpson on the RK4 grid of a piecewise-linear rate: exact up to the summation's rounding.
+    EXPECT_NEAR(b.truth.inertial_angle, a.truth.inertial_angle, 1e-12 * (1.0 + std::abs(a.truth.inertial_angle))) << n;
+    EXPECT_EQ(a.turntable.size(), 1u);
+    EXPECT_TRUE(b.turntable.empty()) << "an axis of a triad logs no table records";
+    ++n;
+  }
+  EXPECT_FALSE(axis.next(&b));
+  EXPECT_GT(n, 6000);
+}
+
 // The bits of a noisy scenario with every random effect of the table log on, as they were before
 // the bias drift and the table clock existed: scenarios without those sections must not change by
 // one bit. The hash is of this compiler and C library (Debian bookworm's gcc and glibc); another

@@ -84,6 +84,94 @@ SimulationConfig atTemperature(const SimulationConfig& config, double temperatur
   return c;
 }
 
+ResonatorConfig parseResonatorSection(const YamlField& r) {
+  r.rejectUnknownKeys({"frequency", "samples_per_period", "periods_per_output", "amplitude", "quadrature", "phase",
+                       "initial_theta", "scale_factor", "drift", "rate_noise", "bias_drift"});
+  ResonatorConfig rc;
+  rc.frequency = r.getDouble("frequency", rc.frequency);
+  if (!(rc.frequency > 0.0)) r["frequency"].fail("must be positive (Hz)");
+  rc.samples_per_period = static_cast<int>(r.getInteger("samples_per_period", rc.samples_per_period));
+  if (rc.samples_per_period < 8 || rc.samples_per_period > 4096) {
+    r["samples_per_period"].fail("must be in [8, 4096]: fewer than 8 samples alias the pickoff nonlinearity");
+  }
+  rc.periods_per_output = static_cast<int>(r.getInteger("periods_per_output", rc.periods_per_output));
+  if (rc.periods_per_output < 1) r["periods_per_output"].fail("must be >= 1");
+  rc.amplitude = r.getDouble("amplitude", rc.amplitude);
+  if (!(rc.amplitude > 0.0)) r["amplitude"].fail("must be positive");
+  rc.quadrature = r.getDouble("quadrature", rc.quadrature);
+  if (!(std::abs(rc.quadrature) < 0.5 * rc.amplitude)) r["quadrature"].fail("|B| must stay below A/2");
+  rc.phase = r.getDouble("phase", rc.phase);
+  rc.initial_theta = r.getDouble("initial_theta", rc.initial_theta);
+  if (r.has("scale_factor")) rc.scale_factor = parseScaleFactorModel(r["scale_factor"]);
+  if (r.has("drift")) rc.drift = parseDriftModel(r["drift"]);
+  rc.rate_noise = r.getDouble("rate_noise", 0.0);
+  if (rc.rate_noise < 0.0) r["rate_noise"].fail("must be >= 0 (rad/sqrt(s))");
+  if (r.has("bias_drift")) rc.bias_drift = parseBiasDrift(r["bias_drift"]);
+  return rc;
+}
+
+PickoffDefects parsePickoffSection(const YamlField& p, double amplitude) {
+  p.rejectUnknownKeys({"misplacement", "gain_error", "amplitude_to_gap", "noise"});
+  PickoffDefects d;
+  if (p.has("misplacement")) {
+    const auto v = p["misplacement"].asDoubles(kPickoffCount);
+    for (int i = 0; i < kPickoffCount; ++i) {
+      if (std::abs(v[i]) > 0.1) p["misplacement"].at(i).fail("misplacement above 0.1 rad is not a small defect");
+      d.misplacement[i] = v[i];
+    }
+  }
+  if (p.has("gain_error")) {
+    const auto v = p["gain_error"].asDoubles(kPickoffCount);
+    for (int i = 0; i < kPickoffCount; ++i) {
+      if (std::abs(v[i]) > 0.5) p["gain_error"].at(i).fail("gain error must be in (-0.5, 0.5)");
+      d.gain_error[i] = v[i];
+    }
+  }
+  const double ratio = p.getDouble("amplitude_to_gap", 0.0);
+  if (ratio < 0.0 || ratio >= 0.5) p["amplitude_to_gap"].fail("A/d0 must be in [0, 0.5)");
+  d.gap = ratio > 0.0 ? amplitude / ratio : INFINITY;
+  d.noise = p.getDouble("noise", 0.0);
+  if (d.noise < 0.0) p["noise"].fail("must be >= 0");
+  return d;
+}
+
+TableRippleConfig parseRippleSection(const YamlField& r) {
+  r.requireMap();
+  r.rejectUnknownKeys({"amplitude", "frequency", "phase"});
+  TableRippleConfig c;
+  c.amplitude = r.getDouble("amplitude", 0.0);
+  if (!(c.amplitude >= 0.0 && c.amplitude < 1.0))
+    r["amplitude"].fail("must be in [0, 1): a fraction of the commanded rate");
+  c.frequency = r.getDouble("frequency", 0.0);
+  if (c.amplitude > 0.0 && !(std::isfinite(c.frequency) && c.frequency > 0.0)) {
+    r["frequency"].fail("must be positive (Hz) when the ripple has an amplitude");
+  }
+  c.phase = r.getDouble("phase", 0.0);
+  if (!std::isfinite(c.phase)) r["phase"].fail("must be finite (rad)");
+  return c;
+}
+
+DeliveryConfig parseChannelDeliverySection(const YamlField& ch) {
+  ch.requireMap();
+  ch.rejectUnknownKeys({"drop_probability", "gaps"});
+  return DeliveryConfig::parse(ch);
+}
+
+YAML::Node loadScenarioDocument(const std::string& path) {
+  std::string text;
+  try {
+    text = readBoundedRegularFile(path, kMaxScenarioFileBytes, "scenario file");
+  } catch (const std::runtime_error& e) {
+    throw ConfigError("", e.what());
+  }
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError("",
+                      "YAML syntax error in '" + path + "' at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+}
+
 SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
   root.requireMap();
   std::vector<std::string> allowed = {"seed",      "start_time", "resonator", "pickoff",
@@ -97,55 +185,8 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
   c.start_time = root.getDouble("start_time", c.start_time);
   if (!(c.start_time > 0.0)) root["start_time"].fail("must be positive (time 0 means 'unset' in ROS)");
 
-  if (root.has("resonator")) {
-    const YamlField r = root["resonator"];
-    r.rejectUnknownKeys({"frequency", "samples_per_period", "periods_per_output", "amplitude", "quadrature", "phase",
-                         "initial_theta", "scale_factor", "drift", "rate_noise", "bias_drift"});
-    ResonatorConfig& rc = c.resonator;
-    rc.frequency = r.getDouble("frequency", rc.frequency);
-    if (!(rc.frequency > 0.0)) r["frequency"].fail("must be positive (Hz)");
-    rc.samples_per_period = static_cast<int>(r.getInteger("samples_per_period", rc.samples_per_period));
-    if (rc.samples_per_period < 8 || rc.samples_per_period > 4096) {
-      r["samples_per_period"].fail("must be in [8, 4096]: fewer than 8 samples alias the pickoff nonlinearity");
-    }
-    rc.periods_per_output = static_cast<int>(r.getInteger("periods_per_output", rc.periods_per_output));
-    if (rc.periods_per_output < 1) r["periods_per_output"].fail("must be >= 1");
-    rc.amplitude = r.getDouble("amplitude", rc.amplitude);
-    if (!(rc.amplitude > 0.0)) r["amplitude"].fail("must be positive");
-    rc.quadrature = r.getDouble("quadrature", rc.quadrature);
-    if (!(std::abs(rc.quadrature) < 0.5 * rc.amplitude)) r["quadrature"].fail("|B| must stay below A/2");
-    rc.phase = r.getDouble("phase", rc.phase);
-    rc.initial_theta = r.getDouble("initial_theta", rc.initial_theta);
-    if (r.has("scale_factor")) rc.scale_factor = parseScaleFactorModel(r["scale_factor"]);
-    if (r.has("drift")) rc.drift = parseDriftModel(r["drift"]);
-    rc.rate_noise = r.getDouble("rate_noise", 0.0);
-    if (rc.rate_noise < 0.0) r["rate_noise"].fail("must be >= 0 (rad/sqrt(s))");
-    if (r.has("bias_drift")) rc.bias_drift = parseBiasDrift(r["bias_drift"]);
-  }
-
-  if (root.has("pickoff")) {
-    const YamlField p = root["pickoff"];
-    p.rejectUnknownKeys({"misplacement", "gain_error", "amplitude_to_gap", "noise"});
-    if (p.has("misplacement")) {
-      const auto v = p["misplacement"].asDoubles(kPickoffCount);
-      for (int i = 0; i < kPickoffCount; ++i) {
-        if (std::abs(v[i]) > 0.1) p["misplacement"].at(i).fail("misplacement above 0.1 rad is not a small defect");
-        c.pickoff.misplacement[i] = v[i];
-      }
-    }
-    if (p.has("gain_error")) {
-      const auto v = p["gain_error"].asDoubles(kPickoffCount);
-      for (int i = 0; i < kPickoffCount; ++i) {
-        if (std::abs(v[i]) > 0.5) p["gain_error"].at(i).fail("gain error must be in (-0.5, 0.5)");
-        c.pickoff.gain_error[i] = v[i];
-      }
-    }
-    const double ratio = p.getDouble("amplitude_to_gap", 0.0);
-    if (ratio < 0.0 || ratio >= 0.5) p["amplitude_to_gap"].fail("A/d0 must be in [0, 0.5)");
-    c.pickoff.gap = ratio > 0.0 ? c.resonator.amplitude / ratio : INFINITY;
-    c.pickoff.noise = p.getDouble("noise", 0.0);
-    if (c.pickoff.noise < 0.0) p["noise"].fail("must be >= 0");
-  }
+  if (root.has("resonator")) c.resonator = parseResonatorSection(root["resonator"]);
+  if (root.has("pickoff")) c.pickoff = parsePickoffSection(root["pickoff"], c.resonator.amplitude);
 
   if (root.has("generator")) {
     const YamlField g = root["generator"];
@@ -170,29 +211,10 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
     c.acceleration = t.getDouble("acceleration", c.acceleration);
     if (!(c.acceleration > 0.0)) t["acceleration"].fail("must be positive (rad/s^2)");
     if (t.has("profile")) c.profile = TurntableProfile::parse(t["profile"], c.acceleration);
-    if (t.has("ripple")) {
-      const YamlField r = t["ripple"];
-      r.requireMap();
-      r.rejectUnknownKeys({"amplitude", "frequency", "phase"});
-      c.ripple.amplitude = r.getDouble("amplitude", 0.0);
-      if (!(c.ripple.amplitude >= 0.0 && c.ripple.amplitude < 1.0)) {
-        r["amplitude"].fail("must be in [0, 1): a fraction of the commanded rate");
-      }
-      c.ripple.frequency = r.getDouble("frequency", 0.0);
-      if (c.ripple.amplitude > 0.0 && !(std::isfinite(c.ripple.frequency) && c.ripple.frequency > 0.0)) {
-        r["frequency"].fail("must be positive (Hz) when the ripple has an amplitude");
-      }
-      c.ripple.phase = r.getDouble("phase", 0.0);
-      if (!std::isfinite(c.ripple.phase)) r["phase"].fail("must be finite (rad)");
-    }
+    if (t.has("ripple")) c.ripple = parseRippleSection(t["ripple"]);
     if (t.has("log")) c.turntable_log = TurntableLogConfig::parse(t["log"]);
   }
-  if (root.has("channels")) {
-    const YamlField ch = root["channels"];
-    ch.requireMap();
-    ch.rejectUnknownKeys({"drop_probability", "gaps"});
-    c.channels = DeliveryConfig::parse(ch);
-  }
+  if (root.has("channels")) c.channels = parseChannelDeliverySection(root["channels"]);
   if (root.has("thermal")) {
     c.thermal = ThermalConfig::parse(root["thermal"]);
     checkThermalLimits(c, root["thermal"]);
@@ -204,20 +226,7 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
 }
 
 SimulationConfig SimulationConfig::load(const std::string& path, const std::vector<std::string>& extra_keys) {
-  YAML::Node root;
-  std::string text;
-  try {
-    text = readBoundedRegularFile(path, kMaxScenarioFileBytes, "scenario file");
-  } catch (const std::runtime_error& e) {
-    throw ConfigError("", e.what());
-  }
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError("",
-                      "YAML syntax error in '" + path + "' at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
-  return parse(YamlField(root, ""), extra_keys);
+  return parse(YamlField(loadScenarioDocument(path), ""), extra_keys);
 }
 
 }  // namespace core

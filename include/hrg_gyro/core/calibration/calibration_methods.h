@@ -30,7 +30,9 @@ class DualRateMethod : public CalibrationMethod {
   CalibrationOutcome finish(const GyroParameters& prior) const override;
 
  private:
-  double minBinTime() const { return 0.25 * settings_.window; }
+  /// Swept time a theta bin needs to count (coverage) and to enter the fit: a quarter of the window
+  /// the increments at this table rate use, which is shorter than `window` at high rates.
+  double minBinTime(double table_rate) const { return 0.25 * windowFor(table_rate); }
   /// The averaging window of a plateau at this table rate, s (see docs/calibration.md).
   double windowFor(double table_rate) const;
   CalibrationSettings settings_;

@@ -25,6 +25,13 @@
 // output window and held over it: the pickoff defects, the amplitude and the intrinsic K and D are
 // those of that temperature, and the sample reports T and f(T). Without one every sample reports
 // the nominal frequency and an unknown (NaN) temperature, exactly as before thermal support existed.
+//
+// One axis of a triad (TriadSimulator) senses the inertial rate about its own sensitive axis instead
+// of the table's vertical rotation: it is built with an AxisRateInput, whose rate replaces
+// Omega_table + Omega_E in the dynamics above; the truth's inertial angle is then that rate's
+// integral (Simpson's rule on the RK4 grid, exact to the order of the RK4 stages), and the axis logs no
+// table records (the triad logs its one table). Without an input the single-axis path is unchanged,
+// bit for bit (GyroSimulatorTest.ScenarioWithoutNewSectionsKeepsItsFingerprint).
 #pragma once
 
 #include <cstdint>
@@ -74,9 +81,20 @@ struct SimulationSample {
   std::vector<TurntableLogRecord> turntable;
 };
 
+/// What one axis of a triad senses: the inertial rate about its sensitive axis, a smooth function of
+/// time. Called several times per resonator period, with times that increase but for a repeat.
+class AxisRateInput {
+ public:
+  virtual ~AxisRateInput() = default;
+  /// Inertial rate about the axis at t s from the scenario start, rad/s.
+  virtual double rateAt(double t) const = 0;
+};
+
 class GyroSimulator {
  public:
-  explicit GyroSimulator(const SimulationConfig& config);
+  /// `input` (not owned, must outlive the simulator): the rate this gyro senses, for one axis of a
+  /// triad; nullptr (the default): the table's rate plus the vertical Earth rate, as a single gyro.
+  explicit GyroSimulator(const SimulationConfig& config, const AxisRateInput* input = nullptr);
   // The dynamics evaluator points into config_: the simulator stays where it was built.
   GyroSimulator(const GyroSimulator&) = delete;
   GyroSimulator& operator=(const GyroSimulator&) = delete;
@@ -95,7 +113,10 @@ class GyroSimulator {
   const TurntableLogCounters& turntableLogCounters() const { return logger_.counters(); }
 
  private:
-  double thetaRate(double t, double theta);
+  /// d theta/dt at time t for the wave angle theta and the sensed inertial rate `sensed` (rad/s).
+  double thetaRate(double t, double theta, double sensed);
+  /// The inertial rate the gyro senses at t: the input's, or the table's plus the vertical Earth rate.
+  double sensedRate(double t) const;
   void nextDynamic(SimulationSample* out);
   void nextGenerator(SimulationSample* out);
   double generatorDuration() const;
@@ -120,6 +141,9 @@ class GyroSimulator {
   double frequency_;          // reported resonance frequency, Hz
   double amplitude_;          // wave amplitude A at the current temperature
   double earth_rate_;
+  const AxisRateInput* input_;  // nullptr: the single-axis table
+  double input_angle_ = 0.0;    // integral of the input's rate up to t_, rad (Kahan-compensated)
+  double input_angle_compensation_ = 0.0;
   double t_ = 0.0;  // s since start, Kahan-compensated
   double t_compensation_ = 0.0;
   double theta_;  // true electrical angle at t_

@@ -89,6 +89,18 @@ struct SimulationConfig {
   static SimulationConfig load(const std::string& path, const std::vector<std::string>& extra_keys = {});
 };
 
+/// The sections one simulated gyro is made of, as a scenario writes them (a triad scenario gives one of
+/// each per axis). Each throws ConfigError naming the key. `amplitude`: the resonator's A, since the
+/// pickoff section gives the electrode gap as A/d0.
+ResonatorConfig parseResonatorSection(const YamlField& resonator);
+PickoffDefects parsePickoffSection(const YamlField& pickoff, double amplitude);
+TableRippleConfig parseRippleSection(const YamlField& ripple);
+DeliveryConfig parseChannelDeliverySection(const YamlField& channels);
+
+/// A scenario file's YAML document: only a regular file of at most kMaxScenarioFileBytes (a FIFO, a
+/// device or a directory is refused at once), a syntax error reported with its line. Throws ConfigError.
+YAML::Node loadScenarioDocument(const std::string& path);
+
 /// Largest scenario file read. The scenarios of config/scenarios are below 6 KiB; a turntable
 /// profile of ten thousand pieces is below 1 MiB.
 constexpr std::size_t kMaxScenarioFileBytes = std::size_t{4} << 20;

@@ -1,0 +1,99 @@
+// The simulated triad on its rate table (TriadSimulationConfig), one output sample at a time: three
+// signal-level gyros (GyroSimulator each, its own defects and noise streams), each sensing
+// A_i . omega_body through the axis-rate input (TriadMotion gives omega_body), sharing the output
+// stamps; one table log (TurntableLogger, as a single gyro's); the fixture's position log; and the
+// truth of the body and of each axis.
+//
+// Per output sample (stamped at the centre of its demodulation window, like a single gyro's):
+//   axes[i]    axis i's SimulationSample: channels, and its truth with inertial_rate = A_i . omega_body
+//              and inertial_angle = its integral from the start; table_angle and table_rate are the table's
+//   turntable  the table records logged since the previous sample (one per sample by default)
+//   fixture    the fixture's state at the sample (position index and name, nominal body_to_table,
+//              locked), `fixture_logged` when it is to be published: at the first sample, whenever the
+//              position or the lock changed since the previous sample, and otherwise every second
+//   body       the body's truth at the sample: omega_body, the true body_to_table (fixture error and
+//              wobble included), the position index
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hrg_gyro/core/simulation/gyro_simulator.h"
+#include "hrg_gyro/core/simulation/triad_motion.h"
+#include "hrg_gyro/core/simulation/triad_simulation_config.h"
+
+namespace hrg_gyro {
+namespace core {
+
+/// How often the fixture's position is logged while nothing changes, s.
+constexpr double kFixtureLogPeriod = 1.0;
+
+struct FixtureState {
+  std::uint32_t index = 0;                                            ///< position in the session plan
+  const std::string* name = nullptr;                                  ///< owned by the simulator's config
+  Eigen::Quaterniond body_to_table = Eigen::Quaterniond::Identity();  ///< nominal (as planned)
+  bool locked = true;                                                 ///< false: being moved into `index`
+};
+
+struct TriadBodyTruth {
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();         ///< rad/s, inertial, body frame
+  Eigen::Quaterniond body_to_table = Eigen::Quaterniond::Identity();  ///< true
+  std::uint32_t position = 0;
+};
+
+struct TriadSample {
+  std::uint64_t index = 0;
+  Nanoseconds stamp = 0;  ///< the axes' common stamp
+  std::array<SimulationSample, 3> axes;
+  std::vector<TurntableLogRecord> turntable;
+  FixtureState fixture;
+  bool fixture_logged = false;
+  TriadBodyTruth body;
+};
+
+class TriadSimulator {
+ public:
+  explicit TriadSimulator(const TriadSimulationConfig& config);
+  ~TriadSimulator();
+  // The axes' inputs point into the simulator: it stays where it was built.
+  TriadSimulator(const TriadSimulator&) = delete;
+  TriadSimulator& operator=(const TriadSimulator&) = delete;
+
+  const TriadSimulationConfig& config() const { return config_; }
+  const TriadMotion& motion() const { return motion_; }
+  /// Simulated duration of the whole session, s.
+  double duration() const { return config_.duration(); }
+  /// Simulated time reached, s from the start.
+  double elapsed() const { return axes_[0]->elapsed(); }
+  bool done() const { return axes_[0]->done(); }
+
+  /// The next output sample; false once the session is complete.
+  bool next(TriadSample* out);
+
+  /// What the table controller has logged so far (records made, lost, glitched).
+  const TurntableLogCounters& turntableLogCounters() const { return logger_.counters(); }
+
+ private:
+  class AxisInput;
+  void logTurntable(double t_center, Nanoseconds stamp, const TriadBodyState& state, TriadSample* out);
+  void logFixture(double t_center, const TriadBodyState& state, TriadSample* out);
+
+  TriadSimulationConfig config_;
+  TriadMotion motion_;
+  std::array<std::unique_ptr<AxisInput>, 3> inputs_;
+  std::array<std::unique_ptr<GyroSimulator>, 3> axes_;
+  TurntableLogger logger_;
+  std::uint64_t next_log_ = 0;  // index of the next record at the table's log rate
+  std::vector<Eigen::Quaterniond> nominal_;
+  bool fixture_logged_once_ = false;
+  double last_fixture_log_ = 0.0;  // s
+  FixtureState last_fixture_;
+};
+
+}  // namespace core
+}  // namespace hrg_gyro

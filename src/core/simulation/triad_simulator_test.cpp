@@ -1,0 +1,300 @@
+// The simulated triad against the exact model: each axis senses its row of A times the body's rate
+// (at rest the Earth's rate, turning the table's rate through A and the orientation), integrates it
+// through its own K and D, and shares the stamps with the others; the table, fixture and body logs;
+// fixture errors and wobble as documented; determinism and independent noise.
+#include "hrg_gyro/core/simulation/triad_simulator.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <functional>
+
+#include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/signal/wave_estimator.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+TriadSimulationConfig parseText(const std::string& text) {
+  return TriadSimulationConfig::parse(YamlField(YAML::Load(text), ""));
+}
+
+/// Each axis its own K(theta) and D(theta) (K_i = -0.56 + c_i cos 2theta, D_i = d_i + e_i sin 2theta).
+const double kCos2[3] = {-2.0e-4, 1.5e-4, 3.0e-4}, kD0[3] = {1.0e-5, -2.0e-5, 0.5e-5},
+             kSin2D[3] = {2.0e-5, 1.0e-5, -1.0e-5};
+
+std::string axis(int i, const std::string& name, const std::string& misalignment, const std::string& extra = "") {
+  return "    - {name: " + name + ", misalignment: " + misalignment + extra +
+         ", resonator: {initial_theta: " + formatDouble(0.2 + i) + ", scale_factor: {orders: [2], mean: -0.56, cos: [" +
+         formatDouble(kCos2[i]) + "], sin: [0.0]}, drift: {orders: [2], mean: " + formatDouble(kD0[i]) +
+         ", cos: [0.0], sin: [" + formatDouble(kSin2D[i]) + "]}}}\n";
+}
+
+/// +z at rest, then turning; moved to -x, turning the other way; moved to a tilted position at rest.
+std::string scenario(const std::string& table = "{latitude: 0.9, azimuth: 0.3}", const std::string& first = "",
+                     const std::string& axis_extra = "") {
+  return "seed: 5\n"
+         "triad:\n"
+         "  frame_id: fixture\n"
+         "  axes:\n" +
+         axis(0, "x", "[2.0e-4, -1.5e-4]", axis_extra) + axis(1, "y", "[3.0e-4, 1.0e-4]", axis_extra) +
+         axis(2, "z", "[-2.5e-4, 0.5e-4]", axis_extra) + "  turntable: " + table +
+         "\n"
+         "  positions:\n"
+         "    - {name: a, up: '+z'" +
+         first +
+         ", profile: [{type: dwell, duration: 5.0}, {type: rate, rate: 0.3, duration: 6.0}]}\n"
+         "    - {name: b, up: '-x', move: 3.0, profile: [{type: rate, rate: -0.25, duration: 6.0}]}\n"
+         "    - {name: c, body_to_table: {roll: 0.7854, pitch: 0.6155, yaw: 0.2}, move: 4.0,\n"
+         "       profile: [{type: dwell, duration: 3.0}]}\n";
+}
+
+/// Every sample of the session. The samples' names and labels point into the simulator: keep it.
+std::vector<TriadSample> runAll(TriadSimulator& sim) {
+  std::vector<TriadSample> out;
+  TriadSample s;
+  while (sim.next(&s)) out.push_back(s);
+  return out;
+}
+
+double timeOf(const TriadSimulationConfig& c, const TriadSample& s) { return toSeconds(s.stamp) - c.start_time; }
+
+/// The first sample at or after t.
+const TriadSample& sampleAt(const TriadSimulationConfig& c, const std::vector<TriadSample>& samples, double t) {
+  for (const TriadSample& s : samples) {
+    if (timeOf(c, s) >= t) return s;
+  }
+  return samples.back();
+}
+
+/// theta(t2) by RK4 of d theta/dt = K_i(theta) r(t) + D_i(theta) from theta(t1), written out here.
+double integrateTheta(int i, double theta, double t1, double t2, const std::function<double(double)>& rate) {
+  auto f = [&](double t, double th) {
+    return (-0.56 + kCos2[i] * std::cos(2 * th)) * rate(t) + kD0[i] + kSin2D[i] * std::sin(2 * th);
+  };
+  const int n = 20000;
+  const double h = (t2 - t1) / n;
+  for (int k = 0; k < n; ++k) {
+    const double t = t1 + k * h;
+    const double k1 = f(t, theta), k2 = f(t + h / 2, theta + h / 2 * k1), k3 = f(t + h / 2, theta + h / 2 * k2),
+                 k4 = f(t + h, theta + h * k3);
+    theta += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+  }
+  return theta;
+}
+
+Eigen::Vector3d earthInPlatter(const TriadSimulationConfig& c, double phi) {
+  const double h = kEarthRotationRate * std::cos(c.turntable.latitude), az = c.turntable.azimuth;
+  return Eigen::Vector3d(h * std::cos(az - phi), h * std::sin(az - phi),
+                         kEarthRotationRate * std::sin(c.turntable.latitude));
+}
+
+TEST(TriadSimulatorTest, AxesShareTheStampsAndSenseTheirRowOfA) {
+  const TriadSimulationConfig c = parseText(scenario());
+  const Eigen::Matrix3d a = c.bodyToAxis();
+  TriadSimulator sim(c);
+  const std::vector<TriadSample> samples = runAll(sim);
+  EXPECT_NEAR(samples.size() * c.outputPeriod(), c.duration(), c.outputPeriod());
+  double worst_wave = 0.0;
+  for (std::size_t n = 0; n < samples.size(); ++n) {
+    const TriadSample& s = samples[n];
+    ASSERT_EQ(s.index, n);
+    for (int i = 0; i < 3; ++i) {
+      const SimulationSample& x = s.axes[i];
+      ASSERT_EQ(x.stamp, s.stamp);
+      ASSERT_EQ(x.index, s.index);
+      EXPECT_NEAR(x.truth.inertial_rate, a.row(i).dot(s.body.angular_velocity), 2e-16) << n << " axis " << i;
+      EXPECT_TRUE(x.turntable.empty());
+      WaveState w;
+      ASSERT_EQ(estimateWave(x.z, WaveLimits{}, &w), WaveStatus::kOk);
+      worst_wave = std::max(worst_wave, std::abs(wrapToPi(2.0 * (w.theta - x.truth.theta)) / 2.0));
+    }
+    // One table record with each sample, stamped like it, with the table's true state.
+    ASSERT_EQ(s.turntable.size(), 1u);
+    EXPECT_EQ(s.turntable[0].stamp, s.stamp);
+    EXPECT_EQ(s.turntable[0].angle, s.axes[0].truth.table_angle);
+    EXPECT_EQ(s.turntable[0].rate, s.axes[0].truth.table_rate);
+  }
+  // Ideal pickoffs: the channels carry each axis's own theta, up to the demodulation's rotation term
+  // theta rate sin(2 tau) / (2 w): 7e-6 rad while the operator turns the body at 1.4 rad/s.
+  EXPECT_LT(worst_wave, 1e-5);
+  EXPECT_EQ(*samples[0].axes[0].truth.segment, "a/dwell_0");
+}
+
+TEST(TriadSimulatorTest, StaticPositionGivesEachAxisItsProjectionOfTheEarthRate) {
+  const TriadSimulationConfig c = parseText(scenario());
+  TriadSimulator sim(c);
+  const std::vector<TriadSample> samples = runAll(sim);
+  const Eigen::Matrix3d a = c.bodyToAxis();
+  // Position a (+z) at rest, and position c (tilted) at rest at the angle the table was left at.
+  for (const auto& [t1, t2] : {std::pair<double, double>{0.5, 4.5}, {c.positions[2].start + 0.2, c.duration() - 0.2}}) {
+    const TriadSample &s1 = sampleAt(c, samples, t1), &s2 = sampleAt(c, samples, t2);
+    const double dt = timeOf(c, s2) - timeOf(c, s1);
+    const Eigen::Matrix3d r = c.positions[s1.body.position].nominal;
+    const Eigen::Vector3d earth = r.transpose() * earthInPlatter(c, s1.axes[0].truth.table_angle);
+    for (int i = 0; i < 3; ++i) {
+      SCOPED_TRACE(i);
+      const double rate = a.row(i).dot(earth);
+      EXPECT_NEAR(s1.axes[i].truth.inertial_rate, rate, 1e-19);
+      // Exact but for the rounding of the angles since the start (up to 2 rad here).
+      EXPECT_NEAR(s2.axes[i].truth.inertial_angle - s1.axes[i].truth.inertial_angle, rate * dt, 1e-15);
+      // theta follows K_i(theta) A_i . R^T omega_E + D_i(theta), integrated here independently.
+      const double theta2 =
+          integrateTheta(i, s1.axes[i].truth.theta, timeOf(c, s1), timeOf(c, s2), [&](double) { return rate; });
+      EXPECT_NEAR(s2.axes[i].truth.theta, theta2, 1e-12);
+    }
+  }
+}
+
+TEST(TriadSimulatorTest, TurningPositionGivesTheTableRateThroughAAndTheOrientation) {
+  const TriadSimulationConfig c = parseText(scenario());
+  TriadSimulator sim(c);
+  const std::vector<TriadSample> samples = runAll(sim);
+  const Eigen::Matrix3d a = c.bodyToAxis();
+  // The plateaus of a (+z, 0.3 rad/s) and b (-x, -0.25 rad/s), away from the ramps.
+  for (const auto& [t1, t2, rate] : {std::tuple<double, double, double>{6.0, 11.0, 0.3},
+                                     {c.positions[1].start + 1.0, c.positions[1].start + 6.0, -0.25}}) {
+    const TriadSample &s1 = sampleAt(c, samples, t1), &s2 = sampleAt(c, samples, t2);
+    ASSERT_EQ(s1.axes[0].truth.table_rate, rate);
+    ASSERT_EQ(s2.axes[0].truth.table_rate, rate);
+    const double tt1 = timeOf(c, s1), tt2 = timeOf(c, s2);
+    const double phi1 = s1.axes[0].truth.table_angle, phi2 = s2.axes[0].truth.table_angle;
+    EXPECT_NEAR(phi2 - phi1, rate * (tt2 - tt1), 1e-12);
+    // The exact integral over the plateau: the table's angle along the table axis, the Earth's rate
+    // turning in the platter's frame (closed form for a constant rate), through R and A.
+    const double h = kEarthRotationRate * std::cos(c.turntable.latitude), az = c.turntable.azimuth;
+    const Eigen::Vector3d integral(-h / rate * (std::sin(az - phi2) - std::sin(az - phi1)),
+                                   h / rate * (std::cos(az - phi2) - std::cos(az - phi1)),
+                                   (phi2 - phi1) + kEarthRotationRate * std::sin(c.turntable.latitude) * (tt2 - tt1));
+    const Eigen::Matrix3d r = c.positions[s1.body.position].nominal;
+    for (int i = 0; i < 3; ++i) {
+      SCOPED_TRACE(i);
+      const double expected = a.row(i).dot(r.transpose() * integral);
+      EXPECT_NEAR(s2.axes[i].truth.inertial_angle - s1.axes[i].truth.inertial_angle, expected, 1e-12);
+      auto sensed = [&](double t) {
+        const double phi = phi1 + rate * (t - tt1);
+        return a.row(i).dot(r.transpose() * (rate * Eigen::Vector3d::UnitZ() + earthInPlatter(c, phi)));
+      };
+      EXPECT_NEAR(s2.axes[i].truth.theta, integrateTheta(i, s1.axes[i].truth.theta, tt1, tt2, sensed), 1e-10);
+    }
+  }
+}
+
+TEST(TriadSimulatorTest, FixtureIsLoggedOnEveryChangeAndEverySecondAndTheMoveTurnsTheBody) {
+  const TriadSimulationConfig c = parseText(scenario());
+  TriadSimulator sim(c);
+  const std::vector<TriadSample> samples = runAll(sim);
+  ASSERT_TRUE(samples[0].fixture_logged);
+  double last_logged = timeOf(c, samples[0]);
+  int changes = 0;
+  for (std::size_t n = 1; n < samples.size(); ++n) {
+    const TriadSample &s = samples[n], &previous = samples[n - 1];
+    const bool changed = s.fixture.index != previous.fixture.index || s.fixture.locked != previous.fixture.locked;
+    if (changed) {
+      ++changes;
+      EXPECT_TRUE(s.fixture_logged) << n;
+    }
+    const double t = timeOf(c, s);
+    if (s.fixture_logged) {
+      EXPECT_TRUE(changed || t - last_logged > 1.0 - c.outputPeriod()) << n;
+      last_logged = t;
+    }
+    EXPECT_LT(t - last_logged, 1.0) << n;
+    EXPECT_EQ(s.fixture.index, s.body.position);
+    const FixturePositionConfig& p = c.positions[s.fixture.index];
+    EXPECT_EQ(*s.fixture.name, p.name);
+    EXPECT_LT(s.fixture.body_to_table.angularDistance(Eigen::Quaterniond(p.nominal)), 1e-15);
+    // Unlocked exactly while the body is moved into the position.
+    EXPECT_EQ(s.fixture.locked, !(t >= p.move_start && t < p.start)) << n;
+  }
+  EXPECT_EQ(changes, 4);  // two moves: unlocked into b, locked in b, unlocked into c, locked in c
+  // The body's orientation: the position's, then turning through the move, then the next one's.
+  for (std::size_t k = 1; k < c.positions.size(); ++k) {
+    const FixturePositionConfig& p = c.positions[k];
+    const Eigen::Quaterniond before(c.positions[k - 1].nominal), after(p.nominal);
+    const TriadSample& mid = sampleAt(c, samples, p.move_start + 0.5 * p.move);
+    EXPECT_GT(mid.body.body_to_table.angularDistance(before), 0.1);
+    EXPECT_GT(mid.body.body_to_table.angularDistance(after), 0.1);
+    EXPECT_GT(mid.body.angular_velocity.norm(), 0.1) << "the operator turns the body";
+    EXPECT_LT(sampleAt(c, samples, p.start).body.body_to_table.angularDistance(after), 1e-15);
+    EXPECT_LT(sampleAt(c, samples, p.move_start - 0.01).body.body_to_table.angularDistance(before), 1e-15);
+  }
+}
+
+TEST(TriadSimulatorTest, FixtureErrorAndWobbleEnterTheCrossAxisResponsesAsDocumented) {
+  // At the pole the Earth's rate lies along the table's axis: each axis's response to the table is
+  // then A_i . R_true^T e_z per rad of inertial table angle. Position a (+z) is off by a small
+  // rotation (rx, ry) and the platter wobbles; a second +z position follows, upside down (-z).
+  const std::string table = "{latitude: 1.5707963267948966, wobble: {amplitude: 1.0e-4, direction: 0.4}}";
+  std::string text = scenario(table, ", error: [1.2e-4, 2.0e-4, 0.0]");
+  text.replace(text.find("up: '-x'"), 8, "up: '-z'");
+  const TriadSimulationConfig c = parseText(text);
+  TriadSimulator sim(c);
+  const std::vector<TriadSample> samples = runAll(sim);
+  const Eigen::Matrix3d a = c.bodyToAxis();
+  auto response = [&](double t1, double t2, int i) {
+    const TriadSample &s1 = sampleAt(c, samples, t1), &s2 = sampleAt(c, samples, t2);
+    const double inertial_table = s2.axes[i].truth.table_angle - s1.axes[i].truth.table_angle +
+                                  kEarthRotationRate * (timeOf(c, s2) - timeOf(c, s1));
+    const double exact = a.row(i).dot(s1.body.body_to_table.toRotationMatrix().transpose() * Eigen::Vector3d::UnitZ());
+    EXPECT_NEAR((s2.axes[i].truth.inertial_angle - s1.axes[i].truth.inertial_angle) / inertial_table, exact, 1e-12);
+    return exact;
+  };
+  const double up_x = response(6.0, 11.0, 0),
+               down_x = response(c.positions[1].start + 1.0, c.positions[1].start + 6.0, 0);
+  const double up_y = response(6.0, 11.0, 1),
+               down_y = response(c.positions[1].start + 1.0, c.positions[1].start + 6.0, 1);
+  // To first order (the second order is below 1e-7 here): the error shifts the cross-axis responses
+  // of its own position by (-ry, +rx); the wobble, a tilt fixed in the platter, by -a (cos d, sin d)
+  // in the platter's x and y. Flipping to -z (a half turn about the platter's x) reverses the body's y
+  // but not its x: the half-difference of up and down keeps A_xz off by half the error and free of
+  // the wobble, but A_yz off by half the error and by the wobble's y part in full.
+  const double wobble = 1.0e-4, d = 0.4, rx = 1.2e-4, ry = 2.0e-4;
+  EXPECT_NEAR(up_x, a(0, 2) - ry - wobble * std::cos(d), 1e-7);
+  EXPECT_NEAR(down_x, -a(0, 2) - wobble * std::cos(d), 1e-7);
+  EXPECT_NEAR(up_y, a(1, 2) + rx - wobble * std::sin(d), 1e-7);
+  EXPECT_NEAR(down_y, -a(1, 2) + wobble * std::sin(d), 1e-7);
+  EXPECT_NEAR(0.5 * (up_x - down_x), a(0, 2) - 0.5 * ry, 1e-7);
+  EXPECT_NEAR(0.5 * (up_y - down_y), a(1, 2) + 0.5 * rx - wobble * std::sin(d), 1e-7);
+}
+
+TEST(TriadSimulatorTest, SameSeedSameSessionAndEachAxisItsOwnNoise) {
+  const std::string noisy = ", pickoff: {noise: 2.0e-4}";
+  const TriadSimulationConfig c =
+      parseText(scenario("{latitude: 0.9, log: {rate: 100, angle_noise: 2.0e-6}}", "", noisy));
+  TriadSimulator sim_first(c), sim_again(c);
+  const std::vector<TriadSample> first = runAll(sim_first), again = runAll(sim_again);
+  ASSERT_EQ(first.size(), again.size());
+  std::size_t records = 0;
+  for (std::size_t n = 0; n < first.size(); ++n) {
+    for (int i = 0; i < 3; ++i) ASSERT_EQ(first[n].axes[i].z, again[n].axes[i].z);
+    records += first[n].turntable.size();
+    ASSERT_EQ(first[n].turntable.size(), again[n].turntable.size());
+    for (std::size_t k = 0; k < first[n].turntable.size(); ++k) {
+      EXPECT_EQ(first[n].turntable[k].angle, again[n].turntable[k].angle);
+    }
+  }
+  // The table at its own rate: a record every 10 ms from the start, up to the last sample's centre.
+  EXPECT_EQ(records, static_cast<std::size_t>(std::floor(timeOf(c, first.back()) * 100.0)) + 1);
+  // The axes' noise is their own: the channel noise of the three axes is uncorrelated.
+  const TriadSimulationConfig quiet = parseText(scenario("{latitude: 0.9, log: {rate: 100, angle_noise: 2.0e-6}}"));
+  TriadSimulator sim_clean(quiet);
+  const std::vector<TriadSample> clean = runAll(sim_clean);
+  double sum_xy = 0.0, sum_xx = 0.0, sum_yy = 0.0;
+  for (std::size_t n = 0; n < first.size(); ++n) {
+    const double nx = first[n].axes[0].z[0] - clean[n].axes[0].z[0], ny = first[n].axes[1].z[0] - clean[n].axes[1].z[0];
+    sum_xy += nx * ny;
+    sum_xx += nx * nx;
+    sum_yy += ny * ny;
+  }
+  // 27 000 samples: an uncorrelated pair's coefficient is below 5 / sqrt(n) = 0.03.
+  EXPECT_LT(std::abs(sum_xy / std::sqrt(sum_xx * sum_yy)), 0.03);
+  EXPECT_GT(sum_xx, 0.0);
+  // The noise changes no truth and no table record.
+  EXPECT_EQ(first.back().axes[2].truth.inertial_angle, clean.back().axes[2].truth.inertial_angle);
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro
