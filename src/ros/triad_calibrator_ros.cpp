@@ -563,7 +563,8 @@ void TriadCalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s
     } else if (s != core::TriadFeed::kTable) {
       stat.add(n + " dropped (non-finite theta)", c.bad_value);
     }
-    stat.add(n + " dropped (late, out of order)", c.late);
+    stat.add(n + " dropped (out of order)", c.out_of_order);
+    stat.add(n + " fed late (behind later stamps)", c.late);
     stat.add(n + " last stamp", stampText(c.last_stamp));
   }
   stat.add("runs", runs_);

@@ -56,8 +56,8 @@ bool TriadFeed::admit(int stream, Nanoseconds stamp) {
     ++c.bad_stamp;
     return false;
   }
-  if (stamp < fed_until_) {
-    if (toSeconds(fed_until_ - stamp) > feed_.backward_reset) {
+  if (stamp < c.last_stamp) {
+    if (toSeconds(c.last_stamp - stamp) > feed_.backward_reset) {
       if (++backward_run_[stream] >= feed_.backward_persist) {
         restart();  // this record is the first of the new timeline
         c.last_stamp = stamp;
@@ -67,24 +67,18 @@ bool TriadFeed::admit(int stream, Nanoseconds stamp) {
     } else {
       backward_run_[stream] = 0;
     }
-    ++c.late;
+    ++c.out_of_order;
     return false;
   }
   backward_run_[stream] = 0;
-  c.last_stamp = std::max(c.last_stamp, stamp);
+  if (stamp < fed_until_) ++c.late;  // fed next, behind later stamps of the other streams
+  c.last_stamp = stamp;
   newest_ = std::max(newest_, stamp);
   return true;
 }
 
-void TriadFeed::queue(int stream, const Item& item) {
-  std::deque<Item>& q = items_[stream];
-  if (q.empty() || q.back().stamp <= item.stamp) {
-    q.push_back(item);
-  } else {  // out of order within its stream, not fed yet: put in its place
-    q.insert(std::upper_bound(q.begin(), q.end(), item.stamp, [](Nanoseconds t, const Item& i) { return t < i.stamp; }),
-             item);
-  }
-}
+// Admitted records come in their stream's order: each stream's queue stays sorted.
+void TriadFeed::queue(int stream, const Item& item) { items_[stream].push_back(item); }
 
 void TriadFeed::addWave(int axis, Nanoseconds stamp, double theta, double frequency) {
   if (axis < 0 || axis > 2) throw std::invalid_argument("triad feed: axis must be 0, 1 or 2");
@@ -112,14 +106,7 @@ void TriadFeed::addFixture(FixtureRecord record) {
     return;
   }
   if (!admit(kFixture, record.stamp)) return;
-  if (fixtures_.empty() || fixtures_.back().stamp <= record.stamp) {
-    fixtures_.push_back(std::move(record));
-  } else {
-    const Nanoseconds t = record.stamp;
-    fixtures_.insert(std::upper_bound(fixtures_.begin(), fixtures_.end(), t,
-                                      [](Nanoseconds s, const FixtureRecord& r) { return s < r.stamp; }),
-                     std::move(record));
-  }
+  fixtures_.push_back(std::move(record));
   release(false);
 }
 
@@ -147,8 +134,8 @@ void TriadFeed::release(bool everything) {
     }
     if (stream < 0) return;
     if (!everything) {
-      // Every stream has delivered up to t (nothing earlier can come without being late), or t lies
-      // the hold behind the newest stamp, or a stream holds too much.
+      // Every stream has delivered up to t (nothing earlier can come but late), or t lies the hold
+      // behind the newest stamp, or a stream holds too much.
       bool ready = toSeconds(newest_ - t) >= feed_.hold;
       if (!ready) {
         ready = true;
@@ -159,7 +146,7 @@ void TriadFeed::release(bool everything) {
       }
       if (!ready) return;
     }
-    fed_until_ = t;
+    fed_until_ = std::max(fed_until_, t);
     if (first_fed_ == 0) first_fed_ = t;
     ++counters_[stream].fed;
     if (stream == kFixture) {

@@ -9,14 +9,17 @@
 // missing stream delays the others by that much, no more), and hands the records to a
 // TriadCalibration in stamp order (equal stamps: the fixture, then the table, then the axes in
 // order). The calibration thus sees what it would see reading a stamp-sorted bag of the same
-// messages. A record stamped far ahead of the others (a clock glitch) makes the others' hold end
-// early: they are then fed in arrival order.
+// messages. A stream that lags more than the hold (a busy computer; sim time run faster than the
+// wall clock shortens the hold in wall time by its factor) still has its records fed, in its own
+// order, after later stamps of the others (counted as late): nothing is lost, but where such a record
+// falls at a change of the fixture's state it is routed by the state fed so far. A record stamped
+// far ahead of the others (a clock glitch) ends the others' hold early in the same way.
 //
 // Bad input is dropped and counted, never fed: a zero stamp; a non-finite wave angle; a fixture
-// orientation that is not a rotation (acceptFixtureOrientation); a record older than those already
-// fed (it came later than the hold allows). A stream whose records lie more than backward_reset s
-// behind what was fed for backward_persist records in a row has moved to a new timeline (a bag loop,
-// a restarted simulator): the run starts over from the priors (restarts counted).
+// orientation that is not a rotation (acceptFixtureOrientation); a record older than the previous one
+// of its own stream (out of order). A stream whose records lie more than backward_reset s behind its
+// previous one for backward_persist records in a row has moved to a new timeline (a bag loop, a
+// restarted simulator): the run starts over from the priors (restarts counted).
 //
 // Auto-finish (shouldFinish): auto_finish_idle > 0, every axis has pointed along the table axis in a
 // locked fixture position (the least an accepted run needs), and the fixture has since been released
@@ -41,12 +44,13 @@ bool acceptFixtureOrientation(FixtureRecord* record);
 
 /// What one input stream has delivered.
 struct TriadStreamCounters {
-  std::uint64_t received = 0;   ///< records offered
-  std::uint64_t fed = 0;        ///< handed to the calibration
-  std::uint64_t bad_stamp = 0;  ///< dropped: zero stamp
-  std::uint64_t bad_value = 0;  ///< dropped: a non-finite wave angle, or a fixture orientation that is no rotation
-  std::uint64_t late = 0;       ///< dropped: older than the records already fed
-  Nanoseconds last_stamp = 0;   ///< newest stamp received (0: none yet)
+  std::uint64_t received = 0;      ///< records offered
+  std::uint64_t fed = 0;           ///< handed to the calibration
+  std::uint64_t bad_stamp = 0;     ///< dropped: zero stamp
+  std::uint64_t bad_value = 0;     ///< dropped: a non-finite wave angle, or a fixture orientation that is no rotation
+  std::uint64_t out_of_order = 0;  ///< dropped: older than the stream's previous record
+  std::uint64_t late = 0;          ///< fed after later-stamped records of other streams (it lagged beyond the hold)
+  Nanoseconds last_stamp = 0;      ///< newest stamp received (0: none yet)
 };
 
 struct TriadFeedSettings {
@@ -99,7 +103,7 @@ class TriadFeed {
     double a, b;  // wave: theta, frequency; table: angle, rate
     std::uint64_t sequence;
   };
-  /// True when the record may be queued; handles late records and a new timeline.
+  /// True when the record may be queued; handles out-of-order records and a new timeline.
   bool admit(int stream, Nanoseconds stamp);
   void queue(int stream, const Item& item);
   /// Feeds the held records that may go (all of them with `everything`).
@@ -120,7 +124,7 @@ class TriadFeed {
   std::array<TriadStreamCounters, kStreamCount> counters_;
   std::array<int, kStreamCount> backward_run_{};
   Nanoseconds newest_ = 0;     // newest stamp received on any stream (this timeline)
-  Nanoseconds fed_until_ = 0;  // stamp of the last record fed
+  Nanoseconds fed_until_ = 0;  // latest stamp fed
   Nanoseconds first_fed_ = 0;
   std::uint64_t restarts_ = 0;
 
