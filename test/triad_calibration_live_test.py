@@ -2,7 +2,8 @@
 """The triad calibration live against the same session offline (test/triad_calibration_live.test).
 
 Offline first: `hrg_bag simulate` of the scenario with the launch's seed into a bag, then
-`hrg_bag calibrate --method triad` on it from the same priors and settings. Then the test subscribes
+`hrg_bag calibrate --method triad` on it from the same priors and settings (the shipped
+test/scenarios/triad_short_calibration.yaml, which the launch loads into the calibrator too). Then the test subscribes
 to /turntable/state, which lets driver_sim start (it waits for two turntable listeners): the same
 samples (the simulator is deterministic: same scenario and seed, same channels bit for bit) go
 through three live processors into the calibrator. Once the calibrator's diagnostic says every
@@ -21,7 +22,6 @@ import unittest
 import rosbag
 import rospy
 import rostest
-import yaml
 from diagnostic_msgs.msg import DiagnosticArray
 from std_srvs.srv import Trigger
 
@@ -67,9 +67,7 @@ class TriadCalibrationLive(unittest.TestCase):
         code, _, err = run("simulate", "--scenario", rospy.get_param("~scenario"), "--seed",
                            str(rospy.get_param("~seed")), "--out", bag)
         self.assertEqual(code, 0, err)
-        settings = os.path.join(self.tmp, "settings.yaml")
-        with open(settings, "w") as f:
-            yaml.safe_dump({"triad": rospy.get_param("~triad_settings")}, f)
+        settings = rospy.get_param("~settings")  # the calibrator's too (the launch loads it)
         args = ["calibrate", "--method", "triad", bag, "--triad", os.path.join(self.priors, "triad.yaml"),
                 "--config", settings, "--out", os.path.join(self.tmp, "triad.yaml"),
                 "--report", os.path.join(self.tmp, "report.yaml"), "--axis-params"]
