@@ -1,4 +1,4 @@
-// The four wrappers as nodelets, for zero-copy pipelines in one manager. Each owns the same wrapper
+// The wrappers as nodelets, for zero-copy pipelines in one manager. Each owns the same wrapper
 // class as its node. The driver never shuts the manager down when its scenario ends; the session
 // monitor does when ~shutdown_when_done asks for it (demos and tests).
 #include <nodelet/nodelet.h>
@@ -12,10 +12,11 @@
 #include "hrg_gyro/ros/driver_sim_ros.h"
 #include "hrg_gyro/ros/processor_ros.h"
 #include "hrg_gyro/ros/session_monitor_ros.h"
+#include "hrg_gyro/ros/triad_ros.h"
 
 namespace hrg_gyro {
 
-/// The common part of the four nodelets: the wrapper they own, built in onInit. The nodelet
+/// The common part of the nodelets: the wrapper they own, built in onInit. The nodelet
 /// manager reports a failed load without the exception's message, so the reason is logged here
 /// (FATAL, under the nodelet's name) before the exception goes on to fail the load as before.
 template <class Wrapper>
@@ -51,9 +52,14 @@ class SessionMonitorNodelet : public WrapperNodelet<SessionMonitorRos> {
   void onInit() override { create(getNodeHandle(), getPrivateNodeHandle()); }
 };
 
+class TriadNodelet : public WrapperNodelet<TriadRos> {
+  void onInit() override { create(getNodeHandle(), getPrivateNodeHandle()); }
+};
+
 }  // namespace hrg_gyro
 
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::DriverSimNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::ProcessorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::CalibratorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::SessionMonitorNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(hrg_gyro::TriadNodelet, nodelet::Nodelet)
