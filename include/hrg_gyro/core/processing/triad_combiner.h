@@ -2,7 +2,7 @@
 // body-frame sample, through the triad file's matrix and bias (triad_parameters.h):
 //
 //   delta_angle_body = M dalpha - bias dt            rad, body frame
-//   angular_velocity = delta_angle_body / dt         rad/s
+//   angular_velocity = delta_angle_body / dt         rad/s (as delta times 1/dt: one division a sample)
 //   covariance       = M diag(sigma_i^2) M^T         (rad/s)^2, of angular_velocity
 //
 // dalpha = (dalpha_1, dalpha_2, dalpha_3) in the order of the file's `axes`, each the axis
@@ -29,9 +29,11 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "hrg_gyro/core/common/ring_buffer.h"
@@ -52,6 +54,8 @@ struct AxisOutput {
   double rate_variance = NAN;
 };
 
+constexpr std::uint8_t kAllTriadAxes = 0x7;  ///< a bit per axis
+
 /// Flags of a triad sample (the same bits as TriadOutput.msg).
 enum TriadFlags : std::uint8_t {
   kTriadFlagGap = 1,          ///< an axis lacked this stamp, its interval differed, or it flagged a gap
@@ -60,6 +64,11 @@ enum TriadFlags : std::uint8_t {
 };
 
 struct TriadBodySample {
+  TriadBodySample() = default;
+  struct Unset {};
+  /// The vectors and the matrix left unset, for the combiner, which writes every field.
+  explicit TriadBodySample(Unset) : delta_angle(), angular_velocity(), covariance() {}
+
   Nanoseconds stamp = 0;  ///< the first axis's stamp (all within the stamp tolerance)
   /// s: a combined sample's is the first axis's dt; a gap's the time since the previous triad
   /// sample (or, with none before it in the same epoch, the smallest dt of its axes).
@@ -128,7 +137,7 @@ class TriadCombiner {
   /// Emits every stamp still held, as gaps (the end of a recording).
   void flush(std::vector<TriadBodySample>* completed);
 
-  std::size_t pending(std::size_t axis) const { return queues_[axis].size(); }
+  std::size_t pending(std::size_t axis) const { return queues_[axis].size() + ((staged_mask_ >> axis) & 1u); }
   /// The axis's rate variance in force, (rad/s)^2.
   double rateVariance(std::size_t axis) const { return variance_[axis]; }
   const TriadCounters& counters() const { return counters_; }
@@ -140,6 +149,12 @@ class TriadCombiner {
     double dt, dalpha, variance;
     std::uint8_t flags;
   };
+  /// add() beyond the usual case: through the queues.
+  __attribute__((noinline)) void addQueued(std::size_t axis, const Held& held, std::vector<TriadBodySample>* completed);
+  /// Moves the staged samples to the queues (they are the oldest of their axes).
+  void unstage();
+  /// False when the sample just added to `axis` cannot have ended a wait (the usual case, cheaply).
+  bool mayHaveEndedAWait(std::size_t axis) const;
   /// Emits what the heads of the queues decide; with `force`, also stamps still awaited.
   void resolve(bool force, std::vector<TriadBodySample>* completed);
   /// The axis whose head comes first (epoch, then stamp); the queues must not all be empty.
@@ -149,14 +164,33 @@ class TriadCombiner {
   bool waitedOut(const Held& head) const;
   /// Pops the heads in `present` (a bit per axis) and appends their triad sample.
   void emit(std::uint8_t present, std::vector<TriadBodySample>* completed);
-  void combine(const std::array<const Held*, 3>& heads, TriadBodySample* out);
+  /// Appends the triad sample of `heads` (null: the axis lacks the stamp); pops nothing.
+  void emitHeads(const std::array<const Held*, 3>& heads, std::uint8_t present,
+                 std::vector<TriadBodySample>* completed);
+  /// A stamp every axis has: combined unless a flag or the intervals say otherwise.
+  void combineAligned(const Held& h0, const Held& h1, const Held& h2, TriadBodySample* out);
+  /// A stamp some axis lacks: a gap (null heads are the missing axes).
+  void combinePartial(const std::array<const Held*, 3>& heads, TriadBodySample* out);
+  /// The axis's variance from now on, if `h` carries one.
+  void takeVariance(std::size_t axis, const Held& h);
+  /// M diag(sigma_i^2) M^T of the variances in force.
+  void writeCovariance(TriadBodySample* out) const;
+  /// Flags, and for a gap or reset no increment over the time since the previous sample.
+  void endSample(std::uint8_t flags, double smallest_dt, std::uint64_t epoch, TriadBodySample* out);
 
   TriadCombinerSettings settings_;
   std::shared_ptr<const TriadParameters> triad_;
   Eigen::Matrix3d m_;
   Eigen::Vector3d bias_;
+  std::array<std::array<double, 6>, 3> outer_;  // m_k m_k^T: xx, xy, xz, yy, yz, zz
   Nanoseconds max_wait_ns_ = 0;
   std::array<RingBuffer<Held>, 3> queues_;
+  // The samples of one stamp, one per axis, while the queues are empty (the usual case).
+  bool staging_ = true;
+  std::uint8_t staged_mask_ = 0;
+  Nanoseconds staged_stamp_ = 0;  // the staged samples' stamp and epoch
+  std::uint64_t staged_epoch_ = 0;
+  std::array<Held, 3> staged_;
   std::array<double, 3> variance_;
   std::array<bool, 3> seen_{{false, false, false}};
   std::array<Nanoseconds, 3> last_stamp_{{0, 0, 0}};
@@ -166,6 +200,44 @@ class TriadCombiner {
   std::uint64_t previous_epoch_ = 0;
   TriadCounters counters_;
 };
+
+// The per-sample entry point, inline: the usual case costs no call until a stamp is complete.
+inline void TriadCombiner::add(std::size_t axis, const AxisOutput& in, std::vector<TriadBodySample>* completed) {
+  if (axis >= 3) throw std::out_of_range("triad combiner: axis index must be 0, 1 or 2");
+  TriadAxisCounters& c = counters_.axes[axis];
+  ++c.received;
+  if (!(in.dt > 0.0) || !std::isfinite(in.dt) || !std::isfinite(in.dalpha)) {
+    ++c.invalid;  // left out: the stamp is then missing on this axis, a gap
+    return;
+  }
+  if (in.stamp <= last_stamp_[axis] && seen_[axis]) {
+    if (in.stamp == last_stamp_[axis]) {
+      ++c.duplicate;
+      return;
+    }
+    ++epoch_[axis];
+    ++c.epochs;
+  }
+  seen_[axis] = true;
+  last_stamp_[axis] = in.stamp;
+  if (in.flags != 0) ++c.flagged;
+  const std::uint8_t bit = static_cast<std::uint8_t>(1u << axis);
+  // The usual case (one clock): the samples of one stamp arrive one per axis while nothing else is
+  // held. They are staged, not queued, and combined when the third arrives: what the queues would
+  // do, without them. Anything else goes to the queues (the staged samples first, being older).
+  if (staging_ &&
+      (staged_mask_ == 0 || (!(staged_mask_ & bit) && in.stamp == staged_stamp_ && epoch_[axis] == staged_epoch_))) {
+    staged_[axis] = Held{in.stamp, epoch_[axis], in.dt, in.dalpha, in.rate_variance, in.flags};
+    staged_stamp_ = in.stamp;
+    staged_epoch_ = epoch_[axis];
+    staged_mask_ |= bit;
+    if (staged_mask_ != kAllTriadAxes) return;
+    staged_mask_ = 0;
+    emitHeads({{&staged_[0], &staged_[1], &staged_[2]}}, kAllTriadAxes, completed);
+    return;
+  }
+  addQueued(axis, Held{in.stamp, epoch_[axis], in.dt, in.dalpha, in.rate_variance, in.flags}, completed);
+}
 
 }  // namespace core
 }  // namespace hrg_gyro
