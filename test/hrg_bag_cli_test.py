@@ -273,6 +273,30 @@ class HrgBagCli(unittest.TestCase):
             self.assertEqual(float(r["dalpha"]), o.dalpha)
             self.assertEqual(float(r["alpha"]), o.alpha)
 
+    def test_process_triad_refuses_what_does_not_make_a_triad(self):
+        # A triad is three axes' channels; --params names each axis's file (AXIS=FILE); the rest of a
+        # single axis's options that the triad decides itself are refused.
+        triad = os.path.join(self.pkg, "config/triad.yaml")
+        out = self.path("triad_refused.csv")
+        every = ["--params", "x=" + self.params, "--params", "y=" + self.params, "--params", "z=" + self.params]
+        cases = [
+            (["--params", "x=" + self.params, "--params", "y=" + self.params], "--params", "no parameter file for axis 'z'"),
+            (every + ["--params", "w=" + self.params], "--params", "axis 'w' is not in the triad file"),
+            (every[:4] + ["--params", "x=" + self.params], "--params", "axis 'x' given twice"),
+            (["--params", self.params], "--params", "AXIS=FILE"),
+            (every + ["--frame-id", "imu"], "--frame-id", "excludes"),
+            (every + ["--max-wait", "0"], "--max-wait", "positive"),
+            (every, "/x/channels", "no hrg_gyro/ChannelAmplitudes topic"),  # the single-axis bag
+        ]
+        for extra, option, why in cases:
+            args = ["process", self.short, "--triad", triad, "--csv", out] + extra
+            self.assertRefused(hrg_bag(*args), option, why, args)
+        self.assertRefused(hrg_bag("process", self.short, "--params", self.params, "--params", self.params),
+                           "--params", "one parameter file", "two --params without --triad")
+        self.assertRefused(hrg_bag("process", self.short, "--params", self.params, "--max-wait", "1"),
+                           "--max-wait", "requires --triad", "a triad setting without --triad")
+        self.assertFalse(os.path.exists(out), "a refused process writes nothing")
+
     def test_calibrate_refuses_what_the_gates_refuse(self):
         out, report = self.path("refused.yaml"), self.path("refused.report.yaml")
         code, stdout, err = hrg_bag("calibrate", self.short, "--method", "dual_rate", "--params", self.params,
