@@ -274,27 +274,31 @@ class HrgBagCli(unittest.TestCase):
             self.assertEqual(float(r["alpha"]), o.alpha)
 
     def test_process_triad_refuses_what_does_not_make_a_triad(self):
-        # A triad is three axes' channels; --params names each axis's file (AXIS=FILE); the rest of a
-        # single axis's options that the triad decides itself are refused.
+        # A triad is three axes' channels; --axis-params names each axis's file (NAME=FILE, as
+        # calibrate --method triad); the single axis's options that the triad decides itself are refused.
         triad = os.path.join(self.pkg, "config/triad.yaml")
         out = self.path("triad_refused.csv")
-        every = ["--params", "x=" + self.params, "--params", "y=" + self.params, "--params", "z=" + self.params]
+        every = ["--axis-params", "x=" + self.params, "--axis-params", "y=" + self.params,
+                 "--axis-params", "z=" + self.params]
         cases = [
-            (["--params", "x=" + self.params, "--params", "y=" + self.params], "--params", "no parameter file for axis 'z'"),
-            (every + ["--params", "w=" + self.params], "--params", "axis 'w' is not in the triad file"),
-            (every[:4] + ["--params", "x=" + self.params], "--params", "axis 'x' given twice"),
-            (["--params", self.params], "--params", "AXIS=FILE"),
+            (every[:4], "--axis-params", "z=FILE missing"),
+            (every + ["--axis-params", "w=" + self.params], "--axis-params", "'w' is not an axis of the triad"),
+            (every[:4] + ["--axis-params", "x=" + self.params], "--axis-params", "gives axis x twice"),
+            (every[:4] + ["--axis-params", self.params], "--axis-params", "expects NAME=VALUE"),
+            (every + ["--params", self.params], "--params", "--axis-params"),
             (every + ["--frame-id", "imu"], "--frame-id", "excludes"),
+            (every + ["--channels-topic", "/channels"], "--channels-topic", "excludes"),
             (every + ["--max-wait", "0"], "--max-wait", "positive"),
+            (every + ["--axis-channels", "x=/nowhere"], "/nowhere", "is not in the bag"),
             (every, "/x/channels", "no hrg_gyro/ChannelAmplitudes topic"),  # the single-axis bag
         ]
         for extra, option, why in cases:
             args = ["process", self.short, "--triad", triad, "--csv", out] + extra
             self.assertRefused(hrg_bag(*args), option, why, args)
-        self.assertRefused(hrg_bag("process", self.short, "--params", self.params, "--params", self.params),
-                           "--params", "one parameter file", "two --params without --triad")
-        self.assertRefused(hrg_bag("process", self.short, "--params", self.params, "--max-wait", "1"),
-                           "--max-wait", "requires --triad", "a triad setting without --triad")
+        for extra, option in ((["--max-wait", "1"], "--max-wait"), (["--axis-params", "x=" + self.params],
+                                                                     "--axis-params")):
+            args = ["process", self.short, "--params", self.params] + extra
+            self.assertRefused(hrg_bag(*args), option, "requires --triad", args)
         self.assertFalse(os.path.exists(out), "a refused process writes nothing")
 
     def test_calibrate_refuses_what_the_gates_refuse(self):

@@ -270,7 +270,7 @@ class Triad(unittest.TestCase):
                 self.assertEqual(seqs, list(range(seqs[0], seqs[0] + len(seqs))), a)
         offline = os.path.join(self.work, "offline.bag")
         p = subprocess.run([HRG_BAG, "process", recorded, "--triad", self.original, "--out", offline] +
-                           ["--params=%s=%s" % (a, self.params) for a in AXES],
+                           ["--axis-params=%s=%s" % (a, self.params) for a in AXES],
                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=120)
         self.assertEqual(p.returncode, 0, p.stdout)
         with rosbag.Bag(offline) as bag:

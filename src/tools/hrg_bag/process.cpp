@@ -176,22 +176,23 @@ class CsvOutput {
 
 struct ProcessOptions {
   std::string bag, params, out, csv, frame_id = "gyro_link", compression = "lz4";
-  std::vector<std::string> given_params;  // --params as given: one FILE, or AXIS=FILE per axis with --triad
   bag_tools::GyroTopics topics;
   core::ProcessorConfig processor;
   bag_tools::TriadOptions triad;
 };
 
-int runProcess(ProcessOptions o) {
+int runProcess(const ProcessOptions& o) {
   using namespace bag_tools;
   if (!o.triad.triad_file.empty()) {
-    return runTriadProcess(o.bag, o.given_params, o.out, o.csv, o.compression, o.processor, o.triad);
+    // As hrg_bag calibrate --method triad: each axis's file with --axis-params.
+    if (!o.params.empty()) {
+      throw UsageError("--params is a single gyro's; with --triad give each axis's with --axis-params NAME=FILE");
+    }
+    return runTriadProcess(o.bag, o.out, o.csv, o.compression, o.processor, o.triad);
   }
-  if (o.given_params.size() != 1) {
-    throw UsageError("--params: one parameter file, given " + std::to_string(o.given_params.size()) +
-                     " (AXIS=FILE for each axis is for --triad)");
+  if (o.params.empty()) {
+    throw UsageError("--params is required (the gyro's parameter file; for a triad, --triad with --axis-params)");
   }
-  o.params = o.given_params.front();
   checkProcessorConfig(o.processor);
   checkOutputPaths({o.bag, o.params}, {o.out, o.csv});
   const auto params = std::make_shared<const core::GyroParameters>(core::loadParameterFile(o.params));
@@ -277,12 +278,9 @@ Command addProcessCommand(CLI::App& root) {
   CLI::App* cmd = root.add_subcommand(
       "process", "the processor offline: /wave and /output into a bag, or a CSV; with --triad, three gyros as one IMU");
   cmd->add_option("BAG", o->bag, "input bag with the gyro's channels")->required();
-  cmd->add_option("--params", o->given_params,
-                  "parameter file (YAML) of the gyro, as the processor node's; with --triad, AXIS=FILE once for "
-                  "each axis of the triad file")
-      ->required()
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option("--params", o->params,
+                  "parameter file (YAML) of the gyro, as the processor node's (not with --triad)")
+      ->check(tools::notEmpty());
   cmd->add_option("--out", o->out, "output bag: /wave and /output, recorded at the input's record time")
       ->check(tools::notEmpty());
   cmd->add_option("--csv", o->csv, "output CSV: one row per input sample with its verdict")->check(tools::notEmpty());
@@ -301,10 +299,10 @@ Command addProcessCommand(CLI::App& root) {
       "back exactly. With neither --out nor --csv, only the summary (a dry run).\n"
       "Outputs are written to temporaries and renamed over --out/--csv only when complete; an output\n"
       "that is the same file as an input or as the other output is refused.\n"
-      "With --triad FILE, the bag holds three gyros' channels, /AXIS/channels for each axis of the triad\n"
-      "file, and --params AXIS=FILE gives each axis's parameter file:\n"
-      "  hrg_bag process triad.bag --triad triad.yaml --params x=x.yaml --params y=y.yaml --params z=z.yaml \\\n"
-      "      --out triad_out.bag --csv triad.csv\n"
+      "With --triad FILE, the bag holds three gyros' channels, /NAME/channels for each axis of the triad\n"
+      "file (or --axis-channels NAME=TOPIC), and --axis-params NAME=FILE gives each axis's parameter file:\n"
+      "  hrg_bag process triad.bag --triad triad.yaml --axis-params x=x.yaml --axis-params y=y.yaml \\\n"
+      "      --axis-params z=z.yaml --out triad_out.bag --csv triad.csv\n"
       "--out then holds /triad/output (TriadOutput, every triad sample), /imu/data_raw (the samples not\n"
       "flagged GAP or RESET) and each /AXIS/output; --csv one row per triad sample. The numbers are the live\n"
       "processor and triad nodes' bit for bit; stamps an axis never delivered end the output as gaps.\n"

@@ -30,37 +30,41 @@ struct Axis {
   std::uint64_t outputs = 0;
 };
 
-/// AXIS=FILE for each axis of the triad, in the triad's order; a UsageError names what is wrong.
-std::array<std::string, 3> axisParameterFiles(const std::vector<std::string>& given,
-                                              const core::TriadParameters& triad) {
-  std::map<std::string, std::string> files;
-  for (const std::string& g : given) {
-    const std::size_t eq = g.find('=');
-    if (eq == std::string::npos || eq == 0 || eq + 1 == g.size()) {
-      throw UsageError("--params: with --triad, give AXIS=FILE for each axis (" + triad.axes[0] + "=..., " +
-                       triad.axes[1] + "=..., " + triad.axes[2] + "=...), got '" + g + "'");
+/// NAME=VALUE items of a per-axis option (--axis-params, --axis-channels): each name an axis of the
+/// triad, given once. A UsageError names what is wrong.
+std::map<std::string, std::string> perAxis(const std::vector<std::string>& items, const core::TriadParameters& triad,
+                                           const std::string& option) {
+  std::map<std::string, std::string> out;
+  for (const std::string& item : items) {
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == item.size()) {
+      throw UsageError("--" + option + " expects NAME=VALUE with NAME an axis of the triad (" + triad.axes[0] + ", " +
+                       triad.axes[1] + ", " + triad.axes[2] + "), got '" + item + "'");
     }
-    const std::string axis = g.substr(0, eq);
+    const std::string axis = item.substr(0, eq);
     if (std::find(triad.axes.begin(), triad.axes.end(), axis) == triad.axes.end()) {
-      throw UsageError("--params: axis '" + axis + "' is not in the triad file (axes " + triad.axes[0] + ", " +
-                       triad.axes[1] + ", " + triad.axes[2] + ")");
+      throw UsageError("--" + option + " " + item + ": '" + axis + "' is not an axis of the triad (its axes: " +
+                       triad.axes[0] + ", " + triad.axes[1] + ", " + triad.axes[2] + ")");
     }
-    if (!files.emplace(axis, g.substr(eq + 1)).second) throw UsageError("--params: axis '" + axis + "' given twice");
+    if (!out.emplace(axis, item.substr(eq + 1)).second)
+      throw UsageError("--" + option + " gives axis " + axis + " twice");
   }
-  std::array<std::string, 3> ordered;
-  for (std::size_t a = 0; a < 3; ++a) {
-    const auto it = files.find(triad.axes[a]);
-    if (it == files.end()) throw UsageError("--params: no parameter file for axis '" + triad.axes[a] + "'");
-    ordered[a] = it->second;
-  }
-  return ordered;
+  return out;
 }
 
-/// The axis's channels: /AXIS/channels, or the one ChannelAmplitudes topic ending in /AXIS/channels
-/// (a triad recorded inside a namespace).
-std::string axisTopic(const rosbag::Bag& bag, const std::string& axis) {
+/// The axis's channels: `chosen` (--axis-channels), or /AXIS/channels, or the one ChannelAmplitudes
+/// topic ending in /AXIS/channels (a triad recorded inside a namespace).
+std::string axisTopic(const rosbag::Bag& bag, const std::string& axis, const std::string& chosen) {
   rosbag::View all(bag);
   const std::string type = ros::message_traits::datatype<ChannelAmplitudes>();
+  if (!chosen.empty()) {
+    for (const rosbag::ConnectionInfo* c : all.getConnections()) {
+      if (c->topic != chosen) continue;
+      if (c->datatype != type) throw UsageError("topic " + chosen + " has type " + c->datatype + ", expected " + type);
+      return chosen;
+    }
+    throw UsageError("topic " + chosen + " (--axis-channels " + axis + "=...) is not in the bag");
+  }
   const std::string suffix = "/" + axis + "/channels";
   std::vector<std::string> found;
   std::string listing;
@@ -107,10 +111,20 @@ CLI::Option* addTriadOptions(CLI::App& command, TriadOptions* o) {
   CLI::Option* triad =
       command
           .add_option("--triad", o->triad_file,
-                      "triad file (frame_id, axes, M, bias): process the three axes' /AXIS/channels into the "
-                      "triad's /triad/output and /imu/data_raw; --params AXIS=FILE once per axis")
+                      "triad file (frame_id, axes, M, bias): process the three axes' /NAME/channels into the "
+                      "triad's /triad/output and /imu/data_raw (with --axis-params)")
           ->check(tools::notEmpty())
           ->group(group);
+  command.add_option("--axis-params", o->axis_params, "NAME=FILE, each axis's parameter file (all three)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->group(group)
+      ->needs(triad);
+  command.add_option("--axis-channels", o->axis_channels, "NAME=TOPIC, an axis's channels (default /NAME/channels)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->group(group)
+      ->needs(triad);
   auto number = [&](const char* name, double* value, const char* meaning) {
     command.add_option(name, *value, meaning)
         ->transform(tools::finiteNumber())
@@ -133,9 +147,8 @@ CLI::Option* addTriadOptions(CLI::App& command, TriadOptions* o) {
   return triad;
 }
 
-int runTriadProcess(const std::string& bag_path, const std::vector<std::string>& params, const std::string& out_path,
-                    const std::string& csv_path, const std::string& compression, const core::ProcessorConfig& processor,
-                    const TriadOptions& o) {
+int runTriadProcess(const std::string& bag_path, const std::string& out_path, const std::string& csv_path,
+                    const std::string& compression, const core::ProcessorConfig& processor, const TriadOptions& o) {
   checkProcessorConfig(processor);
   core::TriadCombinerSettings combiner_settings = o.combiner;
   combiner_settings.initial_rate_variance = o.noise.initial_variance;  // the node's defaults agree
@@ -148,7 +161,16 @@ int runTriadProcess(const std::string& bag_path, const std::vector<std::string>&
     throw UsageError("--" + option + ": " + e.problem());
   }
   const auto triad = std::make_shared<const core::TriadParameters>(core::loadTriadFile(o.triad_file));
-  const std::array<std::string, 3> files = axisParameterFiles(params, *triad);
+  const std::map<std::string, std::string> given = perAxis(o.axis_params, *triad, "axis-params");
+  const std::map<std::string, std::string> channels = perAxis(o.axis_channels, *triad, "axis-channels");
+  std::array<std::string, 3> files;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const auto it = given.find(triad->axes[a]);
+    if (it == given.end()) {
+      throw UsageError("--axis-params " + triad->axes[a] + "=FILE missing: each axis's parameter file is needed");
+    }
+    files[a] = it->second;
+  }
   std::vector<std::string> inputs{bag_path, o.triad_file};
   inputs.insert(inputs.end(), files.begin(), files.end());
   checkOutputPaths(inputs, {out_path, csv_path});
@@ -166,7 +188,8 @@ int runTriadProcess(const std::string& bag_path, const std::vector<std::string>&
   std::vector<std::string> topics;
   std::map<std::string, std::size_t> axis_of_topic;
   for (std::size_t a = 0; a < 3; ++a) {
-    axes[a].topic = axisTopic(*bag, axes[a].name);
+    const auto chosen = channels.find(axes[a].name);
+    axes[a].topic = axisTopic(*bag, axes[a].name, chosen == channels.end() ? std::string() : chosen->second);
     topics.push_back(axes[a].topic);
     axis_of_topic[axes[a].topic] = a;
   }
