@@ -12,6 +12,7 @@
 #include "hrg_gyro/ros/driver_sim_ros.h"
 #include "hrg_gyro/ros/processor_ros.h"
 #include "hrg_gyro/ros/triad_calibrator_ros.h"
+#include "hrg_gyro/ros/triad_ros.h"
 
 namespace hrg_gyro {
 namespace {
@@ -69,6 +70,13 @@ TEST(ParameterTemplateTest, DriverSimTemplateIsCompleteForATriad) {
   DriverSimRos node(ros::NodeHandle("triad_template"), ros::NodeHandle("triad_template/driver_sim"), false);
   EXPECT_EQ(node.parameters().defaultedKeys(), Keys{}) << "keys config/driver_sim.yaml lacks";
   EXPECT_EQ(node.parameters().unknownKeys(), Keys{});
+}
+
+TEST(ParameterTemplateTest, TriadTemplateIsComplete) {
+  TriadRos node(ros::NodeHandle("template"), ros::NodeHandle("template/triad"));
+  EXPECT_EQ(node.parameters().defaultedKeys(), Keys{}) << "keys config/triad_node.yaml lacks";
+  EXPECT_EQ(node.parameters().unknownKeys(), Keys{}) << "keys config/triad_node.yaml has that the node does not read";
+  EXPECT_GT(node.parameters().readKeys().size(), 10u);
 }
 
 TEST(ParameterTemplateTest, TyposAreUnknownKeys) {

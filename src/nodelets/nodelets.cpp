@@ -1,4 +1,4 @@
-// The four wrappers as nodelets (the calibrator's: one of two, by ~method), for zero-copy pipelines in one manager.
+// The five wrappers as nodelets (the calibrator's: one of two, by ~method), for zero-copy pipelines in one manager.
 // Each owns the same wrapper class as its node. The driver never shuts the manager down when its scenario ends; the
 // session monitor does when ~shutdown_when_done asks for it (demos and tests).
 #include <nodelet/nodelet.h>
@@ -13,6 +13,7 @@
 #include "hrg_gyro/ros/processor_ros.h"
 #include "hrg_gyro/ros/session_monitor_ros.h"
 #include "hrg_gyro/ros/triad_calibrator_ros.h"
+#include "hrg_gyro/ros/triad_ros.h"
 
 namespace hrg_gyro {
 
@@ -71,9 +72,14 @@ class SessionMonitorNodelet : public WrapperNodelet<SessionMonitorRos> {
   void onInit() override { create(getNodeHandle(), getPrivateNodeHandle()); }
 };
 
+class TriadNodelet : public WrapperNodelet<TriadRos> {
+  void onInit() override { create(getNodeHandle(), getPrivateNodeHandle()); }
+};
+
 }  // namespace hrg_gyro
 
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::DriverSimNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::ProcessorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::CalibratorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::SessionMonitorNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(hrg_gyro::TriadNodelet, nodelet::Nodelet)
