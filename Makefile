@@ -55,7 +55,7 @@ figures: run
 	chromium --headless --disable-gpu --no-sandbox --hide-scrollbars --window-size=900,1700 \
 	  --screenshot=$(ROOT)/docs/figures/example_report.png file://$(ROOT)/run_output/report.html 2> /dev/null
 
-# Benchmarks: Google Benchmark core suites, calibration, offline and live pipelines (about 15 min);
+# Benchmarks: Google Benchmark core suites, calibration, offline and live pipelines, the live triad (about 17 min);
 # figures in bench_output/results.md. BENCH_ONLY=core,... selects parts (see bench/run_benchmarks.py).
 bench: build
 	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) hrg_gyro_benchmarks

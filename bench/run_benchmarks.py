@@ -10,10 +10,13 @@
      `rosbag play --immediate` of the 1 M bag into the processor node (processed and dropped counted
      from the node's diagnostics). The bags are simulated once into bench_output/ and reused;
   4. live: driver_sim -> processor at 1, 5 and 10 kHz, separate processes vs nodelets: drops,
-     latency p50/p99/max, CPU per process (from /proc).
+     latency p50/p99/max, CPU per process (from /proc);
+  5. triad: three simulated gyros at 10 kHz, their processors and the triad in one nodelet manager
+     (bench/live_triad.launch, sim time): triad samples against the stamps' sequence, flagged and
+     missing ones, the processors' lost input, how far behind /clock, sim time per wall second, CPU.
 Environment: BENCH_LIVE_SECONDS (default 60), BENCH_CAL_HOURS (default 24), BENCH_OFFLINE_REPEATS
 (default 3, medians), BENCH_ONLY (comma list
-of core,calibration,offline,live)."""
+of core,calibration,offline,live,triad)."""
 import json
 import os
 import random
@@ -255,6 +258,38 @@ def live(results):
     results["live"] = rows
 
 
+def live_triad(results):
+    """Three gyros at 10 kHz through one manager: every stamp combined, nothing lost, on time."""
+    seconds = float(os.environ.get("BENCH_LIVE_SECONDS", "60"))
+    log("triad: three gyros at 10 kHz, processors and triad in one manager, %.0f s" % seconds)
+    master = Master()
+    result = os.path.join(OUT, "live_triad.yaml")
+    if os.path.exists(result):
+        os.remove(result)
+    launch = subprocess.Popen(["roslaunch", "-p", str(master.port), "hrg_gyro", "live_triad.launch",
+                               "frequency:=10000.0", "periods_per_output:=1", "duration:=%s" % seconds,
+                               "result_file:=" + result], env=master.env, stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL, preexec_fn=os.setsid)
+    patterns = {"manager": "__name:=triad_manager", "triad_probe": "__name:=triad_probe"}
+    time.sleep(8)
+    first, t_first = process_cpu(patterns), time.time()
+    last = {k: (v, t_first) for k, v in first.items()}
+    while launch.poll() is None:
+        time.sleep(1)
+        now = time.time()
+        for k, v in process_cpu(patterns).items():
+            last[k] = (v, now)
+    cpu = {k: 100.0 * (last[k][0] - first[k]) / CLK / max(last[k][1] - t_first, 1e-9) for k in first if k in last}
+    row = {"rate": 10000, "cpu_percent": cpu}
+    if os.path.exists(result):
+        with open(result) as f:
+            for line in f:
+                k, v = line.split(":", 1)
+                row.setdefault(k.strip(), v.strip())
+    log("  %s" % row)
+    results["triad"] = row
+
+
 def markdown(results):
     lines = ["# hrg_gyro benchmark results", "", "Machine: " + results["machine"], "Date: " + results["date"], ""]
     if "core" in results:
@@ -299,14 +334,27 @@ def markdown(results):
                 r["rate"], r["mode"], r.get("outputs", "-"), r.get("outputs_missing", "-"),
                 r.get("processor_input_lost", "-"), r.get("latency_p50_ms", "-"), r.get("latency_p99_ms", "-"),
                 r.get("latency_max_ms", "-"), ", ".join("%s %.1f" % kv for kv in sorted(r["cpu_percent"].items()))))
+    if "triad" in results:
+        r = results["triad"]
+        lines += ["", "## Live triad: three gyros, processors and triad in one manager", "",
+                  "| rate per axis | triad samples / expected | combined | flagged | stamps missing | processors' input lost "
+                  "| sim s per wall s | behind /clock p50 / p99 / max ms | CPU % |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+                  "| %d Hz | %s / %s | %s | %s | %s | %s | %s | %s / %s / %s | %s |" % (
+                      r["rate"], r.get("samples", "-"), r.get("expected", "-"), r.get("combined", "-"),
+                      r.get("flagged", "-"), r.get("stamps_missing", "-"), r.get("processors_input_lost", "-"),
+                      r.get("sim_per_wall", "-"), r.get("behind_clock_p50_ms", "-"), r.get("behind_clock_p99_ms", "-"),
+                      r.get("behind_clock_max_ms", "-"),
+                      ", ".join("%s %.1f" % kv for kv in sorted(r["cpu_percent"].items())))]
     return "\n".join(lines) + "\n"
 
 
 def main():
     os.makedirs(OUT, exist_ok=True)
-    only = os.environ.get("BENCH_ONLY", "core,calibration,offline,live").split(",")
+    only = os.environ.get("BENCH_ONLY", "core,calibration,offline,live,triad").split(",")
     results = {"machine": machine(), "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}
-    for name, fn in (("core", core_suites), ("calibration", calibration), ("offline", offline), ("live", live)):
+    for name, fn in (("core", core_suites), ("calibration", calibration), ("offline", offline), ("live", live),
+                     ("triad", live_triad)):
         if name in only:
             fn(results)
     with open(os.path.join(OUT, "results.json"), "w") as f:

@@ -302,6 +302,34 @@ class HrgBagCli(unittest.TestCase):
             self.assertEqual(float(r["dalpha"]), o.dalpha)
             self.assertEqual(float(r["alpha"]), o.alpha)
 
+    def test_process_triad_refuses_what_does_not_make_a_triad(self):
+        # A triad is three axes' channels; --axis-params names each axis's file (NAME=FILE, as
+        # calibrate --method triad); the single axis's options that the triad decides itself are refused.
+        triad = os.path.join(self.pkg, "config/triad.yaml")
+        out = self.path("triad_refused.csv")
+        every = ["--axis-params", "x=" + self.params, "--axis-params", "y=" + self.params,
+                 "--axis-params", "z=" + self.params]
+        cases = [
+            (every[:4], "--axis-params", "z=FILE missing"),
+            (every + ["--axis-params", "w=" + self.params], "--axis-params", "'w' is not an axis of the triad"),
+            (every[:4] + ["--axis-params", "x=" + self.params], "--axis-params", "gives axis x twice"),
+            (every[:4] + ["--axis-params", self.params], "--axis-params", "expects NAME=VALUE"),
+            (every + ["--params", self.params], "--params", "--axis-params"),
+            (every + ["--frame-id", "imu"], "--frame-id", "excludes"),
+            (every + ["--channels-topic", "/channels"], "--channels-topic", "excludes"),
+            (every + ["--max-wait", "0"], "--max-wait", "positive"),
+            (every + ["--axis-channels", "x=/nowhere"], "/nowhere", "is not in the bag"),
+            (every, "/x/channels", "no hrg_gyro/ChannelAmplitudes topic"),  # the single-axis bag
+        ]
+        for extra, option, why in cases:
+            args = ["process", self.short, "--triad", triad, "--csv", out] + extra
+            self.assertRefused(hrg_bag(*args), option, why, args)
+        for extra, option in ((["--max-wait", "1"], "--max-wait"), (["--axis-params", "x=" + self.params],
+                                                                     "--axis-params")):
+            args = ["process", self.short, "--params", self.params] + extra
+            self.assertRefused(hrg_bag(*args), option, "requires --triad", args)
+        self.assertFalse(os.path.exists(out), "a refused process writes nothing")
+
     def test_calibrate_refuses_what_the_gates_refuse(self):
         out, report = self.path("refused.yaml"), self.path("refused.report.yaml")
         code, stdout, err = hrg_bag("calibrate", self.short, "--method", "dual_rate", "--params", self.params,
@@ -467,7 +495,7 @@ class HrgBagCli(unittest.TestCase):
             match = re.search(r"unknown method 'x' \(([a-z_, ]+)\)", refused[2])
             self.assertTrue(match, "%s: %s" % (tool, refused[2]))
             methods = match.group(1).split(", ")
-            self.assertEqual(len(methods), 5, methods)
+            self.assertEqual(len(methods), 6, methods)  # with the triad calibration
             self.assertIn("|".join(methods), helped[1], tool)
 
     def test_calibrate_config_errors_name_the_file_and_key(self):

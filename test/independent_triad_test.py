@@ -8,7 +8,8 @@ the table's and the Earth's rotation (the up axis by its scale factor, the two o
 misalignments, sign included), and at rest each axis drifts at K_i A_i . R^T omega_E + D_i (the
 latitude, the azimuth and the position's orientation). The simulator's bag passing the same checks
 from its scenario file as the generator's from its truth file says the two share every convention.
-The calibration of these sessions is the triad calibration's test."""
+Both sessions are then calibrated by `hrg_bag calibrate --method triad`: the axis matrix must come out
+within 5 urad and 3 reported sigmas of each maker's, each axis's K within 1 ppm of the generator's."""
 import math
 import os
 import shutil
@@ -26,6 +27,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import independent_triad as generator  # noqa: E402 (the generator's own frames: the test's reference)
 
+AXES = generator.AXES
 HRG_BAG = subprocess.check_output(["catkin_find", "--first-only", "--libexec", "hrg_gyro", "hrg_bag"],
                                   universal_newlines=True).strip()
 
@@ -265,6 +267,61 @@ class IndependentTriad(unittest.TestCase):
             np.testing.assert_array_equal(r.T @ [0.0, 0.0, 1.0], (1.0 if p["up"][0] == "+" else -1.0) * np.eye(3)[axis])
             self.assertEqual(len(p["plateaus"]), 2)
         self.assertAlmostEqual(np.linalg.norm(t["earth_rate_table_zero"]), generator.EARTH_RATE, delta=1e-18)
+
+    def calibrate(self, bag, name):
+        """hrg_bag calibrate --method triad on a session, each axis's prior the shipped uncalibrated file."""
+        out = os.path.join(self.work, name)
+        os.makedirs(out, exist_ok=True)
+        package = rospy.get_param("~package_dir")
+        args = [HRG_BAG, "calibrate", bag, "--config", os.path.join(package, "test", "scenarios",
+                                                                     "triad_short_calibration.yaml"),
+                "--out", os.path.join(out, "triad.yaml"), "--report", os.path.join(out, "report.yaml")]
+        for a in AXES:
+            prior = os.path.join(out, "prior_%s.yaml" % a)
+            shutil.copyfile(os.path.join(package, "config", "params_uncalibrated.yaml"), prior)
+            args += ["--axis-params", "%s=%s" % (a, prior)]
+        p = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True, timeout=600)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        with open(os.path.join(out, "report.yaml")) as f:
+            report = yaml.safe_load(f)
+        with open(os.path.join(out, "triad.yaml")) as f:
+            written = yaml.safe_load(f)
+        return report, written, out
+
+    def check_matrix(self, report, written, truth, name):
+        """The axes' directions within 5 urad and 3 reported sigmas of the injected ones, M = A^-1 written."""
+        self.assertTrue(report["accepted"], report["reason"])
+        a_est, a_std = np.array(report["body_to_axis"]), np.array(report["body_to_axis_std"])
+        off = ~np.eye(3, dtype=bool)
+        error = (a_est - truth["A"])[off]
+        print("[ measured ] %s: triad calibration, misalignment errors %s urad, sigmas %s urad" %
+              (name, np.array2string(1e6 * error, precision=3), np.array2string(1e6 * a_std[off], precision=3)))
+        self.assertLessEqual(np.abs(error).max(), 5e-6)
+        self.assertTrue(np.all(np.abs(error) <= 3.0 * a_std[off]), (error, a_std[off]))
+        np.testing.assert_allclose(np.array(written["axis_to_body"]) @ truth["A"], np.eye(3), atol=5e-6)
+        # No body bias was injected: what the rests leave is within its sigmas.
+        bias, bias_std = np.array(report["bias"]), np.array(report["bias_std"])
+        self.assertTrue(np.all(np.abs(bias) <= 3.0 * bias_std), (bias, bias_std))
+
+    def test_calibration_of_the_generator_session_finds_its_triad(self):
+        report, written, out = self.calibrate(os.path.join(self.work, "generator.bag"), "generator_calibration")
+        self.check_matrix(report, written, self.generated_truth, "generator")
+        # Each axis's K(theta) against the generator's (ideal pickoffs: the intrinsic model is what the
+        # processor sees), over the half turn of theta.
+        theta = np.linspace(0.0, math.pi, 721)
+        for i, a in enumerate(AXES):
+            fit = report["axis_reports"][a]["scale_factor"][0]
+            estimated = harmonic(fit)
+            truth = self.generated_truth["K"][i]
+            peak = max(abs(estimated(t) - truth(t)) for t in theta) / abs(truth.mean)
+            print("[ measured ] generator: axis %s peak K error %.3f ppm" % (a, 1e6 * peak))
+            self.assertLess(peak, 1e-6, a)
+            with open(os.path.join(out, "%s.yaml" % a)) as f:
+                self.assertEqual(yaml.safe_load(f)["calibration"]["method"], "triad")
+
+    def test_calibration_of_the_simulator_session_finds_its_triad(self):
+        report, written, _ = self.calibrate(os.path.join(self.work, "simulator.bag"), "simulator_calibration")
+        self.check_matrix(report, written, self.simulated_truth, "simulator")
 
 
 if __name__ == "__main__":

@@ -3,10 +3,16 @@
 // reported as unknown, and a node started without a template lists its defaults.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <map>
 
 #include "hrg_gyro/ros/calibrator_ros.h"
 #include "hrg_gyro/ros/driver_sim_ros.h"
 #include "hrg_gyro/ros/processor_ros.h"
+#include "hrg_gyro/ros/triad_calibrator_ros.h"
+#include "hrg_gyro/ros/triad_ros.h"
 
 namespace hrg_gyro {
 namespace {
@@ -27,6 +33,31 @@ TEST(ParameterTemplateTest, CalibratorTemplateIsComplete) {
   EXPECT_GT(node.parameters().readKeys().size(), 40u);
 }
 
+TEST(ParameterTemplateTest, TriadCalibratorTemplateIsComplete) {
+  // The same template with method triad (parameter_templates.test) and the files the launch would
+  // name: the triad mode reads every key of it too, and finds none it does not know.
+  char pattern[] = "/tmp/hrg_triad_template.XXXXXX";
+  ASSERT_NE(::mkdtemp(pattern), nullptr);
+  const std::string dir = pattern, config = std::string(HRG_GYRO_SOURCE_DIR) + "/config/";
+  std::filesystem::copy_file(config + "triad.yaml", dir + "/triad.yaml");
+  std::map<std::string, std::string> files;
+  for (const std::string axis : {"x", "y", "z"}) {
+    files[axis] = dir + "/" + axis + ".yaml";
+    std::filesystem::copy_file(config + "params_uncalibrated.yaml", files[axis]);
+  }
+  ros::NodeHandle pnh("template_triad/calibrator");
+  pnh.setParam("triad_file", dir + "/triad.yaml");
+  pnh.setParam("axis_parameter_files", files);
+  {
+    ASSERT_TRUE(TriadCalibratorRos::selected(pnh));
+    TriadCalibratorRos node(ros::NodeHandle("template_triad"), pnh);
+    EXPECT_EQ(node.parameters().defaultedKeys(), Keys{}) << "keys config/calibrator.yaml lacks";
+    EXPECT_EQ(node.parameters().unknownKeys(), Keys{});
+    EXPECT_GT(node.parameters().readKeys().size(), 45u);
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ParameterTemplateTest, DriverSimTemplateIsComplete) {
   DriverSimRos node(ros::NodeHandle("template"), ros::NodeHandle("template/driver_sim"), false);
   EXPECT_EQ(node.parameters().defaultedKeys(), Keys{}) << "keys config/driver_sim.yaml lacks";
@@ -39,6 +70,13 @@ TEST(ParameterTemplateTest, DriverSimTemplateIsCompleteForATriad) {
   DriverSimRos node(ros::NodeHandle("triad_template"), ros::NodeHandle("triad_template/driver_sim"), false);
   EXPECT_EQ(node.parameters().defaultedKeys(), Keys{}) << "keys config/driver_sim.yaml lacks";
   EXPECT_EQ(node.parameters().unknownKeys(), Keys{});
+}
+
+TEST(ParameterTemplateTest, TriadTemplateIsComplete) {
+  TriadRos node(ros::NodeHandle("template"), ros::NodeHandle("template/triad"));
+  EXPECT_EQ(node.parameters().defaultedKeys(), Keys{}) << "keys config/triad_node.yaml lacks";
+  EXPECT_EQ(node.parameters().unknownKeys(), Keys{}) << "keys config/triad_node.yaml has that the node does not read";
+  EXPECT_GT(node.parameters().readKeys().size(), 10u);
 }
 
 TEST(ParameterTemplateTest, TyposAreUnknownKeys) {

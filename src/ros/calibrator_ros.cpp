@@ -6,6 +6,7 @@
 
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/ModelInfo.h"
+#include "hrg_gyro/core/calibration/triad_calibration.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/output_directory.h"
 #include "hrg_gyro/core/model/parameter_file.h"
@@ -24,8 +25,10 @@ using diagnostic_msgs::DiagnosticStatus;
 
 const std::vector<std::string>& nodeOnlyKeys() {
   static const std::vector<std::string> keys = {
-      "parameter_file", "report_file", "output_directory", "reload_service",    "write",
-      "autostart",      "stages",      "queue_size",       "diagnostic_period", "heap_trim_period"};
+      "parameter_file", "report_file", "output_directory", "reload_service", "write", "autostart", "stages",
+      "queue_size", "diagnostic_period", "heap_trim_period",
+      // read by the triad mode only (TriadCalibratorRos), accepted in the shared template
+      "triad_file", "axis_parameter_files", "reload_services", "stream_hold", "triad"};
   return keys;
 }
 
@@ -42,6 +45,15 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   base_settings_ = core::CalibrationSettings::parse(core::YamlField(privateParameters(pnh_), ""), nodeOnlyKeys());
   params_.claim(core::CalibrationSettings::keyPaths());
   params_.claim({"diagnostic_period"});  // read by diagnostic_updater itself
+  // The triad mode's keys (TriadCalibratorRos reads them): shared template, not used by one axis.
+  std::vector<std::string> triad_keys{"triad_file", "reload_services", "stream_hold"};
+  for (const std::string& k : core::TriadCalibrationSettings::keys()) triad_keys.push_back("triad/" + k);
+  params_.claim(triad_keys);
+  params_.claim({"axis_parameter_files"}, true);  // a map; the template's {} is no parameter at all
+  if (!params_.get<std::string>("triad_file", "").empty()) {
+    ROS_WARN("calibrator: ~triad_file is read in triad mode only (~method: triad); method %s ignores it",
+             core::nameOf(base_settings_.method).c_str());
+  }
   parameter_file_ = params_.get<std::string>("parameter_file", "");
   if (parameter_file_.empty())
     throw std::invalid_argument("calibrator: ~parameter_file is required (the file to refresh)");

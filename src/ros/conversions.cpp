@@ -48,6 +48,49 @@ GyroOutput toOutputMessage(const std_msgs::Header& header, const core::Processor
   return out;
 }
 
+core::AxisOutput toAxisOutput(const GyroOutput& msg) {
+  core::AxisOutput o;
+  o.stamp = toNanoseconds(msg.header.stamp);
+  o.dt = msg.dt;
+  o.dalpha = msg.dalpha;
+  o.flags = msg.flags;
+  return o;
+}
+
+TriadOutput toTriadOutputMessage(const core::TriadBodySample& s, const std::string& frame_id) {
+  TriadOutput m;
+  m.header.stamp = toRosTime(s.stamp);
+  m.header.frame_id = frame_id;
+  m.dt = s.dt;
+  m.delta_angle.x = s.delta_angle.x();
+  m.delta_angle.y = s.delta_angle.y();
+  m.delta_angle.z = s.delta_angle.z();
+  m.angular_velocity.x = s.angular_velocity.x();
+  m.angular_velocity.y = s.angular_velocity.y();
+  m.angular_velocity.z = s.angular_velocity.z();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) m.angular_velocity_covariance[3 * i + j] = s.covariance(i, j);
+  }
+  m.flags = s.flags;
+  return m;
+}
+
+sensor_msgs::Imu toImuMessage(const core::TriadBodySample& s, const std::string& frame_id) {
+  sensor_msgs::Imu m;
+  m.header.stamp = toRosTime(s.stamp);
+  m.header.frame_id = frame_id;
+  // REP-145: a gyro triad measures neither orientation nor acceleration.
+  m.orientation_covariance[0] = -1.0;
+  m.linear_acceleration_covariance[0] = -1.0;
+  m.angular_velocity.x = s.angular_velocity.x();
+  m.angular_velocity.y = s.angular_velocity.y();
+  m.angular_velocity.z = s.angular_velocity.z();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) m.angular_velocity_covariance[3 * i + j] = s.covariance(i, j);
+  }
+  return m;
+}
+
 ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::Time& stamp, std::uint32_t seq,
                                     const std::string& frame_id) {
   ChannelAmplitudes m;
@@ -269,6 +312,17 @@ core::CalibrationOutcome fromMessage(const CalibrationResult& m) {
   }
   for (const QualityGate& q : m.gates) o.gates.push_back({q.name, q.passed != 0, q.value, q.limit, q.message});
   return o;
+}
+
+core::FixtureRecord fromMessage(const FixturePosition& msg) {
+  core::FixtureRecord r;
+  r.stamp = toNanoseconds(msg.header.stamp);
+  r.index = msg.index;
+  r.name = msg.name;
+  r.body_to_table =
+      Eigen::Quaterniond(msg.body_to_table.w, msg.body_to_table.x, msg.body_to_table.y, msg.body_to_table.z);
+  r.locked = msg.locked;
+  return r;
 }
 
 }  // namespace hrg_gyro

@@ -25,13 +25,6 @@ using diagnostic_msgs::DiagnosticStatus;
 // marker for single axes; a huge variance tells a filter to ignore them).
 constexpr double kUnmeasuredVariance = 1e6;
 
-// Until this many second differences of alpha have been seen (1 s at 200 Hz), the measured noise
-// is not trusted and ~initial_angular_velocity_variance is reported instead.
-constexpr int kSettledDifferences = 200;
-// Floor of the measured variance: a noiseless input (a simulation without noise) must still not
-// claim a perfect measurement, which filters read as infinitely certain. (1e-6 rad/s)^2.
-constexpr double kMinimumVariance = 1e-12;
-
 core::ProcessorConfig processorConfig(ParameterReader& params) {
   core::ProcessorConfig c;
   c.max_gap = params.get("max_gap", c.max_gap);
@@ -69,15 +62,13 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   processor_ = std::make_unique<core::GyroProcessor>(processorConfig(params_), params);
   frame_id_ = params_.get<std::string>("frame_id", "gyro_link");
   publish_imu_ = params_.get("publish_imu", publish_imu_);
-  configured_rate_variance_ = params_.get("angular_velocity_variance", configured_rate_variance_);
-  if (configured_rate_variance_ == 0.0 || !std::isfinite(configured_rate_variance_)) {
-    throw std::invalid_argument(
-        "processor: ~angular_velocity_variance must be positive ((rad/s)^2), or negative for the measured noise; "
-        "0 would claim a perfect gyro");
-  }
-  initial_rate_variance_ = params_.get("initial_angular_velocity_variance", initial_rate_variance_);
-  if (!(initial_rate_variance_ > 0.0) || !std::isfinite(initial_rate_variance_)) {
-    throw std::invalid_argument("processor: ~initial_angular_velocity_variance must be positive ((rad/s)^2)");
+  core::RateNoiseSettings noise;
+  noise.configured_variance = params_.get("angular_velocity_variance", noise.configured_variance);
+  noise.initial_variance = params_.get("initial_angular_velocity_variance", noise.initial_variance);
+  try {
+    rate_noise_ = core::RateNoiseEstimator(noise);
+  } catch (const core::ConfigError& e) {
+    throw std::invalid_argument("processor: ~" + e.key() + " " + e.problem());
   }
   stall_timeout_ = params_.get("stall_timeout", stall_timeout_);
   quadrature_warn_ = params_.get("quadrature_warn", quadrature_warn_);
@@ -147,14 +138,6 @@ void ProcessorRos::publishModel(const ros::Time& since) {
   model_pub_.publish(m);
 }
 
-double ProcessorRos::angularVelocityVariance() const {
-  if (configured_rate_variance_ > 0.0) return configured_rate_variance_;
-  if (second_differences_ < kSettledDifferences || !(dt_last_ > 0.0)) return initial_rate_variance_;
-  // White angle noise sigma^2 per sample gives second differences of variance 6 sigma^2 and a
-  // per-sample rate (difference / dt) of variance 2 sigma^2 / dt^2.
-  return std::max((d2_variance_ / 3.0) / (dt_last_ * dt_last_), kMinimumVariance);
-}
-
 void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   frequency_->tick();
@@ -201,22 +184,8 @@ void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
 
   if (capture_ && !capture_->finished() && capture_->add(inc, r.flags)) capture_cv_.notify_all();
 
-  // Noise of alpha from its second differences (running mean, then exponential over ~1000): the
-  // three alphas must be continuous, but the estimate itself survives gaps and resets.
+  rate_noise_.add(r.alpha, inc.dt, r.flags);
   const bool continuous = !(r.flags & (core::kFlagGap | core::kFlagReset));
-  if (continuous) {
-    if (history_ >= 2) {
-      const double d2 = r.alpha - 2.0 * alpha1_ + alpha2_;
-      ++second_differences_;
-      d2_variance_ += (d2 * d2 - d2_variance_) * (second_differences_ < 1000 ? 1.0 / second_differences_ : 1e-3);
-    }
-    alpha2_ = alpha1_;
-    alpha1_ = r.alpha;
-    if (history_ < 2) ++history_;
-    dt_last_ = inc.dt;
-  } else {
-    history_ = 0;
-  }
   if (!publish_imu_ || !continuous) return;
   auto imu = boost::make_shared<sensor_msgs::Imu>();
   imu->header = wave->header;
@@ -226,7 +195,7 @@ void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   imu->angular_velocity.z = out->rate;
   imu->angular_velocity_covariance[0] = kUnmeasuredVariance;
   imu->angular_velocity_covariance[4] = kUnmeasuredVariance;
-  imu->angular_velocity_covariance[8] = angularVelocityVariance();
+  imu->angular_velocity_covariance[8] = rate_noise_.variance();
   imu_pub_.publish(imu);
 }
 

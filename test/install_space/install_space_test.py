@@ -37,7 +37,7 @@ class InstallSpace(unittest.TestCase):
         self.assertEqual(p.stdout.strip(), os.path.join(PREFIX, "share", "hrg_gyro"))
 
     def test_everything_a_user_runs_is_installed(self):
-        for exe in ("driver_sim", "processor", "calibrator", "session_monitor", "hrg_bag", "hrg_session",
+        for exe in ("driver_sim", "processor", "triad", "calibrator", "session_monitor", "hrg_bag", "hrg_session",
                     "plot_calibration.py", "hrg_report.py", "hrg_batch.py", "hrg_gyro_core_bench",
                     "hrg_gyro_calibration_bench"):
             path = os.path.join(PREFIX, "lib", "hrg_gyro", exe)
@@ -48,6 +48,10 @@ class InstallSpace(unittest.TestCase):
                     "include/hrg_gyro/ChannelAmplitudes.h", "share/hrg_gyro/nodelet_plugins.xml",
                     "share/hrg_gyro/package.xml", "share/hrg_gyro/launch/processor.launch",
                     "share/hrg_gyro/launch/example_navigation_stack.launch", "share/hrg_gyro/config/processor.yaml",
+                    "include/hrg_gyro/core/processing/triad_combiner.h", "include/hrg_gyro/ros/triad_ros.h",
+                    "include/hrg_gyro/TriadOutput.h", "share/hrg_gyro/launch/triad.launch",
+                    "share/hrg_gyro/launch/example_triad_stack.launch", "share/hrg_gyro/config/triad_node.yaml",
+                    "share/hrg_gyro/config/triad.yaml",
                     "share/hrg_gyro/config/calibrator.yaml", "share/hrg_gyro/config/driver_sim.yaml",
                     "share/hrg_gyro/config/params_uncalibrated.yaml", "share/hrg_gyro/config/scenarios/dual_rate.yaml",
                     "share/hrg_gyro/config/report_spec.yaml", "share/hrg_gyro/templates/report.html.j2",

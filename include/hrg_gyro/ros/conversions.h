@@ -2,6 +2,7 @@
 #pragma once
 
 #include <ros/time.h>
+#include <sensor_msgs/Imu.h>
 
 #include <string>
 
@@ -13,11 +14,14 @@
 #include "hrg_gyro/GyroOutput.h"
 #include "hrg_gyro/PrecessionCommand.h"
 #include "hrg_gyro/PrecessionState.h"
+#include "hrg_gyro/TriadOutput.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
 #include "hrg_gyro/core/calibration/calibration_outcome.h"
+#include "hrg_gyro/core/calibration/triad_calibration.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
+#include "hrg_gyro/core/processing/triad_combiner.h"
 #include "hrg_gyro/core/simulation/gyro_simulator.h"
 #include "hrg_gyro/core/simulation/triad_simulator.h"
 
@@ -38,6 +42,14 @@ inline ros::Time toRosTime(core::Nanoseconds ns) {
 core::ChannelSample fromMessage(const ChannelAmplitudes& msg);
 WaveState toWaveMessage(const ChannelAmplitudes& input, const core::WaveState& wave, const std::string& frame_id);
 GyroOutput toOutputMessage(const std_msgs::Header& header, const core::ProcessorResult& result);
+
+// The triad: an axis's output as the combiner takes it, and a triad sample as TriadOutput and as
+// sensor_msgs/Imu (REP-145: orientation and acceleration not measured, covariance[0] = -1; the
+// full 3x3 angular velocity covariance). The triad node and `hrg_bag process --triad` both use
+// these, so the offline tool gives the node's messages bit for bit.
+core::AxisOutput toAxisOutput(const GyroOutput& msg);
+TriadOutput toTriadOutputMessage(const core::TriadBodySample& sample, const std::string& frame_id);
+sensor_msgs::Imu toImuMessage(const core::TriadBodySample& sample, const std::string& frame_id);
 
 // The messages of one simulated sample (driver_sim and `hrg_bag simulate`).
 ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::Time& stamp, std::uint32_t seq,
@@ -70,5 +82,9 @@ CalibrationResult toMessage(const core::CalibrationOutcome& outcome, bool writte
                             const ros::Time& stamp);
 /// The parts of an outcome a message carries (for summaries built from a received result).
 core::CalibrationOutcome fromMessage(const CalibrationResult& msg);
+
+/// The fixture's position as logged, its quaternion as is: core::acceptFixtureOrientation decides
+/// whether it is a rotation (the live calibrator and `hrg_bag calibrate --method triad` alike).
+core::FixtureRecord fromMessage(const FixturePosition& msg);
 
 }  // namespace hrg_gyro

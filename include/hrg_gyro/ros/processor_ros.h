@@ -23,6 +23,7 @@
 #include "hrg_gyro/ChannelAmplitudes.h"
 #include "hrg_gyro/core/processing/bias_capture.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
+#include "hrg_gyro/core/processing/rate_noise_estimator.h"
 #include "hrg_gyro/ros/input_thread.h"
 #include "hrg_gyro/ros/parameter_reader.h"
 
@@ -44,7 +45,6 @@ class ProcessorRos {
   void diagnoseInput(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseWave(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseModel(diagnostic_updater::DiagnosticStatusWrapper& stat);
-  double angularVelocityVariance() const;
   /// Publishes ~model for the model now in force; `since` is the last stamp of the previous one.
   void publishModel(const ros::Time& since);
 
@@ -55,8 +55,7 @@ class ProcessorRos {
   std::string parameter_file_;
   std::string frame_id_;
   bool publish_imu_ = true;
-  double configured_rate_variance_ = -1.0;  // (rad/s)^2; negative: the measured noise
-  double initial_rate_variance_ = 1e-4;     // (rad/s)^2 until the measured noise has settled
+  core::RateNoiseEstimator rate_noise_;  // the Imu's z variance
   double stall_timeout_ = 0.5;
   double quadrature_warn_ = 0.1;
 
@@ -94,10 +93,6 @@ class ProcessorRos {
   core::WaveState last_wave_;
   bool has_wave_ = false;
   std::uint8_t last_flags_ = 0;
-  // Angle-noise estimate from second differences of alpha, for the IMU covariance.
-  double alpha1_ = 0.0, alpha2_ = 0.0, dt_last_ = 0.0, d2_variance_ = 0.0;
-  int history_ = 0;                       // continuous alphas held (0..2)
-  std::uint64_t second_differences_ = 0;  // in the noise estimate
 };
 
 }  // namespace hrg_gyro

@@ -165,18 +165,32 @@ void TriadCalibration::addTurntable(Nanoseconds stamp, double angle, double rate
                                  sequence);
     }
   }
-  if (!std::isfinite(angle) || stamp <= 0) return;
-  if (last_table_kept_ != 0 && toSeconds(stamp - last_table_kept_) < 1.0 / settings_.store_rate) return;
-  if (last_table_kept_ != 0 && stamp < last_table_kept_) return;
-  last_table_kept_ = stamp;
+  if (!std::isfinite(angle) || !std::isfinite(rate) || stamp <= 0) return;
   // Stored unwrapped: a controller may log its angle modulo 2 pi.
-  double unwrapped = angle;
-  if (!table_.empty()) {
-    const double previous = table_.back().value;
-    unwrapped = angle + kTwoPi * std::round((previous - angle) / kTwoPi);
+  const double unwrapped =
+      std::isfinite(table_unwrapped_) ? angle + kTwoPi * std::round((table_unwrapped_ - angle) / kTwoPi) : angle;
+  if (table_block_.count > 0 && stamp <= table_block_.last) return;  // out of order: not data here
+  table_unwrapped_ = unwrapped;
+  addToBlock(&table_block_, stamp, unwrapped, rate, &table_, &table_rates_);
+}
+
+void TriadCalibration::addToBlock(BlockMean* block, Nanoseconds stamp, double value, double rate,
+                                  std::vector<StoredSample>* out, std::vector<double>* rates) const {
+  const double length = 1.0 / settings_.store_rate;
+  const bool ends = block->count > 0 && (stamp <= block->last || toSeconds(stamp - block->start) >= length ||
+                                         toSeconds(stamp - block->last) > 0.5 * length);
+  if (ends) {
+    const double n = block->count;
+    out->push_back({block->start + static_cast<Nanoseconds>(std::llround(1e9 * block->time / n)), block->value / n});
+    if (rates) rates->push_back(block->rate / n);
+    *block = BlockMean();
   }
-  table_.push_back({stamp, unwrapped});
-  table_rates_.push_back(rate);
+  if (block->count == 0) block->start = stamp;
+  block->last = stamp;
+  block->time += toSeconds(stamp - block->start);
+  block->value += value;
+  block->rate += rate;
+  ++block->count;
 }
 
 void TriadCalibration::addWave(int axis, Nanoseconds stamp, double theta, double frequency) {
@@ -186,11 +200,9 @@ void TriadCalibration::addWave(int axis, Nanoseconds stamp, double theta, double
   if (fixture && fixture->locked && verticalSign(*fixture, axis) != 0) {
     sessions_[axis]->addWave(stamp, theta, frequency);
   }
-  if (!std::isfinite(theta)) return;
-  Nanoseconds& last = last_wave_kept_[axis];
-  if (last != 0 && (stamp <= last || toSeconds(stamp - last) < 1.0 / settings_.store_rate)) return;
-  last = stamp;
-  waves_[axis].push_back({stamp, theta});
+  if (!std::isfinite(theta) || stamp <= 0) return;
+  if (wave_blocks_[axis].count > 0 && stamp <= wave_blocks_[axis].last) return;  // out of order
+  addToBlock(&wave_blocks_[axis], stamp, theta, 0.0, &waves_[axis], nullptr);
 }
 
 std::vector<TriadCalibration::Interval> TriadCalibration::lockedIntervals() const {
@@ -248,6 +260,9 @@ TriadOutcome TriadCalibration::finish() const {
       alpha[i].push_back({w[k].stamp, a});
     }
   }
+  std::array<std::vector<std::pair<Nanoseconds, double>>, 3> theta;
+  for (int i = 0; i < 3; ++i)
+    for (const StoredSample& w : waves_[i]) theta[i].push_back({w.stamp, w.value});
   std::vector<std::pair<Nanoseconds, double>> table;
   for (const StoredSample& s : table_) table.push_back({s.stamp, s.value});
   const double max_gap = std::max(axis_settings_.plateau.max_gap, 3.0 / settings_.store_rate);
@@ -272,6 +287,7 @@ TriadOutcome TriadCalibration::finish() const {
     struct Point {
       Nanoseconds stamp;
       double alpha[3];
+      double theta[3];
       double phi;
       std::uint64_t plateau;
       bool is_static;
@@ -291,7 +307,10 @@ TriadOutcome TriadCalibration::finish() const {
       p.plateau = b.plateau.id;
       p.is_static = b.plateau.is_static;
       bool ok = interpolate(table, s.first, max_gap, &p.phi);
-      for (int i = 0; i < 3 && ok; ++i) ok = interpolate(alpha[i], s.first, max_gap, &p.alpha[i]);
+      for (int i = 0; i < 3 && ok; ++i) {
+        ok = interpolate(alpha[i], s.first, max_gap, &p.alpha[i]) &&
+             interpolate(theta[i], s.first, max_gap, &p.theta[i]);
+      }
       if (ok) points.push_back(p);
     }
 
@@ -406,6 +425,19 @@ TriadOutcome TriadCalibration::finish() const {
           }
           rest.axis_rates(i) = slope;
           rest.axis_rates_std(i) = std::sqrt(squares / (n - 2.0) / var_t);
+          // Stage 1's D(theta) is uncertain where the wave rests: that error enters the rate as
+          // -dD / K, the same in every rest at this angle (not averaged away by more rests).
+          double theta_mean = 0.0;
+          for (std::size_t k = begin; k < end; ++k) theta_mean += points[k].theta[i] / n;
+          if (!o.axes[i].drift.empty() && !o.axes[i].scale_factor.empty()) {
+            const HarmonicFitResult& d = o.axes[i].drift.front();
+            double variance = d.mean_std * d.mean_std;
+            for (std::size_t h = 0; h < d.orders.size(); ++h) {
+              variance += std::pow(d.cos_std[h] * std::cos(d.orders[h] * theta_mean), 2) +
+                          std::pow(d.sin_std[h] * std::sin(d.orders[h] * theta_mean), 2);
+            }
+            rest.axis_drift_std(i) = std::sqrt(variance) / std::abs(o.axes[i].scale_factor.front().mean);
+          }
         }
         rest.earth_body = r_bt.transpose() * earthInPlatter(latitude, settings_.azimuth, phi);
         o.rests.push_back(rest);
@@ -488,9 +520,17 @@ TriadOutcome TriadCalibration::finish() const {
     const double n = static_cast<double>(o.rests.size());
     const Eigen::Vector3d mean = sum / n;
     Eigen::Vector3d scatter = Eigen::Vector3d::Zero();
-    for (const TriadRest& r : o.rests) scatter += (r.bias - mean).cwiseAbs2();
+    Eigen::Vector3d drift_variance = Eigen::Vector3d::Zero();  // per axis, mean over the rests
+    for (const TriadRest& r : o.rests) {
+      scatter += (r.bias - mean).cwiseAbs2();
+      drift_variance += r.axis_drift_std.cwiseAbs2() / n;
+    }
     Eigen::Vector3d std = (noise / (n * n)).cwiseSqrt();
     if (n >= 3.0) std = std.cwiseMax((scatter / ((n - 1.0) * n)).cwiseSqrt());
+    // Plus the axes' D(theta) uncertainty at the rests, through M: common to the rests, so it is
+    // added, not divided by their number.
+    const Eigen::Vector3d drift_part = (m.cwiseAbs2() * drift_variance).cwiseSqrt();
+    std = (std.cwiseAbs2() + drift_part.cwiseAbs2()).cwiseSqrt();
     o.triad.bias = mean;
     o.triad.bias_std = std;
     o.bias_estimated = true;

@@ -88,6 +88,8 @@ std::string emitTriadReport(const TriadOutcome& o) {
     emitVector(out, r.axis_rates);
     out << YAML::Key << "axis_rates_std" << YAML::Value;
     emitVector(out, r.axis_rates_std);
+    out << YAML::Key << "axis_drift_std" << YAML::Comment("from D(theta)'s uncertainty at the rest") << YAML::Value;
+    emitVector(out, r.axis_drift_std);
     out << YAML::Key << "earth_body" << YAML::Value;
     emitVector(out, r.earth_body);
     out << YAML::Key << "bias" << YAML::Value;

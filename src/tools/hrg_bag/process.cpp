@@ -11,12 +11,16 @@
 
 #include "../cli_checks.h"
 #include "bag_tools.h"
+#include "csv_text.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "process_triad.h"
 #include "serial_worker.h"
 
 namespace hrg_gyro {
 namespace {
+
+using bag_tools::CsvText;
 
 const char* verdictName(const core::ProcessorResult& r) {
   switch (r.verdict) {
@@ -37,62 +41,6 @@ const char* verdictName(const core::ProcessorResult& r) {
   }
   return "unknown";
 }
-
-// CSV text of a batch of rows, formatted straight into one growing buffer (no per-field string or
-// stream call). Numbers in the shortest form that reads back to the same double (std::to_chars),
-// several times faster than printf's %.17g and just as exact.
-class CsvText {
- public:
-  void clear() { used_ = 0; }
-  const char* data() const { return buffer_.data(); }
-  std::size_t size() const { return used_; }
-  /// Room for one row (at most 19 fields of 32 characters) at the end of the buffer.
-  void beginRow() {
-    if (buffer_.size() < used_ + kRowRoom) buffer_.resize(2 * (used_ + kRowRoom));
-    cursor_ = buffer_.data() + used_;
-    first_ = true;
-  }
-  void number(double v, bool present = true) {
-    separator();
-    if (present) cursor_ = std::to_chars(cursor_, cursor_ + 32, v).ptr;
-  }
-  void integer(std::uint64_t v) {
-    separator();
-    cursor_ = std::to_chars(cursor_, cursor_ + 32, v).ptr;
-  }
-  /// sec.nsec with nine digits after the point, as printf's "%u.%09u".
-  void stamp(std::uint32_t sec, std::uint32_t nsec) {
-    separator();
-    if (nsec >= 1000000000u) {  // not normalised: printf's own form, as many digits as it takes
-      cursor_ += std::snprintf(cursor_, 32, "%u.%09u", sec, nsec);
-      return;
-    }
-    cursor_ = std::to_chars(cursor_, cursor_ + 16, sec).ptr;
-    *cursor_++ = '.';
-    for (int digit = 8; digit >= 0; --digit, nsec /= 10) cursor_[digit] = static_cast<char>('0' + nsec % 10);
-    cursor_ += 9;
-  }
-  void text(const char* t) {
-    separator();
-    while (*t != '\0') *cursor_++ = *t++;
-  }
-  void endRow() {
-    *cursor_++ = '\n';
-    used_ = static_cast<std::size_t>(cursor_ - buffer_.data());
-  }
-
- private:
-  static constexpr std::size_t kRowRoom = 19 * 33 + 1;
-  void separator() {
-    if (!first_) *cursor_++ = ',';
-    first_ = false;
-  }
-
-  std::string buffer_;
-  std::size_t used_ = 0;
-  char* cursor_ = nullptr;
-  bool first_ = true;
-};
 
 // The numbers of one CSV row, kept as they are until a formatter thread formats them.
 struct CsvRow {
@@ -230,10 +178,21 @@ struct ProcessOptions {
   std::string bag, params, out, csv, frame_id = "gyro_link", compression = "lz4";
   bag_tools::GyroTopics topics;
   core::ProcessorConfig processor;
+  bag_tools::TriadOptions triad;
 };
 
 int runProcess(const ProcessOptions& o) {
   using namespace bag_tools;
+  if (!o.triad.triad_file.empty()) {
+    // As hrg_bag calibrate --method triad: each axis's file with --axis-params.
+    if (!o.params.empty()) {
+      throw UsageError("--params is a single gyro's; with --triad give each axis's with --axis-params NAME=FILE");
+    }
+    return runTriadProcess(o.bag, o.out, o.csv, o.compression, o.processor, o.triad);
+  }
+  if (o.params.empty()) {
+    throw UsageError("--params is required (the gyro's parameter file; for a triad, --triad with --axis-params)");
+  }
   checkProcessorConfig(o.processor);
   checkOutputPaths({o.bag, o.params}, {o.out, o.csv});
   const auto params = std::make_shared<const core::GyroParameters>(core::loadParameterFile(o.params));
@@ -316,25 +275,39 @@ namespace bag_tools {
 
 Command addProcessCommand(CLI::App& root) {
   auto o = std::make_shared<ProcessOptions>();
-  CLI::App* cmd = root.add_subcommand("process", "the processor offline: /wave and /output into a bag, or a CSV");
+  CLI::App* cmd = root.add_subcommand(
+      "process", "the processor offline: /wave and /output into a bag, or a CSV; with --triad, three gyros as one IMU");
   cmd->add_option("BAG", o->bag, "input bag with the gyro's channels")->required();
-  cmd->add_option("--params", o->params, "parameter file (YAML) of the gyro, as the processor node's")->required();
+  cmd->add_option("--params", o->params,
+                  "parameter file (YAML) of the gyro, as the processor node's (not with --triad)")
+      ->check(tools::notEmpty());
   cmd->add_option("--out", o->out, "output bag: /wave and /output, recorded at the input's record time")
       ->check(tools::notEmpty());
   cmd->add_option("--csv", o->csv, "output CSV: one row per input sample with its verdict")->check(tools::notEmpty());
-  cmd->add_option("--frame-id", o->frame_id, "frame_id of the written messages")
-      ->check(tools::frameId())
-      ->capture_default_str();
+  CLI::Option* frame_id = cmd->add_option("--frame-id", o->frame_id, "frame_id of the written messages")
+                              ->check(tools::frameId())
+                              ->capture_default_str();
   addCompressionOption(*cmd, &o->compression);
   addTopicOptions(*cmd, &o->topics, false);
   addProcessorOptions(*cmd, &o->processor);
+  CLI::Option* triad = addTriadOptions(*cmd, &o->triad);
+  // The triad's frame is its file's, each axis's channels topic /AXIS/channels.
+  triad->excludes(frame_id);
+  triad->excludes(cmd->get_option("--channels-topic"));
   cmd->footer(
       "Runs the processor on the bag's channels. Numbers in the CSV are in the shortest form that reads\n"
       "back exactly. With neither --out nor --csv, only the summary (a dry run).\n"
       "Outputs are written to temporaries and renamed over --out/--csv only when complete; an output\n"
       "that is the same file as an input or as the other output is refused.\n"
-      "Exit 0 success, 1 when no sample was accepted, 2 bad usage or unreadable input, 3 an output\n"
-      "could not be written (nothing left at its path, an existing file unchanged).");
+      "With --triad FILE, the bag holds three gyros' channels, /NAME/channels for each axis of the triad\n"
+      "file (or --axis-channels NAME=TOPIC), and --axis-params NAME=FILE gives each axis's parameter file:\n"
+      "  hrg_bag process triad.bag --triad triad.yaml --axis-params x=x.yaml --axis-params y=y.yaml \\\n"
+      "      --axis-params z=z.yaml --out triad_out.bag --csv triad.csv\n"
+      "--out then holds /triad/output (TriadOutput, every triad sample), /imu/data_raw (the samples not\n"
+      "flagged GAP or RESET) and each /AXIS/output; --csv one row per triad sample. The numbers are the live\n"
+      "processor and triad nodes' bit for bit; stamps an axis never delivered end the output as gaps.\n"
+      "Exit 0 success, 1 when no sample was accepted (with --triad: combined), 2 bad usage or unreadable\n"
+      "input, 3 an output could not be written (nothing left at its path, an existing file unchanged).");
   return [o] { return runProcess(*o); };
 }
 

@@ -10,6 +10,7 @@
 #include "hrg_gyro/FixturePosition.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/core/calibration/triad_calibration.h"
+#include "hrg_gyro/core/calibration/triad_feed.h"
 #include "hrg_gyro/core/calibration/triad_result_files.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/output_directory.h"
@@ -192,14 +193,8 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
       if (topic == fixture) {
         const FixturePosition::ConstPtr f = m.instantiate<FixturePosition>();
         if (!f) continue;
-        core::FixtureRecord record;
-        record.stamp = toNanoseconds(f->header.stamp);
-        record.index = f->index;
-        record.name = f->name;
-        const Eigen::Quaterniond q(f->body_to_table.w, f->body_to_table.x, f->body_to_table.y, f->body_to_table.z);
-        if (!std::isfinite(q.norm()) || std::abs(q.norm() - 1.0) > 1e-3) continue;  // not a rotation: not used
-        record.body_to_table = q.normalized();
-        record.locked = f->locked;
+        core::FixtureRecord record = fromMessage(*f);
+        if (!core::acceptFixtureOrientation(&record)) continue;  // not a rotation: not used (as live)
         calibration.addFixture(record);
         continue;
       }

@@ -16,13 +16,15 @@
 //     missing body axes named). M = A^-1.
 //  3. The body bias: in every rest of a locked position, the axes' mean compensated rates through M
 //     against the Earth's 3-D rate in the body frame (latitude from the axes' parameter files, the
-//     table's azimuth from the settings, the table angle at rest from the log).
+//     table's azimuth from the settings, the table angle at rest from the log). Its standard error
+//     is the rests' noise (or their scatter, if larger) plus stage 1's D(theta) uncertainty at the
+//     angles where the waves rested: that part is common to the rests and does not shrink with them.
 //
 // A fixture position off by a small rotation makes u_p, and so the responses of that position, off by
 // it: the error enters A as the least-squares image of the positions' errors (docs/triad.md).
 //
-// Memory: stage 1 is streamed (the sessions' sums); stage 2 keeps each axis's wave angle and the
-// table's angle thinned to `store_rate`, and the fixture's timeline. No ROS.
+// Memory: stage 1 is streamed (the sessions' sums); stages 2 and 3 keep each axis's wave angle and the
+// table's angle as block means at `store_rate`, and the fixture's timeline. No ROS.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -39,7 +41,7 @@ namespace core {
 struct TriadCalibrationSettings {
   double azimuth = 0.0;                             ///< rad: the table's zero mark from North towards East
   double window = 1.0;                              ///< s: window of the cross-axis response fit
-  double store_rate = 20.0;                         ///< Hz: wave and table samples kept per axis for stages 2 and 3
+  double store_rate = 20.0;                         ///< Hz: wave and table block means kept for stages 2 and 3
   double vertical_tolerance = 0.02;                 ///< an axis is along the table axis when |u . e_i| >= 1 - this
   double min_rest = 20.0;                           ///< s of settled rest for a bias estimate
   double min_position_time = 60.0;                  ///< s of moving plateaus for a position's responses
@@ -82,6 +84,16 @@ class TriadCalibration {
     Nanoseconds stamp;
     double value;  // the wave angle, or the table angle
   };
+  /// Samples averaged over blocks of 1 / store_rate s (not picked): the stored series keeps the noise
+  /// reduction of every sample. A block ends at its length, at a gap or at a stamp that goes back.
+  struct BlockMean {
+    Nanoseconds start = 0, last = 0;
+    double time = 0.0, value = 0.0, rate = 0.0;  // sums: s from start, the value, the rate
+    int count = 0;
+  };
+  /// Adds a sample to `block`; a completed block's mean goes to `out` (and its mean rate to `rates`).
+  void addToBlock(BlockMean* block, Nanoseconds stamp, double value, double rate, std::vector<StoredSample>* out,
+                  std::vector<double>* rates) const;
   struct Interval {  // a locked fixture position
     Nanoseconds from = 0, to = 0;
     FixtureRecord fixture;
@@ -101,9 +113,10 @@ class TriadCalibration {
   std::array<std::vector<StoredSample>, 3> waves_;
   std::vector<StoredSample> table_;  // the table angle, thinned
   std::vector<double> table_rates_;  // the reported rate of each stored table sample
-  std::array<Nanoseconds, 3> last_wave_kept_{{0, 0, 0}};
-  Nanoseconds last_table_kept_ = 0;
-  Nanoseconds origin_ = 0;  // first stamp seen: the Earth-rate term's time origin
+  std::array<BlockMean, 3> wave_blocks_;
+  BlockMean table_block_;
+  double table_unwrapped_ = NAN;  // the last table angle, unwrapped
+  Nanoseconds origin_ = 0;        // first stamp seen: the Earth-rate term's time origin
 };
 
 }  // namespace core

@@ -34,6 +34,8 @@ struct TriadRest {
   double table_angle = 0.0;                              ///< rad, where the table rested
   Eigen::Vector3d axis_rates = Eigen::Vector3d::Zero();  ///< rad/s, the axes' compensated mean rates
   Eigen::Vector3d axis_rates_std = Eigen::Vector3d::Zero();
+  /// rad/s: what stage 1's D(theta) uncertainty at the rest's wave angles makes of each axis's rate
+  Eigen::Vector3d axis_drift_std = Eigen::Vector3d::Zero();
   Eigen::Vector3d earth_body = Eigen::Vector3d::Zero();  ///< rad/s, the Earth's rate in the body frame
   Eigen::Vector3d bias = Eigen::Vector3d::Zero();        ///< rad/s, M rates - Earth: this rest's body bias
   double duration = 0.0;                                 ///< s

@@ -1,0 +1,305 @@
+// The live triad calibrator's feed (triad_feed.h) on an angle-level triad session (core/testing/
+// angle_level_triad.h): streams that arrive late relative to each other give the calibration, bit
+// for bit, what it gets from the records in stamp order (what hrg_bag reads from a bag); a stream
+// that lags beyond the hold is fed late, not lost; a missing axis stream delays the others by the
+// hold only and its gate names the axis; bad records are dropped and counted; a stream that goes back
+// for good restarts the run; the auto-finish rule.
+#include "hrg_gyro/core/calibration/triad_feed.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+#include "core/testing/angle_level_triad.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+using testing::AngleLevelTriad;
+using testing::TriadPosition;
+
+/// One record of the session, as some stream delivers it.
+struct Event {
+  int stream;  // TriadFeed::Stream
+  Nanoseconds stamp;
+  double a = 0.0, b = 0.0;
+  std::uint32_t sequence = 0;
+  FixtureRecord fixture;
+};
+
+AngleLevelTriad triad() {
+  AngleLevelTriad g;
+  g.k[0] = HarmonicModel({2, 4}, -0.56, {-6e-4, 2e-3}, {4e-4, 0.0});
+  g.k[1] = HarmonicModel({2, 4}, -0.561, {5e-4, -1.5e-3}, {-3e-4, 2e-4});
+  g.k[2] = HarmonicModel({2, 4}, -0.559, {-4e-4, 1e-3}, {2e-4, -1e-4});
+  g.d[0] = HarmonicModel({2}, 1e-5, {2e-5}, {-1e-5});
+  g.body_to_axis << 1.0, 1.2e-4, -8e-5, -6e-5, 1.0, 2.1e-4, 1.5e-4, -9e-5, 1.0;
+  g.noise = 1.1e-5;
+  g.rate_hz = 200.0;  // enough for the fits, and a session of 1.5 M records
+  return g;
+}
+
+/// The session's records in the order the simulation emits them (stamp order), computed once.
+const std::vector<Event>& session() {
+  static const std::vector<Event> events = [] {
+    std::vector<Event> out;
+    testing::TriadSinks sinks;
+    sinks.table = [&](Nanoseconds stamp, double angle, double rate, std::uint32_t seq) {
+      out.push_back({TriadFeed::kTable, stamp, angle, rate, seq, {}});
+    };
+    sinks.fixture = [&](const FixtureRecord& f) { out.push_back({TriadFeed::kFixture, f.stamp, 0, 0, 0, f}); };
+    sinks.wave = [&](int axis, Nanoseconds stamp, double theta) {
+      out.push_back({TriadFeed::kAxis0 + axis, stamp, theta, NAN, 0, {}});
+    };
+    runAngleLevelTriad(triad(), testing::sixPositions(0.4, 40.0, 2, 30.0), sinks);
+    return out;
+  }();
+  return events;
+}
+
+std::array<GyroParameters, 3> priors() {
+  std::array<GyroParameters, 3> p;
+  for (auto& one : p) one.earth_rate.latitude = triad().latitude;
+  return p;
+}
+
+CalibrationSettings axisSettings() {
+  CalibrationSettings s;
+  s.scale_factor_orders = {2, 4};
+  s.drift_orders = {2};
+  return s;
+}
+
+TriadCalibrationSettings triadSettings() {
+  TriadCalibrationSettings s;
+  s.azimuth = triad().azimuth;
+  return s;
+}
+
+TriadFeed makeFeed(const TriadFeedSettings& settings = TriadFeedSettings()) {
+  return TriadFeed(axisSettings(), triadSettings(), priors(), TriadParameters(), settings);
+}
+
+void deliver(TriadFeed* feed, const Event& e) {
+  switch (e.stream) {
+    case TriadFeed::kFixture:
+      feed->addFixture(e.fixture);
+      break;
+    case TriadFeed::kTable:
+      feed->addTurntable(e.stamp, e.a, e.b, e.sequence);
+      break;
+    default:
+      feed->addWave(e.stream - TriadFeed::kAxis0, e.stamp, e.a, e.b);
+  }
+}
+
+/// The events in the order they arrive when each stream is `delay[stream]` s late (transport, a
+/// bench that publishes the fixture from another computer).
+std::vector<Event> arrival(const std::vector<Event>& events, const std::array<double, TriadFeed::kStreamCount>& delay) {
+  std::vector<std::pair<Nanoseconds, std::size_t>> order;
+  order.reserve(events.size());
+  for (std::size_t k = 0; k < events.size(); ++k) {
+    order.push_back({events[k].stamp + toNanoseconds(delay[events[k].stream]), k});
+  }
+  std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Event> out;
+  out.reserve(events.size());
+  for (const auto& o : order) out.push_back(events[o.second]);
+  return out;
+}
+
+TEST(TriadFeedTest, LateStreamsGiveTheCalibrationExactlyWhatTheStampOrderGives) {
+  // The reference: the records straight into the calibration in stamp order, as hrg_bag does.
+  TriadCalibration direct(axisSettings(), triadSettings(), priors(), TriadParameters());
+  for (const Event& e : session()) {
+    if (e.stream == TriadFeed::kFixture) direct.addFixture(e.fixture);
+    if (e.stream == TriadFeed::kTable) direct.addTurntable(e.stamp, e.a, e.b, e.sequence);
+    if (e.stream >= TriadFeed::kAxis0) direct.addWave(e.stream - TriadFeed::kAxis0, e.stamp, e.a, e.b);
+  }
+  const TriadOutcome reference = direct.finish();
+  ASSERT_TRUE(reference.accepted) << reference.reason;
+
+  // Live: the fixture 0.9 s late (it repeats once a second), axis y 0.3 s, the table 50 ms.
+  const std::vector<Event> live = arrival(session(), {{0.9, 0.05, 0.0, 0.3, 0.01}});
+  TriadFeed feed = makeFeed();
+  std::size_t most_held = 0;
+  for (const Event& e : live) {
+    deliver(&feed, e);
+    most_held = std::max(most_held, feed.held());
+  }
+  const TriadOutcome o = feed.finish();
+  ASSERT_TRUE(o.accepted) << o.reason;
+  EXPECT_EQ(o.triad.axis_to_body, reference.triad.axis_to_body);
+  EXPECT_EQ(o.triad.bias, reference.triad.bias);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(o.axes[i].parameters.scale_factor, reference.axes[i].parameters.scale_factor) << i;
+    EXPECT_EQ(o.axes[i].parameters.drift, reference.axes[i].parameters.drift) << i;
+  }
+  for (int s = 0; s < TriadFeed::kStreamCount; ++s) {
+    EXPECT_EQ(feed.counters(s).fed, feed.counters(s).received) << s;
+    EXPECT_EQ(feed.counters(s).late, 0u) << s;
+    EXPECT_EQ(feed.counters(s).out_of_order, 0u) << s;
+  }
+  // Held: about the fixture's delay plus its repeat period of every stream, not more.
+  const double rate = triad().rate_hz;
+  std::printf("most records held: %zu (%.2f s of the four fast streams)\n", most_held, most_held / (4 * rate));
+  EXPECT_LE(most_held, static_cast<std::size_t>(4 * rate * TriadFeedSettings().hold + 10));
+}
+
+TEST(TriadFeedTest, AStreamLaggingBeyondTheHoldIsFedLateNotLost) {
+  // Axis z 3 s behind the others, with a hold of 1 s: its records come after later stamps of the
+  // others. They are fed all the same (counted late), in z's own order, and no stream restarts.
+  TriadFeedSettings settings;
+  settings.hold = 1.0;
+  TriadFeed feed = makeFeed(settings);
+  for (const Event& e : arrival(session(), {{0.0, 0.0, 0.0, 0.0, 3.0}})) deliver(&feed, e);
+  const TriadStreamCounters& z = feed.counters(TriadFeed::kAxis0 + 2);
+  EXPECT_GT(z.late, z.received / 2);
+  EXPECT_EQ(z.out_of_order, 0u);
+  EXPECT_EQ(feed.restarts(), 0u);
+  const TriadOutcome o = feed.finish();
+  EXPECT_EQ(z.fed, z.received);
+  ASSERT_TRUE(o.accepted) << o.reason;
+  // Each axis's stage and the stored samples are in stamp order per stream: only a z record at a
+  // change of the fixture's state could be routed otherwise, and this plan changes it at rest.
+  TriadFeed ordered = makeFeed();
+  for (const Event& e : session()) deliver(&ordered, e);
+  const TriadOutcome reference = ordered.finish();
+  EXPECT_EQ(o.triad.axis_to_body, reference.triad.axis_to_body);
+}
+
+TEST(TriadFeedTest, AMissingAxisStreamDelaysTheOthersByTheHoldAndItsGateNamesIt) {
+  TriadFeedSettings settings;
+  settings.hold = 1.5;
+  TriadFeed feed = makeFeed(settings);
+  std::size_t most_held = 0;
+  for (const Event& e : session()) {
+    if (e.stream == TriadFeed::kAxis0 + 1) continue;  // axis y never arrives
+    deliver(&feed, e);
+    most_held = std::max(most_held, feed.held());
+  }
+  // Three fast streams of 200 Hz held for 1.5 s, and the fixture's records within it.
+  EXPECT_LE(most_held, static_cast<std::size_t>(3 * 200 * 1.5 + 10));
+  EXPECT_EQ(feed.counters(TriadFeed::kAxis0 + 1).received, 0u);
+  const TriadOutcome o = feed.finish();
+  EXPECT_FALSE(o.accepted);
+  bool gate = false;
+  for (const GateResult& g : o.gates) gate = gate || (g.name == "axis_y" && !g.passed);
+  EXPECT_TRUE(gate);
+  EXPECT_NE(o.reason.find("axis y"), std::string::npos) << o.reason;
+  bool note = false;
+  for (const std::string& n : o.notes) note = note || n.find("axis y: no wave sample was fed") != std::string::npos;
+  EXPECT_TRUE(note);
+  std::printf("axis y missing: %s\n", o.reason.c_str());
+}
+
+TEST(TriadFeedTest, BadRecordsAreDroppedAndCounted) {
+  TriadFeedSettings settings;
+  settings.hold = 0.5;
+  TriadFeed feed = makeFeed(settings);
+  FixtureRecord f;
+  f.stamp = toNanoseconds(1.0);
+  f.locked = true;
+  f.body_to_table = Eigen::Quaterniond(1.0, 0.1, 0.0, 0.0);  // norm 1.005: not a rotation
+  feed.addFixture(f);
+  f.body_to_table = Eigen::Quaterniond(1.0005, 0.0, 0.0, 0.0);  // within 1e-3: a rotation, normalised
+  feed.addFixture(f);
+  f.body_to_table = Eigen::Quaterniond(NAN, 0.0, 0.0, 0.0);
+  feed.addFixture(f);
+  feed.addWave(0, toNanoseconds(1.0), NAN, NAN);
+  feed.addWave(0, toNanoseconds(1.0), INFINITY, NAN);
+  feed.addWave(1, 0, 0.1, NAN);  // zero stamp
+  for (int k = 0; k < 400; ++k) {
+    const Nanoseconds t = toNanoseconds(1.0 + 0.005 * k);
+    feed.addTurntable(t, 0.0, 0.0, k);
+    for (int i = 0; i < 3; ++i) feed.addWave(i, t, 0.1 * i, NAN);
+  }
+  // A record older than its stream's previous one (not far enough back to be a new timeline).
+  feed.addWave(2, toNanoseconds(1.9), 0.2, NAN);
+  EXPECT_EQ(feed.counters(TriadFeed::kFixture).bad_value, 2u);
+  EXPECT_EQ(feed.counters(TriadFeed::kFixture).fed, 1u);
+  ASSERT_NE(feed.fixture(), nullptr);
+  EXPECT_DOUBLE_EQ(feed.fixture()->body_to_table.norm(), 1.0);
+  EXPECT_EQ(feed.counters(TriadFeed::kAxis0).bad_value, 2u);
+  EXPECT_EQ(feed.counters(TriadFeed::kAxis0 + 1).bad_stamp, 1u);
+  EXPECT_EQ(feed.counters(TriadFeed::kAxis0 + 2).out_of_order, 1u);
+  EXPECT_EQ(feed.restarts(), 0u);
+  const TriadOutcome o = feed.finish();  // too little for anything, but no crash and a named refusal
+  EXPECT_FALSE(o.accepted);
+  EXPECT_FALSE(o.reason.empty());
+}
+
+TEST(TriadFeedTest, AStreamThatGoesBackForGoodRestartsTheRun) {
+  TriadFeedSettings settings;
+  settings.hold = 0.5;
+  TriadFeed feed = makeFeed(settings);
+  // The first two positions' worth, twice (a bag played in a loop).
+  const std::vector<Event>& all = session();
+  const std::size_t part = all.size() / 3;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::size_t k = 0; k < part; ++k) deliver(&feed, all[k]);
+  }
+  EXPECT_EQ(feed.restarts(), 1u);
+  // After the restart the run knows only the second pass: the fixture from its records.
+  ASSERT_NE(feed.fixture(), nullptr);
+  EXPECT_TRUE(feed.axesAlongTable()[2]);
+  EXPECT_LT(feed.duration(), toSeconds(all[part - 1].stamp - all[0].stamp) + 1e-9);
+  EXPECT_GT(feed.duration(), toSeconds(all[part - 1].stamp - all[0].stamp) - 2.0);
+}
+
+TEST(TriadFeedTest, AutoFinishOnceEveryAxisWasAlongTheTableAndTheFixtureStaysReleased) {
+  TriadFeedSettings settings;
+  settings.hold = 0.5;
+  settings.auto_finish_idle = 10.0;
+  TriadFeed feed = makeFeed(settings);
+  const std::vector<Event>& all = session();
+  for (const Event& e : all) {
+    deliver(&feed, e);
+    // Released between positions, but not every axis has been along the table axis yet.
+    if (!(feed.axesAlongTable()[0] && feed.axesAlongTable()[1])) ASSERT_FALSE(feed.shouldFinish());
+  }
+  EXPECT_FALSE(feed.shouldFinish());  // the last position is still locked
+  // The operator releases the fixture; the table keeps logging at rest.
+  FixtureRecord released = *feed.fixture();
+  released.locked = false;
+  const Nanoseconds end = all.back().stamp;
+  released.stamp = end + toNanoseconds(0.005);
+  feed.addFixture(released);
+  bool finished_at_idle = false;
+  for (int k = 1; k <= 3000; ++k) {
+    const Nanoseconds t = end + toNanoseconds(0.005 * k);
+    feed.addTurntable(t, 0.0, 0.0, 1000000 + k);
+    for (int i = 0; i < 3; ++i) feed.addWave(i, t, 0.0, NAN);
+    if (feed.shouldFinish()) {
+      // The idle time is counted on the records fed, which trail the newest by the hold.
+      const double idle = toSeconds(t - released.stamp);
+      EXPECT_GE(idle, settings.auto_finish_idle);
+      EXPECT_LE(idle, settings.auto_finish_idle + settings.hold + 0.05);
+      finished_at_idle = true;
+      break;
+    }
+  }
+  EXPECT_TRUE(finished_at_idle);
+}
+
+TEST(TriadFeedTest, NoAutoFinishWhileAnAxisWasNeverAlongTheTable) {
+  TriadFeedSettings settings;
+  settings.hold = 0.5;
+  settings.auto_finish_idle = 1.0;
+  TriadFeed feed = makeFeed(settings);
+  // Only +z and -z: x and y never along the table axis, although the fixture is released between.
+  const std::vector<Event>& all = session();
+  for (std::size_t k = 0; k < all.size() / 3; ++k) {
+    deliver(&feed, all[k]);
+    ASSERT_FALSE(feed.shouldFinish());
+  }
+  EXPECT_GE(feed.lockedPositions(), 2u);
+  EXPECT_FALSE(feed.axesAlongTable()[0]);
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro

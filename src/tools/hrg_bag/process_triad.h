@@ -1,0 +1,40 @@
+// hrg_bag process --triad: three gyros' channels through three processors and the triad combiner,
+// offline. The same core objects and message conversions as the live processor and triad nodes
+// (GyroProcessor, RateNoiseEstimator for the variance each processor's Imu carries, TriadCombiner),
+// so the TriadOutput stream is bit for bit the triad node's on the same channels.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "hrg_gyro/core/processing/gyro_processor.h"
+#include "hrg_gyro/core/processing/rate_noise_estimator.h"
+#include "hrg_gyro/core/processing/triad_combiner.h"
+
+namespace hrg_gyro {
+namespace bag_tools {
+
+/// What --triad adds to the single-axis options of process.
+struct TriadOptions {
+  std::string triad_file;
+  std::vector<std::string> axis_params;    ///< NAME=FILE, each axis's parameter file
+  std::vector<std::string> axis_channels;  ///< NAME=TOPIC, an axis's channels (default /NAME/channels)
+  core::RateNoiseSettings noise;           ///< each axis's, as its processor node's
+  core::TriadCombinerSettings combiner;    ///< as the triad node's
+};
+
+/// --triad, --axis-params, --axis-channels (the forms of hrg_bag calibrate --method triad) and the
+/// triad node's settings as options (--stamp-tolerance, --max-wait, --max-pending,
+/// --angular-velocity-variance, --initial-angular-velocity-variance). Returns the --triad option.
+CLI::Option* addTriadOptions(CLI::App& command, TriadOptions* options);
+
+/// Runs the triad on `bag`: each axis of the triad file needs its --axis-params NAME=FILE; its
+/// channels are --axis-channels NAME=TOPIC, or the bag's /NAME/channels (or the one
+/// ChannelAmplitudes topic ending in /NAME/channels). `out`: /triad/output, /imu/data_raw and each
+/// /NAME/output; `csv`: one row per triad sample. Returns the exit code.
+int runTriadProcess(const std::string& bag, const std::string& out, const std::string& csv,
+                    const std::string& compression, const core::ProcessorConfig& processor, const TriadOptions& triad);
+
+}  // namespace bag_tools
+}  // namespace hrg_gyro
