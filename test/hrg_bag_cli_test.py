@@ -495,7 +495,7 @@ class HrgBagCli(unittest.TestCase):
             match = re.search(r"unknown method 'x' \(([a-z_, ]+)\)", refused[2])
             self.assertTrue(match, "%s: %s" % (tool, refused[2]))
             methods = match.group(1).split(", ")
-            self.assertEqual(len(methods), 6, methods)  # with the triad calibration
+            self.assertEqual(len(methods), 7, methods)  # with the triad and the field calibrations
             self.assertIn("|".join(methods), helped[1], tool)
 
     def test_calibrate_config_errors_name_the_file_and_key(self):
