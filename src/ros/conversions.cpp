@@ -223,6 +223,21 @@ core::HarmonicFitResult fromMessage(const HarmonicEstimate& m) {
   return f;
 }
 
+std::vector<QualityGate> toMessages(const std::vector<core::GateResult>& gates) {
+  std::vector<QualityGate> out;
+  out.reserve(gates.size());
+  for (const core::GateResult& g : gates) {
+    QualityGate q;
+    q.name = g.name;
+    q.passed = g.passed;
+    q.value = g.value;
+    q.limit = g.limit;
+    q.message = g.message;
+    out.push_back(q);
+  }
+  return out;
+}
+
 CalibrationResult toMessage(const core::CalibrationOutcome& o, bool written, const std::string& file,
                             const ros::Time& stamp) {
   CalibrationResult m;
@@ -258,15 +273,7 @@ CalibrationResult toMessage(const core::CalibrationOutcome& o, bool written, con
     p.turns = g.turns;
     m.plateaus.push_back(p);
   }
-  for (const core::GateResult& g : o.gates) {
-    QualityGate q;
-    q.name = g.name;
-    q.passed = g.passed;
-    q.value = g.value;
-    q.limit = g.limit;
-    q.message = g.message;
-    m.gates.push_back(q);
-  }
+  m.gates = toMessages(o.gates);
   for (const core::DefectDiagnosis& d : o.diagnosis) {
     DefectDiagnosis x;
     x.frequency = d.frequency;

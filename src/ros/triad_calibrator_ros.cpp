@@ -393,15 +393,7 @@ bool TriadCalibratorRos::finishRun(std::string* message) {
     r.axis_nonlinearity_ppm[i] = o.axes[i].nonlinearity_ppm;
     r.axis_reasons.push_back(o.axes[i].accepted ? std::string() : o.axes[i].reason);
   }
-  for (const core::GateResult& g : o.gates) {
-    QualityGate q;
-    q.name = g.name;
-    q.passed = g.passed;
-    q.value = g.value;
-    q.limit = g.limit;
-    q.message = g.message;
-    r.gates.push_back(q);
-  }
+  r.gates = toMessages(o.gates);
   r.notes = o.notes;
   r.duration = duration;
 

@@ -5,6 +5,7 @@
 #include <sensor_msgs/Imu.h>
 
 #include <string>
+#include <vector>
 
 #include "hrg_gyro/BodyTruth.h"
 #include "hrg_gyro/CalibrationResult.h"
@@ -77,6 +78,8 @@ inline std::string triadAxisTopic(const std::string& axis, const std::string& st
 HarmonicEstimate toMessage(const core::HarmonicFitResult& fit, double frequency);
 core::HarmonicFitResult fromMessage(const HarmonicEstimate& msg);
 
+/// The calibration's gates as messages (single-axis and triad results alike).
+std::vector<QualityGate> toMessages(const std::vector<core::GateResult>& gates);
 /// The outcome as a message; `written` and `file` say what happened to the parameter file.
 CalibrationResult toMessage(const core::CalibrationOutcome& outcome, bool written, const std::string& file,
                             const ros::Time& stamp);

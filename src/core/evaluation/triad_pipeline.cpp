@@ -1,5 +1,11 @@
 #include "hrg_gyro/core/evaluation/triad_pipeline.h"
 
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "hrg_gyro/core/simulation/triad_motion.h"
+
 namespace hrg_gyro {
 namespace core {
 
@@ -40,6 +46,123 @@ OfflineTriadCalibration calibrateOnTriadSimulation(const TriadSimulationConfig& 
   for (int i = 0; i < 3; ++i) out.processors[i] = processors[i]->counters();
   out.simulated_seconds = sim.duration();
   return out;
+}
+
+namespace {
+
+/// One set of files on the simulated triad: its processors, its combiner, its sums per segment.
+struct VerifiedChain {
+  std::array<std::unique_ptr<GyroProcessor>, 3> processors;
+  std::unique_ptr<TriadCombiner> combiner;
+  std::vector<Eigen::Vector3d> published, exact;  // rad, summed increments per segment
+  std::vector<double> seconds;
+  std::vector<TriadBodySample> completed;
+};
+
+struct Window {
+  double begin, end;  // s from the scenario start
+};
+
+}  // namespace
+
+std::vector<TriadVerification> verifyTriadOnSimulation(const TriadSimulationConfig& scenario,
+                                                       const std::vector<TriadCalibrationFiles>& files,
+                                                       const ProcessorConfig& processor, double margin) {
+  const TriadMotion motion(scenario);
+  std::vector<TriadVerificationSegment> segments;
+  std::vector<Window> windows;
+  for (const TurntableProfile::Piece& piece : scenario.table_profile.pieces()) {
+    const bool move = piece.label.size() >= 5 && piece.label.compare(piece.label.size() - 5, 5, "/move") == 0;
+    if (move || piece.accel != 0.0 || piece.duration <= 2.0 * margin) continue;
+    TriadVerificationSegment segment;
+    segment.label = piece.label;
+    segment.table_rate = piece.rate0;
+    segment.position = motion.stateAt(piece.start + 0.5 * piece.duration).position;
+    segments.push_back(segment);
+    windows.push_back({piece.start + margin, piece.start + piece.duration - margin});
+  }
+
+  std::vector<VerifiedChain> chains(files.size());
+  for (std::size_t c = 0; c < files.size(); ++c) {
+    for (int i = 0; i < 3; ++i)
+      chains[c].processors[i] =
+          std::make_unique<GyroProcessor>(processor, std::make_shared<const GyroParameters>(files[c].axes[i]));
+    chains[c].combiner = std::make_unique<TriadCombiner>(TriadCombinerSettings(),
+                                                         std::make_shared<const TriadParameters>(files[c].triad));
+    chains[c].published.assign(segments.size(), Eigen::Vector3d::Zero());
+    chains[c].exact.assign(segments.size(), Eigen::Vector3d::Zero());
+    chains[c].seconds.assign(segments.size(), 0.0);
+  }
+
+  // A combined sample belongs to the segment whose window holds its whole interval.
+  std::size_t cursor = 0;
+  auto accumulate = [&](VerifiedChain* chain) {
+    for (const TriadBodySample& b : chain->completed) {
+      if (!b.integrated()) continue;
+      const double t_end = 1e-9 * static_cast<double>(b.stamp) - scenario.start_time;
+      const double t_begin = t_end - b.dt;
+      std::size_t k = cursor;
+      while (k < windows.size() && windows[k].end < t_end) ++k;
+      if (k == windows.size() || t_begin < windows[k].begin) continue;
+      chain->published[k] += b.delta_angle;
+      chain->exact[k] += motion.angularVelocityAt(t_end - 0.5 * b.dt) * b.dt;
+      chain->seconds[k] += b.dt;
+    }
+    chain->completed.clear();
+  };
+
+  TriadSimulator sim(scenario);
+  TriadSample s;
+  while (sim.next(&s)) {
+    const double t = 1e-9 * static_cast<double>(s.stamp) - scenario.start_time;
+    while (cursor < windows.size() && windows[cursor].end < t - 1.0) ++cursor;  // samples arrive within 1 s
+    for (VerifiedChain& chain : chains) {
+      for (std::size_t i = 0; i < 3; ++i) {
+        const SimulationSample& a = s.axes[i];
+        if (!a.channels_delivered) continue;
+        const ProcessorResult r = chain.processors[i]->process({a.stamp, a.z, a.frequency, a.temperature});
+        if (!r.has_output) continue;
+        AxisOutput out;
+        out.stamp = a.stamp;
+        out.dt = r.increment.dt;
+        out.dalpha = r.increment.dalpha;
+        out.flags = r.flags;
+        chain.combiner->add(i, out, &chain.completed);
+      }
+      accumulate(&chain);
+    }
+  }
+
+  std::vector<TriadVerification> results(files.size());
+  for (std::size_t c = 0; c < files.size(); ++c) {
+    VerifiedChain& chain = chains[c];
+    cursor = 0;
+    chain.combiner->flush(&chain.completed);
+    accumulate(&chain);
+    TriadVerification& v = results[c];
+    v.name = files[c].name;
+    v.combiner = chain.combiner->counters();
+    double sum_square = 0.0;
+    int turning = 0;
+    for (std::size_t k = 0; k < segments.size(); ++k) {
+      if (!(chain.seconds[k] > 0.0)) continue;
+      TriadVerificationSegment segment = segments[k];
+      segment.seconds = chain.seconds[k];
+      segment.mean_rate = chain.exact[k] / chain.seconds[k];
+      segment.mean_error = (chain.published[k] - chain.exact[k]) / chain.seconds[k];
+      if (segment.turning()) {
+        const double ppm = segment.relativeErrorPpm();
+        v.worst_turning_ppm = std::max(v.worst_turning_ppm, ppm);
+        sum_square += ppm * ppm;
+        ++turning;
+      } else {
+        v.worst_rest_error = std::max(v.worst_rest_error, segment.mean_error.norm());
+      }
+      v.segments.push_back(segment);
+    }
+    if (turning > 0) v.rms_turning_ppm = std::sqrt(sum_square / turning);
+  }
+  return results;
 }
 
 }  // namespace core
