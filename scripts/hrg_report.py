@@ -7,7 +7,9 @@
 REPORT.yaml is the calibration report (`hrg_bag calibrate --report`, or the calibrator node's
 <parameter file>.<method>.report.yaml). A triad's report (method triad) gets a page of its own: the
 axis matrix with its misalignment angles, the positions' responses, the body bias against the Earth's
-rate and each axis's K(theta); it is drawn from the YAML alone (no --bag, --params, --verification). With --bag, the session's turntable profile and temperature
+rate and each axis's K(theta); it is drawn from the YAML alone (no --bag, --params, --verification).
+A field calibration's report (method field: a still gyro whose precession loop turned the wave) shows
+D(theta), the realised gain of the virtual rate G_v(theta) and says that K was kept from the prior. With --bag, the session's turntable profile and temperature
 are drawn from the bag, and the Allan deviation of the compensated rate is computed over the bag's
 longest rest (or --rest FROM TO, channel stamps in s) by `hrg_bag allan`, which runs the package's
 processor with the calibrated parameters (--params, else the parameters in the report, else the
@@ -326,24 +328,35 @@ def validate_report(report, path):
         f.number(report, key)
     f.count(report, "samples")
     f.numbers(report, "frequency_nodes", optional=True)
+    def harmonic_fit(fit, here, nonzero=False):
+        orders = f.get(fit, "orders", here)
+        if not isinstance(orders, list):
+            f.fail(f.path(here, "orders"), "a list of whole numbers", orders)
+        for i in range(len(orders)):
+            f.count(orders, i, f.path(here, "orders"), minimum=1)
+        f.number(fit, "frequency", here, optional=True)
+        # K0 divides every figure in ppm: zero or non-finite would end in a division by zero or NaNs.
+        f.number(fit, "mean", here, finite=True, nonzero=nonzero)
+        f.number(fit, "mean_std", here, minimum=0.0)
+        length = (len(orders), f.path(here, "orders"))
+        for key in ("cos", "sin"):
+            f.numbers(fit, key, here, length=length, finite=True)
+        for key in ("cos_std", "sin_std"):
+            f.numbers(fit, key, here, length=length, minimum=0.0)
+        f.number(fit, "residual_rms", here, minimum=0.0)
+        f.count(fit, "points", here)
+
     for part in ("scale_factor", "drift"):
         for here, fit in f.items(report, part):
-            orders = f.get(fit, "orders", here)
-            if not isinstance(orders, list):
-                f.fail(f.path(here, "orders"), "a list of whole numbers", orders)
-            for i in range(len(orders)):
-                f.count(orders, i, f.path(here, "orders"), minimum=1)
-            f.number(fit, "frequency", here, optional=True)
-            # K0 divides every figure in ppm: zero or non-finite would end in a division by zero or NaNs.
-            f.number(fit, "mean", here, finite=True, nonzero=part == "scale_factor")
-            f.number(fit, "mean_std", here, minimum=0.0)
-            length = (len(orders), f.path(here, "orders"))
-            for key in ("cos", "sin"):
-                f.numbers(fit, key, here, length=length, finite=True)
-            for key in ("cos_std", "sin_std"):
-                f.numbers(fit, key, here, length=length, minimum=0.0)
-            f.number(fit, "residual_rms", here, minimum=0.0)
-            f.count(fit, "points", here)
+            harmonic_fit(fit, here, nonzero=part == "scale_factor")
+    if report["method"] == "field" or "field" in report:  # the virtual rotation of a still gyro
+        field = f.mapping(report, "field")
+        # The gain divides the amplitudes in ppm: zero would end in a division by zero.
+        harmonic_fit(f.mapping(field, "virtual_rate_gain", "field"), "field.virtual_rate_gain", nonzero=True)
+        harmonic_fit(f.mapping(field, "measured_drift", "field"), "field.measured_drift")
+        for key in ("earth_rate", "k0_prior", "positive_rate", "negative_rate", "positive_turns", "negative_turns",
+                    "positive_time", "negative_time", "excess_scatter"):
+            f.number(field, key, "field", finite=True)
     f.count(report, "turntable_records")
     rejected = f.mapping(report, "turntable_rejected")
     for key in rejected:
@@ -871,6 +884,7 @@ def build(args):
            "report_path": os.path.basename(args.report), "bag_path": os.path.basename(args.bag) if args.bag else None,
            "r": report, "frequency_note": frequency_note, "band_sigma": band_sigma,
            "k_rows": harmonic_rows(k_est, k_est["mean"]) if k_est else [],
+           "field": None,
            "d_rows": harmonic_rows(d_est) if d_est else [],
            "k_figure": None, "d_figure": None, "nonlinearity": None, "verification": verification,
            "session": None, "profile_figure": None, "temperature_figure": None, "rest": None,
@@ -885,6 +899,12 @@ def build(args):
                                "after_rms": 1e6 * k_est["residual_rms"] / abs(k0)}
     if d_est:
         ctx["d_figure"] = model_figure(theta, binned.get("d"), d_est, None, 1e6, "D (urad/s)", band_sigma)
+    if "field" in report:
+        # The binned k of a field session is the realised gain of the virtual rate, G_v(theta).
+        gain = report["field"]["virtual_rate_gain"]
+        ctx["field"] = {"gain_rows": harmonic_rows(gain, gain["mean"]),
+                        "gain_figure": model_figure(theta, binned.get("k"), gain, gain["mean"], None,
+                                                    "G_v / G_v0 - 1 (ppm)", band_sigma)}
 
     params_path, work = args.params, tempfile.mkdtemp(prefix="hrg_report.")
     try:

@@ -166,6 +166,35 @@ class HrgBagCli(unittest.TestCase):
         self.assertAlmostEqual(mean, 0.1, delta=5 * 0.002 / math.sqrt(n))
         self.assertAlmostEqual(std, 0.002, delta=5 * 0.002 / math.sqrt(2 * n))
 
+    def test_simulate_writes_the_precession_commands_and_state(self):
+        # A gyro with a precession loop (the averaged resonator): the schedule's commands on
+        # /command/precession at the carrier period that took each up, as a commanding node sends them,
+        # and the loop's state with every channel sample (the rate in force and its integral).
+        with open(os.path.join(self.pkg, "test/scenarios/precession_short.yaml")) as f:
+            scenario = f.read()
+        scenario = scenario.replace("  commands: []", "  commands: [{time: 1.0, rate: 0.4}, {time: 3.0, rate: -0.2}]")
+        scenario = scenario.replace("duration: 90.0", "duration: 5.0")
+        path, bag_path = self.path("precession.yaml"), self.path("precession.bag")
+        with open(path, "w") as f:
+            f.write(scenario)
+        code, _, err = hrg_bag("simulate", "--scenario", path, "--out", bag_path, "--no-truth")
+        self.assertEqual(code, 0, err)
+        with rosbag.Bag(bag_path) as bag:
+            info = bag.get_type_and_topic_info().topics
+            commands = [(t.to_sec(), m) for _, m, t in bag.read_messages(topics=["/command/precession"])]
+            states = [m for _, m, _ in bag.read_messages(topics=["/precession/state"])]
+        self.assertEqual(info["/command/precession"].msg_type, "hrg_gyro/PrecessionCommand")
+        self.assertEqual(info["/precession/state"].msg_type, "hrg_gyro/PrecessionState")
+        self.assertEqual(info["/precession/state"].message_count, info["/channels"].message_count)
+        self.assertEqual([m.rate for _, m in commands], [0.4, -0.2])
+        for (t, m), due in zip(commands, (1.0, 3.0)):
+            self.assertAlmostEqual(t, 1.0 + due, delta=1e-6)  # start_time 1.0
+            self.assertAlmostEqual(m.header.stamp.to_sec(), t, delta=1e-9)
+        last = states[-1]
+        self.assertEqual((last.rate, last.commands), (-0.2, 2))
+        # At the last sample's centre (4.9975 s): 0.4 rad/s for 2 s, then -0.2 rad/s for 1.9975 s.
+        self.assertAlmostEqual(last.angle, 0.4 * 2.0 - 0.2 * 1.9975, delta=1e-9)
+
     def test_simulate_writes_a_triads_topics(self):
         # A triad scenario: exactly each axis's channels and truth under its name, the table, the
         # fixture's log and the body's truth; --no-truth drops the truths; --seed draws the noise and
@@ -468,7 +497,7 @@ class HrgBagCli(unittest.TestCase):
             match = re.search(r"unknown method 'x' \(([a-z_, ]+)\)", refused[2])
             self.assertTrue(match, "%s: %s" % (tool, refused[2]))
             methods = match.group(1).split(", ")
-            self.assertEqual(len(methods), 6, methods)  # with the triad calibration
+            self.assertEqual(len(methods), 7, methods)  # with the triad and the field calibrations
             listed = [m for m in methods if not (single_axis and m == "triad")]
             self.assertIn("|".join(listed) + ("\n" if single_axis else ""), helped[1], tool)
         triad = run(HRG_SESSION, *(common + ["--method", "triad"]))

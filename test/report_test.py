@@ -167,6 +167,71 @@ class ReportTest(unittest.TestCase):
                              "--report", report)
         return code, params, report, out + err
 
+    def check_shown_numbers(self, page, report_path):
+        """Every number the page shows with its data-q equals the report YAML's, to the digits shown."""
+        with open(report_path) as f:
+            report = yaml.load(f, Loader=self.report_module.Loader)
+        checked = 0
+        for q, shown in page.by_q.items():
+            expected = lookup(report, q)
+            if isinstance(expected, str):
+                self.assertEqual(shown, expected, q)
+            elif isinstance(expected, int) and not isinstance(expected, bool):
+                self.assertEqual(int(shown), expected, q)
+            else:
+                digits = len(re.sub(r"[^0-9]", "", re.split(r"e", shown.lstrip("-"))[0]).lstrip("0")) or 1
+                self.assertEqual(float(shown), float("%.*g" % (digits, expected)), "%s: page %s, YAML %r" %
+                                 (q, shown, expected))
+            checked += 1
+        return report, checked
+
+    def test_a_field_calibration_shows_the_gain_the_drift_and_that_k_was_kept(self):
+        # A still gyro whose precession loop turned the wave both ways (config/scenarios/resonator_field.yaml).
+        bag = self.path("field.bag")
+        code, _, err = run(HRG_BAG, "simulate", "--scenario", os.path.join(self.pkg, "config", "scenarios",
+                                                                            "resonator_field.yaml"), "--out", bag)
+        self.assertEqual(code, 0, err)
+        params, report_path = self.path("field.params.yaml"), self.path("field.report.yaml")
+        code, out, err = run(HRG_BAG, "calibrate", bag, "--method", "field", "--params", self.prior, "--out", params,
+                             "--report", report_path)
+        self.assertEqual(code, 0, out + err)
+        html_path = self.path("field.html")
+        code, stdout, err = run("/usr/bin/python3", self.script, report_path, "--out", html_path)
+        self.assertEqual(code, 0, err)
+        self.assertIn("ACCEPTED", stdout)
+        code, page, err = render(html_path, self.work)
+        self.assertEqual(code, 0, err[-2000:])
+        console = [line for line in err.splitlines() if "CONSOLE" in line or "net::ERR" in line]
+        self.assertEqual(console, [], "the page logged errors")
+        self.assertEqual(page.body.get("data-images"), "2/2", "every figure decoded (D and the virtual rate's gain)")
+        report, checked = self.check_shown_numbers(page, report_path)
+        self.assertEqual(report["method"], "field")
+        self.assertEqual(report["scale_factor"], [], "K is not estimated by a field calibration")
+        gain, d = report["field"]["virtual_rate_gain"], report["drift"][0]
+        # The gain's and D's every coefficient with its standard error, the field's own figures.
+        for i in range(len(gain["orders"])):
+            for key in ("cos", "cos_std", "sin", "sin_std"):
+                self.assertIn("field.virtual_rate_gain.%s.%d" % (key, i), page.by_q)
+        for i in range(len(d["orders"])):
+            for key in ("cos", "cos_std", "sin", "sin_std"):
+                self.assertIn("drift.0.%s.%d" % (key, i), page.by_q)
+        for key in ("field.virtual_rate_gain.mean", "field.virtual_rate_gain.mean_std", "drift.0.mean",
+                    "drift.0.mean_std", "field.k0_prior", "field.earth_rate", "field.positive_turns",
+                    "field.negative_turns", "field.excess_scatter"):
+            self.assertIn(key, page.by_q)
+        self.assertIn("K was kept from the table calibration", page.by_id["k-kept"])
+        self.assertNotIn("harmonics-scale_factor", page.by_id, "no K table: K was not estimated")
+        # The page says the gain the simulated drive realised (1 + virtual_rate_gain_error = 1.003, within
+        # the loop's theta-dependent part) and the prior's K0 it kept.
+        self.assertAlmostEqual(float(page.by_q["field.virtual_rate_gain.mean"]), 1.003, delta=1e-3)
+        with open(params) as f:
+            written = f.read()
+        with open(self.prior) as f:
+            prior = yaml.safe_load(f)
+        self.assertEqual(yaml.safe_load(written)["scale_factor"], prior["scale_factor"], "K kept from the prior")
+        print("report test: field page, %d numbers checked; G_v0 %s +- %s" %
+              (checked, page.by_q["field.virtual_rate_gain.mean"], page.by_q["field.virtual_rate_gain.mean_std"]))
+
     def test_the_page_shows_the_numbers_of_the_calibration_report(self):
         code, params, report_path, log = self.calibrate("quiet")
         self.assertEqual(code, 0, log)
@@ -189,20 +254,7 @@ class ReportTest(unittest.TestCase):
         self.assertEqual(page.body.get("data-images"), "4/4", "every figure decoded (profile, K, D, Allan)")
         self.assertTrue(all(link.startswith("data:image/png;base64,") for link in page.links), page.links[:3])
 
-        with open(report_path) as f:
-            report = yaml.load(f, Loader=self.report_module.Loader)
-        checked = 0
-        for q, shown in page.by_q.items():
-            expected = lookup(report, q)
-            if isinstance(expected, str):
-                self.assertEqual(shown, expected, q)
-            elif isinstance(expected, int) and not isinstance(expected, bool):
-                self.assertEqual(int(shown), expected, q)
-            else:
-                digits = len(re.sub(r"[^0-9]", "", re.split(r"e", shown.lstrip("-"))[0]).lstrip("0")) or 1
-                self.assertEqual(float(shown), float("%.*g" % (digits, expected)), "%s: page %s, YAML %r" %
-                                 (q, shown, expected))
-            checked += 1
+        report, checked = self.check_shown_numbers(page, report_path)
         # Every harmonic coefficient and its standard error, every gate, every plateau, the diagnosis.
         k = report["scale_factor"][0]
         self.assertGreaterEqual(checked, 4 * len(k["orders"]) * 2 + 2 * len(report["gates"]) + 6 * len(

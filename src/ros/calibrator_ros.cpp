@@ -1,11 +1,13 @@
 #include "hrg_gyro/ros/calibrator_ros.h"
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <thread>
 
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/ModelInfo.h"
+#include "hrg_gyro/PrecessionCommand.h"
 #include "hrg_gyro/core/calibration/triad_calibration.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/output_directory.h"
@@ -101,6 +103,11 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   turntable_sub_ = in.subscribe("turntable/state", queue_size, &CalibratorRos::onTurntable, this,
                                 ros::TransportHints().tcpNoDelay());
   wave_sub_ = in.subscribe("wave", queue_size, &CalibratorRos::onWave, this, ros::TransportHints().tcpNoDelay());
+  // The field method's streams: the precession loop's state in, its commands out (for every method,
+  // since ~start may choose field; a driver without the loop publishes no state).
+  precession_sub_ = in.subscribe("precession/state", queue_size, &CalibratorRos::onPrecession, this,
+                                 ros::TransportHints().tcpNoDelay());
+  command_pub_ = nh_.advertise<PrecessionCommand>("command/precession", 10);
   if (calibration_->usesGeneratorPairs()) {
     channels_sub_ =
         in.subscribe("channels", queue_size, &CalibratorRos::onChannels, this, ros::TransportHints().tcpNoDelay());
@@ -143,6 +150,7 @@ CalibratorRos::~CalibratorRos() {
   wave_sub_.shutdown();
   channels_sub_.shutdown();
   truth_sub_.shutdown();
+  precession_sub_.shutdown();
   input_.stop();
   {
     std::lock_guard<std::mutex> lock(reload_mutex_);
@@ -217,6 +225,17 @@ bool CalibratorRos::startRun(bool restart, std::string* reason) {
     skip_waves_until_ = ros::Time();
     sweep_end_ = last_channels_stamp_ = ros::Time();
     pairing_.clear();
+    field_plan_.clear();
+    field_next_ = 0;
+    field_start_ = ros::Time();
+    if (fieldRun()) {
+      field_plan_ = core::fieldCommandPlan(session()->settings());
+      ROS_INFO(
+          "calibrator: field: %zu segments at %g rad/s planned over %.1f s of stream time, from the first "
+          "precession state while the driver listens on %s",
+          session()->settings().field.directions.size(), session()->settings().field.rate, field_plan_.back().time,
+          command_pub_.getTopic().c_str());
+    }
     ROS_INFO("calibrator: %s run started (prior %s)", method.c_str(), parameter_file_.c_str());
     return true;
   } catch (const std::exception& e) {
@@ -237,11 +256,49 @@ void CalibratorRos::noteRestart(std::uint64_t restarts_before) {
   skip_waves_until_ = ros::Time();
   sweep_end_ = last_channels_stamp_ = ros::Time();
   pairing_.clear();
+  if (!field_plan_.empty()) {
+    // The field plan starts over with the run, from the next precession state.
+    stopFieldPlan("its run restarted");
+    field_next_ = 0;
+    field_start_ = ros::Time();
+  }
+}
+
+void CalibratorRos::publishPrecession(double rate) {
+  PrecessionCommand command;
+  command.header.stamp = ros::Time::now();
+  command.rate = rate;
+  command_pub_.publish(command);
+  ++field_commands_sent_;
+}
+
+void CalibratorRos::advanceFieldPlan(const ros::Time& now) {
+  if (field_plan_.empty() || field_next_ >= field_plan_.size()) return;
+  if (field_start_.isZero()) {
+    // Commands sent before the driver listens would be lost: the plan waits for it.
+    if (command_pub_.getNumSubscribers() == 0) return;
+    field_start_ = now;
+  }
+  const double elapsed = (now - field_start_).toSec();
+  while (field_next_ < field_plan_.size() && field_plan_[field_next_].time <= elapsed) {
+    const core::PlannedPrecession& p = field_plan_[field_next_++];
+    publishPrecession(p.rate);
+    ROS_INFO("calibrator: field: virtual rotation at %g rad/s commanded (%zu of %zu, %.1f s into the plan)", p.rate,
+             field_next_, field_plan_.size(), elapsed);
+  }
+}
+
+void CalibratorRos::stopFieldPlan(const char* why) {
+  // Between its first and its last command the plan has the wave turning: stop it.
+  if (field_next_ == 0 || field_next_ >= field_plan_.size()) return;
+  publishPrecession(0.0);
+  field_next_ = field_plan_.size();
+  ROS_WARN("calibrator: field: virtual rotation stopped (rate 0 commanded): %s before the plan's end", why);
 }
 
 void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!session()) return;
+  if (!session() || fieldRun()) return;  // the field method's rotation is the precession loop's
   if (!sweep_end_.isZero() && (msg->header.stamp - sweep_end_).toSec() > kSweepChannelsWait) {
     ROS_WARN(
         "calibrator: the raw channels did not reach the end of the generator sweep within %.0f s; "
@@ -250,8 +307,19 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
     endGeneratorSweep();
     if (!session()) return;
   }
+  addRotationRecord(msg->header.stamp, msg->angle, msg->rate, msg->header.seq);
+}
+
+void CalibratorRos::onPrecession(const PrecessionState::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!fieldRun()) return;
+  addRotationRecord(msg->header.stamp, msg->angle, msg->rate, msg->header.seq);
+  if (session()) advanceFieldPlan(msg->header.stamp);
+}
+
+void CalibratorRos::addRotationRecord(const ros::Time& stamp, double angle, double rate, std::uint32_t seq) {
   const std::uint64_t restarts = session()->counters().restarts;
-  session()->addTurntable(toNanoseconds(msg->header.stamp), msg->angle, msg->rate, msg->header.seq);
+  session()->addTurntable(toNanoseconds(stamp), angle, rate, seq);
   noteRestart(restarts);
   if (session()->shouldFinish()) {
     bool written = false;
@@ -310,6 +378,7 @@ void CalibratorRos::endGeneratorSweep() {
 }
 
 core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* message) {
+  stopFieldPlan("the run finished");
   core::CalibrationOutcome o = calibration_->finishStage();
   *written = false;
   if (o.accepted && write_) {
@@ -337,7 +406,12 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
   ++runs_;
   last_accepted_ = o.accepted && *written;
   last_result_ = *message;
-  if (*written) {
+  if (*written && o.field.present) {
+    // The field method estimates no K: say what it measured instead.
+    ROS_INFO("calibrator: %s %s (D0 %.4g rad/s, virtual rate gain %.7f, K kept from the prior)",
+             core::nameOf(o.method).c_str(), message->c_str(), o.drift.empty() ? NAN : o.drift[0].mean,
+             o.field.virtual_rate_gain.mean);
+  } else if (*written) {
     ROS_INFO("calibrator: %s %s (peak nonlinearity of the new K: %.1f ppm, coverage %.1f %%)",
              core::nameOf(o.method).c_str(), message->c_str(), o.nonlinearity_ppm, 100 * o.coverage);
   } else {
@@ -404,6 +478,7 @@ bool CalibratorRos::onAbort(std_srvs::Trigger::Request&, std_srvs::Trigger::Resp
   res.success = session() != nullptr;
   res.message =
       session() ? "aborted " + core::nameOf(session()->settings().method) + ": nothing written" : "no run in progress";
+  stopFieldPlan("the run was aborted");
   calibration_->abort();
   return true;
 }
@@ -414,7 +489,9 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
     const core::CalibrationProgress p = session()->progress();
     const core::SessionCounters& c = session()->counters();
     if (c.turntable == 0 && c.wave > 100) {
-      stat.summary(DiagnosticStatus::WARN, "wave samples but no turntable state: check turntable/state");
+      stat.summary(DiagnosticStatus::WARN, fieldRun() ? "wave samples but no precession state: check "
+                                                        "precession/state (a driver whose gyro has the loop)"
+                                                      : "wave samples but no turntable state: check turntable/state");
     } else if (resets_ > reported_resets_) {
       stat.summaryf(DiagnosticStatus::WARN, "time went backwards: run restarted; %s %.0f %%", p.summary.c_str(),
                     100 * p.fraction);
@@ -435,6 +512,11 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
     stat.add("turntable dropped (zero stamp)", c.rejected.bad_stamp);
     stat.add("turntable dropped (duplicate stamp)", c.rejected.duplicate);
     stat.add("turntable dropped (out-of-order stamp)", c.rejected.out_of_order);
+    if (!field_plan_.empty()) {
+      stat.add("field commands sent", field_commands_sent_);
+      stat.add("field commands planned", field_plan_.size());
+      stat.add("field plan started", !field_start_.isZero());
+    }
   } else if (runs_ > 0 && !last_accepted_) {
     stat.summary(DiagnosticStatus::WARN, "idle; last run " + last_result_);
   } else {

@@ -137,6 +137,24 @@ GroundTruth toTruthMessage(const core::SimulationSample& s, const std_msgs::Head
   return t;
 }
 
+PrecessionState toPrecessionStateMessage(const core::SimulationSample& s, const std_msgs::Header& header) {
+  PrecessionState m;
+  m.header = header;
+  m.rate = s.precession.rate;
+  m.angle = s.precession.angle;
+  m.commands = static_cast<std::uint32_t>(s.precession.commands);
+  return m;
+}
+
+PrecessionCommand toPrecessionCommandMessage(const core::AppliedPrecession& command, const ros::Time& stamp,
+                                             const std::string& frame_id) {
+  PrecessionCommand m;
+  m.header.stamp = stamp;
+  m.header.frame_id = frame_id;
+  m.rate = command.rate;
+  return m;
+}
+
 namespace {
 
 geometry_msgs::Quaternion toQuaternionMessage(const Eigen::Quaterniond& q) {

@@ -32,8 +32,9 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
     start_time_ = config_->start_time;
   }
   // The scenario sections are the core parser's (it refuses unknown keys in them).
-  params_.claim(
-      {"seed", "start_time", "resonator", "pickoff", "turntable", "generator", "thermal", "channels", "triad"}, true);
+  params_.claim({"seed", "start_time", "resonator", "pickoff", "turntable", "generator", "thermal", "channels", "triad",
+                 "dynamics"},
+                true);
   time_scale_ = params_.get("time_scale", time_scale_);
   // clock_period: "auto" (the template's value) or unset means: with every output sample, but no
   // more often than kFinestAutoClockPeriod. A consumer's timer under sim time fires only when /clock
@@ -103,7 +104,11 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   } else {
     channels_pub_ = nh_.advertise<ChannelAmplitudes>("channels", queue_size);
     truth_pub_ = nh_.advertise<GroundTruth>("truth", queue_size);
+    has_precession_loop_ = config_->dynamics.averaged();
+    if (has_precession_loop_) precession_pub_ = nh_.advertise<PrecessionState>("precession/state", queue_size);
   }
+  // Subscribed either way: a command to a gyro without the loop is answered with a warning.
+  command_sub_ = nh_.subscribe("command/precession", 10, &DriverSimRos::onPrecessionCommand, this);
   done_pub_ = pnh_.advertise<std_msgs::Bool>("done", 1, true);
   if (use_sim_time_ && publish_clock_) clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 100);
   std_msgs::Bool done;
@@ -120,6 +125,40 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
              time_scale_ > 0.0 ? std::to_string(time_scale_).c_str() : "as fast as possible");
   }
   worker_ = std::thread(&DriverSimRos::run, this);
+}
+
+void DriverSimRos::onPrecessionCommand(const PrecessionCommand::ConstPtr& msg) {
+  if (!has_precession_loop_) {
+    // Throttled on the wall clock: under sim time the clock may stand still or start near 0.
+    const ros::WallTime now = ros::WallTime::now();
+    ++ignored_commands_;
+    if (ignored_commands_ == 1 || (now - last_ignored_warning_).toSec() >= 10.0) {
+      last_ignored_warning_ = now;
+      ROS_WARN(
+          "driver_sim: precession command (%g rad/s) ignored (%llu so far): this scenario's gyro has no precession "
+          "loop (its dynamics.model is not averaged; docs/simulation.md)",
+          msg->rate, static_cast<unsigned long long>(ignored_commands_));
+    }
+    return;
+  }
+  if (!std::isfinite(msg->rate) || std::abs(msg->rate) > kMaxPrecessionRate) {
+    ROS_WARN("driver_sim: precession command %g rad/s ignored: not a finite rate within +-%g rad/s", msg->rate,
+             kMaxPrecessionRate);
+    return;
+  }
+  std::lock_guard<std::mutex> lock(command_mutex_);
+  pending_command_ = msg->rate;
+}
+
+void DriverSimRos::takeCommand(core::GyroSimulator& sim) {
+  std::optional<double> rate;
+  {
+    std::lock_guard<std::mutex> lock(command_mutex_);
+    rate.swap(pending_command_);
+  }
+  if (!rate) return;
+  sim.commandVirtualRate(*rate);
+  ROS_INFO("driver_sim: precession at %g rad/s from %.3f s of the scenario", *rate, sim.elapsed());
 }
 
 DriverSimRos::~DriverSimRos() {
@@ -168,6 +207,9 @@ void DriverSimRos::publishSingle(const core::SimulationSample& s, const ros::Tim
   if (truth_pub_.getNumSubscribers() > 0) {
     truth_pub_.publish(boost::make_shared<GroundTruth>(toTruthMessage(s, channels->header)));
   }
+  if (has_precession_loop_) {
+    precession_pub_.publish(boost::make_shared<PrecessionState>(toPrecessionStateMessage(s, channels->header)));
+  }
 }
 
 void DriverSimRos::publishTriad(const core::TriadSample& s, const ros::Time& stamp, core::Nanoseconds origin) {
@@ -209,7 +251,10 @@ void DriverSimRos::play(Simulator& sim, Sample* sample, const Publish& publish) 
   Sample& s = *sample;
   double next_clock = 0.0;
   std::uint32_t seq = 0;
-  while (!stop_ && ros::ok() && sim.next(&s)) {
+  for (;;) {
+    if (stop_ || !ros::ok()) break;
+    takeCommand(sim);
+    if (!sim.next(&s)) break;
     const ros::Time stamp = toRosTime(origin + s.stamp);
     double late = 0.0;
     const double wait = schedule.waitFor(sim.elapsed(), ros::WallTime::now().toSec(), &late);

@@ -9,6 +9,11 @@
 // runs several methods in a row: [correction_matrix, dual_rate] is the paper's two-stage
 // refinement (P first, then the residual K and D measured through the new P). The calibration
 // itself (stages, generator pairing, reports' names) is the core's: this class wires it to ROS.
+//
+// The field method (a still gyro, no table) reads `precession/state` in place of `turntable/state`
+// and commands the virtual rotation itself: it publishes core::fieldCommandPlan's commands on
+// `command/precession` as the gyro's own stream time (the precession state's stamps) passes, and a
+// rate of 0 when the run ends before the plan does.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -26,9 +31,11 @@
 
 #include "hrg_gyro/ChannelAmplitudes.h"
 #include "hrg_gyro/GroundTruth.h"
+#include "hrg_gyro/PrecessionState.h"
 #include "hrg_gyro/StartCalibration.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
+#include "hrg_gyro/core/calibration/field_command_plan.h"
 #include "hrg_gyro/core/calibration/generator_pairing.h"
 #include "hrg_gyro/core/calibration/staged_calibration.h"
 #include "hrg_gyro/ros/input_thread.h"
@@ -47,6 +54,16 @@ class CalibratorRos {
 
  private:
   void onTurntable(const TurntableState::ConstPtr& msg);
+  void onPrecession(const PrecessionState::ConstPtr& msg);
+  /// Feeds a table (or, for the field method, precession loop) record and finishes when complete.
+  void addRotationRecord(const ros::Time& stamp, double angle, double rate, std::uint32_t seq);
+  /// Field method: publishes the planned commands whose time has come at stream time `now` (the
+  /// plan's clock starts at the first precession state seen while the driver listens).
+  void advanceFieldPlan(const ros::Time& now);
+  /// Field method: a run that ends (finished, aborted, restarted) before its plan stops the rotation.
+  void stopFieldPlan(const char* why);
+  void publishPrecession(double rate);
+  bool fieldRun() { return session() && core::traitsOf(session()->settings().method).virtual_rotation; }
   void onWave(const WaveState::ConstPtr& msg);
   void onChannels(const ChannelAmplitudes::ConstPtr& msg);
   void onTruth(const GroundTruth::ConstPtr& msg);
@@ -90,8 +107,15 @@ class CalibratorRos {
   ros::Time sweep_end_, last_channels_stamp_;
 
   InputThread input_;  // serves the four subscriptions below
-  ros::Subscriber turntable_sub_, wave_sub_, channels_sub_, truth_sub_;
+  ros::Subscriber turntable_sub_, wave_sub_, channels_sub_, truth_sub_, precession_sub_;
   ros::Publisher result_pub_;
+  ros::Publisher command_pub_;  // command/precession, the field method's virtual rotation
+
+  // The field method's plan (under mutex_): commands, the next to send, the stream time it started.
+  std::vector<core::PlannedPrecession> field_plan_;
+  std::size_t field_next_ = 0;
+  ros::Time field_start_;
+  std::uint64_t field_commands_sent_ = 0;
   ros::ServiceServer start_srv_, finish_srv_, abort_srv_;
   diagnostic_updater::Updater updater_;
   ros::WallTimer diagnostics_timer_;

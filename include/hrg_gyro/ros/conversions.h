@@ -13,6 +13,8 @@
 #include "hrg_gyro/FixturePosition.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/GyroOutput.h"
+#include "hrg_gyro/PrecessionCommand.h"
+#include "hrg_gyro/PrecessionState.h"
 #include "hrg_gyro/TriadOutput.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
@@ -58,6 +60,12 @@ ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::
 TurntableState toTurntableMessage(const core::TurntableLogRecord& r, core::Nanoseconds origin,
                                   const std::string& frame_id);
 GroundTruth toTruthMessage(const core::SimulationSample& s, const std_msgs::Header& header);
+/// The precession loop's state at a sample (averaged resonator): stamped with the sample.
+PrecessionState toPrecessionStateMessage(const core::SimulationSample& s, const std_msgs::Header& header);
+/// A command the loop took up, as the commanding node would have issued it (`hrg_bag simulate` writes
+/// the scenario's schedule so); stamped at `stamp`.
+PrecessionCommand toPrecessionCommandMessage(const core::AppliedPrecession& command, const ros::Time& stamp,
+                                             const std::string& frame_id);
 
 // The messages of one simulated triad sample (driver_sim and `hrg_bag simulate` on a triad scenario):
 // the fixture's position (fixture/position) and the body's truth (truth), stamped with the sample,

@@ -14,6 +14,12 @@
 // (frame_id the axis's name), `turntable/state`, `fixture/position` (hrg_gyro/FixturePosition, on a
 // change of position or lock and every second) and `truth` (hrg_gyro/BodyTruth), the last two with
 // the triad's frame_id (its triad.frame_id; ~frame_id is the single gyro's).
+//
+// A gyro with a precession loop (dynamics.model: averaged, core::DynamicsConfig) also takes commands
+// of its virtual rotation on `command/precession` (hrg_gyro/PrecessionCommand), executed from the
+// next carrier period as its electronics would, beside the scenario's own schedule, and publishes what
+// the loop executes on `precession/state` (hrg_gyro/PrecessionState) with every sample. A command to
+// a gyro without the loop is ignored with a warning naming why.
 #pragma once
 
 #include <ros/ros.h>
@@ -21,10 +27,12 @@
 #include <array>
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
 
+#include "hrg_gyro/PrecessionCommand.h"
 #include "hrg_gyro/core/simulation/gyro_simulator.h"
 #include "hrg_gyro/core/simulation/playback_schedule.h"
 #include "hrg_gyro/core/simulation/triad_simulator.h"
@@ -50,6 +58,10 @@ class DriverSimRos {
   void publishSingle(const core::SimulationSample& s, const ros::Time& stamp, core::Nanoseconds origin);
   void publishTriad(const core::TriadSample& s, const ros::Time& stamp, core::Nanoseconds origin);
   bool waitForSubscribers();
+  void onPrecessionCommand(const PrecessionCommand::ConstPtr& msg);
+  /// Hands the last command received to the simulator (worker thread, before each sample).
+  void takeCommand(core::GyroSimulator& sim);
+  void takeCommand(core::TriadSimulator&) {}
   /// The fewest subscribers of the channels: of the one topic, or of the triad's three axes.
   std::uint32_t channelSubscribers() const;
 
@@ -63,6 +75,13 @@ class DriverSimRos {
   ros::Publisher channels_pub_, turntable_pub_, truth_pub_, clock_pub_, done_pub_;
   std::array<ros::Publisher, 3> axis_channels_pub_, axis_truth_pub_;  // a triad's; truth_pub_ its body truth
   ros::Publisher fixture_pub_;
+  ros::Publisher precession_pub_;  // a gyro with a precession loop only
+  ros::Subscriber command_sub_;
+  std::mutex command_mutex_;
+  std::optional<double> pending_command_;  // under command_mutex_: received, not yet taken up
+  bool has_precession_loop_ = false;
+  std::uint64_t ignored_commands_ = 0;  // commands to a gyro without the loop (callback thread only)
+  ros::WallTime last_ignored_warning_;
   double time_scale_ = 1.0;
   double max_lag_ = 0.25;                           // s, sim time only
   std::optional<core::PlaybackSchedule> schedule_;  // built (and validated) with the parameters
@@ -70,6 +89,7 @@ class DriverSimRos {
   // for each, and every timer under sim time waits for one.
   double clock_period_ = 0.0;
   static constexpr double kFinestAutoClockPeriod = 1e-3;  // s: "auto" publishes at most 1 kHz
+  static constexpr double kMaxPrecessionRate = 10.0;      // rad/s: the scenario schedule's bound too
   std::string frame_id_ = "gyro_link";
   bool use_sim_time_ = false;
   bool publish_clock_ = true;

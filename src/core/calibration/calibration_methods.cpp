@@ -5,6 +5,7 @@
 #include <ctime>
 #include <sstream>
 
+#include "hrg_gyro/core/calibration/field_method.h"
 #include "hrg_gyro/core/calibration/thermal_method.h"
 #include "hrg_gyro/core/common/units.h"
 
@@ -83,6 +84,8 @@ std::unique_ptr<CalibrationMethod> makeCalibrationMethod(const CalibrationSettin
           "on a bag with the three axes' channels and the fixture's positions, or the calibrator in triad mode)");
     case CalibrationMethodKind::kThermal:
       return std::make_unique<ThermalMethod>(s, k0);
+    case CalibrationMethodKind::kField:
+      return std::make_unique<FieldMethod>(s);
   }
   throw std::invalid_argument("calibration method out of range");
 }

@@ -171,6 +171,27 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
     out << YAML::EndSeq;
     out << YAML::EndMap;
   }
+  if (o.field.present) {
+    // The field method: K kept, the virtual rate's realised gain, the drift as the still gyro showed it.
+    const FieldReport& f = o.field;
+    out << YAML::Key << "field" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "virtual_rate_gain" << YAML::Value;
+    emitFit(out, f.virtual_rate_gain, NAN);  // realised over commanded virtual rate, G_v(theta)
+    out << YAML::Key << "measured_drift" << YAML::Value;
+    emitFit(out, f.measured_drift, NAN);  // rad/s: D + K Omega_s, before the Earth rate's share came off
+    out << YAML::Key << "earth_rate" << YAML::Value << formatDouble(f.earth_rate) << YAML::Comment("rad/s, Omega_s");
+    out << YAML::Key << "k0_prior" << YAML::Value << formatDouble(f.k0_prior) << YAML::Comment("kept");
+    out << YAML::Key << "positive_rate" << YAML::Value << formatDouble(f.positive_rate) << YAML::Comment("rad/s");
+    out << YAML::Key << "negative_rate" << YAML::Value << formatDouble(f.negative_rate) << YAML::Comment("rad/s");
+    out << YAML::Key << "positive_turns" << YAML::Value << formatDouble(f.positive_turns);
+    out << YAML::Key << "negative_turns" << YAML::Value << formatDouble(f.negative_turns)
+        << YAML::Comment("full turns of theta");
+    out << YAML::Key << "positive_time" << YAML::Value << formatDouble(f.positive_time) << YAML::Comment("s");
+    out << YAML::Key << "negative_time" << YAML::Value << formatDouble(f.negative_time) << YAML::Comment("s");
+    out << YAML::Key << "excess_scatter" << YAML::Value << formatDouble(f.excess_scatter)
+        << YAML::Comment("D0's standard error over the white-noise prediction: stillness");
+    out << YAML::EndMap;
+  }
   if (o.bias_trend.order > 0) {
     // The bias's polynomial in time fitted with K and D: D0(t) = drift.mean + sum_j b_j (t - t_ref)^j.
     const BiasTrendFit& t = o.bias_trend;

@@ -95,7 +95,8 @@ bool CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double ra
   ++counters_.turntable_total;
   // The table's clock first: a known offset, then the line through a fixed-rate log's stamps (a
   // glitched stamp comes back as it was, and is dropped below like any other).
-  if (stamp > 0) {
+  // (A precession loop's state is stamped by the gyro's own driver: nothing to correct.)
+  if (stamp > 0 && !traitsOf(settings_.method).virtual_rotation) {
     stamp -= toNanoseconds(settings_.table_clock.offset);
     stamp = regulariser_.regularise(stamp, sequence);
   }
@@ -258,15 +259,16 @@ std::string CalibrationSession::plateauDiagnosis(bool* names_a_cause) const {
   const SessionCounters& c = counters_;
   const PlateauSettings& ps = settings_.plateau;
   const PlateauStatistics st = detector_.statistics();
+  const std::string stream = traitsOf(settings_.method).virtual_rotation ? "precession state" : "turntable";
   if (c.turntable == 0) {
-    return "no turntable record arrived" +
+    return "no " + stream + " record arrived" +
            (c.rejected.total() > 0 ? " that was not a glitch (" + std::to_string(c.rejected.total()) + " dropped)"
                                    : std::string()) +
-           ": check the turntable stream";
+           ": check the " + stream + " stream";
   }
   if (c.wave == 0) {
-    return "turntable records arrived without the wave (" + std::to_string(c.turntable) +
-           " turntable records, no wave sample)";
+    return stream + " records arrived without the wave (" + std::to_string(c.turntable) + " " + stream +
+           " records, no wave sample)";
   }
   if (c.unsynchronized > c.used + c.unsettled) {
     return std::to_string(c.unsynchronized) + " of " + std::to_string(c.wave) +
@@ -382,7 +384,9 @@ CalibrationOutcome CalibrationSession::finish() const {
     o.reason = "plateaus: " + cause + " (" + o.reason + ")";
   }
   o.quadrature_ratio = quadrature_count_ > 0 ? quadrature_sum_ / quadrature_count_ : 0.0;
-  if (!traitsOf(settings_.method).uses_generator_pairs && counters_.turntable_total > 0) reportTableClock(&o);
+  // A precession loop's state is on the gyro's clock: no table clock to measure.
+  const CalibrationMethodTraits& traits = traitsOf(settings_.method);
+  if (!traits.uses_generator_pairs && !traits.virtual_rotation && counters_.turntable_total > 0) reportTableClock(&o);
   diagnose(&o, prior_.correction);
   o.turntable_records = counters_.turntable_total;
   o.turntable_rejected = counters_.rejected;

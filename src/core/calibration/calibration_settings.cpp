@@ -29,6 +29,9 @@ const std::vector<std::string> kGateKeys = {
 const std::vector<std::string> kTableClockKeys = {"offset", "regularise", "window", "max_jitter", "max_offset"};
 const std::vector<std::string> kThermalKeys = {"frequency_nodes", "node_count", "interpolation", "slice_width",
                                                "max_slices"};
+const std::vector<std::string> kFieldKeys = {"gain_orders",        "rate",           "turns",
+                                             "directions",         "rest",           "min_turns",
+                                             "max_excess_scatter", "max_gain_error", "max_drift_std"};
 const std::vector<std::string> kScalarKeys = {
     "method",         "scale_factor_orders", "drift_orders",    "bins",
     "window",         "window_span",         "group_tolerance", "auto_finish_idle",
@@ -48,6 +51,7 @@ std::vector<std::string> CalibrationSettings::keyPaths() {
   for (const std::string& k : kGateKeys) keys.push_back("gates/" + k);
   for (const std::string& k : kThermalKeys) keys.push_back("thermal/" + k);
   for (const std::string& k : kTableClockKeys) keys.push_back("table_clock/" + k);
+  for (const std::string& k : kFieldKeys) keys.push_back("field/" + k);
   return keys;
 }
 
@@ -55,7 +59,7 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   CalibrationSettings s;
   root.requireMap();
   std::vector<std::string> allowed = kScalarKeys;
-  allowed.insert(allowed.end(), {"plateau", "gates", "thermal", "table_clock"});
+  allowed.insert(allowed.end(), {"plateau", "gates", "thermal", "table_clock", "field"});
   allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
   root.rejectUnknownKeys(allowed);
   if (root.has("method")) {
@@ -133,6 +137,34 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
     if (!(tc.window >= 1.0 && tc.window <= 3600.0)) c["window"].fail("must be in [1, 600] s");
     tc.max_jitter = positive(c, "max_jitter", tc.max_jitter);
     tc.max_offset = positive(c, "max_offset", tc.max_offset);
+  }
+  if (root.has("field")) {
+    const YamlField f = root["field"];
+    f.requireMap();
+    f.rejectUnknownKeys(kFieldKeys);
+    FieldSettings& fs = s.field;
+    if (f.has("gain_orders")) fs.gain_orders = parseEvenOrders(f["gain_orders"]);
+    fs.rate = positive(f, "rate", fs.rate);
+    if (fs.rate > 10.0) f["rate"].fail("must be at most 10 rad/s (electrical)");
+    fs.turns = positive(f, "turns", fs.turns);
+    if (f.has("directions")) {
+      const YamlField d = f["directions"];
+      const auto raw = d.asIntegers();
+      fs.directions.clear();
+      for (std::size_t i = 0; i < raw.size(); ++i) {
+        if (raw[i] != 1 && raw[i] != -1) d.at(i).fail("must be 1 or -1 (the sign of the commanded rate)");
+        fs.directions.push_back(static_cast<int>(raw[i]));
+      }
+      if (fs.directions.empty()) d.fail("need at least one segment");
+    }
+    fs.rest = f.getDouble("rest", fs.rest);
+    if (!(fs.rest >= 0.0)) f["rest"].fail("must be >= 0 (s)");
+    fs.min_turns = f.getDouble("min_turns", fs.min_turns);
+    if (!(fs.min_turns >= 0.0)) f["min_turns"].fail("must be >= 0");
+    fs.max_excess_scatter = f.getDouble("max_excess_scatter", fs.max_excess_scatter);
+    if (!(fs.max_excess_scatter >= 1.0)) f["max_excess_scatter"].fail("must be >= 1 (a ratio of scatters)");
+    fs.max_gain_error = positive(f, "max_gain_error", fs.max_gain_error);
+    fs.max_drift_std = positive(f, "max_drift_std", fs.max_drift_std);
   }
   if (root.has("thermal")) {
     const YamlField t = root["thermal"];

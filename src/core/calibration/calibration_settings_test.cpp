@@ -42,9 +42,42 @@ TEST(CalibrationSettingsTest, TheBiasTrendIsLinearByDefaultAndItsKeysAreChecked)
   EXPECT_EQ(refusedKey("gates: {max_trend_k0_std: -1e-6}"), "gates.max_trend_k0_std");
 }
 
+TEST(CalibrationSettingsTest, TheFieldMethodsKeysAreReadAndChecked) {
+  const FieldSettings d = parse("{}").field;
+  EXPECT_EQ(d.gain_orders, (std::vector<int>{2, 4}));
+  EXPECT_EQ(d.directions, (std::vector<int>{1, -1, -1, 1}));
+  EXPECT_DOUBLE_EQ(d.rate, 0.2);
+  const FieldSettings f = parse(
+                              "field: {gain_orders: [2], rate: 0.5, turns: 3, directions: [-1, 1], rest: 0, min_turns: "
+                              "2, max_excess_scatter: 1.5, max_gain_error: 0.01, max_drift_std: 2.0e-8}")
+                              .field;
+  EXPECT_EQ(f.gain_orders, (std::vector<int>{2}));
+  EXPECT_DOUBLE_EQ(f.rate, 0.5);
+  EXPECT_DOUBLE_EQ(f.turns, 3.0);
+  EXPECT_EQ(f.directions, (std::vector<int>{-1, 1}));
+  EXPECT_DOUBLE_EQ(f.rest, 0.0);
+  EXPECT_DOUBLE_EQ(f.min_turns, 2.0);
+  EXPECT_DOUBLE_EQ(f.max_excess_scatter, 1.5);
+  EXPECT_DOUBLE_EQ(f.max_gain_error, 0.01);
+  EXPECT_DOUBLE_EQ(f.max_drift_std, 2e-8);
+  EXPECT_EQ(refusedKey("field: {rate: 0}"), "field.rate");
+  EXPECT_EQ(refusedKey("field: {rate: 11}"), "field.rate");
+  EXPECT_EQ(refusedKey("field: {rate: .nan}"), "field.rate");
+  EXPECT_EQ(refusedKey("field: {turns: -1}"), "field.turns");
+  EXPECT_EQ(refusedKey("field: {directions: []}"), "field.directions");
+  EXPECT_EQ(refusedKey("field: {directions: [1, 2]}"), "field.directions[1]");
+  EXPECT_EQ(refusedKey("field: {rest: -1}"), "field.rest");
+  EXPECT_EQ(refusedKey("field: {gain_orders: [3]}").rfind("field.gain_orders", 0), 0u);
+  EXPECT_EQ(refusedKey("field: {max_excess_scatter: 0.5}"), "field.max_excess_scatter");
+  EXPECT_EQ(refusedKey("field: {max_drift_std: 0}"), "field.max_drift_std");
+  EXPECT_EQ(refusedKey("field: {speed: 1}"), "field.speed");
+  EXPECT_EQ(refusedKey("field: 1"), "field");
+}
+
 TEST(CalibrationSettingsTest, KeyPathsListEveryKeyOnce) {
   const std::vector<std::string> keys = CalibrationSettings::keyPaths();
-  for (const char* k : {"bias_trend_order", "gates/max_trend_inflation", "gates/max_trend_k0_std"}) {
+  for (const char* k : {"bias_trend_order", "gates/max_trend_inflation", "gates/max_trend_k0_std", "field/rate",
+                        "field/directions", "field/gain_orders"}) {
     EXPECT_EQ(std::count(keys.begin(), keys.end(), k), 1) << k;
   }
 }

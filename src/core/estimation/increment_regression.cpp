@@ -464,12 +464,13 @@ IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std
     const double earth = earth_shift(i);
     const double basis = 0.1 * std::abs(beta(i)) * (1.0 - scale[i]);
     total_std[i] = std::sqrt(statistical * statistical + earth * earth + basis * basis);
-    if (i < n_kterms) {
-      budget.statistical.push_back(statistical);
-      budget.angle_noise.push_back(noise);
-      budget.beyond_noise.push_back(beyond);
-      budget.earth_rate.push_back(earth);
-      budget.basis_noise.push_back(basis);
+    IncrementErrorBudget* part = i < n_kterms ? &budget : (i < n_kterms + 1 + 2 * n_d ? &fit.drift_budget : nullptr);
+    if (part) {
+      part->statistical.push_back(statistical);
+      part->angle_noise.push_back(noise);
+      part->beyond_noise.push_back(beyond);
+      part->earth_rate.push_back(earth);
+      part->basis_noise.push_back(basis);
     }
   }
   auto fill = [&](HarmonicFitResult* f, const std::vector<int>& orders, int offset) {

@@ -14,6 +14,8 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
   GeneratorPairing pairing([&session](Nanoseconds t, const ChannelVector& raw, const ChannelVector& reference) {
     session.addGeneratorPair(t, raw, reference);
   });
+  // The field method synchronises with the precession loop's state, as the live calibrator does.
+  const bool virtual_rotation = traitsOf(calibration.method).virtual_rotation;
   SimulationSample s;
   while (sim.next(&s)) {
     if (s.truth.generator) {
@@ -22,9 +24,13 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
       pairing.addReference(s.stamp, {s.truth.amplitude, s.truth.quadrature, s.truth.theta, s.truth.phase});
       continue;
     }
-    // What the table controller logged, not the truth.
-    for (const TurntableLogRecord& record : s.turntable)
-      session.addTurntable(record.stamp, record.angle, record.rate, record.index);
+    // What the table controller logged, not the truth; or what the precession loop executed.
+    if (virtual_rotation) {
+      if (sim.hasPrecessionLoop()) session.addTurntable(s.stamp, s.precession.angle, s.precession.rate, s.index);
+    } else {
+      for (const TurntableLogRecord& record : s.turntable)
+        session.addTurntable(record.stamp, record.angle, record.rate, record.index);
+    }
     if (!s.channels_delivered) continue;
     const ProcessorResult r = proc.process({s.stamp, s.z, s.frequency, s.temperature});
     if (r.has_wave)

@@ -12,26 +12,32 @@ struct Entry {
 };
 
 // The methods, listed once. Columns: name, description, generator pairs, turntable, K and D, P,
-// frequency dependent, three axes.
+// frequency dependent, three axes, virtual rotation.
 const Entry kMethods[] = {
     {CalibrationMethodKind::kDualRate,
      {"dual_rate", "two opposite table rates: K(theta) and D(theta), the drift cancels", false, true, true, false,
-      false, false}},
+      false, false, false}},
     {CalibrationMethodKind::kConstantRate,
-     {"constant_rate", "a dwell then one table rate: K(theta) and D", false, true, true, false, false, false}},
+     {"constant_rate", "a dwell then one table rate: K(theta) and D", false, true, true, false, false, false, false}},
     {CalibrationMethodKind::kStep,
      {"step", "table steps between dwells: K(theta) from the steps, D from the dwells", false, true, true, false, false,
-      false}},
+      false, false}},
     {CalibrationMethodKind::kCorrectionMatrix,
-     {"correction_matrix", "generator sweep at rest: the correction matrix P", true, false, false, true, false, false}},
+     {"correction_matrix", "generator sweep at rest: the correction matrix P", true, false, false, true, false, false,
+      false}},
     {CalibrationMethodKind::kThermal,
      {"thermal", "dual rate across temperature: K and D as splines over the resonator frequency", false, true, true,
-      false, true, false}},
+      false, true, false, false}},
     {CalibrationMethodKind::kTriad,
      {"triad",
       "three axes in a fixture turned through positions: each axis's K(theta) and D(theta), the triad's matrix and "
       "bias",
-      false, true, true, false, false, true}},
+      false, true, true, false, false, true, false}},
+    {CalibrationMethodKind::kField,
+     {"field",
+      "a still gyro, no table: its precession loop turns the wave both ways; D(theta) and the virtual rate's gain, K "
+      "kept",
+      false, false, false, false, false, false, true}},
 };
 
 const Entry& entryOf(CalibrationMethodKind method) {

@@ -40,9 +40,9 @@ TEST(CalibrationMethodKindTest, EveryMethodHasOneDistinctNameThatParsesBack) {
     EXPECT_EQ(parseCalibrationMethod(nameOf(m)), m);
     ASSERT_TRUE(findCalibrationMethod(nameOf(m)).has_value());
   }
-  EXPECT_EQ(names.size(), 6u);
+  EXPECT_EQ(names.size(), 7u);
   EXPECT_EQ(allCalibrationMethods().front(), CalibrationSettings().method);  // the default comes first
-  EXPECT_EQ(calibrationMethodNames("|"), "dual_rate|constant_rate|step|correction_matrix|thermal|triad");
+  EXPECT_EQ(calibrationMethodNames("|"), "dual_rate|constant_rate|step|correction_matrix|thermal|triad|field");
 }
 
 TEST(CalibrationMethodKindTest, UnknownNameIsRefusedWithTheList) {
@@ -60,15 +60,18 @@ TEST(CalibrationMethodKindTest, UnknownNameIsRefusedWithTheList) {
 TEST(CalibrationMethodKindTest, TraitsSayWhatEachMethodNeedsAndGives) {
   for (CalibrationMethodKind m : allCalibrationMethods()) {
     const CalibrationMethodTraits& t = traitsOf(m);
-    // A method estimates K and D on the turntable, or P from the generator sweep, never both.
-    EXPECT_NE(t.estimates_k_and_d, t.estimates_correction) << t.name;
+    // A method estimates K and D on the turntable, P from the generator sweep, or D from the virtual
+    // rotation of a still gyro: one of the three.
+    EXPECT_EQ(t.estimates_k_and_d + t.estimates_correction + t.virtual_rotation, 1) << t.name;
     EXPECT_EQ(t.uses_generator_pairs, t.estimates_correction) << t.name;
-    EXPECT_EQ(t.needs_turntable, !t.uses_generator_pairs) << t.name;
+    EXPECT_EQ(t.needs_turntable, !t.uses_generator_pairs && !t.virtual_rotation) << t.name;
     EXPECT_GT(std::string(t.description).size(), 10u) << t.name;
   }
   EXPECT_TRUE(traitsOf(CalibrationMethodKind::kCorrectionMatrix).uses_generator_pairs);
   EXPECT_TRUE(traitsOf(CalibrationMethodKind::kThermal).frequency_dependent);
   EXPECT_FALSE(traitsOf(CalibrationMethodKind::kDualRate).frequency_dependent);
+  EXPECT_TRUE(traitsOf(CalibrationMethodKind::kField).virtual_rotation);
+  EXPECT_FALSE(traitsOf(CalibrationMethodKind::kField).needs_turntable);
 }
 
 TEST(ParameterOriginTest, NoneManualAndEveryMethodRoundTripThroughText) {

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
+
+#include "hrg_gyro/core/simulation/intrinsic_model.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -24,6 +27,50 @@ GyroSimulator::GyroSimulator(const SimulationConfig& config, const AxisRateInput
     config_.profile.setRipple(config_.ripple.amplitude, config_.ripple.frequency, config_.ripple.phase);
   }
   if (config_.thermal.enabled) updateTemperature(0.0);
+  const DynamicsConfig& d = config_.dynamics;
+  if (d.averaged()) {
+    if (input_) throw std::invalid_argument("the averaged resonator is a single gyro's dynamics, not a triad axis's");
+    const ResonatorConfig& rc = config_.resonator;
+    const IntrinsicModel intrinsic(config_);
+    shell_bias_ = intrinsic.meanDrift() - rc.drift.meanAt(rc.frequency);
+    dynamics_.emplace(d.shell, d.loops, d.drive, WaveParameters{rc.amplitude, 0.0, theta_, rc.phase});
+    // The loops lock at rest (the sensed rate of the first instant, no virtual rate) before the
+    // first sample, as in a gyro that has been running.
+    if (d.settle_time > 0.0) {
+      ResonatorInputs rest;
+      rest.body_rate_start = rest.body_rate_end = sensedRate(0.0);
+      const double period = 1.0 / rc.frequency;
+      const long periods = std::lround(d.settle_time / period);
+      for (long i = 0; i < periods; ++i) {
+        if (!dynamics_->step(period, rest))
+          throw std::runtime_error("resonator: the wave stopped standing while the loops settled");
+      }
+    }
+    theta_ = dynamics_->wave().theta;
+  }
+}
+
+void GyroSimulator::commandVirtualRate(double rate) {
+  if (!dynamics_) throw std::logic_error("no precession loop: the scenario's dynamics are not the averaged resonator");
+  if (!std::isfinite(rate)) throw std::invalid_argument("virtual rate must be finite");
+  commanded_ = rate;
+}
+
+void GyroSimulator::applyPrecessionCommands(SimulationSample* out) {
+  const std::vector<ScheduledPrecession>& schedule = config_.dynamics.commands;
+  // Due when its time falls before the middle of this period (stamps are on the period grid).
+  const double due = t_ + 0.5 / config_.resonator.frequency;
+  while (next_scheduled_ < schedule.size() && schedule[next_scheduled_].time < due) {
+    virtual_rate_ = schedule[next_scheduled_++].rate;
+    ++precession_commands_;
+    out->precession_commands.push_back({t_, virtual_rate_, true});
+  }
+  if (commanded_) {
+    virtual_rate_ = *commanded_;
+    commanded_.reset();
+    ++precession_commands_;
+    out->precession_commands.push_back({t_, virtual_rate_, false});
+  }
 }
 
 void GyroSimulator::logTurntable(double t_center, SimulationSample* out) {
@@ -93,7 +140,8 @@ double GyroSimulator::thetaRate(double t, double theta, double sensed) {
 
 double GyroSimulator::injectedBias(double t) const {
   const HarmonicModel& d = config_.thermal.enabled ? thermal_d_ : config_.resonator.drift;
-  return d.meanAt(config_.resonator.frequency) + config_.resonator.bias_drift.trendAt(t) + bias_walk_;
+  const double d0 = d.meanAt(config_.resonator.frequency);
+  return (dynamics_ ? d0 + shell_bias_ : d0) + config_.resonator.bias_drift.trendAt(t) + bias_walk_;
 }
 
 void GyroSimulator::stamp(double t_center, SimulationSample* out) const {
@@ -116,6 +164,10 @@ bool GyroSimulator::next(SimulationSample* out) {
 }
 
 void GyroSimulator::nextDynamic(SimulationSample* out) {
+  if (dynamics_) {
+    nextResonator(out);
+    return;
+  }
   const ResonatorConfig& rc = config_.resonator;
   const int m = rc.periods_per_output;
   const double period = 1.0 / rc.frequency;
@@ -195,6 +247,73 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
   truth.temperature = temperature_;
   truth.bias = injectedBias(t_center);
   truth.generator = false;
+  logTurntable(t_center, out);
+}
+
+void GyroSimulator::nextResonator(SimulationSample* out) {
+  const ResonatorConfig& rc = config_.resonator;
+  const int m = rc.periods_per_output;
+  const double period = 1.0 / rc.frequency;
+  double boundary_theta[2] = {0.0, 0.0}, boundary_psi[2] = {0.0, 0.0};
+  const int lo = std::min(m / 2, m - 1);  // the period holding the window's centre
+  const double frac = 0.5 * m - lo;
+  const double t_start = t_;
+  out->precession_commands.clear();
+  ChannelVector sum = ChannelVector::Zero();
+  ResonatorInputs in;
+  for (int p = 0; p < m; ++p) {
+    applyPrecessionCommands(out);
+    const double h = period, t = t_;
+    in.body_rate_start = sensedRate(t);
+    in.body_rate_end = sensedRate(t + h);
+    if (rc.rate_noise > 0.0) {
+      // A white body-rate noise held over the period: the angle random walk of the harmonic path.
+      const double noise = rc.rate_noise / std::sqrt(h) * rate_noise_.next();
+      in.body_rate_start += noise;
+      in.body_rate_end += noise;
+    }
+    in.virtual_rate = virtual_rate_;
+    const BiasDriftConfig& drift = rc.bias_drift;
+    const double added = rc.drift.orders().empty() ? rc.drift.meanAt(rc.frequency) : rc.drift(theta_, rc.frequency);
+    in.angle_rate = added + (drift.enabled() ? drift.trendAt(t + 0.5 * h) + bias_walk_ : 0.0);
+    const WaveParameters start = dynamics_->wave();
+    if (!dynamics_->step(h, in)) throw std::runtime_error("resonator: the wave stopped standing (A^2 <= B^2)");
+    const double theta_end = dynamics_->wave().theta;
+    sum += synth_.period(start, theta_end);
+    if (p == lo) {
+      boundary_theta[0] = theta_, boundary_psi[0] = virtual_angle_;
+      boundary_theta[1] = theta_end, boundary_psi[1] = virtual_angle_ + virtual_rate_ * h;
+    }
+    theta_ = theta_end;
+    virtual_angle_ += virtual_rate_ * h;
+    const double y = h - t_compensation_;
+    const double sum_t = t_ + y;
+    t_compensation_ = (sum_t - t_) - y;
+    t_ = sum_t;
+  }
+  const WaveParameters& wave = dynamics_->wave();
+  frequency_ = dynamics_->referenceFrequency();
+  out->z = sum / m;
+  out->frequency = frequency_;
+  out->temperature = temperature_;
+  out->periods = static_cast<std::uint32_t>(m);
+  const double t_center = 0.5 * (t_start + t_);
+  stamp(t_center, out);
+  TruthState& truth = out->truth;
+  truth.theta = boundary_theta[0] + frac * (boundary_theta[1] - boundary_theta[0]);
+  config_.profile.evaluate(t_center - generatorDuration(), &truth.table_angle, &truth.table_rate, &truth.segment);
+  truth.inertial_rate = truth.table_rate + earth_rate_;
+  truth.inertial_angle = truth.table_angle + earth_rate_ * t_center;
+  truth.amplitude = wave.amplitude;
+  truth.quadrature = wave.quadrature;
+  truth.phase = wave.phase;
+  truth.frequency = frequency_;
+  truth.temperature = temperature_;
+  truth.bias = injectedBias(t_center);
+  truth.generator = false;
+  out->precession.rate = virtual_rate_;
+  out->precession.angle = boundary_psi[0] + frac * (boundary_psi[1] - boundary_psi[0]);
+  out->precession.commands = precession_commands_;
   logTurntable(t_center, out);
 }
 

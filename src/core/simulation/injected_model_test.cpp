@@ -9,6 +9,7 @@
 
 #include "hrg_gyro/core/estimation/dual_rate_estimator.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
+#include "hrg_gyro/core/simulation/intrinsic_model.h"
 #include "hrg_gyro/core/simulation/signal_synthesizer.h"
 
 namespace hrg_gyro {
@@ -61,6 +62,45 @@ TEST(InjectedModelTest, ExactUpToAmplitudeToGapOfOneFifth) {
         ratio, cos4, cos8, worst);
     EXPECT_LT(worst, 0.01) << ratio;
   }
+}
+
+// The averaged resonator: through ideal pickoffs the injected D and G_v are the intrinsic (settled)
+// ones, harmonic by harmonic; without a precession loop there is no G_v to fit.
+TEST(InjectedModelTest, AveragedResonatorIsItsIntrinsicModelThroughIdealPickoffs) {
+  SimulationConfig c;
+  c.dynamics.model = DynamicsModel::kAveraged;
+  c.dynamics.shell.damping_anisotropy = 4e-5;
+  c.dynamics.shell.damping_axis = 0.4;
+  c.dynamics.shell.frequency_split = 2.0 * kPi * 5e-3;
+  c.dynamics.shell.frequency_axis = -0.7;
+  c.dynamics.drive.gain_error_c = 2e-3;
+  c.dynamics.drive.gain_error_s = -1e-3;
+  c.dynamics.drive.phase_error = 1e-3;
+  c.dynamics.drive.virtual_rate_gain_error = 3e-3;
+  c.resonator.quadrature = 0.0;
+  c.resonator.drift = HarmonicModel(1e-5);
+  const IntrinsicModel intrinsic(c);
+  const EffectiveModel e = computeEffectiveModel(c, CorrectionMatrix(), {2, 4}, {2, 4}, {2, 4});
+  ASSERT_TRUE(e.virtual_rate_gain.ok);
+  double worst_d = 0.0, worst_g = 0.0;
+  for (int i = 0; i < 360; ++i) {
+    const double theta = kPi * i / 360;
+    worst_d = std::max(worst_d, std::abs(toModel(e.drift)(theta, NAN) - intrinsic.drift(theta)));
+    worst_g = std::max(worst_g, std::abs(toModel(e.virtual_rate_gain)(theta, NAN) - intrinsic.virtualRateGain(theta)));
+  }
+  std::printf(
+      "[ measured ] G_v mean %.8f, cos 2theta %.3g; largest difference from the intrinsic model: D %.2g rad/s, "
+      "G_v %.2g\n",
+      e.virtual_rate_gain.mean, e.virtual_rate_gain.cos[0], worst_d, worst_g);
+  EXPECT_NEAR(e.drift.mean, intrinsic.meanDrift(), 1e-15);
+  EXPECT_LT(worst_d, 2e-11);  // orders 6 and up: products of three small numbers (8e-12 rad/s)
+  EXPECT_LT(worst_g, 1e-8);
+  // G_v = 1 + e_v + g - gamma cos 2theta to first order.
+  EXPECT_NEAR(e.virtual_rate_gain.mean, 1.0 + 3e-3 + 0.5e-3, 1e-5);
+  EXPECT_NEAR(e.virtual_rate_gain.cos[0], -1.5e-3, 1e-5);
+
+  c.dynamics.model = DynamicsModel::kHarmonic;
+  EXPECT_FALSE(computeEffectiveModel(c, CorrectionMatrix(), {2}, {2}, {2, 4}).virtual_rate_gain.ok);
 }
 
 }  // namespace

@@ -174,8 +174,8 @@ YAML::Node loadScenarioDocument(const std::string& path) {
 
 SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
   root.requireMap();
-  std::vector<std::string> allowed = {"seed",      "start_time", "resonator", "pickoff",
-                                      "turntable", "generator",  "thermal",   "channels"};
+  std::vector<std::string> allowed = {"seed",      "start_time", "resonator", "pickoff", "turntable",
+                                      "generator", "thermal",    "channels",  "dynamics"};
   allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
   root.rejectUnknownKeys(allowed);
   SimulationConfig c;
@@ -218,6 +218,22 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
   if (root.has("thermal")) {
     c.thermal = ThermalConfig::parse(root["thermal"]);
     checkThermalLimits(c, root["thermal"]);
+  }
+  if (root.has("dynamics")) {
+    const ResonatorConfig& rc = c.resonator;
+    c.dynamics = parseDynamicsSection(root["dynamics"], rc.frequency, rc.amplitude, rc.phase);
+  }
+  if (c.dynamics.averaged()) {
+    // One description of each quantity: the shell's K and the loops' B = 0 replace the given ones.
+    if (root.has("resonator") && root["resonator"].has("scale_factor")) {
+      root["resonator"]["scale_factor"].fail("the averaged resonator's K follows from dynamics.shell.bryan_factor");
+    }
+    if (root.has("resonator") && root["resonator"].has("quadrature")) {
+      root["resonator"]["quadrature"].fail("the averaged resonator's quadrature loop holds B at 0");
+    }
+    if (c.thermal.enabled) root["thermal"].fail("not available with dynamics.model: averaged");
+    c.resonator.scale_factor = HarmonicModel(c.dynamics.shell.scaleFactor());
+    c.resonator.quadrature = 0.0;
   }
   if (!c.generator.enabled && c.profile.pieces().empty()) {
     throw ConfigError("turntable.profile", "missing: give a turntable profile (or enable the generator)");

@@ -215,7 +215,8 @@ void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_t
       ->check(tools::notEmpty());
 }
 
-GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable) {
+GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable,
+                      bool need_precession) {
   rosbag::View all(bag);
   std::map<std::string, std::string> types;
   for (const rosbag::ConnectionInfo* c : all.getConnections()) types[c->topic] = c->datatype;
@@ -249,6 +250,9 @@ GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool nee
   t.turntable =
       pick(chosen.turntable, "turntable-topic", ros::message_traits::datatype<TurntableState>(), need_turntable);
   t.truth = pick(chosen.truth, "truth-topic", ros::message_traits::datatype<GroundTruth>(), false);
+  if (need_precession) {
+    t.precession = pick(chosen.precession, "precession-topic", ros::message_traits::datatype<PrecessionState>(), true);
+  }
   return t;
 }
 

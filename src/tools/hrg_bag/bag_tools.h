@@ -60,6 +60,7 @@ std::unique_ptr<rosbag::Bag> openBag(const std::string& path);
 /// options: empty means "the single topic of the right type").
 struct GyroTopics {
   std::string channels, turntable, truth;
+  std::string precession;  ///< hrg_gyro/PrecessionState: the field method's stand-in for the turntable
 };
 /// A topic to write: a valid ROS graph resource name (ros::names::validate: a letter or '/' first,
 /// then letters, digits, '_' and '/'), global ('/' first, as rosbag record writes topics), without
@@ -68,8 +69,10 @@ CLI::Validator topicName();
 /// Adds --channels-topic and, when asked, --turntable-topic and --truth-topic.
 void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_truth);
 /// Explicit topics win; otherwise the single topic of the right type is taken. Throws UsageError
-/// when a required topic is missing, ambiguous or of the wrong type.
-GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable);
+/// when a required topic is missing, ambiguous or of the wrong type. The precession state is looked
+/// for only when needed.
+GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable,
+                      bool need_precession = false);
 
 /// Percentage and rate on stderr, at most twice a second.
 class Progress {

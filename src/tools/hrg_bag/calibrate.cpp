@@ -99,7 +99,7 @@ int runCalibrate(const CalibrateOptions& o) {
   const auto prior = std::make_shared<const core::GyroParameters>(o.params.empty() ? core::GyroParameters()
                                                                                    : core::loadParameterFile(o.params));
   const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
-  const GyroTopics topics = findTopics(*bag, o.topics, true, method.needs_turntable);
+  const GyroTopics topics = findTopics(*bag, o.topics, true, method.needs_turntable, method.virtual_rotation);
   if (method.uses_generator_pairs && topics.truth.empty()) {
     throw UsageError(std::string(method.name) + " needs the generator reference (a GroundTruth topic)");
   }
@@ -111,7 +111,12 @@ int runCalibrate(const CalibrateOptions& o) {
         session.addGeneratorPair(t, raw, reference);
       });
   std::vector<std::string> wanted{topics.channels};
-  if (!topics.turntable.empty()) wanted.push_back(topics.turntable);
+  // The field method synchronises with the precession loop's state in place of the table's.
+  if (method.virtual_rotation) {
+    wanted.push_back(topics.precession);
+  } else if (!topics.turntable.empty()) {
+    wanted.push_back(topics.turntable);
+  }
   if (!topics.truth.empty()) wanted.push_back(topics.truth);
   rosbag::View view(*bag, rosbag::TopicQuery(wanted));
   Progress progress("calibrate", view.size());
@@ -133,6 +138,9 @@ int runCalibrate(const CalibrateOptions& o) {
           session.addWave(in.stamp, r.wave.theta, in.frequency,
                           core::quadratureRatio(r.wave.quadrature, r.wave.amplitude));
         }
+      } else if (m.getTopic() == topics.precession) {
+        const PrecessionState::ConstPtr p = m.instantiate<PrecessionState>();
+        if (p) session.addTurntable(toNanoseconds(p->header.stamp), p->angle, p->rate, p->header.seq);
       } else if (m.getTopic() == topics.turntable) {
         const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
         if (t) session.addTurntable(toNanoseconds(t->header.stamp), t->angle, t->rate, t->header.seq);
@@ -204,7 +212,10 @@ namespace bag_tools {
 Command addCalibrateCommand(CLI::App& root) {
   auto o = std::make_shared<CalibrateOptions>();
   CLI::App* cmd = root.add_subcommand("calibrate", "the calibrator offline, with its quality gates");
-  cmd->add_option("BAG", o->bag, "input bag: channels, turntable state (and the generator reference)")->required();
+  cmd->add_option("BAG", o->bag,
+                  "input bag: channels, turntable state or, for field, the precession state (and the generator "
+                  "reference)")
+      ->required();
   cmd->add_option("--method", o->method,
                   core::calibrationMethodNames("|") + " (default: --config's, else " +
                       core::nameOf(core::CalibrationSettings().method) + ")")
@@ -222,6 +233,9 @@ Command addCalibrateCommand(CLI::App& root) {
       cmd->add_option("--report", o->report, "calibration report (YAML), written either way")->check(tools::notEmpty());
   cmd->add_option("--plot", o->plot, "PNG drawn from the report")->needs(report)->check(tools::notEmpty());
   addTopicOptions(*cmd, &o->topics, true);
+  cmd->add_option("--precession-topic", o->topics.precession,
+                  "field: the precession loop's hrg_gyro/PrecessionState topic (default: the only one in the bag)")
+      ->check(tools::notEmpty());
   addProcessorOptions(*cmd, &o->processor);
   cmd->add_option("--triad", o->triad.triad,
                   "triad: prior triad file (axis names and order, frame_id; default nominal)")
@@ -239,6 +253,8 @@ Command addCalibrateCommand(CLI::App& root) {
       "Processes the bag's channels with the prior parameters and runs the calibrator's method with its\n"
       "quality gates on the turntable plateaus. Thermal writes K and D as splines over the resonator\n"
       "frequency (the bag's channels must carry it).\n"
+      "Field (docs/field_calibration.md): a still gyro whose precession loop turned the wave both ways; reads\n"
+      "the loop's state (hrg_gyro/PrecessionState) in place of the table, refreshes D(theta) and keeps K.\n"
       "Triad (docs/triad.md): each axis's channels through its own processor, the table and the fixture's\n"
       "positions; writes each axis's parameter file and the triad file, all or none checked before the first.\n"
       "Every output replaces its path only when complete; an output that is the same file as an input\n"

@@ -88,6 +88,13 @@ int runSimulate(const SimulateOptions& o) {
                 toTurntableMessage(r, 0, o.frame_id));
     }
     if (truth) bag.write("/truth", stamp, toTruthMessage(s, ch.header));
+    // A gyro with a precession loop: the schedule's commands as the commanding node would have sent
+    // them (at the carrier period that took each up), and what the loop executes, with every sample.
+    for (const core::AppliedPrecession& a : s.precession_commands) {
+      const ros::Time at = toRosTime(core::toNanoseconds(config.start_time + a.time));
+      bag.write("/command/precession", at, toPrecessionCommandMessage(a, at, o.frame_id));
+    }
+    if (sim.hasPrecessionLoop()) bag.write("/precession/state", stamp, toPrecessionStateMessage(s, ch.header));
     progress.update(sim.elapsed(), ++seq);
   }
   bag.commit();
@@ -116,7 +123,9 @@ Command addSimulateCommand(CLI::App& root) {
   addCompressionOption(*cmd, &o->compression);
   cmd->footer(
       "Runs the simulated gyro of a scenario and writes /channels, /turntable/state and /truth (unless\n"
-      "--no-truth), stamped and recorded at simulated time, as fast as it runs. A triad scenario (a\n"
+      "--no-truth), stamped and recorded at simulated time, as fast as it runs. A gyro with a precession\n"
+      "loop (dynamics.model: averaged) adds /precession/state with every sample and its schedule's\n"
+      "commands (dynamics.commands) on /command/precession, as sent to a live driver. A triad scenario (a\n"
       "`triad` section) writes /<axis>/channels and /<axis>/truth for each axis, /turntable/state,\n"
       "/fixture/position and the body's /truth (hrg_gyro/BodyTruth). Chunks are LZ4-compressed\n"
       "by default (several times faster to read back; every rosbag reader handles it).\n"

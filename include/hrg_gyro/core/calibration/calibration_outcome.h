@@ -38,6 +38,23 @@ struct TableClockReport {
   double k_scaled = 1.0;           ///< K was multiplied by this for the clocks' rate difference
 };
 
+/// What the field method measured besides D(theta) (method field): the realised gain of the virtual
+/// rate, the drift as measured before the Earth rate's share came off, and how the session went.
+struct FieldReport {
+  bool present = false;
+  HarmonicFitResult virtual_rate_gain;                ///< G_v(theta): realised over commanded virtual rate
+  HarmonicFitResult measured_drift;                   ///< D(theta) + K(theta) Omega_s, rad/s: the still gyro's rate
+  double earth_rate = 0.0;                            ///< Omega_s, rad/s: the prior's vertical Earth rate
+  double k0_prior = 0.0;                              ///< the prior's K0, kept
+  double positive_rate = 0.0, negative_rate = 0.0;    ///< rad/s, the commanded rates of the two directions
+  double positive_turns = 0.0, negative_turns = 0.0;  ///< full turns (2 pi) of theta in each direction's data
+  double positive_time = 0.0, negative_time = 0.0;    ///< s of each direction's settled data
+  /// The standard errors of D's harmonics over what the white wave-angle noise alone predicts (rms of
+  /// the ratios, >= 1): the stillness of the case (a case that moves, or a gyro's own rate noise,
+  /// raises it)
+  double excess_scatter = 1.0;
+};
+
 struct GroupSummary {
   double rate = 0.0;      ///< mean table rate, rad/s
   double rate_std = 0.0;  ///< rad/s
@@ -84,6 +101,7 @@ struct CalibrationOutcome {
   /// the bias at bias_trend.reference_stamp, the mean time of the data.
   BiasTrendFit bias_trend;
   TableClockReport table_clock;
+  FieldReport field;  ///< method field only
 
   /// Appends a gate; the first failing one becomes the reason.
   void gate(const std::string& name, bool passed, double value, double limit, const std::string& message);

@@ -57,6 +57,23 @@ struct TableClockSettings {
   double max_offset = 0.5;   ///< s: an estimated offset beyond this (3 sigma included) is refused
 };
 
+/// The field method (field_method.h): a still gyro whose precession loop turns the wave both ways.
+/// `rate`, `turns`, `directions` and `rest` plan the virtual rotation the live calibrator commands
+/// (fieldCommandPlan); the rest are the estimator's orders and the method's own gates.
+struct FieldSettings {
+  std::vector<int> gain_orders{2, 4};         ///< harmonic orders of the virtual rate's gain G_v(theta)
+  double rate = 0.2;                          ///< rad/s (electrical), |commanded virtual rate|
+  double turns = 2.0;                         ///< full turns of theta (2 pi) per segment
+  std::vector<int> directions{1, -1, -1, 1};  ///< the segments' signs, in order (+ - - +: a linear bias trend cancels)
+  double rest = 5.0;                          ///< s at rest (commanded 0) before the first segment
+  double min_turns = 1.0;                     ///< gate: full turns of theta per direction
+  /// gate (stillness): the scatter of the data about the fit over what the white wave-angle noise
+  /// predicts, on D0: a case that moves (or a rate noise) raises it
+  double max_excess_scatter = 3.0;
+  double max_gain_error = 0.05;  ///< gate: |G_v0 - 1|, a loop that does not realise the command
+  double max_drift_std = 1e-7;   ///< gate: rad/s, the largest standard error of a D term
+};
+
 struct CalibrationSettings {
   CalibrationMethodKind method = CalibrationMethodKind::kDualRate;
   std::vector<int> scale_factor_orders{2, 4, 6, 8};
@@ -77,6 +94,7 @@ struct CalibrationSettings {
   QualityLimits gates;
   ThermalSettings thermal;
   TableClockSettings table_clock;
+  FieldSettings field;
 
   /// Parses the calibrator settings map. Throws ConfigError naming the key.
   static CalibrationSettings parse(const YamlField& root, const std::vector<std::string>& extra_keys = {});

@@ -82,6 +82,7 @@ struct IncrementFit {
   HarmonicFitResult k;  ///< K(theta), standard errors include the systematic terms of `budget`
   HarmonicFitResult d;  ///< D(theta), rad/s
   IncrementErrorBudget budget;
+  IncrementErrorBudget drift_budget;     ///< the same for the D terms (mean, cos..., sin...)
   std::vector<BinnedCurvePoint> binned;  ///< fitted model plus the binned residual of the two main groups
   double angle_noise = 0.0;              ///< estimated white wave-angle noise per sample, rad
   double mean_window = 0.0;              ///< s between consecutive window means

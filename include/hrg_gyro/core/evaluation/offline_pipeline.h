@@ -22,6 +22,7 @@ struct OfflineCalibration {
 };
 
 /// Runs a scenario through a processor with `parameters` into a calibration session, then finishes it.
+/// A method fed by the virtual rotation (field) gets the precession loop's state instead of the table's.
 OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
                                          std::shared_ptr<const GyroParameters> parameters,
                                          const CalibrationSettings& calibration, const ProcessorConfig& processor = {});

@@ -25,6 +25,7 @@ enum class CalibrationMethodKind {
   kCorrectionMatrix,  ///< generator sweep at rest: the correction matrix P
   kThermal,           ///< dual-rate across temperature: K and D as splines over the frequency
   kTriad,             ///< three axes in a fixture turned through positions: each axis's K and D, the triad's M and bias
+  kField,             ///< a still gyro, its wave turned both ways by the precession loop: D(theta), K kept
 };
 
 /// What a method needs from a session and what it estimates.
@@ -38,6 +39,9 @@ struct CalibrationMethodTraits {
   bool estimates_correction;  ///< writes the correction matrix P
   bool frequency_dependent;   ///< K and D over the resonator frequency (the input must carry it)
   bool three_axes;            ///< calibrates a triad (three axes' streams and the fixture's position)
+  /// fed the precession loop's state (precession/state) instead of the turntable's: the virtual
+  /// rotation of a still gyro stands in for the table (refreshes D(theta), keeps K)
+  bool virtual_rotation;
 };
 
 /// Every method, in the order help texts list them; the first is the default.

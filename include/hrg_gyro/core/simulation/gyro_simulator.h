@@ -26,6 +26,19 @@
 // those of that temperature, and the sample reports T and f(T). Without one every sample reports
 // the nominal frequency and an unknown (NaN) temperature, exactly as before thermal support existed.
 //
+// With the averaged resonator (SimulationConfig::dynamics, dynamics_config.h) the wave is not
+// integrated from given K and D: ResonatorDynamics is stepped once per carrier period with the sensed
+// rate at the period's ends (linear in between, as the RK4 stages above see it), the commanded
+// virtual rate and, as an angle rate from outside the shell, the resonator section's drift at the
+// period's start angle plus the bias drift (its trend at the period's middle: exact for a linear
+// trend). The rate noise enters as a body-rate noise held over the period (the same angle random
+// walk). The synthesizer gets the resonator's (A, B, theta, tau) at the period's start, the truth
+// reports them and the reference carrier's frequency (the phase loop's), and so does the sample.
+// The loops run at rest for dynamics.settle_time s before the first sample. The precession loop
+// follows the scenario's schedule (dynamics.commands) and commandVirtualRate(), each applied from
+// the start of the next carrier period; every sample carries the rate in force, the commanded
+// virtual angle (its integral) and the commands applied within its window.
+//
 // One axis of a triad (TriadSimulator) senses the inertial rate about its own sensitive axis instead
 // of the table's vertical rotation: it is built with an AxisRateInput, whose rate replaces
 // Omega_table + Omega_E in the dynamics above; the truth's inertial angle is then that rate's
@@ -35,11 +48,13 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/model_pair_evaluator.h"
+#include "hrg_gyro/core/resonator/resonator_dynamics.h"
 #include "hrg_gyro/core/simulation/gaussian_noise.h"
 #include "hrg_gyro/core/simulation/signal_synthesizer.h"
 #include "hrg_gyro/core/simulation/simulation_config.h"
@@ -67,6 +82,21 @@ struct TruthState {
   const std::string* segment = nullptr;  ///< profile label (owned by the simulator)
 };
 
+/// A command the precession loop took up: from `time` (s from the scenario start) it turns the
+/// wave at `rate` (electrical rad/s, as commanded).
+struct AppliedPrecession {
+  double time = 0.0;
+  double rate = 0.0;
+  bool scheduled = false;  ///< from the scenario's schedule; false: commandVirtualRate()
+};
+
+/// The precession loop's state at a sample (averaged resonator only).
+struct PrecessionState {
+  double rate = 0.0;   ///< commanded electrical rate in force at the sample's end, rad/s
+  double angle = 0.0;  ///< commanded virtual angle at the sample's centre: the integral of the commanded rate, rad
+  std::uint64_t commands = 0;  ///< commands applied so far
+};
+
 struct SimulationSample {
   std::uint64_t index = 0;
   Nanoseconds stamp = 0;  ///< centre of the demodulation window
@@ -79,6 +109,10 @@ struct SimulationSample {
   bool channels_delivered = true;
   /// Turntable records logged since the previous sample, up to this one's stamp, in log order.
   std::vector<TurntableLogRecord> turntable;
+  /// Averaged resonator only: the precession loop's state, and the commands it took up within this
+  /// sample's window (in order).
+  PrecessionState precession;
+  std::vector<AppliedPrecession> precession_commands;
 };
 
 /// What one axis of a triad senses: the inertial rate about its sensitive axis, a smooth function of
@@ -94,6 +128,7 @@ class GyroSimulator {
  public:
   /// `input` (not owned, must outlive the simulator): the rate this gyro senses, for one axis of a
   /// triad; nullptr (the default): the table's rate plus the vertical Earth rate, as a single gyro.
+  /// Throws std::invalid_argument for an input with the averaged resonator (a single gyro's only).
   explicit GyroSimulator(const SimulationConfig& config, const AxisRateInput* input = nullptr);
   // The dynamics evaluator points into config_: the simulator stays where it was built.
   GyroSimulator(const GyroSimulator&) = delete;
@@ -109,6 +144,13 @@ class GyroSimulator {
   /// The next output sample; false once the scenario is complete.
   bool next(SimulationSample* out);
 
+  /// Whether the wave comes from the averaged resonator with its loops (which take precession commands).
+  bool hasPrecessionLoop() const { return dynamics_.has_value(); }
+  /// Commands the precession loop to turn the wave at `rate` (electrical rad/s) from the start of the
+  /// next carrier period, until the next command (a scheduled one included). Throws std::logic_error
+  /// without a precession loop, std::invalid_argument for a rate that is not finite.
+  void commandVirtualRate(double rate);
+
   /// What the table controller has logged so far (records made, lost, glitched).
   const TurntableLogCounters& turntableLogCounters() const { return logger_.counters(); }
 
@@ -118,6 +160,10 @@ class GyroSimulator {
   /// The inertial rate the gyro senses at t: the input's, or the table's plus the vertical Earth rate.
   double sensedRate(double t) const;
   void nextDynamic(SimulationSample* out);
+  /// nextDynamic for the averaged resonator.
+  void nextResonator(SimulationSample* out);
+  /// Takes up the scheduled and commanded precession due at the current time.
+  void applyPrecessionCommands(SimulationSample* out);
   void nextGenerator(SimulationSample* out);
   double generatorDuration() const;
   std::uint64_t generatorOutputsPerState() const;
@@ -154,6 +200,14 @@ class GyroSimulator {
   std::uint64_t generator_state_ = 0;
   std::uint64_t generator_outputs_in_state_ = 0;
   std::string generator_label_ = "generator";
+  // The averaged resonator (dynamics.model: averaged), its precession commands and their integral.
+  std::optional<ResonatorDynamics> dynamics_;
+  std::size_t next_scheduled_ = 0;
+  std::optional<double> commanded_;  // commandVirtualRate(), not yet taken up
+  double virtual_rate_ = 0.0;
+  double virtual_angle_ = 0.0;  // at t_, rad
+  std::uint64_t precession_commands_ = 0;
+  double shell_bias_ = 0.0;  // the mean of the averaged shell's settled drift, rad/s (TruthState::bias)
 };
 
 }  // namespace core

@@ -5,6 +5,9 @@
 // effective models are K_eff(theta~) = g' K and D_eff(theta~) = g' D. g is measured noise free at
 // signal level on a fine grid of true angles, g' by five-point central differences, and both effective models
 // are fitted with harmonics of theta~. This is the "injected" reference of the summaries and tests.
+// K and D at the true angle are intrinsic_model.h's: the given models, or those the averaged
+// resonator settles to. With the averaged resonator the realised gain of the virtual rate is
+// measured the same way: G_v,eff(theta~) = g' G_v (what the field calibration estimates).
 #pragma once
 
 #include <vector>
@@ -20,6 +23,9 @@ struct EffectiveModel {
   HarmonicFitResult scale_factor;  ///< K_eff over the requested orders
   HarmonicFitResult drift;         ///< D_eff, rad/s
   double nonlinearity_ppm = 0.0;   ///< peak |K_eff - K0| / |K0| including every order up to 16
+  /// G_v,eff over the requested orders (computeEffectiveModel with gain orders; averaged resonator
+  /// only, else not ok).
+  HarmonicFitResult virtual_rate_gain;
 };
 
 /// The injected turn-on bias D0(t) of a scenario at t s from its start, rad/s, without the random
@@ -27,8 +33,10 @@ struct EffectiveModel {
 /// random walk's realisation is a draw of the run: the ground truth carries it (TruthState::bias).
 double injectedBiasTrend(const SimulationConfig& config, double t);
 
+/// `gain_orders`: those of G_v,eff, fitted only for the averaged resonator (empty: not fitted).
 EffectiveModel computeEffectiveModel(const SimulationConfig& config, const CorrectionMatrix& correction,
-                                     const std::vector<int>& k_orders, const std::vector<int>& d_orders);
+                                     const std::vector<int>& k_orders, const std::vector<int>& d_orders,
+                                     const std::vector<int>& gain_orders = {});
 
 }  // namespace core
 }  // namespace hrg_gyro

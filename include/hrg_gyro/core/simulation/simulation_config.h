@@ -12,6 +12,7 @@
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/model/harmonic_model.h"
 #include "hrg_gyro/core/signal/pickoff_array.h"
+#include "hrg_gyro/core/simulation/dynamics_config.h"
 #include "hrg_gyro/core/simulation/stream_delivery.h"
 #include "hrg_gyro/core/simulation/temperature_dependence.h"
 #include "hrg_gyro/core/simulation/turntable_log.h"
@@ -78,6 +79,10 @@ struct SimulationConfig {
   DeliveryConfig channels;           ///< lost channel-amplitude samples (default: none)
   GeneratorConfig generator;
   ThermalConfig thermal;  ///< disabled unless the scenario has a thermal section
+  /// How the wave moves (dynamics_config.h): the given K and D by default, or the averaged resonator
+  /// with its loops. With the latter, resonator.scale_factor is K0 = -2 k of the shell and
+  /// resonator.quadrature 0 (the quadrature loop holds B at 0); resonator.drift adds to the shell's.
+  DynamicsConfig dynamics;
 
   double outputPeriod() const { return resonator.periods_per_output / resonator.frequency; }
 

@@ -1,0 +1,63 @@
+// The field method: D(theta) refreshed on a still gyro, without a table. The precession loop turns
+// the standing wave at a commanded virtual rate w_v, both ways, through full turns, while the case
+// stands still; the wave then turns at
+//   d theta/dt = G_v(theta) w_v + K(theta) Omega_s + D(theta)
+// with G_v the drive's realised gain of the command and Omega_s the Earth rate about the sensitive
+// axis. That is the dual-rate method's equation with the commanded virtual angle psi (the integral of
+// w_v, reported on precession/state) in place of the table angle and G_v in place of K: the same
+// increment regression (increment_regression.h) fits G_v(theta) and the still gyro's rate
+// D(theta) + K(theta) Omega_s at once, exactly for any window, with the block-sandwich standard errors.
+// Both directions separate the two, as two table rates separate K and D.
+//
+// What a still gyro cannot give: K. Without a real rotation nothing scales with a body rate, so K0
+// and its harmonics are kept from the prior (a table calibration), and the Earth rate's share,
+// K(theta) Omega_s with Omega_s from the prior's latitude, is taken off the measured rate to leave
+// D(theta). D0 is therefore only as good as K0 Omega_s is known, and a case that turns at a constant
+// rate throughout is indistinguishable from a bias (say so where the gyro is installed). A case that
+// moves at all is seen as scatter beyond the wave-angle noise, which a gate bounds.
+//
+// Fed by the session (calibration_session.h) from the precession state stream in place of the
+// turntable's: its plateaus are the segments of constant commanded rate; static ones (w_v = 0) are
+// skipped. Memory is bounded by the regression's sums and the bins.
+#pragma once
+
+#include <vector>
+
+#include "hrg_gyro/core/calibration/calibration_method_interface.h"
+#include "hrg_gyro/core/estimation/increment_regression.h"
+#include "hrg_gyro/core/estimation/rate_groups.h"
+
+namespace hrg_gyro {
+namespace core {
+
+class FieldMethod : public CalibrationMethod {
+ public:
+  explicit FieldMethod(const CalibrationSettings& settings);
+  CalibrationMethodKind kind() const override { return CalibrationMethodKind::kField; }
+  void addSample(const PlateauSample& s) override;
+  bool complete() const override;
+  CalibrationProgress progress() const override;
+  CalibrationOutcome finish(const GyroParameters& prior) const override;
+
+ private:
+  /// The averaging window at this virtual rate: the wave sweeps at most window_span and the highest
+  /// order's phase at most 1 rad in it (as the dual-rate method's), `window` the upper bound.
+  double windowFor(double rate) const;
+  double minBinTime(double rate) const { return 0.25 * windowFor(rate); }
+  /// The longest-running group of each sign of the commanded rate (-1: none).
+  void directionGroups(int* positive, int* negative) const;
+
+  CalibrationSettings settings_;
+  RateGroups groups_;
+  IncrementRegression regression_;
+  std::vector<double> group_rates_;  // commanded rate of each regression group
+  bool in_chain_ = false;
+  std::uint64_t chain_plateau_ = 0;
+  Nanoseconds last_stamp_ = 0;
+  double frequency_sum_ = 0.0;  // of the samples' resonator frequency, for a frequency-dependent prior K
+  std::uint64_t frequency_count_ = 0;
+  std::uint64_t samples_ = 0;
+};
+
+}  // namespace core
+}  // namespace hrg_gyro

@@ -1,0 +1,249 @@
+#include "hrg_gyro/core/calibration/field_method.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "hrg_gyro/core/common/units.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+double largestStd(const HarmonicFitResult& f) {
+  double m = f.mean_std;
+  for (std::size_t j = 0; j < f.orders.size(); ++j) m = std::max({m, f.cos_std[j], f.sin_std[j]});
+  return m;
+}
+
+GroupSummary summarize(const RateGroup& g, double min_bin_time) {
+  GroupSummary s;
+  s.rate = g.meanRate();
+  s.rate_std = g.rateStd();
+  s.duration = g.rates().totalTime();
+  s.samples = g.rates().samples();
+  s.coverage = g.rates().coverage(min_bin_time);
+  s.turns = g.rates().thetaSwept() / kPi;
+  return s;
+}
+
+}  // namespace
+
+FieldMethod::FieldMethod(const CalibrationSettings& s)
+    : settings_(s),
+      // The wave turns at about the commanded rate: one radian of theta per radian of psi.
+      groups_(s.bins, s.window, s.window_span, 1.0, maxFittedOrder(s.field.gain_orders, s.drift_orders),
+              s.group_tolerance, s.plateau.max_gap),
+      regression_(s.field.gain_orders, s.drift_orders, s.bins, s.bias_trend_order) {}
+
+double FieldMethod::windowFor(double rate) const {
+  const int top = maxFittedOrder(settings_.field.gain_orders, settings_.drift_orders);
+  const double span = std::min(settings_.window_span, 1.0 / top);
+  const double sweep = std::abs(rate);
+  return sweep > 0.0 ? std::min(settings_.window, span / sweep) : settings_.window;
+}
+
+void FieldMethod::addSample(const PlateauSample& s) {
+  // At rest (w_v = 0) the wave hardly moves: nothing to separate.
+  if (s.plateau.is_static || !std::isfinite(s.theta) || !std::isfinite(s.table_angle) || !std::isfinite(s.table_rate))
+    return;
+  groups_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.table_rate);
+  ++samples_;
+  if (std::isfinite(s.frequency)) {
+    frequency_sum_ += s.frequency;
+    ++frequency_count_;
+  }
+  const bool gap = in_chain_ && toSeconds(s.stamp - last_stamp_) > settings_.plateau.max_gap;
+  if (!in_chain_ || s.plateau.id != chain_plateau_ || gap || s.stamp <= last_stamp_) {
+    int group = -1;
+    for (std::size_t g = 0; g < group_rates_.size(); ++g)
+      if (std::abs(group_rates_[g] - s.plateau.rate) <= settings_.group_tolerance) group = static_cast<int>(g);
+    if (group < 0) {
+      group = static_cast<int>(group_rates_.size());
+      group_rates_.push_back(s.plateau.rate);
+    }
+    regression_.startChain(group, windowFor(s.plateau.rate));
+    in_chain_ = true;
+    chain_plateau_ = s.plateau.id;
+  }
+  // psi is the driver's own integral of the command: exact, and continuous (never wrapped).
+  regression_.add(s.stamp, s.theta, s.table_angle);
+  last_stamp_ = s.stamp;
+}
+
+void FieldMethod::directionGroups(int* positive, int* negative) const {
+  *positive = *negative = -1;
+  for (std::size_t i : groups_.byDuration()) {
+    const double rate = groups_.groups()[i].meanRate();
+    if (rate > 0.0 && *positive < 0) *positive = static_cast<int>(i);
+    if (rate < 0.0 && *negative < 0) *negative = static_cast<int>(i);
+  }
+}
+
+bool FieldMethod::complete() const { return progress().fraction >= 1.0; }
+
+CalibrationProgress FieldMethod::progress() const {
+  CalibrationProgress p;
+  int plus, minus;
+  directionGroups(&plus, &minus);
+  std::ostringstream s;
+  s << "field:";
+  double fraction = 1.0;
+  const FieldSettings& f = settings_.field;
+  for (const auto& [index, name] : {std::pair<int, const char*>{plus, "+"}, {minus, "-"}}) {
+    if (index < 0) {
+      s << " " << name << " no data;";
+      fraction = 0.0;
+      continue;
+    }
+    const RateGroup& g = groups_.groups()[index];
+    const double coverage = g.rates().coverage(minBinTime(g.meanRate()));
+    const double turns = g.rates().thetaSwept() / kTwoPi;
+    s << " " << formatShort(g.meanRate(), 3) << " rad/s: " << formatShort(turns, 3) << " turns, coverage "
+      << formatShort(100 * coverage, 3) << " %;";
+    fraction =
+        std::min({fraction, coverage / settings_.gates.min_coverage, f.min_turns > 0 ? turns / f.min_turns : 1.0});
+  }
+  p.fraction = std::min(1.0, fraction);
+  p.summary = s.str();
+  return p;
+}
+
+CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
+  CalibrationOutcome o;
+  o.method = kind();
+  const QualityLimits& q = settings_.gates;
+  const FieldSettings& fs = settings_.field;
+  for (std::size_t i : groups_.byDuration()) {
+    const RateGroup& g = groups_.groups()[i];
+    o.plateaus.push_back(summarize(g, minBinTime(g.meanRate())));
+  }
+  o.samples = samples_;
+  o.gate("samples", samples_ >= q.min_samples, static_cast<double>(samples_), static_cast<double>(q.min_samples),
+         std::to_string(samples_) + " wave samples while the wave was precessed");
+  int plus, minus;
+  directionGroups(&plus, &minus);
+  const int directions = (plus >= 0) + (minus >= 0);
+  o.gate("directions", directions == 2, directions, 2.0,
+         directions == 2 ? "virtual rotation in both directions"
+                         : std::string("need the wave precessed both ways (the two separate D from the gain), found ") +
+                               (plus >= 0    ? "only positive"
+                                : minus >= 0 ? "only negative"
+                                             : "no") +
+                               " rates");
+  if (directions < 2) {
+    o.decide();
+    return o;
+  }
+  const RateGroup& gp = groups_.groups()[plus];
+  const RateGroup& gm = groups_.groups()[minus];
+  FieldReport& r = o.field;
+  r.present = true;
+  r.positive_rate = gp.meanRate();
+  r.negative_rate = gm.meanRate();
+  r.positive_turns = gp.rates().thetaSwept() / kTwoPi;
+  r.negative_turns = gm.rates().thetaSwept() / kTwoPi;
+  r.positive_time = gp.rates().totalTime();
+  r.negative_time = gm.rates().totalTime();
+  o.duration = r.positive_time + r.negative_time;
+  const double min_bin_time = std::max(minBinTime(r.positive_rate), minBinTime(r.negative_rate));
+  o.coverage =
+      std::min(gp.rates().coverage(minBinTime(r.positive_rate)), gm.rates().coverage(minBinTime(r.negative_rate)));
+  o.gate("coverage", o.coverage >= q.min_coverage, o.coverage, q.min_coverage,
+         "theta bins covered in both directions: " + formatShort(100 * o.coverage) + " %");
+  const double turns = std::min(r.positive_turns, r.negative_turns);
+  o.gate("turns", turns >= fs.min_turns, turns, fs.min_turns,
+         formatShort(r.positive_turns, 3) + " full turns of theta at " + formatShort(r.positive_rate, 3) + " rad/s, " +
+             formatShort(r.negative_turns, 3) + " at " + formatShort(r.negative_rate, 3) + " rad/s");
+  // psi carries no Earth rate: the regression's D is the still gyro's whole rate, D + K Omega_s.
+  const IncrementFit e = regression_.solve(0.0, 0.0, min_bin_time, q.max_condition);
+  if (!e.ok) {
+    o.gate("fit", false, 0.0, 0.0, e.reason);
+    o.decide();
+    return o;
+  }
+  r.virtual_rate_gain = e.k;
+  r.measured_drift = e.d;
+  // K kept from the prior, at the session's resonator frequency (a thermal prior's K(theta, f)).
+  const double frequency = frequency_count_ > 0 ? frequency_sum_ / frequency_count_ : NAN;
+  const HarmonicModel& k_prior = prior.scale_factor;
+  std::vector<double> k(k_prior.termCount());
+  k_prior.coefficientsAt(frequency, k.data());
+  r.earth_rate = prior.earth_rate.verticalRate();
+  r.k0_prior = k[0];
+  // D = measured - K(theta) Omega_s, term by term where K has D's order (K's other orders times
+  // Omega_s are ~1e-9 rad/s and stay in the fit's residual).
+  HarmonicFitResult d = e.d;
+  d.mean -= k[0] * r.earth_rate;
+  const std::size_t nk = k_prior.orders().size();
+  for (std::size_t j = 0; j < d.orders.size(); ++j) {
+    for (std::size_t i = 0; i < nk; ++i) {
+      if (k_prior.orders()[i] != d.orders[j]) continue;
+      d.cos[j] -= k[1 + i] * r.earth_rate;
+      d.sin[j] -= k[1 + nk + i] * r.earth_rate;
+    }
+  }
+  o.scale_factor.clear();  // K is not estimated: kept
+  o.drift = {d};
+  o.binned = e.binned;
+  for (BinnedCurvePoint& p : o.binned) p.d -= k_prior(p.theta, frequency) * r.earth_rate;
+  o.smoothing_factor = 1.0;
+  if (e.trend.order > 0) o.bias_trend = e.trend;
+
+  o.gate("fit_condition", e.k.condition_number <= q.max_condition, e.k.condition_number, q.max_condition,
+         "regression condition number " + formatShort(e.k.condition_number));
+  // Stillness from D's harmonics: their regressors oscillate, so the block sandwich measures their
+  // scatter without the excess it shows on slopes such as D0 (whose increments telescope across the
+  // blocks' boundaries, which the sandwich does not pair).
+  double excess = 0.0;
+  int terms = 0;
+  for (std::size_t i = 1; i < e.drift_budget.statistical.size(); ++i) {
+    if (!(e.drift_budget.angle_noise[i] > 0.0)) continue;
+    const double ratio = e.drift_budget.statistical[i] / e.drift_budget.angle_noise[i];
+    excess += ratio * ratio;
+    ++terms;
+  }
+  r.excess_scatter = terms > 0 ? std::sqrt(excess / terms) : 1.0;
+  o.gate("stillness", r.excess_scatter <= fs.max_excess_scatter, r.excess_scatter, fs.max_excess_scatter,
+         "the data scatter " + formatShort(r.excess_scatter, 3) +
+             " times what the wave-angle noise predicts on D's harmonics (rms; a case that moves, or a rate noise, "
+             "raises it)");
+  const double gain_error = std::abs(e.k.mean - 1.0);
+  o.gate("virtual_rate_gain", gain_error <= fs.max_gain_error, gain_error, fs.max_gain_error,
+         "the precession loop realised " + formatShort(e.k.mean, 8) + " of the commanded rate (+- " +
+             formatShort(e.k.mean_std, 2) + ")");
+  const double worst = largestStd(d);
+  o.gate("drift_std", worst <= fs.max_drift_std, worst, fs.max_drift_std,
+         "largest standard error of a D term " + formatShort(worst, 3) + " rad/s");
+  if (e.trend.order > 0) {
+    const BiasTrendFit& t = e.trend;
+    const double g0_std = e.k.mean_std / std::abs(e.k.mean);
+    const bool separable = t.k0_inflation <= q.max_trend_inflation || g0_std <= q.max_trend_k0_std;
+    o.gate("bias_trend", separable, t.k0_inflation, q.max_trend_inflation,
+           "bias trend " + formatShort(t.coefficients.front() * 3600.0, 3) + " +- " +
+               formatShort(t.stds.front() * 3600.0, 2) + " rad/s per hour fitted with D and the gain (the gain's " +
+               "standard error x" + formatShort(t.k0_inflation, 3) + ")" +
+               (separable ? std::string() : ": order the directions so that a trend cancels (+ - - +)"));
+  }
+  o.notes.push_back("K kept from the prior (K0 = " + formatShort(r.k0_prior, 9) +
+                    "): a still gyro is turned by its precession loop, never by a rotation, so nothing in this "
+                    "session scales with a body rate; refresh K on a table");
+  o.notes.push_back(
+      "D = the still gyro's rate - K(theta) Omega_s with Omega_s = " + formatShort(r.earth_rate, 6) +
+      " rad/s (the prior's latitude " + formatShort(prior.earth_rate.latitude, 6) +
+      " rad): D0 is only as good as K0 Omega_s, and a case turning at a constant rate would read as bias");
+  o.notes.push_back("the commanded rate was realised with gain " + formatShort(e.k.mean, 8) + " +- " +
+                    formatShort(e.k.mean_std, 2) + " (theta-dependent part up to " +
+                    formatShort(toModel(e.k).peakDeviation(), 3) + "); window " + formatShort(e.mean_window) +
+                    " s, angle noise " + formatShort(e.angle_noise) + " rad, " + std::to_string(e.increments) +
+                    " increments in " + std::to_string(e.blocks) + " blocks");
+  o.parameters = prior;
+  o.parameters.drift = toModel(d);
+  o.parameters.calibration.method = ParameterOrigin::calibratedBy(o.method);
+  o.parameters.calibration.time = utcNow();
+  o.decide();
+  return o;
+}
+
+}  // namespace core
+}  // namespace hrg_gyro

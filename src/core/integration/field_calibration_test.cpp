@@ -1,0 +1,183 @@
+// The field method on a gyro simulated from its equations of motion (config/scenarios/
+// resonator_field.yaml: the averaged resonator on a still table, its wave precessed both ways): D(theta)
+// and the realised gain of the virtual rate against the injected model (the exact settled drift and
+// gain through the pickoffs), its standard errors over many seeds, and its gates.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+
+#include "hrg_gyro/core/calibration/field_command_plan.h"
+#include "hrg_gyro/core/evaluation/offline_pipeline.h"
+#include "hrg_gyro/core/simulation/injected_model.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+SimulationConfig shippedScenario(const std::string& name) {
+  return SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/" + name, nodeOnlyScenarioKeys());
+}
+
+CalibrationSettings fieldSettings() {
+  CalibrationSettings s;
+  s.method = CalibrationMethodKind::kField;
+  return s;
+}
+
+/// What a perfect table calibration left: the injected K and D, the site's latitude.
+std::shared_ptr<GyroParameters> tablePrior(const SimulationConfig& c, const CalibrationSettings& s) {
+  auto p = std::make_shared<GyroParameters>();
+  const EffectiveModel e = computeEffectiveModel(c, p->correction, s.scale_factor_orders, s.drift_orders);
+  p->scale_factor = toModel(e.scale_factor);
+  p->drift = toModel(e.drift);
+  p->earth_rate.latitude = c.latitude;
+  return p;
+}
+
+/// The scenario with the virtual rotation the settings plan, and the table still until its end plus 3 s.
+SimulationConfig withPlan(SimulationConfig c, const CalibrationSettings& s) {
+  c.dynamics.commands.clear();
+  for (const PlannedPrecession& p : fieldCommandPlan(s)) c.dynamics.commands.push_back({p.time, p.rate});
+  c.profile = TurntableProfile();
+  c.profile.append(c.dynamics.commands.back().time + 3.0, 0.0, 0.0, "still");
+  return c;
+}
+
+/// (estimate - injected) / sigma for every term of a fit, mean first.
+std::vector<double> normalisedErrors(const HarmonicFitResult& estimate, const HarmonicFitResult& injected) {
+  std::vector<double> z{(estimate.mean - injected.mean) / estimate.mean_std};
+  for (std::size_t j = 0; j < estimate.orders.size(); ++j) {
+    z.push_back((estimate.cos[j] - injected.cos[j]) / estimate.cos_std[j]);
+    z.push_back((estimate.sin[j] - injected.sin[j]) / estimate.sin_std[j]);
+  }
+  return z;
+}
+
+double largestMagnitude(const std::vector<double>& v) {
+  double m = 0.0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+
+TEST(FieldCalibration, ShippedScenarioCarriesTheShippedPlan) {
+  const SimulationConfig c = shippedScenario("resonator_field.yaml");
+  const std::vector<PlannedPrecession> plan = fieldCommandPlan(CalibrationSettings());
+  ASSERT_EQ(c.dynamics.commands.size(), plan.size());
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    EXPECT_NEAR(c.dynamics.commands[i].time, plan[i].time, 1e-6) << i;
+    EXPECT_EQ(c.dynamics.commands[i].rate, plan[i].rate) << i;
+  }
+  EXPECT_EQ(c.profile.pieces().size(), 1u);  // the table never moves
+}
+
+TEST(FieldCalibration, RecoversTheInjectedDriftAndGainOnAStillGyro) {
+  const SimulationConfig c = shippedScenario("resonator_field.yaml");
+  const CalibrationSettings s = fieldSettings();
+  const auto prior = tablePrior(c, s);
+  const auto start = std::chrono::steady_clock::now();
+  const OfflineCalibration run = calibrateOnSimulation(c, prior, s);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const CalibrationOutcome& o = run.outcome;
+  for (const GateResult& g : o.gates)
+    std::printf("  %s %s: %s\n", g.passed ? "pass" : "FAIL", g.name.c_str(), g.message.c_str());
+  ASSERT_TRUE(o.accepted) << o.reason;
+  EXPECT_TRUE(o.scale_factor.empty());  // K is kept
+  EXPECT_EQ(o.parameters.scale_factor, prior->scale_factor);
+  const EffectiveModel injected =
+      computeEffectiveModel(c, prior->correction, s.scale_factor_orders, s.drift_orders, s.field.gain_orders);
+  const HarmonicFitResult& d = o.drift[0];
+  const HarmonicFitResult& g = o.field.virtual_rate_gain;
+  std::printf("[ measured ] %.0f s simulated, calibrated in %.1f s\n", run.simulated_seconds, seconds);
+  std::printf(
+      "[ measured ] D0 %.5g (injected %.5g, sigma %.2g); cos2 %.6g (%.6g, %.2g); sin2 %.6g (%.6g, %.2g) rad/s\n",
+      d.mean, injected.drift.mean, d.mean_std, d.cos[0], injected.drift.cos[0], d.cos_std[0], d.sin[0],
+      injected.drift.sin[0], d.sin_std[0]);
+  std::printf("[ measured ] G_v0 %.8f (injected %.8f, sigma %.2g); cos2 %.5g (%.5g, %.2g)\n", g.mean,
+              injected.virtual_rate_gain.mean, g.mean_std, g.cos[0], injected.virtual_rate_gain.cos[0], g.cos_std[0]);
+  const std::vector<double> zd = normalisedErrors(d, injected.drift),
+                            zg = normalisedErrors(g, injected.virtual_rate_gain);
+  std::printf("[ measured ] largest |estimate - injected| / sigma: D %.2f, G_v %.2f; stillness %.3f\n",
+              largestMagnitude(zd), largestMagnitude(zg), o.field.excess_scatter);
+  EXPECT_LT(largestMagnitude(zd), 3.0);
+  EXPECT_LT(largestMagnitude(zg), 3.0);
+}
+
+// Over many seeds, the estimates scatter about the injected model as their standard errors say. The
+// harmonics' errors come from the block sandwich; D0's and G_v0's (slopes in time) are conservative
+// (the sandwich does not pair the increments across the blocks' boundaries, which telescope there).
+TEST(FieldCalibration, StandardErrorsAreHonestOverSeeds) {
+  CalibrationSettings s = fieldSettings();
+  s.field.directions = {1, -1};
+  const SimulationConfig base = withPlan(shippedScenario("resonator_field.yaml"), s);
+  const auto prior = tablePrior(base, s);
+  const EffectiveModel injected =
+      computeEffectiveModel(base, prior->correction, s.scale_factor_orders, s.drift_orders, s.field.gain_orders);
+  std::vector<double> harmonics, d0, g0;
+  const int seeds = 10;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    SimulationConfig c = base;
+    c.seed = 1000 + seed;
+    const CalibrationOutcome o = calibrateOnSimulation(c, prior, s).outcome;
+    ASSERT_TRUE(o.accepted) << seed << ": " << o.reason;
+    const std::vector<double> zd = normalisedErrors(o.drift[0], injected.drift);
+    const std::vector<double> zg = normalisedErrors(o.field.virtual_rate_gain, injected.virtual_rate_gain);
+    d0.push_back(zd[0]);
+    g0.push_back(zg[0]);
+    harmonics.insert(harmonics.end(), zd.begin() + 1, zd.end());
+    harmonics.insert(harmonics.end(), zg.begin() + 1, zg.end());
+  }
+  auto rms = [](const std::vector<double>& v) {
+    double ss = 0.0;
+    for (double x : v) ss += x * x;
+    return std::sqrt(ss / v.size());
+  };
+  std::printf(
+      "[ measured ] %d seeds: rms of (estimate - injected) / sigma: harmonics of D and G_v %.2f (%zu terms, "
+      "largest %.2f), D0 %.2f, G_v0 %.2f\n",
+      seeds, rms(harmonics), harmonics.size(), largestMagnitude(harmonics), rms(d0), rms(g0));
+  // 80 terms: the rms of honest errors lies within 0.78..1.22 with 95 % probability.
+  EXPECT_GT(rms(harmonics), 0.75);
+  EXPECT_LT(rms(harmonics), 1.25);
+  EXPECT_LT(largestMagnitude(harmonics), 4.0);
+  EXPECT_LT(rms(d0), 1.3);
+  EXPECT_LT(rms(g0), 1.3);
+}
+
+// What a field session cannot give is refused by name: one direction only (D and the gain are then
+// one unknown), and a case that moves (its rotation is read as drift).
+TEST(FieldCalibration, GatesRefuseOneDirectionAndAMovingCase) {
+  CalibrationSettings s = fieldSettings();
+  s.field.directions = {1, 1};
+  SimulationConfig c = withPlan(shippedScenario("resonator_field.yaml"), s);
+  const auto prior = tablePrior(c, s);
+  CalibrationOutcome o = calibrateOnSimulation(c, prior, s).outcome;
+  EXPECT_FALSE(o.accepted);
+  EXPECT_EQ(o.reason.rfind("directions", 0), 0u) << o.reason;
+
+  s.field.directions = {1, -1};
+  c = withPlan(shippedScenario("resonator_field.yaml"), s);
+  // The vehicle sways: +-2e-4 rad/s at 0.2 Hz, 0.16 mrad of heading.
+  const double end = c.profile.duration();
+  std::string points;
+  for (double t = 0.0; t <= end + 1e-9; t += 0.25) {
+    points += (points.empty() ? "" : ", ") + std::string("[") + std::to_string(t) + ", " +
+              std::to_string(2e-4 * std::sin(kTwoPi * 0.2 * t)) + "]";
+  }
+  c.profile = TurntableProfile::parse(
+      YamlField(YAML::Load("profile: [{type: piecewise, points: [" + points + "]}]"), "")["profile"], c.acceleration);
+  o = calibrateOnSimulation(c, prior, s).outcome;
+  EXPECT_FALSE(o.accepted);
+  bool stillness_failed = false;
+  for (const GateResult& g : o.gates) {
+    if (g.name == "stillness") {
+      stillness_failed = !g.passed;
+      std::printf("[ measured ] a swaying case: %s\n", g.message.c_str());
+    }
+  }
+  EXPECT_TRUE(stillness_failed) << o.reason;
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro
