@@ -174,7 +174,8 @@ std::string withoutLines(const std::string& text, const std::string& prefix) {
 
 /// The scenarios of the gyro simulated from its equations of motion (dynamics.model: averaged).
 const std::set<std::string>& resonatorScenarios() {
-  static const std::set<std::string> names = {"resonator_dual_rate.yaml", "resonator_field.yaml"};
+  static const std::set<std::string> names = {"resonator_dual_rate.yaml", "resonator_field.yaml",
+                                              "resonator_still.yaml"};
   return names;
 }
 
