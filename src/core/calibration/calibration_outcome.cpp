@@ -189,7 +189,7 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
     out << YAML::Key << "positive_time" << YAML::Value << formatDouble(f.positive_time) << YAML::Comment("s");
     out << YAML::Key << "negative_time" << YAML::Value << formatDouble(f.negative_time) << YAML::Comment("s");
     out << YAML::Key << "excess_scatter" << YAML::Value << formatDouble(f.excess_scatter)
-        << YAML::Comment("D0's standard error over the white-noise prediction: stillness");
+        << YAML::Comment("D's harmonics' standard errors over the white-noise prediction (rms): stillness");
     out << YAML::EndMap;
   }
   if (o.bias_trend.order > 0) {

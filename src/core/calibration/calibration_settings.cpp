@@ -1,7 +1,10 @@
 #include "hrg_gyro/core/calibration/calibration_settings.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+
+#include "hrg_gyro/core/common/units.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -29,9 +32,9 @@ const std::vector<std::string> kGateKeys = {
 const std::vector<std::string> kTableClockKeys = {"offset", "regularise", "window", "max_jitter", "max_offset"};
 const std::vector<std::string> kThermalKeys = {"frequency_nodes", "node_count", "interpolation", "slice_width",
                                                "max_slices"};
-const std::vector<std::string> kFieldKeys = {"gain_orders",        "rate",           "turns",
-                                             "directions",         "rest",           "min_turns",
-                                             "max_excess_scatter", "max_gain_error", "max_drift_std"};
+const std::vector<std::string> kFieldKeys = {
+    "gain_orders",        "rate",           "turns",        "directions", "rest", "axis_earth_rate", "min_turns",
+    "max_excess_scatter", "max_gain_error", "max_drift_std"};
 const std::vector<std::string> kScalarKeys = {
     "method",         "scale_factor_orders", "drift_orders",    "bins",
     "window",         "window_span",         "group_tolerance", "auto_finish_idle",
@@ -155,7 +158,24 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
         if (raw[i] != 1 && raw[i] != -1) d.at(i).fail("must be 1 or -1 (the sign of the commanded rate)");
         fs.directions.push_back(static_cast<int>(raw[i]));
       }
-      if (fs.directions.empty()) d.fail("need at least one segment");
+      if (std::find(fs.directions.begin(), fs.directions.end(), 1) == fs.directions.end() ||
+          std::find(fs.directions.begin(), fs.directions.end(), -1) == fs.directions.end()) {
+        d.fail("need both signs (1 and -1): the two directions separate D from the gain, one alone is refused");
+      }
+    }
+    if (f.has("axis_earth_rate")) {
+      const YamlField a = f["axis_earth_rate"];
+      const char* problem = "must be 'vertical' or the Earth's rate about the sensitive axis in rad/s (|x| <= 7.29e-5)";
+      if (a.node().IsScalar() && a.node().Scalar() == "vertical") {
+        fs.axis_earth_rate = NAN;
+      } else {
+        try {
+          fs.axis_earth_rate = a.asDouble();
+        } catch (const ConfigError&) {
+          a.fail(problem);
+        }
+        if (!(std::abs(fs.axis_earth_rate) <= kEarthRotationRate * (1.0 + 1e-6))) a.fail(problem);
+      }
     }
     fs.rest = f.getDouble("rest", fs.rest);
     if (!(fs.rest >= 0.0)) f["rest"].fail("must be >= 0 (s)");

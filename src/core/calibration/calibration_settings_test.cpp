@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,9 @@ TEST(CalibrationSettingsTest, TheFieldMethodsKeysAreReadAndChecked) {
   EXPECT_EQ(d.gain_orders, (std::vector<int>{2, 4}));
   EXPECT_EQ(d.directions, (std::vector<int>{1, -1, -1, 1}));
   EXPECT_DOUBLE_EQ(d.rate, 0.2);
+  EXPECT_TRUE(std::isnan(d.axis_earth_rate));  // vertical at the prior's latitude
+  EXPECT_TRUE(std::isnan(parse("field: {axis_earth_rate: vertical}").field.axis_earth_rate));
+  EXPECT_DOUBLE_EQ(parse("field: {axis_earth_rate: -3.1e-5}").field.axis_earth_rate, -3.1e-5);
   const FieldSettings f = parse(
                               "field: {gain_orders: [2], rate: 0.5, turns: 3, directions: [-1, 1], rest: 0, min_turns: "
                               "2, max_excess_scatter: 1.5, max_gain_error: 0.01, max_drift_std: 2.0e-8}")
@@ -66,6 +70,9 @@ TEST(CalibrationSettingsTest, TheFieldMethodsKeysAreReadAndChecked) {
   EXPECT_EQ(refusedKey("field: {turns: -1}"), "field.turns");
   EXPECT_EQ(refusedKey("field: {directions: []}"), "field.directions");
   EXPECT_EQ(refusedKey("field: {directions: [1, 2]}"), "field.directions[1]");
+  EXPECT_EQ(refusedKey("field: {directions: [1, 1]}"), "field.directions");          // one way cannot pass
+  EXPECT_EQ(refusedKey("field: {axis_earth_rate: 1e-4}"), "field.axis_earth_rate");  // beyond the Earth's rate
+  EXPECT_EQ(refusedKey("field: {axis_earth_rate: up}"), "field.axis_earth_rate");
   EXPECT_EQ(refusedKey("field: {rest: -1}"), "field.rest");
   EXPECT_EQ(refusedKey("field: {gain_orders: [3]}").rfind("field.gain_orders", 0), 0u);
   EXPECT_EQ(refusedKey("field: {max_excess_scatter: 0.5}"), "field.max_excess_scatter");

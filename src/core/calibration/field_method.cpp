@@ -114,6 +114,16 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
   o.method = kind();
   const QualityLimits& q = settings_.gates;
   const FieldSettings& fs = settings_.field;
+  if (prior.drift.frequencyDependent()) {
+    // One session stands at one temperature: it cannot refresh a D(theta, f), and a flat D would
+    // silently drop the thermal calibration's dependence.
+    o.gate("prior_drift", false, 1.0, 0.0,
+           "the prior's D(theta) depends on the resonator frequency (a thermal calibration); the field method "
+           "refreshes one D(theta) at the session's temperature and would lose that: refresh it with the thermal "
+           "method");
+    o.decide();
+    return o;
+  }
   for (std::size_t i : groups_.byDuration()) {
     const RateGroup& g = groups_.groups()[i];
     o.plateaus.push_back(summarize(g, minBinTime(g.meanRate())));
@@ -137,8 +147,7 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
   }
   const RateGroup& gp = groups_.groups()[plus];
   const RateGroup& gm = groups_.groups()[minus];
-  FieldReport& r = o.field;
-  r.present = true;
+  FieldReport& r = o.field;  // present once the fit gave its numbers
   r.positive_rate = gp.meanRate();
   r.negative_rate = gm.meanRate();
   r.positive_turns = gp.rates().thetaSwept() / kTwoPi;
@@ -162,6 +171,7 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
     o.decide();
     return o;
   }
+  r.present = true;
   r.virtual_rate_gain = e.k;
   r.measured_drift = e.d;
   // K kept from the prior, at the session's resonator frequency (a thermal prior's K(theta, f)).
@@ -169,7 +179,10 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
   const HarmonicModel& k_prior = prior.scale_factor;
   std::vector<double> k(k_prior.termCount());
   k_prior.coefficientsAt(frequency, k.data());
-  r.earth_rate = prior.earth_rate.verticalRate();
+  // Omega_s: the Earth's rate about the sensitive axis as configured (the vehicle's attitude), else
+  // its vertical component at the prior's latitude (an axis that points up).
+  const bool axis_rate_given = !std::isnan(fs.axis_earth_rate);
+  r.earth_rate = axis_rate_given ? fs.axis_earth_rate : prior.earth_rate.verticalRate();
   r.k0_prior = k[0];
   // D = measured - K(theta) Omega_s, term by term where K has D's order (K's other orders times
   // Omega_s are ~1e-9 rad/s and stay in the fit's residual).
@@ -228,10 +241,12 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
   o.notes.push_back("K kept from the prior (K0 = " + formatShort(r.k0_prior, 9) +
                     "): a still gyro is turned by its precession loop, never by a rotation, so nothing in this "
                     "session scales with a body rate; refresh K on a table");
-  o.notes.push_back(
-      "D = the still gyro's rate - K(theta) Omega_s with Omega_s = " + formatShort(r.earth_rate, 6) +
-      " rad/s (the prior's latitude " + formatShort(prior.earth_rate.latitude, 6) +
-      " rad): D0 is only as good as K0 Omega_s, and a case turning at a constant rate would read as bias");
+  o.notes.push_back("D = the still gyro's rate - K(theta) Omega_s with Omega_s = " + formatShort(r.earth_rate, 6) +
+                    (axis_rate_given
+                         ? std::string(" rad/s (field/axis_earth_rate)")
+                         : " rad/s (vertical at the prior's latitude " + formatShort(prior.earth_rate.latitude, 6) +
+                               " rad: the sensitive axis assumed up)") +
+                    ": D0 is only as good as K0 Omega_s, and a case turning at a constant rate would read as bias");
   o.notes.push_back("the commanded rate was realised with gain " + formatShort(e.k.mean, 8) + " +- " +
                     formatShort(e.k.mean_std, 2) + " (theta-dependent part up to " +
                     formatShort(toModel(e.k).peakDeviation(), 3) + "); window " + formatShort(e.mean_window) +

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "hrg_gyro/core/calibration/field_command_plan.h"
@@ -62,7 +63,11 @@ double largestMagnitude(const std::vector<double>& v) {
 
 TEST(FieldCalibration, ShippedScenarioCarriesTheShippedPlan) {
   const SimulationConfig c = shippedScenario("resonator_field.yaml");
-  const std::vector<PlannedPrecession> plan = fieldCommandPlan(CalibrationSettings());
+  // The plan of config/calibrator.yaml's field section (which the live calibrator loads).
+  YAML::Node settings;
+  settings["field"] = YAML::LoadFile(std::string(HRG_GYRO_SOURCE_DIR) + "/config/calibrator.yaml")["field"];
+  const std::vector<PlannedPrecession> plan = fieldCommandPlan(CalibrationSettings::parse(YamlField(settings, "")));
+  ASSERT_EQ(plan.size(), fieldCommandPlan(CalibrationSettings()).size());  // the template is the defaults
   ASSERT_EQ(c.dynamics.commands.size(), plan.size());
   for (std::size_t i = 0; i < plan.size(); ++i) {
     EXPECT_NEAR(c.dynamics.commands[i].time, plan[i].time, 1e-6) << i;
@@ -142,6 +147,35 @@ TEST(FieldCalibration, StandardErrorsAreHonestOverSeeds) {
   EXPECT_LT(largestMagnitude(harmonics), 4.0);
   EXPECT_LT(rms(d0), 1.3);
   EXPECT_LT(rms(g0), 1.3);
+}
+
+// A gyro whose sensitive axis is not vertical sees another share of the Earth's rate: a horizontal
+// axis pointing North at 51.6 deg N sees Omega_E cos(lat), simulated as the vertical rate of the
+// complementary latitude. Taken as vertical at the prior's latitude, D0 is off by K0 times the
+// difference; given in field/axis_earth_rate, D0 is right again.
+TEST(FieldCalibration, TheEarthRateAboutATiltedAxisComesFromTheSettings) {
+  SimulationConfig c = shippedScenario("resonator_field.yaml");
+  const double site = c.latitude;
+  c.latitude = 0.5 * M_PI - site;  // the horizontal North axis's share, as a vertical one
+  CalibrationSettings s = fieldSettings();
+  auto prior = tablePrior(c, s);
+  prior->earth_rate.latitude = site;  // the prior knows the site, not the mounting
+  const EffectiveModel injected = computeEffectiveModel(c, prior->correction, s.scale_factor_orders, s.drift_orders);
+  const CalibrationOutcome assumed = calibrateOnSimulation(c, prior, s).outcome;
+  s.field.axis_earth_rate = kEarthRotationRate * std::cos(site);
+  const CalibrationOutcome told = calibrateOnSimulation(c, prior, s).outcome;
+  ASSERT_TRUE(told.accepted) << told.reason;
+  const double expected_offset =
+      prior->scale_factor.meanAt(NAN) * kEarthRotationRate * (std::cos(site) - std::sin(site));  // K0 dOmega
+  const double assumed_error = assumed.drift.at(0).mean - injected.drift.mean;
+  const double told_error = told.drift.at(0).mean - injected.drift.mean;
+  std::printf(
+      "[ measured ] horizontal axis: D0 off by %.3e rad/s taken as vertical (K0 dOmega %.3e), %.2e with "
+      "field/axis_earth_rate (sigma %.1e)\n",
+      assumed_error, expected_offset, told_error, told.drift[0].mean_std);
+  EXPECT_NEAR(assumed_error, expected_offset, 3.0 * assumed.drift.at(0).mean_std + 1e-9);
+  EXPECT_LT(std::abs(told_error), 3.0 * told.drift[0].mean_std);
+  EXPECT_DOUBLE_EQ(told.field.earth_rate, s.field.axis_earth_rate);
 }
 
 // What a field session cannot give is refused by name: one direction only (D and the gain are then

@@ -2,6 +2,7 @@
 // parameters (and `hrg_bag calibrate --config`), parsed by one function for both.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -66,9 +67,13 @@ struct FieldSettings {
   double turns = 2.0;                         ///< full turns of theta (2 pi) per segment
   std::vector<int> directions{1, -1, -1, 1};  ///< the segments' signs, in order (+ - - +: a linear bias trend cancels)
   double rest = 5.0;                          ///< s at rest (commanded 0) before the first segment
-  double min_turns = 1.0;                     ///< gate: full turns of theta per direction
+  /// rad/s, the Earth's rate about the sensitive axis where the gyro stands (Omega_E . u, from the
+  /// vehicle's attitude and latitude), taken off with K to leave D0; NaN ('vertical'): the vertical
+  /// component at the prior's latitude, for an axis that points up
+  double axis_earth_rate = NAN;
+  double min_turns = 1.0;  ///< gate: full turns of theta per direction
   /// gate (stillness): the scatter of the data about the fit over what the white wave-angle noise
-  /// predicts, on D0: a case that moves (or a rate noise) raises it
+  /// predicts, on D's harmonics (not D0): a case that moves (or a rate noise) raises it
   double max_excess_scatter = 3.0;
   double max_gain_error = 0.05;  ///< gate: |G_v0 - 1|, a loop that does not realise the command
   double max_drift_std = 1e-7;   ///< gate: rad/s, the largest standard error of a D term
