@@ -349,7 +349,9 @@ def validate_report(report, path):
     for part in ("scale_factor", "drift"):
         for here, fit in f.items(report, part):
             harmonic_fit(fit, here, nonzero=part == "scale_factor")
-    if report["method"] == "field" or "field" in report:  # the virtual rotation of a still gyro
+    # The virtual rotation of a still gyro: the section comes with every field calibration whose fit
+    # ran (a refused one may end before it: one direction only, a thermal prior).
+    if "field" in report or (report["method"] == "field" and report["accepted"] is True):
         field = f.mapping(report, "field")
         # The gain divides the amplitudes in ppm: zero would end in a division by zero.
         harmonic_fit(f.mapping(field, "virtual_rate_gain", "field"), "field.virtual_rate_gain", nonzero=True)

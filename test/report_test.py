@@ -232,6 +232,35 @@ class ReportTest(unittest.TestCase):
         print("report test: field page, %d numbers checked; G_v0 %s +- %s" %
               (checked, page.by_q["field.virtual_rate_gain.mean"], page.by_q["field.virtual_rate_gain.mean_std"]))
 
+    def test_a_refused_field_calibration_is_drawn_with_its_gate(self):
+        # The wave precessed one way only: refused by the directions gate before any fit, so the report
+        # has no field section; the page still draws, REFUSED, naming the gate.
+        scenario = self.path("field_one_way.yaml")
+        with open(os.path.join(self.pkg, "config", "scenarios", "resonator_field.yaml")) as f:
+            text = f.read()
+        self.assertEqual(text.count("rate: -0.2}"), 2)
+        with open(scenario, "w") as f:
+            f.write(text.replace("rate: -0.2}", "rate: 0.2}"))
+        bag = self.path("field_one_way.bag")
+        code, _, err = run(HRG_BAG, "simulate", "--scenario", scenario, "--out", bag)
+        self.assertEqual(code, 0, err)
+        params, report_path = self.path("field_one_way.params.yaml"), self.path("field_one_way.report.yaml")
+        code, out, err = run(HRG_BAG, "calibrate", bag, "--method", "field", "--params", self.prior, "--out", params,
+                             "--report", report_path)
+        self.assertEqual(code, 1, out + err)
+        self.assertFalse(os.path.exists(params))
+        with open(report_path) as f:
+            report = yaml.safe_load(f)
+        self.assertNotIn("field", report)
+        self.assertEqual([g["name"] for g in report["gates"] if not g["passed"]], ["directions"])
+        html_path = self.path("field_one_way.html")
+        code, stdout, err = run("/usr/bin/python3", self.script, report_path, "--out", html_path)
+        self.assertEqual(code, 0, err)
+        self.assertIn("REFUSED", stdout)
+        with open(html_path) as f:
+            page = f.read()
+        self.assertIn("found only positive rates", page)
+
     def test_the_page_shows_the_numbers_of_the_calibration_report(self):
         code, params, report_path, log = self.calibrate("quiet")
         self.assertEqual(code, 0, log)

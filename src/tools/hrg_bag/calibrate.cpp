@@ -96,6 +96,13 @@ int runCalibrate(const CalibrateOptions& o) {
   if (!o.method.empty()) settings.method = core::parseCalibrationMethod(o.method);  // checked by --method's validator
   const core::CalibrationMethodTraits& method = core::traitsOf(settings.method);
   const std::string& out_path = o.out;
+  if (settings.method == core::CalibrationMethodKind::kField && o.params.empty()) {
+    // The field method keeps K and the latitude from its prior: the nominal one would be written back
+    // as if a table had calibrated it.
+    throw UsageError(
+        "--method field needs --params: the table-calibrated file whose K it keeps and whose D it "
+        "refreshes");
+  }
   const auto prior = std::make_shared<const core::GyroParameters>(o.params.empty() ? core::GyroParameters()
                                                                                    : core::loadParameterFile(o.params));
   const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
@@ -182,8 +189,12 @@ int runCalibrate(const CalibrateOptions& o) {
     } catch (const std::exception& e) {
       throw OutputError(std::string("the calibration was accepted but not written: ") + e.what());
     }
-    std::cout << "calibrate: wrote " << out_path << " (peak nonlinearity of the new K: " << outcome.nonlinearity_ppm
-              << " ppm)\n";
+    if (outcome.scale_factor.empty()) {
+      std::cout << "calibrate: wrote " << out_path << " (D refreshed, K kept from " << o.params << ")\n";
+    } else {
+      std::cout << "calibrate: wrote " << out_path << " (peak nonlinearity of the new K: " << outcome.nonlinearity_ppm
+                << " ppm)\n";
+    }
   } else {
     std::cout << "calibrate: " << out_path << " not written\n";
   }
@@ -224,7 +235,8 @@ Command addCalibrateCommand(CLI::App& root) {
                   "calibrated parameter file (triad: the triad file), written atomically only when every gate passes")
       ->required()
       ->check(tools::notEmpty());
-  cmd->add_option("--params", o->params, "prior parameter file (default: the nominal model at latitude 0)")
+  cmd->add_option("--params", o->params,
+                  "prior parameter file (default: the nominal model at latitude 0; required by --method field)")
       ->check(tools::notEmpty());
   cmd->add_option("--config", o->config,
                   "calibrator settings (YAML: bins, window, gates/..., thermal/..., as the node's)")
