@@ -2,11 +2,16 @@
 """Each calibration method live on its matching profile (separate nodes, sim time): the calibrator
 finishes by itself, accepts, writes the parameter file and reloads the processor; the estimates
 show what each method is known to get right (and, for constant rate, its known drift leak). The field
-method commands its own virtual rotation: the driver must have executed the calibrator's plan."""
+method commands its own virtual rotation: the driver must have executed the calibrator's plan, and a
+calibrator interrupted mid-plan must stop it."""
 import os
+import signal
 import sys
 import unittest
+from xmlrpc.client import ServerProxy
 
+import rosgraph
+import rosnode
 import rospy
 import rostest
 
@@ -109,6 +114,20 @@ class CalibrationMethod(unittest.TestCase):
                           "the driver to have executed the four planned commands")
             self.assertEqual(self.precession.msg.commands, 4)
             self.assertEqual(self.precession.msg.rate, 0.0)
+        elif self.case == "field_interrupted":
+            # SIGINT while the wave turns at the plan's +0.2 rad/s: the calibrator commands 0 before it exits.
+            with open(rospy.get_param("~parameter_file")) as f:
+                before = f.read()
+            util.wait_for(lambda: self.precession.msg is not None and self.precession.msg.commands == 2 and
+                          self.precession.msg.rate > 0.0, 60, "the first segment of the virtual rotation")
+            pid = ServerProxy(rosgraph.Master("/calibration_method_test").lookupNode("/calibrator")).getPid("/test")[2]
+            os.kill(pid, signal.SIGINT)
+            util.wait_for(lambda: self.precession.msg.commands == 3, 20, "the calibrator's stop command")
+            self.assertEqual(self.precession.msg.rate, 0.0, "the wave left turning")
+            util.wait_for(lambda: not rosnode.rosnode_ping("/calibrator", max_count=1), 20, "the calibrator to exit")
+            self.assertEqual(self.results.count, 0, "no result from an interrupted run")
+            with open(rospy.get_param("~parameter_file")) as f:
+                self.assertEqual(f.read(), before, "the parameter file untouched")
         else:
             self.fail("unknown case " + self.case)
 

@@ -107,7 +107,8 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   // since ~start may choose field; a driver without the loop publishes no state).
   precession_sub_ = in.subscribe("precession/state", queue_size, &CalibratorRos::onPrecession, this,
                                  ros::TransportHints().tcpNoDelay());
-  command_pub_ = nh_.advertise<PrecessionCommand>("command/precession", 10);
+  // Latched: a driver that reconnects (or starts late) gets the command in force, rate 0 after a stop.
+  command_pub_ = nh_.advertise<PrecessionCommand>("command/precession", 10, true);
   if (calibration_->usesGeneratorPairs()) {
     channels_sub_ =
         in.subscribe("channels", queue_size, &CalibratorRos::onChannels, this, ros::TransportHints().tcpNoDelay());
@@ -146,6 +147,7 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 CalibratorRos::~CalibratorRos() {
+  stopVirtualRotation("the calibrator shut down");
   turntable_sub_.shutdown();
   wave_sub_.shutdown();
   channels_sub_.shutdown();
@@ -286,6 +288,11 @@ void CalibratorRos::advanceFieldPlan(const ros::Time& now) {
     ROS_INFO("calibrator: field: virtual rotation at %g rad/s commanded (%zu of %zu, %.1f s into the plan)", p.rate,
              field_next_, field_plan_.size(), elapsed);
   }
+}
+
+void CalibratorRos::stopVirtualRotation(const char* why) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  stopFieldPlan(why);
 }
 
 void CalibratorRos::stopFieldPlan(const char* why) {

@@ -52,6 +52,10 @@ class CalibratorRos {
   /// The private parameters as read at start-up (unknown and defaulted keys).
   const ParameterReader& parameters() const { return params_; }
 
+  /// A field run's virtual rotation stopped (rate 0 commanded) if it is under way: the node calls it
+  /// on SIGINT before ROS shuts down, the destructor in any case (a nodelet unloaded).
+  void stopVirtualRotation(const char* why);
+
  private:
   void onTurntable(const TurntableState::ConstPtr& msg);
   void onPrecession(const PrecessionState::ConstPtr& msg);
