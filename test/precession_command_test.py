@@ -48,8 +48,13 @@ class PrecessionCommandTest(unittest.TestCase):
         state = util.Latest("/field/precession/state", PrecessionState, keep_all=True)
         commands = util.Latest("/field/command/precession", PrecessionCommand, keep_all=True)
         pub = rospy.Publisher("/field/command/precession", PrecessionCommand, queue_size=10, latch=False)
-        util.wait_for(lambda: truth.count > 100 and state.count > 100 and pub.get_num_connections() >= 2, 60,
-                      "the driver's truth, its precession state and two subscribers of the commands")
+        # Three subscribers of the commands: the driver, the recorder and this test's own `commands`
+        # (rospy connects a node's publisher to its own subscriber). Waiting for two let the first
+        # command go out before a recorder that started late under load: it then never saw its
+        # three messages and never closed its bag.
+        util.wait_for(lambda: truth.count > 100 and state.count > 100 and pub.get_num_connections() >= 3, 60,
+                      "the driver's truth, its precession state, and the driver, the recorder and this test "
+                      "subscribed to the commands")
         self.assertEqual(state.msg.rate, 0.0)
         self.assertEqual(state.msg.commands, 0)
         # The recorder writes <bag>.active and renames it when it closes: a bag of an earlier run must go.
