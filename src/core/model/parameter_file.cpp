@@ -207,22 +207,34 @@ GyroParameters parseParameters(const YAML::Node& root) {
   p.earth_rate.latitude = er["latitude"].asDouble();
   if (std::abs(p.earth_rate.latitude) > kPi / 2) er["latitude"].fail("latitude must be in [-pi/2, pi/2] rad");
 
-  if (doc.has("calibration")) {
-    const YamlField cal = doc["calibration"];
-    cal.requireMap();
-    cal.rejectUnknownKeys({"method", "time", "source", "notes"});
-    if (cal.has("method")) {
-      try {
-        p.calibration.method = ParameterOrigin::parse(cal["method"].asString());
-      } catch (const std::invalid_argument& e) {
-        cal["method"].fail(e.what());
-      }
-    }
-    p.calibration.time = cal.getString("time", "");
-    p.calibration.source = cal.getString("source", "");
-    p.calibration.notes = cal.getString("notes", "");
-  }
+  if (doc.has("calibration")) p.calibration = parseProvenance(doc["calibration"]);
   return p;
+}
+
+CalibrationProvenance parseProvenance(const YamlField& cal) {
+  cal.requireMap();
+  cal.rejectUnknownKeys({"method", "time", "source", "notes"});
+  CalibrationProvenance c;
+  if (cal.has("method")) {
+    try {
+      c.method = ParameterOrigin::parse(cal["method"].asString());
+    } catch (const std::invalid_argument& e) {
+      cal["method"].fail(e.what());
+    }
+  }
+  c.time = cal.getString("time", "");
+  c.source = cal.getString("source", "");
+  c.notes = cal.getString("notes", "");
+  return c;
+}
+
+void emitProvenance(YAML::Emitter& out, const CalibrationProvenance& c) {
+  out << YAML::Key << "calibration" << YAML::Comment("provenance") << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "method" << YAML::Value << c.method.name();
+  out << YAML::Key << "time" << YAML::Value << YAML::DoubleQuoted << c.time;
+  out << YAML::Key << "source" << YAML::Value << YAML::DoubleQuoted << c.source;
+  out << YAML::Key << "notes" << YAML::Value << YAML::DoubleQuoted << c.notes;
+  out << YAML::EndMap;
 }
 
 GyroParameters parseParameterText(const std::string& text) {
@@ -283,12 +295,7 @@ std::string emitParameters(const GyroParameters& p) {
   out << YAML::Key << "latitude" << YAML::Value << formatDouble(p.earth_rate.latitude)
       << YAML::Comment("rad; vertical Earth rate = 7.2921150e-5 sin(latitude) rad/s");
   out << YAML::EndMap;
-  out << YAML::Key << "calibration" << YAML::Comment("provenance") << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "method" << YAML::Value << p.calibration.method.name();
-  out << YAML::Key << "time" << YAML::Value << YAML::DoubleQuoted << p.calibration.time;
-  out << YAML::Key << "source" << YAML::Value << YAML::DoubleQuoted << p.calibration.source;
-  out << YAML::Key << "notes" << YAML::Value << YAML::DoubleQuoted << p.calibration.notes;
-  out << YAML::EndMap;
+  emitProvenance(out, p.calibration);
   out << YAML::EndMap;
   if (!out.good()) throw std::runtime_error("YAML emitter error: " + out.GetLastError());
   return std::string(out.c_str()) + "\n";

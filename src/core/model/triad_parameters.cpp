@@ -106,21 +106,7 @@ TriadParameters parseTriadParameters(const YAML::Node& root) {
     t.bias_std = readVector(doc["bias_std"]);
     if (!(t.bias_std.minCoeff() >= 0.0)) doc["bias_std"].fail("standard errors must be >= 0");
   }
-  if (doc.has("calibration")) {
-    const YamlField cal = doc["calibration"];
-    cal.requireMap();
-    cal.rejectUnknownKeys({"method", "time", "source", "notes"});
-    if (cal.has("method")) {
-      try {
-        t.calibration.method = ParameterOrigin::parse(cal["method"].asString());
-      } catch (const std::invalid_argument& e) {
-        cal["method"].fail(e.what());
-      }
-    }
-    t.calibration.time = cal.getString("time", "");
-    t.calibration.source = cal.getString("source", "");
-    t.calibration.notes = cal.getString("notes", "");
-  }
+  if (doc.has("calibration")) t.calibration = parseProvenance(doc["calibration"]);
   return t;
 }
 
@@ -178,12 +164,7 @@ std::string emitTriadParameters(const TriadParameters& t) {
   out << YAML::Comment("rad/s, body frame");
   out << YAML::Key << "bias_std" << YAML::Value;
   emitVector(out, t.bias_std);
-  out << YAML::Key << "calibration" << YAML::Comment("provenance") << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "method" << YAML::Value << t.calibration.method.name();
-  out << YAML::Key << "time" << YAML::Value << YAML::DoubleQuoted << t.calibration.time;
-  out << YAML::Key << "source" << YAML::Value << YAML::DoubleQuoted << t.calibration.source;
-  out << YAML::Key << "notes" << YAML::Value << YAML::DoubleQuoted << t.calibration.notes;
-  out << YAML::EndMap;
+  emitProvenance(out, t.calibration);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

@@ -46,6 +46,10 @@ HarmonicModel parseDriftModel(const YamlField& section);
 
 /// Validates and converts a parsed document. Throws ConfigError naming the key.
 GyroParameters parseParameters(const YAML::Node& root);
+/// The `calibration` (provenance) block of a parameter or triad file: method, time, source, notes.
+CalibrationProvenance parseProvenance(const YamlField& section);
+/// Writes that block (key and map) into an open map.
+void emitProvenance(YAML::Emitter& out, const CalibrationProvenance& provenance);
 /// Reads and validates a file. Throws ConfigError (unreadable file, not a regular file, above the
 /// size limit, YAML syntax error with its line, or a bad key).
 GyroParameters loadParameterFile(const std::string& path);
