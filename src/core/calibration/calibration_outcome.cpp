@@ -82,6 +82,24 @@ void diagnose(CalibrationOutcome* o, const CorrectionMatrix& correction_in_force
   }
 }
 
+void emitGatesAndNotes(YAML::Emitter& out, const std::vector<GateResult>& gates,
+                       const std::vector<std::string>& notes) {
+  out << YAML::Key << "gates" << YAML::Value << YAML::BeginSeq;
+  for (const GateResult& g : gates) {
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << g.name;
+    out << YAML::Key << "passed" << YAML::Value << g.passed;
+    out << YAML::Key << "value" << YAML::Value << formatDouble(g.value);
+    out << YAML::Key << "limit" << YAML::Value << formatDouble(g.limit);
+    out << YAML::Key << "message" << YAML::Value << YAML::DoubleQuoted << g.message;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::Key << "notes" << YAML::Value << YAML::BeginSeq;
+  for (const std::string& n : notes) out << YAML::DoubleQuoted << n;
+  out << YAML::EndSeq;
+}
+
 std::string emitCalibrationReport(const CalibrationOutcome& o) {
   YAML::Emitter out;
   out << YAML::Comment("hrg_gyro calibration report. K dimensionless, D in rad/s, angles in rad.");
@@ -249,20 +267,7 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
     out << YAML::EndMap;
   }
   out << YAML::EndSeq;
-  out << YAML::Key << "gates" << YAML::Value << YAML::BeginSeq;
-  for (const GateResult& g : o.gates) {
-    out << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "name" << YAML::Value << g.name;
-    out << YAML::Key << "passed" << YAML::Value << g.passed;
-    out << YAML::Key << "value" << YAML::Value << formatDouble(g.value);
-    out << YAML::Key << "limit" << YAML::Value << formatDouble(g.limit);
-    out << YAML::Key << "message" << YAML::Value << YAML::DoubleQuoted << g.message;
-    out << YAML::EndMap;
-  }
-  out << YAML::EndSeq;
-  out << YAML::Key << "notes" << YAML::Value << YAML::BeginSeq;
-  for (const std::string& n : o.notes) out << YAML::DoubleQuoted << n;
-  out << YAML::EndSeq;
+  emitGatesAndNotes(out, o.gates, o.notes);
   out << YAML::Key << "binned" << YAML::Value << YAML::BeginMap;
   std::vector<double> th, k, d, w;
   for (const BinnedCurvePoint& p : o.binned) {

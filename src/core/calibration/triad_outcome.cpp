@@ -98,20 +98,7 @@ std::string emitTriadReport(const TriadOutcome& o) {
     out << YAML::EndMap;
   }
   out << YAML::EndSeq;
-  out << YAML::Key << "gates" << YAML::Value << YAML::BeginSeq;
-  for (const GateResult& g : o.gates) {
-    out << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "name" << YAML::Value << g.name;
-    out << YAML::Key << "passed" << YAML::Value << g.passed;
-    out << YAML::Key << "value" << YAML::Value << formatDouble(g.value);
-    out << YAML::Key << "limit" << YAML::Value << formatDouble(g.limit);
-    out << YAML::Key << "message" << YAML::Value << YAML::DoubleQuoted << g.message;
-    out << YAML::EndMap;
-  }
-  out << YAML::EndSeq;
-  out << YAML::Key << "notes" << YAML::Value << YAML::BeginSeq;
-  for (const std::string& n : o.notes) out << YAML::DoubleQuoted << n;
-  out << YAML::EndSeq;
+  emitGatesAndNotes(out, o.gates, o.notes);
   // Each axis's own calibration report, as `hrg_bag calibrate` writes it for one axis.
   out << YAML::Key << "axis_reports" << YAML::Value << YAML::BeginMap;
   for (int i = 0; i < 3; ++i) {

@@ -16,6 +16,10 @@
 #include "hrg_gyro/core/model/correction_matrix.h"
 #include "hrg_gyro/core/model/gyro_parameters.h"
 
+namespace YAML {
+class Emitter;
+}
+
 namespace hrg_gyro {
 namespace core {
 
@@ -121,6 +125,8 @@ void diagnose(CalibrationOutcome* outcome, const CorrectionMatrix& correction_in
 
 /// Human- and machine-readable YAML of the outcome (report files, plots).
 std::string emitCalibrationReport(const CalibrationOutcome& outcome);
+/// The `gates` and `notes` keys of a report, into an open map (the single-axis and triad reports).
+void emitGatesAndNotes(YAML::Emitter& out, const std::vector<GateResult>& gates, const std::vector<std::string>& notes);
 
 }  // namespace core
 }  // namespace hrg_gyro
