@@ -55,13 +55,7 @@ void FieldMethod::addSample(const PlateauSample& s) {
   }
   const bool gap = in_chain_ && toSeconds(s.stamp - last_stamp_) > settings_.plateau.max_gap;
   if (!in_chain_ || s.plateau.id != chain_plateau_ || gap || s.stamp <= last_stamp_) {
-    int group = -1;
-    for (std::size_t g = 0; g < group_rates_.size(); ++g)
-      if (std::abs(group_rates_[g] - s.plateau.rate) <= settings_.group_tolerance) group = static_cast<int>(g);
-    if (group < 0) {
-      group = static_cast<int>(group_rates_.size());
-      group_rates_.push_back(s.plateau.rate);
-    }
+    const int group = regressionGroupOf(&group_rates_, s.plateau.rate, settings_.group_tolerance);
     regression_.startChain(group, windowFor(s.plateau.rate));
     in_chain_ = true;
     chain_plateau_ = s.plateau.id;

@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <vector>
@@ -98,6 +99,19 @@ class RateGroups {
   int slice_count_ = 0;
   std::vector<RateGroup> groups_;
 };
+
+/// The regression group of a plateau at `rate`: the index in *rates of the last rate within
+/// `tolerance` of it, or a new entry (appended) when none is.
+inline int regressionGroupOf(std::vector<double>* rates, double rate, double tolerance) {
+  int group = -1;
+  for (std::size_t g = 0; g < rates->size(); ++g)
+    if (std::abs((*rates)[g] - rate) <= tolerance) group = static_cast<int>(g);
+  if (group < 0) {
+    group = static_cast<int>(rates->size());
+    rates->push_back(rate);
+  }
+  return group;
+}
 
 }  // namespace core
 }  // namespace hrg_gyro
