@@ -771,7 +771,18 @@ class ReportTest(unittest.TestCase):
             print("report test: no read-only tmpfs (%s)" % mount.stdout.strip())
         if os.geteuid() != 0:
             return
-        # A bag folder the user may not list (root lists everything: run as nobody).
+        # A bag folder the user may not list (root lists everything: run as nobody). Nobody must reach
+        # the script and the work folder: a checkout inside a private folder (mktemp -d) keeps it out.
+        def reachable_by_others(path, mode):
+            path = os.path.realpath(path)
+            parents = [os.path.dirname(path)]
+            while parents[-1] != os.path.dirname(parents[-1]):
+                parents.append(os.path.dirname(parents[-1]))
+            return os.stat(path).st_mode & mode and all(os.stat(p).st_mode & 0o001 for p in parents)
+        if not (reachable_by_others(os.path.join(self.pkg, "scripts", "hrg_batch.py"), 0o004) and reachable_by_others(d, 0o001)):
+            print("report test: the checkout or the work folder is private to its owner; the unlistable "
+                  "bag folder is not tried as nobody")
+            return
         private = os.path.join(d, "private")
         os.makedirs(private, mode=0o700)
         mpl = os.path.join(d, "mpl")
