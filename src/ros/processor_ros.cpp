@@ -29,6 +29,7 @@ core::ProcessorConfig processorConfig(ParameterReader& params) {
   core::ProcessorConfig c;
   c.max_gap = params.get("max_gap", c.max_gap);
   c.backward_reset = params.get("backward_reset", c.backward_reset);
+  c.jump_persist = params.get("jump_persist", c.jump_persist);
   c.max_rate = params.get("max_rate", c.max_rate);
   c.max_consecutive_jumps = params.get("max_consecutive_jumps", c.max_consecutive_jumps);
   c.limits.min_anisotropy = params.get("min_anisotropy", c.limits.min_anisotropy);
@@ -161,6 +162,10 @@ void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
     ROS_WARN_THROTTLE(5.0, "processor: rejected a sample: %s", core::toString(r.wave_status));
   } else if (r.verdict == core::SampleVerdict::kRejectedJump) {
     ROS_WARN_THROTTLE(5.0, "processor: rejected a wave-angle jump above ~max_rate (glitch or sign flip)");
+  } else if (r.verdict == core::SampleVerdict::kStampJump) {
+    ROS_WARN_THROTTLE(5.0,
+                      "processor: dropped a sample whose stamp jumped (back by more than ~backward_reset or ahead by "
+                      "more than ~max_gap); a jump is taken only after ~jump_persist samples in a row");
   }
   if (r.flags & core::kFlagReset) {
     ROS_WARN("processor: time went backwards (bag loop?): state reset, alpha restarts");
@@ -304,6 +309,8 @@ void ProcessorRos::diagnoseInput(diagnostic_updater::DiagnosticStatusWrapper& st
   } else if (lost > 0) {
     stat.summaryf(DiagnosticStatus::WARN, "%lu messages lost (sequence gaps) since the last report",
                   static_cast<unsigned long>(lost));
+  } else if (c.stamp_jumps > reported_.stamp_jumps) {
+    stat.summary(DiagnosticStatus::WARN, "samples whose stamp jumped (a glitch) dropped");
   } else if (c.zero_stamp + c.duplicate + c.out_of_order >
              reported_.zero_stamp + reported_.duplicate + reported_.out_of_order) {
     stat.summary(DiagnosticStatus::WARN, "samples with zero, duplicate or out-of-order stamps dropped");
@@ -319,6 +326,7 @@ void ProcessorRos::diagnoseInput(diagnostic_updater::DiagnosticStatusWrapper& st
   stat.add("zero stamps", c.zero_stamp);
   stat.add("duplicate stamps", c.duplicate);
   stat.add("out-of-order stamps", c.out_of_order);
+  stat.add("stamp jumps dropped", c.stamp_jumps);
   stat.add("gaps not integrated", c.gaps);
   stat.add("largest gap (s)", c.largest_gap);
   stat.add("resets (time went backwards)", c.resets);

@@ -12,6 +12,14 @@ namespace {
 
 double largestMean(const HarmonicModel& k) { return k.nodeValues().row(0).cwiseAbs().maxCoeff(); }
 
+StampRule stampRule(const ProcessorConfig& c) {
+  StampRule r;
+  r.backward_reset = c.backward_reset;
+  r.forward_jump = c.max_gap;  // a step beyond max_gap is a gap if it persists, a glitch if not
+  r.persist = c.jump_persist;
+  return r;
+}
+
 void requirePositive(const char* key, double value, const char* unit) {
   if (!(std::isfinite(value) && value > 0.0)) {
     throw ConfigError(key, std::string("must be a positive number of ") + unit + ", got " + formatDouble(value));
@@ -23,6 +31,9 @@ void requirePositive(const char* key, double value, const char* unit) {
 void validate(const ProcessorConfig& c) {
   requirePositive("max_gap", c.max_gap, "seconds");
   requirePositive("backward_reset", c.backward_reset, "seconds");
+  if (c.jump_persist < 1 || c.jump_persist > 1000) {
+    throw ConfigError("jump_persist", "must be in [1, 1000] samples, got " + std::to_string(c.jump_persist));
+  }
   requirePositive("max_rate", c.max_rate, "rad/s");
   if (c.max_consecutive_jumps < 0) {
     throw ConfigError("max_consecutive_jumps", "must be >= 0, got " + std::to_string(c.max_consecutive_jumps));
@@ -42,6 +53,7 @@ void validate(const ProcessorConfig& c) {
 
 GyroProcessor::GyroProcessor(const ProcessorConfig& config, std::shared_ptr<const GyroParameters> parameters)
     : config_(config),
+      timeline_(stampRule(config)),
       compensator_(std::move(parameters)),
       max_abs_k0_(largestMean(compensator_.parameters().scale_factor)) {}
 
@@ -62,6 +74,11 @@ void GyroProcessor::setParameters(std::shared_ptr<const GyroParameters> paramete
 }
 
 void GyroProcessor::reset() {
+  resetState();
+  timeline_.clear();
+}
+
+void GyroProcessor::resetState() {
   unwrapper_.reset();
   has_previous_ = false;
   alpha_ = 0.0;
@@ -96,28 +113,36 @@ inline void GyroProcessor::reject(SampleVerdict verdict, ProcessorResult* r) {
 }
 
 inline bool GyroProcessor::admitStamp(Nanoseconds stamp, Nanoseconds* dt_ns, ProcessorResult* r) {
-  if (stamp <= 0) {
-    ++counters_.zero_stamp;
-    reject(SampleVerdict::kRejectedStamp, r);
-    return false;
-  }
-  if (!has_previous_) return true;
-  *dt_ns = stamp - previous_stamp_;
-  if (*dt_ns == 0) {
-    ++counters_.duplicate;
-    reject(SampleVerdict::kDuplicate, r);
-    return false;
-  }
-  if (*dt_ns < 0) {
-    if (toSeconds(-*dt_ns) <= config_.backward_reset) {
+  switch (timeline_.check(stamp)) {
+    case StampVerdict::kNext:
+    case StampVerdict::kResumedAhead:  // a gap: admitStep flags it (dt > max_gap)
+      break;
+    case StampVerdict::kNewTimeline:
+      ++counters_.resets;  // time went back for good (bag loop): start over
+      resetState();
+      pending_flags_ |= kFlagReset;
+      return true;
+    case StampVerdict::kNonPositive:
+      ++counters_.zero_stamp;
+      reject(SampleVerdict::kRejectedStamp, r);
+      return false;
+    case StampVerdict::kDuplicate:
+      ++counters_.duplicate;
+      reject(SampleVerdict::kDuplicate, r);
+      return false;
+    case StampVerdict::kBehind:
       ++counters_.out_of_order;
       reject(SampleVerdict::kOutOfOrder, r);
       return false;
-    }
-    ++counters_.resets;  // time jumped back (bag loop): start over
-    reset();
-    pending_flags_ |= kFlagReset;
+    case StampVerdict::kJumpedBack:
+    case StampVerdict::kJumpedAhead:
+      ++counters_.stamp_jumps;
+      reject(SampleVerdict::kStampJump, r);
+      return false;
   }
+  // The timeline's last stamp may be a sample whose values were rejected since: the step is from
+  // the last accepted one, which lies before it.
+  if (has_previous_) *dt_ns = stamp - previous_stamp_;
   return true;
 }
 

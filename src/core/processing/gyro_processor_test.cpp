@@ -93,28 +93,71 @@ TEST_F(GyroProcessorTest, DropsZeroDuplicateAndOutOfOrderStamps) {
   EXPECT_EQ(proc_.counters().out_of_order, 1u);
 }
 
-TEST_F(GyroProcessorTest, BackwardJumpResetsAndFlags) {
+TEST_F(GyroProcessorTest, BackwardJumpThatPersistsResetsAndFlags) {
   for (int i = 0; i < 100; ++i) proc_.process(at((5000 + i) * kMs));
-  EXPECT_EQ(proc_.process(at(1000 * kMs)).verdict, SampleVerdict::kFirst);  // bag looped
-  const ProcessorResult r = proc_.process(at(1001 * kMs));
+  // Bag looped: the first jump_persist - 1 samples of the new timeline are dropped as jumps, the
+  // jump_persist-th starts over.
+  const int persist = ProcessorConfig{}.jump_persist;
+  for (int i = 0; i < persist - 1; ++i) {
+    EXPECT_EQ(proc_.process(at((1000 + i) * kMs)).verdict, SampleVerdict::kStampJump) << i;
+  }
+  EXPECT_EQ(proc_.process(at((1000 + persist - 1) * kMs)).verdict, SampleVerdict::kFirst);
+  const ProcessorResult r = proc_.process(at((1000 + persist) * kMs));
   EXPECT_TRUE(r.flags & kFlagReset);
   EXPECT_NEAR(r.alpha, r.increment.dalpha, 1e-18);  // alpha restarted
   EXPECT_EQ(proc_.counters().resets, 1u);
-  EXPECT_FALSE(proc_.process(at(1002 * kMs)).flags & kFlagReset);
+  EXPECT_EQ(proc_.counters().stamp_jumps, static_cast<std::uint64_t>(persist - 1));
+  EXPECT_FALSE(proc_.process(at((1001 + persist) * kMs)).flags & kFlagReset);
 }
 
 TEST_F(GyroProcessorTest, DoesNotIntegrateAcrossAGap) {
   proc_.process(at(1000 * kMs));
   const double alpha_before = proc_.process(at(1001 * kMs)).alpha;
-  const ProcessorResult r = proc_.process(at(2001 * kMs));  // 1 s gap > max_gap
+  // 1 s later (above max_gap), for good: a gap, taken at the jump_persist-th sample after it.
+  const int persist = ProcessorConfig{}.jump_persist;
+  for (int i = 0; i < persist - 1; ++i) {
+    EXPECT_EQ(proc_.process(at((2001 + i) * kMs)).verdict, SampleVerdict::kStampJump) << i;
+  }
+  const Nanoseconds resumed = (2001 + persist - 1) * kMs;
+  const ProcessorResult r = proc_.process(at(resumed));
   EXPECT_TRUE(r.flags & kFlagGap);
   EXPECT_EQ(r.increment.dalpha, 0.0);
   EXPECT_EQ(r.alpha, alpha_before);
   EXPECT_EQ(proc_.counters().gaps, 1u);
-  EXPECT_NEAR(proc_.counters().largest_gap, 1.0, 1e-12);
-  const ProcessorResult next = proc_.process(at(2002 * kMs));
+  EXPECT_NEAR(proc_.counters().largest_gap, toSeconds(resumed - 1001 * kMs), 1e-12);
+  const ProcessorResult next = proc_.process(at(resumed + kMs));
   EXPECT_FALSE(next.flags & kFlagGap);
   EXPECT_NEAR(next.alpha - alpha_before, -0.028 * 0.001 / -0.56, 1e-12);
+}
+
+TEST_F(GyroProcessorTest, OneSampleStampedAheadOrFarBackCostsThatSampleOnly) {
+  // The same stream with and without single glitched stamps (1000 s ahead, 0.2 s ahead, 100 s back):
+  // every other sample gives the same output, and alpha ends the same.
+  GyroProcessor clean(ProcessorConfig{}, params_);
+  ProcessorResult a, b;
+  int glitches = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Nanoseconds t = (500000 + i) * kMs;  // 500 s: 100 s back is still a stamp
+    if (i == 500 || i == 900 || i == 1300) {
+      const Nanoseconds off = i == 500 ? 1000000 * kMs : i == 900 ? 200 * kMs : -100000 * kMs;
+      ChannelSample glitched = at(t);
+      glitched.stamp = t + off;
+      EXPECT_EQ(proc_.process(glitched).verdict, SampleVerdict::kStampJump) << i;
+      ++glitches;
+      continue;  // the glitched sample replaces the good one of its instant
+    }
+    a = clean.process(at(t));
+    b = proc_.process(at(t));
+    if (i == 501 || i == 901 || i == 1301) {
+      EXPECT_EQ(b.rejected_before, 1u);
+      EXPECT_EQ(b.flags, 0u) << "no gap, no reset after a glitch";
+      EXPECT_NEAR(b.increment.dt, 0.002, 1e-15);  // the increment spans the dropped sample
+    }
+  }
+  EXPECT_EQ(proc_.counters().stamp_jumps, 3u);
+  EXPECT_EQ(proc_.counters().gaps + proc_.counters().resets, 0u);
+  EXPECT_NEAR(b.alpha, a.alpha, 1e-15);  // nothing lost
+  EXPECT_EQ(glitches, 3);
 }
 
 TEST_F(GyroProcessorTest, RejectsAChannelSignFlipAsAGlitchThenReanchors) {
@@ -248,6 +291,8 @@ TEST(ProcessorConfigTest, AcceptsTheDefaultsAndNamesTheKeyOfEachRefusal) {
       {"max_gap", [](ProcessorConfig& c) { c.max_gap = 0.0; }},
       {"max_gap", [](ProcessorConfig& c) { c.max_gap = -1.0; }},
       {"backward_reset", [](ProcessorConfig& c) { c.backward_reset = -5.0; }},
+      {"jump_persist", [](ProcessorConfig& c) { c.jump_persist = 0; }},
+      {"jump_persist", [](ProcessorConfig& c) { c.jump_persist = 1001; }},
       {"max_rate", [](ProcessorConfig& c) { c.max_rate = 0.0; }},
       {"max_consecutive_jumps", [](ProcessorConfig& c) { c.max_consecutive_jumps = -1; }},
       {"min_anisotropy", [](ProcessorConfig& c) { c.limits.min_anisotropy = 2.0; }},
@@ -363,7 +408,7 @@ void expectBatchMatchesOneCallPerSample(bool frequency_dependent) {
   EXPECT_EQ(a.frequency_out_of_range, b.frequency_out_of_range);
   // The stream really exercises every rule (the frequency ones only bind a frequency-dependent model).
   for (std::uint64_t count : {a.non_finite, a.no_signal, a.degenerate, a.amplitude_out_of_range, a.zero_stamp,
-                              a.duplicate, a.out_of_order, a.jumps, a.gaps, a.resets}) {
+                              a.duplicate, a.out_of_order, a.jumps, a.gaps, a.resets, a.stamp_jumps}) {
     EXPECT_GT(count, 0u);
   }
   if (frequency_dependent) {

@@ -1,7 +1,8 @@
 // Test support: a long, reproducible stream of channel samples that exercises every rule of the
 // processor: clean samples of a wave turning at a varying rate with noise, interleaved with bad values
 // (NaN, infinity, no signal, a degenerate wave, an absurd amplitude), stamp faults (zero, duplicate,
-// out of order, a bag-loop jump back, forward gaps), channel sign flips (single glitches and runs long
+// out of order, single samples stamped far ahead or back, a bag-loop jump back, forward gaps), channel
+// sign flips (single glitches and runs long
 // enough to re-anchor) and unknown or out-of-range frequencies. Tests compare two ways of running the
 // processor over it (one call per sample against the batch entry point, say).
 #pragma once
@@ -61,6 +62,10 @@ inline std::vector<ChannelSample> faultyChannelStream(std::size_t n, std::uint64
       s.stamp = out.back().stamp;  // duplicate
     else if (fault < 0.020 && !out.empty())
       s.stamp = out.back().stamp - 300000;  // out of order
+    else if (fault < 0.0205)
+      s.stamp += 1000000000000;  // one sample 1000 s ahead
+    else if (fault < 0.021)
+      s.stamp -= 100000000000;  // one sample 100 s back
     else if (fault < 0.023)
       s.frequency = nan;
     else if (fault < 0.025)

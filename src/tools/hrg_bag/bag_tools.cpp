@@ -284,8 +284,14 @@ void addProcessorOptions(CLI::App& command, core::ProcessorConfig* c) {
   auto number = [&](const char* name, double* value, const char* meaning) {
     command.add_option(name, *value, meaning)->transform(tools::finiteNumber())->capture_default_str()->group(group);
   };
-  number("--max-gap", &c->max_gap, "s, > 0: a forward stamp step above this is a gap, not integrated across");
-  number("--backward-reset", &c->backward_reset, "s, > 0: a backward stamp jump above this resets the angle");
+  number("--max-gap", &c->max_gap,
+         "s, > 0: a forward stamp step above this is a jump: a dropped glitch, or (persisting) a gap not integrated "
+         "across");
+  number("--backward-reset", &c->backward_reset,
+         "s, > 0: a backward stamp step above this is a jump: a dropped glitch, or (persisting) a reset");
+  command.add_option("--jump-persist", c->jump_persist, "samples in a row, in [1, 1000], that make a stamp jump real")
+      ->capture_default_str()
+      ->group(group);
   number("--max-rate", &c->max_rate, "rad/s, > 0: body rate above which a wave-angle step is a glitch");
   number("--min-anisotropy", &c->limits.min_anisotropy,
          "in (0, 1): floor of (A^2 - B^2)/(A^2 + B^2); a rounder wave is rejected");

@@ -38,6 +38,8 @@ const char* verdictName(const core::ProcessorResult& r) {
       return "out_of_order";
     case core::SampleVerdict::kRejectedJump:
       return "rejected_jump";
+    case core::SampleVerdict::kStampJump:
+      return "stamp_jump";
   }
   return "unknown";
 }
@@ -257,13 +259,13 @@ int runProcess(const ProcessOptions& o) {
   if (out) out->commit();
   const core::ProcessorCounters& c = processor.counters();
   std::cerr << "process: " << c.received << " samples, " << outputs << " outputs, " << c.rejected() << " rejected, "
-            << c.gaps << " gaps, " << c.resets << " resets\n";
+            << c.gaps << " gaps, " << c.resets << " resets, " << c.stamp_jumps << " stamp jumps dropped\n";
   if (c.accepted == 0) {
     // Nothing usable: an output file of rejections only is not a successful run.
     std::cerr << "process: no sample accepted (" << c.non_finite << " non-finite, " << c.no_signal << " no signal, "
               << c.degenerate << " degenerate, " << c.amplitude_out_of_range << " amplitude out of range, "
               << c.zero_stamp << " zero stamp, " << c.duplicate << " duplicate, " << c.out_of_order << " out of order, "
-              << c.jumps << " jumps)\n";
+              << c.stamp_jumps << " stamp jumps, " << c.jumps << " jumps)\n";
     return 1;
   }
   return 0;

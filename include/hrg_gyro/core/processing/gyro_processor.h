@@ -2,11 +2,14 @@
 //   Z -> (E - P) Z -> wave state -> unwrapped theta -> dalpha = (dtheta - D dt) / K -> alpha.
 // It also owns the rules for bad input, so that the live node, the nodelet and `hrg_bag process`
 // behave identically (and give bit-identical numbers):
-//   - zero stamps, duplicates (same stamp) and small backward steps (out of order) are dropped;
-//   - a backward jump larger than backward_reset (a bag loop) resets the state: alpha restarts at 0
-//     and the next output carries FLAG_RESET;
-//   - a forward gap larger than max_gap is not integrated across: the sample re-anchors the angle,
-//     its output has dalpha = 0 and FLAG_GAP;
+//   - stamps follow the one stamp rule (common/stamp_timeline.h) with backward_reset, max_gap as
+//     its forward jump and jump_persist: zero stamps, duplicates and small backward steps (out of
+//     order) are dropped; a single sample stamped further back or more than max_gap ahead is a
+//     glitch, dropped and counted (stamp_jumps), and the stream goes on where it was;
+//   - a jump back that persists for jump_persist samples (a bag loop, a restarted driver) resets the
+//     state: alpha restarts at 0 and the next output carries FLAG_RESET;
+//   - a jump ahead that persists (a gap: the source stopped, messages were lost) is not integrated
+//     across: the sample re-anchors the angle, its output has dalpha = 0 and FLAG_GAP;
 //   - non-finite, empty, degenerate (A ~ B) or implausible-amplitude channels are rejected;
 //   - a wave-angle step implying more than max_rate of body rate is rejected as a glitch (a channel
 //     sign flip, say); after max_consecutive_jumps such samples the new angle is accepted as a
@@ -19,6 +22,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "hrg_gyro/core/common/stamp_timeline.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/processing/compensator.h"
 #include "hrg_gyro/core/signal/theta_unwrapper.h"
@@ -31,12 +35,14 @@ struct ProcessorConfig {
   WaveLimits limits;
   double max_gap = 0.1;         ///< s
   double backward_reset = 0.5;  ///< s
+  int jump_persist = 5;         ///< samples in a row that make a stamp jump real (common/stamp_timeline.h)
   double max_rate = 20.0;       ///< rad/s of body rate
   int max_consecutive_jumps = 5;
 };
 
 /// The one rule set for the processor's limits, shared by the processor node and `hrg_bag`:
-/// max_gap, backward_reset and max_rate finite and positive; max_consecutive_jumps >= 0;
+/// max_gap, backward_reset and max_rate finite and positive; jump_persist in [1, 1000];
+/// max_consecutive_jumps >= 0;
 /// 0 < min_anisotropy < 1; 0 <= min_amplitude < max_amplitude, both finite. Throws ConfigError
 /// (yaml_field.h) whose key() is the node's parameter name (max_gap, min_amplitude, ...).
 void validate(const ProcessorConfig& config);
@@ -63,7 +69,8 @@ enum class SampleVerdict : std::uint8_t {
   kRejectedStamp,  ///< zero or negative stamp
   kDuplicate,
   kOutOfOrder,
-  kRejectedJump,
+  kRejectedJump,  ///< the wave angle jumped (max_rate)
+  kStampJump,     ///< the stamp jumped back or ahead (a glitch until it persists)
 };
 
 struct ProcessorResult {
@@ -82,10 +89,12 @@ struct ProcessorCounters {
   std::uint64_t received = 0, accepted = 0, outputs = 0;
   std::uint64_t non_finite = 0, no_signal = 0, degenerate = 0, amplitude_out_of_range = 0;
   std::uint64_t zero_stamp = 0, duplicate = 0, out_of_order = 0, jumps = 0;
+  std::uint64_t stamp_jumps = 0;  ///< samples whose stamp jumped back or ahead, dropped
   std::uint64_t gaps = 0, resets = 0, frequency_out_of_range = 0, frequency_unknown = 0;
   double largest_gap = 0.0;  ///< s
   std::uint64_t rejected() const {
-    return non_finite + no_signal + degenerate + amplitude_out_of_range + zero_stamp + duplicate + out_of_order + jumps;
+    return non_finite + no_signal + degenerate + amplitude_out_of_range + zero_stamp + duplicate + out_of_order +
+           jumps + stamp_jumps;
   }
 };
 
@@ -111,11 +120,14 @@ class GyroProcessor {
   void processBatch(const ChannelSample* in, std::size_t n, ProcessorResult* out);
 
   const ProcessorCounters& counters() const { return counters_; }
-  /// Forgets the state (next sample is a first sample, alpha restarts at 0); counters are kept.
+  /// Forgets the state (next sample is a first sample, alpha restarts at 0, the stamps start
+  /// afresh); counters are kept.
   void reset();
 
  private:
   void countRejection(WaveStatus status);
+  /// reset() but for the stamps' timeline.
+  void resetState();
   /// The body of both process() forms, inlined into each: the by-value form (the live node's) then
   /// makes no second call.
   void processInto(const ChannelSample& in, ProcessorResult* result);
@@ -128,8 +140,9 @@ class GyroProcessor {
   // The phases of process(), in its order.
   /// Counts a rejected sample toward the next output's rejected_before.
   void reject(SampleVerdict verdict, ProcessorResult* r);
-  /// Zero, duplicate and out-of-order stamps are rejected (false); a large backward jump resets the
-  /// state. *dt_ns: the step from the previous sample (left at 0 without one).
+  /// The stamp rule: zero, duplicate, out-of-order and jumped stamps are rejected (false); a jump
+  /// back that persists resets the state. *dt_ns: the step from the previous sample (left at 0
+  /// without one).
   bool admitStamp(Nanoseconds stamp, Nanoseconds* dt_ns, ProcessorResult* r);
   /// The first sample (after a start or reset) anchors the unwrapped angle; no output.
   void anchor(const ChannelSample& in, WaveState* wave, ProcessorResult* r);
@@ -144,6 +157,7 @@ class GyroProcessor {
   void remember(const ChannelSample& in, const WaveState& wave);
 
   ProcessorConfig config_;
+  StampTimeline timeline_;
   Compensator compensator_;
   double max_abs_k0_;  // |K0| for the glitch limit on the wave-angle step
   ThetaUnwrapper unwrapper_;
