@@ -23,6 +23,10 @@ core::TriadCombinerSettings combinerSettings(ParameterReader& params) {
   if (max_pending < 1) throw std::invalid_argument("triad: ~max_pending must be at least 1 (samples per axis)");
   s.max_pending = static_cast<std::size_t>(max_pending);
   s.initial_rate_variance = params.get("initial_angular_velocity_variance", s.initial_rate_variance);
+  s.max_rate = params.get("max_rate", s.max_rate);
+  s.backward_reset = params.get("backward_reset", s.backward_reset);
+  s.forward_jump = params.get("forward_jump", s.forward_jump);
+  s.jump_persist = params.get("jump_persist", s.jump_persist);
   try {
     s.validate();
   } catch (const core::ConfigError& e) {
@@ -215,7 +219,9 @@ void TriadRos::diagnoseAxis(std::size_t axis, diagnostic_updater::DiagnosticStat
   const std::uint64_t missing = c.missing - h.reported.missing;
   const std::uint64_t flagged = c.flagged - h.reported.flagged;
   const std::uint64_t mismatched = c.mismatched - h.reported.mismatched;
-  const std::uint64_t invalid = c.invalid - h.reported.invalid + c.duplicate - h.reported.duplicate;
+  const std::uint64_t invalid = c.invalid - h.reported.invalid + c.duplicate - h.reported.duplicate + c.bad_stamp -
+                                h.reported.bad_stamp + c.out_of_order - h.reported.out_of_order + c.stamp_jumps -
+                                h.reported.stamp_jumps;
   if (!h.seen) {
     stat.summaryf(DiagnosticStatus::ERROR, "no output received yet on %s/output", name.c_str());
   } else if (since > stall_timeout_) {
@@ -240,6 +246,9 @@ void TriadRos::diagnoseAxis(std::size_t axis, diagnostic_updater::DiagnosticStat
   stat.add("last flags", static_cast<unsigned>(h.last_flags));
   stat.add("dropped (invalid)", c.invalid);
   stat.add("dropped (duplicate stamp)", c.duplicate);
+  stat.add("dropped (zero stamp)", c.bad_stamp);
+  stat.add("dropped (out-of-order stamp)", c.out_of_order);
+  stat.add("dropped (stamp jump)", c.stamp_jumps);
   stat.add("times went backwards", c.epochs);
   stat.add("rate variance in force ((rad/s)^2)", combiner_->rateVariance(axis));
   stat.add("outputs without their variance", p.without_variance);
@@ -274,6 +283,8 @@ void TriadRos::diagnoseTriad(diagnostic_updater::DiagnosticStatusWrapper& stat) 
   stat.add("axis flagged", c.axis_flagged);
   stat.add("waited out (an axis too late)", c.timeouts);
   stat.add("overflowed (emitted as gaps)", c.non_finite);
+  stat.add("stamps skipped by an axis (carried into the next)", c.carried);
+  stat.add("late (after their stamp went out)", c.late);
   stat.add("last stamp", last_stamp_.toSec());
   reported_ = c;
 }

@@ -34,6 +34,32 @@ Nanoseconds saturatedNanoseconds(double seconds) {
   return ns <= 0.0 ? 0 : static_cast<Nanoseconds>(ns);
 }
 
+// (rad/s)^2: a variance below this is no gyro's either (5e-324 would claim a perfect one).
+constexpr double kSmallestRateVariance = 1e-20;
+
+StampRule stampRule(const TriadCombinerSettings& s) {
+  StampRule r;
+  r.backward_reset = s.backward_reset;
+  r.forward_jump = s.forward_jump;
+  r.persist = s.jump_persist;
+  return r;
+}
+
+std::array<StampTimeline, 3> makeTimelines(const TriadCombinerSettings& s) {
+  const StampTimeline t(stampRule(s));
+  return {{t, t, t}};
+}
+
+/// The settings checked before anything is built from them.
+const TriadCombinerSettings& validated(const TriadCombinerSettings& s) {
+  try {
+    s.validate();
+  } catch (const ConfigError& e) {
+    throw std::invalid_argument(std::string("triad combiner: ") + e.what());
+  }
+  return s;
+}
+
 void checkFinite(const TriadParameters& triad) {
   if (!triad.axis_to_body.allFinite() || !triad.bias.allFinite()) {
     throw std::invalid_argument("triad combiner: axis_to_body and bias must be finite");
@@ -48,20 +74,23 @@ void TriadCombinerSettings::validate() const {
   }
   if (!(max_wait > 0.0) || !std::isfinite(max_wait)) throw ConfigError("max_wait", "must be positive (s)");
   if (max_pending < 1) throw ConfigError("max_pending", "must be at least 1 (samples per axis)");
-  if (!(initial_rate_variance > 0.0) || !(initial_rate_variance <= kLargestRateVariance)) {
-    throw ConfigError("initial_angular_velocity_variance", "must be positive ((rad/s)^2)");
+  if (!(initial_rate_variance >= kSmallestRateVariance) || !(initial_rate_variance <= kLargestRateVariance)) {
+    throw ConfigError("initial_angular_velocity_variance", "must be in [1e-20, 1e12] (rad/s)^2");
   }
+  if (!(max_rate > 0.0) || !std::isfinite(max_rate)) throw ConfigError("max_rate", "must be positive (rad/s)");
+  if (!(backward_reset > 0.0) || !(backward_reset <= 1e9)) {
+    throw ConfigError("backward_reset", "must be positive (s), at most 1e9");
+  }
+  if (!(forward_jump > 0.0) || !(forward_jump <= 1e9))
+    throw ConfigError("forward_jump", "must be positive (s), at most 1e9");
+  if (jump_persist < 1 || jump_persist > 1000) throw ConfigError("jump_persist", "must be in [1, 1000] (samples)");
 }
 
 TriadCombiner::TriadCombiner(const TriadCombinerSettings& settings, std::shared_ptr<const TriadParameters> triad)
-    : settings_(settings),
+    : settings_(validated(settings)),
       queues_{{RingBuffer<Held>(settings.max_pending), RingBuffer<Held>(settings.max_pending),
-               RingBuffer<Held>(settings.max_pending)}} {
-  try {
-    settings_.validate();
-  } catch (const ConfigError& e) {
-    throw std::invalid_argument(std::string("triad combiner: ") + e.what());
-  }
+               RingBuffer<Held>(settings.max_pending)}},
+      timelines_(makeTimelines(settings)) {
   max_wait_ns_ = saturatedNanoseconds(settings_.max_wait);
   staging_ = settings_.max_pending > 1;  // one sample may always wait: max_pending 1 does not let it
   variance_.fill(settings_.initial_rate_variance);
@@ -81,6 +110,35 @@ void TriadCombiner::setParameters(std::shared_ptr<const TriadParameters> triad) 
   }
 }
 
+bool TriadCombiner::admitUnusual(std::size_t axis, Nanoseconds stamp, StampVerdict verdict) {
+  TriadAxisCounters& c = counters_.axes[axis];
+  switch (verdict) {
+    case StampVerdict::kNext:
+    case StampVerdict::kResumedAhead:  // a gap: the stamps this axis lacks are gaps
+      break;
+    case StampVerdict::kNewTimeline:
+      ++epoch_[axis];
+      ++c.epochs;
+      break;
+    case StampVerdict::kNonPositive:
+      ++c.bad_stamp;
+      return false;
+    case StampVerdict::kDuplicate:
+      ++c.duplicate;
+      return false;
+    case StampVerdict::kBehind:
+      ++c.out_of_order;
+      return false;
+    case StampVerdict::kJumpedBack:
+    case StampVerdict::kJumpedAhead:
+      ++c.stamp_jumps;
+      return false;
+  }
+  seen_[axis] = true;
+  last_stamp_[axis] = stamp;
+  return true;
+}
+
 void TriadCombiner::addQueued(std::size_t axis, const Held& held, std::vector<TriadBodySample>* completed) {
   if (staging_) unstage();
   RingBuffer<Held>& queue = queues_[axis];
@@ -90,7 +148,8 @@ void TriadCombiner::addQueued(std::size_t axis, const Held& held, std::vector<Tr
   // While an axis has nothing, only this sample can have ended a wait: by its stamp or a full queue.
   if ((queues_[0].empty() || queues_[1].empty() || queues_[2].empty()) && !mayHaveEndedAWait(axis)) return;
   resolve(false, completed);
-  staging_ = settings_.max_pending > 1 && queues_[0].empty() && queues_[1].empty() && queues_[2].empty();
+  staging_ =
+      settings_.max_pending > 1 && queues_[0].empty() && queues_[1].empty() && queues_[2].empty() && carry_mask_ == 0;
 }
 
 void TriadCombiner::unstage() {
@@ -170,17 +229,63 @@ void TriadCombiner::resolve(bool force, std::vector<TriadBodySample>* completed)
       const Held& h = queues_[a].front();
       if (h.epoch == first.epoch && difference(h.stamp, first.stamp) <= tolerance) present |= 1u << a;
     }
+    if (!awaited && carryOver(present, tolerance)) continue;
     if (awaited) ++counters_.timeouts;
     emit(present, completed);
     if (force) return;  // one stamp at a time: the caller decides how far to go
   }
 }
 
+bool TriadCombiner::carryOver(std::uint8_t present, Nanoseconds tolerance) {
+  if (present == kAllAxes) return false;  // nothing skipped
+  std::size_t lead_axis = 0;
+  while (!(present & (1u << lead_axis))) ++lead_axis;
+  const Held* lead = &queues_[lead_axis].front();
+  // Where the present axes' intervals began (with what was carried before): the skipping axis's
+  // next interval must begin there too, one instant (within the tolerance).
+  const Nanoseconds start = lead->stamp - saturatedNanoseconds(lead->dt + carry_dt_[lead_axis]);
+  for (std::size_t a = 0; a < 3; ++a) {
+    const Held& h = queues_[a].front();
+    if (present & (1u << a)) {
+      if (h.flags & (kFlagGap | kFlagReset)) return false;  // no increment to carry
+      continue;
+    }
+    const Nanoseconds began = h.stamp - saturatedNanoseconds(h.dt);
+    if (h.epoch != lead->epoch || h.flags != 0 || difference(h.stamp, lead->stamp) <= tolerance ||
+        difference(began, start) > tolerance || difference(start, began) > tolerance) {
+      return false;
+    }
+  }
+  for (std::size_t a = 0; a < 3; ++a) {
+    if (!(present & (1u << a))) continue;
+    const Held& h = queues_[a].front();
+    takeVariance(a, h);
+    carry_dalpha_[a] += h.dalpha;
+    carry_dt_[a] += h.dt;
+    carry_mask_ |= static_cast<std::uint8_t>(1u << a);
+    queues_[a].pop_front();
+  }
+  ++counters_.carried;
+  return true;
+}
+
 void TriadCombiner::emit(std::uint8_t present, std::vector<TriadBodySample>* completed) {
   std::array<const Held*, 3> heads{{nullptr, nullptr, nullptr}};
+  std::array<Held, 3> with_carry;
   for (std::size_t a = 0; a < 3; ++a) {
-    if (present & (1u << a)) heads[a] = &queues_[a].front();
+    if (!(present & (1u << a))) continue;
+    heads[a] = &queues_[a].front();
+    if (carry_mask_ & (1u << a)) {  // this axis's increments of the stamps it was carried over
+      with_carry[a] = *heads[a];
+      with_carry[a].dalpha += carry_dalpha_[a];
+      with_carry[a].dt += carry_dt_[a];
+      heads[a] = &with_carry[a];
+    }
   }
+  // A gap or a partial stamp after carried increments: they are not integrated (the gap's dt spans them).
+  carry_mask_ = 0;
+  carry_dalpha_.fill(0.0);
+  carry_dt_.fill(0.0);
   emitHeads(heads, present, completed);
   for (std::size_t a = 0; a < 3; ++a) {
     if (present & (1u << a)) queues_[a].pop_front();
@@ -189,6 +294,12 @@ void TriadCombiner::emit(std::uint8_t present, std::vector<TriadBodySample>* com
 
 void TriadCombiner::emitHeads(const std::array<const Held*, 3>& heads, std::uint8_t present,
                               std::vector<TriadBodySample>* completed) {
+  const Held* lead = heads[0] ? heads[0] : heads[1] ? heads[1] : heads[2];
+  if (has_previous_ &&
+      (lead->epoch < previous_epoch_ || (lead->epoch == previous_epoch_ && lead->stamp <= previous_stamp_))) {
+    ++counters_.late;  // its time has gone out already: the output's stamps never go back in an epoch
+    return;
+  }
   completed->emplace_back(TriadBodySample::Unset());
   TriadBodySample& out = completed->back();
   if (present == kAllAxes) {
@@ -205,7 +316,7 @@ void TriadCombiner::emitHeads(const std::array<const Held*, 3>& heads, std::uint
 }
 
 void TriadCombiner::takeVariance(std::size_t axis, const Held& h) {
-  if (h.variance > 0.0 && h.variance <= kLargestRateVariance) variance_[axis] = h.variance;
+  if (h.variance >= kSmallestRateVariance && h.variance <= kLargestRateVariance) variance_[axis] = h.variance;
 }
 
 void TriadCombiner::writeCovariance(TriadBodySample* out) const {
@@ -225,6 +336,8 @@ void TriadCombiner::writeCovariance(TriadBodySample* out) const {
 }
 
 void TriadCombiner::endSample(std::uint8_t flags, double smallest_dt, std::uint64_t epoch, TriadBodySample* out) {
+  // The first sample of a new epoch: the stamps went back, and a client must restart from here.
+  if (has_previous_ && epoch != previous_epoch_) flags |= kTriadFlagReset;
   if (flags & (kTriadFlagGap | kTriadFlagReset)) {
     out->delta_angle.setZero();
     out->angular_velocity.setZero();

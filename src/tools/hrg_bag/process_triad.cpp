@@ -140,6 +140,20 @@ CLI::Option* addTriadOptions(CLI::App& command, TriadOptions* o) {
       ->capture_default_str()
       ->group(group)
       ->needs(triad);
+  // The triad node's stamp rule and plausibility bound on the axes' outputs (its parameters of the
+  // same names without the prefix; the processors' own are --max-gap, --backward-reset, ...).
+  number("--triad-max-rate", &o->combiner.max_rate, "rad/s, > 0: an axis output with |dalpha| / dt above is dropped");
+  number("--triad-backward-reset", &o->combiner.backward_reset,
+         "s, > 0: an axis output stamped further back is a jump (a glitch unless it persists)");
+  number("--triad-forward-jump", &o->combiner.forward_jump,
+         "s, > 0: an axis output stamped further ahead is a jump (a glitch unless it persists)");
+  command
+      .add_option("--triad-jump-persist", o->combiner.jump_persist,
+                  "axis outputs in a row past one jump that make it real")
+      ->transform(tools::wholeNumber(1, 1000))
+      ->capture_default_str()
+      ->group(group)
+      ->needs(triad);
   number("--angular-velocity-variance", &o->noise.configured_variance,
          "(rad/s)^2 of each axis's rate: positive, as given; negative, measured (the processor's own estimate)");
   number("--initial-angular-velocity-variance", &o->noise.initial_variance,
@@ -157,6 +171,9 @@ int runTriadProcess(const std::string& bag_path, const std::string& out_path, co
     combiner_settings.validate();
   } catch (const core::ConfigError& e) {
     std::string option = e.key();
+    if (option == "max_rate" || option == "backward_reset" || option == "forward_jump" || option == "jump_persist") {
+      option = "triad_" + option;  // the processors' options have these names
+    }
     std::replace(option.begin(), option.end(), '_', '-');
     throw UsageError("--" + option + ": " + e.problem());
   }
@@ -269,13 +286,14 @@ int runTriadProcess(const std::string& bag_path, const std::string& out_path, co
   const core::TriadCounters& c = combiner.counters();
   std::cerr << "process: triad " << triad->frame_id << ": " << c.samples << " samples, " << c.integrated
             << " combined, " << c.gaps << " gaps, " << c.resets << " resets, " << c.axis_flagged << " axis flagged, "
-            << c.timeouts << " waited out\n";
+            << c.timeouts << " waited out, " << c.carried << " stamps skipped by an axis (carried into the next)\n";
   for (std::size_t a = 0; a < 3; ++a) {
     const core::ProcessorCounters& p = axes[a].processor->counters();
     const core::TriadAxisCounters& t = c.axes[a];
     std::cerr << "  axis " << axes[a].name << " (" << axes[a].topic << ", " << axes[a].parameter_file
               << "): " << p.received << " samples, " << axes[a].outputs << " outputs, " << p.rejected() << " rejected, "
-              << t.missing << " stamps missing, " << t.mismatched << " intervals mismatched\n";
+              << t.missing << " stamps missing, " << t.mismatched << " intervals mismatched, "
+              << p.stamp_jumps + t.stamp_jumps << " stamp jumps dropped\n";
   }
   if (c.integrated == 0) {
     std::cerr << "process: no triad sample combined from all three axes\n";

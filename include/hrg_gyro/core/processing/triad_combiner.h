@@ -13,18 +13,28 @@
 // combiner holds each axis's outputs in a FIFO and merges the three streams by stamp:
 //   - a stamp that every axis has (within the stamp tolerance), over the same interval dt, is
 //     combined;
-//   - a stamp that an axis lacks (its sample dropped, rejected or not yet delivered when another
-//     axis has moved past it), or whose intervals differ (an axis missed the stamp before, so its
-//     dalpha spans two intervals), or that carries an axis's gap or reset flag, gives a sample with
-//     FLAG_GAP (or FLAG_RESET), no increment and no rate: never a mix of stale and fresh axes;
+//   - a stamp that an axis skipped (its processor dropped that sample: the axis's next output,
+//     already here, spans it) is not emitted: the other axes' increments of that stamp are carried
+//     into the next stamp, which is combined over both intervals (dt the sum) when every axis's
+//     interval then agrees. The output skips the stamp as the processor's own output skips a
+//     dropped sample, and nothing is lost from the angle;
+//   - a stamp that an axis lacks otherwise (not delivered when its wait runs out), or whose
+//     intervals differ, or that carries an axis's gap or reset flag, gives a sample with FLAG_GAP
+//     (or FLAG_RESET), no increment and no rate: never a mix of stale and fresh axes;
 //   - while an axis has nothing buffered the others wait for it, up to max_wait seconds of their
 //     stamps or max_pending samples each; then the waiting stamps are emitted as gaps (an axis
 //     that stopped costs bounded memory and delay).
 // Given the same three streams, the output is the same whatever order the axes' samples arrive in
 // (the live node's three subscriptions, the offline tool's bag order), unless a wait runs out.
-// A stamp going backwards on an axis (a bag loop, after which the processor flags a reset) starts
-// a new epoch of that axis: its samples are compared with the other axes' of the same epoch.
-// Nothing non-finite is ever emitted. No ROS.
+// Each axis's stamps follow the one stamp rule (common/stamp_timeline.h: backward_reset,
+// forward_jump, jump_persist), against its own last sample and the other axes' newest: a zero,
+// duplicate or out-of-order stamp, or a single sample whose stamp jumps back or ahead (a stray
+// message), is dropped and counted, and the axis goes on where it was. Only a jump back that persists
+// (a bag loop, after which the processor flags a reset) starts a new epoch of that axis: its samples
+// are compared with the other axes' of the same epoch, and the first triad sample of a new epoch
+// carries FLAG_RESET, so the emitted stamps only go back with it. A sample that is no measurement
+// (dt below 1 ns, dt or dalpha not finite, |dalpha| / dt above max_rate) is dropped, and a variance
+// outside [1e-20, 1e12] (rad/s)^2 is not taken. Nothing non-finite is ever emitted. No ROS.
 #pragma once
 
 #include <Eigen/Core>
@@ -37,6 +47,7 @@
 #include <vector>
 
 #include "hrg_gyro/core/common/ring_buffer.h"
+#include "hrg_gyro/core/common/stamp_timeline.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/triad_parameters.h"
 
@@ -59,7 +70,7 @@ constexpr std::uint8_t kAllTriadAxes = 0x7;  ///< a bit per axis
 /// Flags of a triad sample (the same bits as TriadOutput.msg).
 enum TriadFlags : std::uint8_t {
   kTriadFlagGap = 1,          ///< an axis lacked this stamp, its interval differed, or it flagged a gap
-  kTriadFlagReset = 2,        ///< an axis reset (time went backwards)
+  kTriadFlagReset = 2,        ///< an axis reset, or the stamps went back for good (a new epoch)
   kTriadFlagAxisFlagged = 4,  ///< an axis's output carried a frequency flag (values still combined)
 };
 
@@ -92,19 +103,29 @@ struct TriadCombinerSettings {
   std::size_t max_pending = 100000;
   /// (rad/s)^2, an axis's rate variance until its first sample that carries one.
   double initial_rate_variance = 1e-4;
+  /// rad/s: an axis sample whose |dalpha| / dt is above this is no measurement (dropped).
+  double max_rate = 100.0;
+  /// The stamp rule of each axis's stream (s, s, samples).
+  double backward_reset = 0.5;
+  double forward_jump = 0.1;
+  int jump_persist = 5;
   /// Throws ConfigError (yaml_field.h) naming the triad node's parameter (stamp_tolerance,
-  /// max_wait, max_pending, initial_angular_velocity_variance).
+  /// max_wait, max_pending, initial_angular_velocity_variance, max_rate, backward_reset,
+  /// forward_jump, jump_persist).
   void validate() const;
 };
 
 struct TriadAxisCounters {
   std::uint64_t received = 0;
-  std::uint64_t invalid = 0;     ///< dropped: dt not positive, or dt or dalpha not finite
-  std::uint64_t duplicate = 0;   ///< dropped: the stamp of the axis's previous sample again
-  std::uint64_t missing = 0;     ///< triad stamps this axis had no sample for
-  std::uint64_t flagged = 0;     ///< its samples with a gap, reset or frequency flag
-  std::uint64_t mismatched = 0;  ///< its samples whose dt differed from the other two axes'
-  std::uint64_t epochs = 0;      ///< times its stamps went backwards
+  std::uint64_t invalid = 0;       ///< dropped: dt below 1 ns, dt or dalpha not finite, |dalpha| / dt above max_rate
+  std::uint64_t bad_stamp = 0;     ///< dropped: zero or negative stamp
+  std::uint64_t duplicate = 0;     ///< dropped: the stamp of the axis's previous sample again
+  std::uint64_t out_of_order = 0;  ///< dropped: behind the axis's previous sample by at most backward_reset
+  std::uint64_t stamp_jumps = 0;   ///< dropped: the stamp jumped back or ahead (a glitch until it persists)
+  std::uint64_t missing = 0;       ///< triad stamps this axis had no sample for
+  std::uint64_t flagged = 0;       ///< its samples with a gap, reset or frequency flag
+  std::uint64_t mismatched = 0;    ///< its samples whose dt differed from the other two axes'
+  std::uint64_t epochs = 0;        ///< times its stamps went back for good (jump_persist samples)
 };
 
 struct TriadCounters {
@@ -115,6 +136,11 @@ struct TriadCounters {
   std::uint64_t axis_flagged = 0;  ///< with FLAG_AXIS_FLAGGED
   std::uint64_t timeouts = 0;      ///< emitted because an axis was waited for too long (max_wait, max_pending)
   std::uint64_t non_finite = 0;    ///< combinations that overflowed (emitted as gaps)
+  /// Stamps not emitted: an axis delivered them after a later stamp had gone out (as a gap, once its
+  /// wait ran out), or they belong to an epoch already left. Emitted stamps only go back with RESET.
+  std::uint64_t late = 0;
+  /// Stamps an axis skipped whose other axes' increments were carried into the next stamp.
+  std::uint64_t carried = 0;
   std::array<TriadAxisCounters, 3> axes;
 };
 
@@ -149,6 +175,11 @@ class TriadCombiner {
     double dt, dalpha, variance;
     std::uint8_t flags;
   };
+  /// A sample's stamp through its axis's timeline: false when it is dropped (counted); a jump back
+  /// that persists starts a new epoch of the axis.
+  bool admitStamp(std::size_t axis, Nanoseconds stamp);
+  /// admitStamp() beyond the usual case (the next stamp of the axis).
+  __attribute__((noinline)) bool admitUnusual(std::size_t axis, Nanoseconds stamp, StampVerdict verdict);
   /// add() beyond the usual case: through the queues.
   __attribute__((noinline)) void addQueued(std::size_t axis, const Held& held, std::vector<TriadBodySample>* completed);
   /// Moves the staged samples to the queues (they are the oldest of their axes).
@@ -164,6 +195,9 @@ class TriadCombiner {
   bool waitedOut(const Held& head) const;
   /// Pops the heads in `present` (a bit per axis) and appends their triad sample.
   void emit(std::uint8_t present, std::vector<TriadBodySample>* completed);
+  /// Whether the stamp of the heads in `present` was skipped by every other axis, whose next
+  /// sample (its head) spans it: then their increments are carried (and popped), nothing emitted.
+  bool carryOver(std::uint8_t present, Nanoseconds tolerance);
   /// Appends the triad sample of `heads` (null: the axis lacks the stamp); pops nothing.
   void emitHeads(const std::array<const Held*, 3>& heads, std::uint8_t present,
                  std::vector<TriadBodySample>* completed);
@@ -192,34 +226,40 @@ class TriadCombiner {
   std::uint64_t staged_epoch_ = 0;
   std::array<Held, 3> staged_;
   std::array<double, 3> variance_;
+  std::array<StampTimeline, 3> timelines_;
+  double min_dt_ = 1e-9;  // s: below one stamp tick, no interval
   std::array<bool, 3> seen_{{false, false, false}};
   std::array<Nanoseconds, 3> last_stamp_{{0, 0, 0}};
   std::array<std::uint64_t, 3> epoch_{{0, 0, 0}};
+  // The increments of stamps an axis skipped, per axis, to be added to its next sample.
+  std::uint8_t carry_mask_ = 0;
+  std::array<double, 3> carry_dalpha_{{0.0, 0.0, 0.0}}, carry_dt_{{0.0, 0.0, 0.0}};
   bool has_previous_ = false;
   Nanoseconds previous_stamp_ = 0;
   std::uint64_t previous_epoch_ = 0;
   TriadCounters counters_;
 };
 
+inline bool TriadCombiner::admitStamp(std::size_t axis, Nanoseconds stamp) {
+  const Nanoseconds others = std::max(last_stamp_[axis == 0 ? 1 : 0], last_stamp_[axis == 2 ? 1 : 2]);
+  const StampVerdict verdict = timelines_[axis].check(stamp, others);
+  if (verdict != StampVerdict::kNext) return admitUnusual(axis, stamp, verdict);
+  seen_[axis] = true;
+  last_stamp_[axis] = stamp;
+  return true;
+}
+
 // The per-sample entry point, inline: the usual case costs no call until a stamp is complete.
 inline void TriadCombiner::add(std::size_t axis, const AxisOutput& in, std::vector<TriadBodySample>* completed) {
   if (axis >= 3) throw std::out_of_range("triad combiner: axis index must be 0, 1 or 2");
   TriadAxisCounters& c = counters_.axes[axis];
   ++c.received;
-  if (!(in.dt > 0.0) || !std::isfinite(in.dt) || !std::isfinite(in.dalpha)) {
+  // Also false for NaN: dt in [1 ns, inf), |dalpha| <= max_rate dt.
+  if (!(in.dt >= min_dt_) || !(in.dt < INFINITY) || !(std::abs(in.dalpha) <= settings_.max_rate * in.dt)) {
     ++c.invalid;  // left out: the stamp is then missing on this axis, a gap
     return;
   }
-  if (in.stamp <= last_stamp_[axis] && seen_[axis]) {
-    if (in.stamp == last_stamp_[axis]) {
-      ++c.duplicate;
-      return;
-    }
-    ++epoch_[axis];
-    ++c.epochs;
-  }
-  seen_[axis] = true;
-  last_stamp_[axis] = in.stamp;
+  if (!admitStamp(axis, in.stamp)) return;
   if (in.flags != 0) ++c.flagged;
   const std::uint8_t bit = static_cast<std::uint8_t>(1u << axis);
   // The usual case (one clock): the samples of one stamp arrive one per axis while nothing else is
