@@ -254,7 +254,7 @@ void CalibratorRos::noteRestart(std::uint64_t restarts_before) {
   // run over from its prior; what the node keeps about the run starts over too.
   ++resets_;
   ROS_WARN("calibrator: time went back for %d records in a row (bag loop?): %s run restarted",
-           base_settings_.backward_persist, core::nameOf(session()->settings().method).c_str());
+           base_settings_.jump_persist, core::nameOf(session()->settings().method).c_str());
   skip_waves_until_ = ros::Time();
   sweep_end_ = last_channels_stamp_ = ros::Time();
   pairing_.clear();
@@ -513,12 +513,14 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
     stat.add("not on a settled plateau", c.unsettled);
     stat.add("without turntable state", c.unsynchronized);
     stat.add("dropped (out-of-order stamps)", c.out_of_order);
+    stat.add("dropped (stamp jumps)", c.wave_jumps);
     // Glitched turntable records, dropped before the plateau detector (all runs of this session).
     stat.add("turntable dropped (bad rate)", c.rejected.bad_rate);
     stat.add("turntable dropped (bad angle)", c.rejected.bad_angle);
     stat.add("turntable dropped (zero stamp)", c.rejected.bad_stamp);
     stat.add("turntable dropped (duplicate stamp)", c.rejected.duplicate);
     stat.add("turntable dropped (out-of-order stamp)", c.rejected.out_of_order);
+    stat.add("turntable dropped (stamp jump)", c.rejected.stamp_jump);
     if (!field_plan_.empty()) {
       stat.add("field commands sent", field_commands_sent_);
       stat.add("field commands planned", field_plan_.size());

@@ -180,8 +180,7 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   feed_settings_.hold = params_.get("stream_hold", feed_settings_.hold);
   if (!(feed_settings_.hold >= 0.0) || feed_settings_.hold > 60.0) throw error("~stream_hold must be in [0, 60] s");
   feed_settings_.auto_finish_idle = axis_settings_.auto_finish_idle;
-  feed_settings_.backward_reset = axis_settings_.backward_reset;
-  feed_settings_.backward_persist = axis_settings_.backward_persist;
+  feed_settings_.stamps = axis_settings_.stampRule();
   const int queue_size = params_.get("queue_size", 50000);
   const double heap_trim_period = params_.get("heap_trim_period", 10.0);
   const bool autostart = params_.get("autostart", true);
@@ -289,7 +288,7 @@ void TriadCalibratorRos::maybeFinish() {
     ROS_WARN(
         "%s: a stream went back by more than %.3f s for %d records in a row (bag loop? restarted simulator?): "
         "the run restarted from the priors",
-        kNode, feed_settings_.backward_reset, feed_settings_.backward_persist);
+        kNode, feed_settings_.stamps.backward_reset, feed_settings_.stamps.persist);
   }
   if (feed_->shouldFinish()) {
     ROS_INFO("%s: every axis has been along the table axis and the fixture released for %.1f s: finishing", kNode,
@@ -556,6 +555,7 @@ void TriadCalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s
       stat.add(n + " dropped (non-finite theta)", c.bad_value);
     }
     stat.add(n + " dropped (out of order)", c.out_of_order);
+    stat.add(n + " dropped (stamp jump)", c.stamp_jump);
     stat.add(n + " fed late (behind later stamps)", c.late);
     stat.add(n + " last stamp", stampText(c.last_stamp));
   }

@@ -145,6 +145,7 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
   out << YAML::Key << "bad_stamp" << YAML::Value << o.turntable_rejected.bad_stamp;
   out << YAML::Key << "duplicate" << YAML::Value << o.turntable_rejected.duplicate;
   out << YAML::Key << "out_of_order" << YAML::Value << o.turntable_rejected.out_of_order;
+  out << YAML::Key << "stamp_jump" << YAML::Value << o.turntable_rejected.stamp_jump;
   out << YAML::EndMap;
   out << YAML::Key << "restarts" << YAML::Value << o.restarts;
   if (o.table_clock.measured) {

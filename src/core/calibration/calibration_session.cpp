@@ -63,8 +63,8 @@ CalibrationSession::CalibrationSession(const CalibrationSettings& settings, cons
       pending_(kMaxPending + 1),
       regulariser_(stampSettings(settings.table_clock)),
       clock_offset_(offsetSettings(settings.table_clock)),
-      turntable_timeline_(settings.backward_reset, settings.backward_persist),
-      wave_timeline_(settings.backward_reset, settings.backward_persist) {}
+      turntable_timeline_(settings.stampRule()),
+      wave_timeline_(settings.stampRule()) {}
 
 bool CalibrationSession::plausible(Nanoseconds stamp, double angle, double rate) {
   if (!std::isfinite(rate) || std::abs(rate) > settings_.plateau.max_rate) {
@@ -79,9 +79,9 @@ bool CalibrationSession::plausible(Nanoseconds stamp, double angle, double rate)
   }
   if (has_last_good_ && std::isfinite(last_good_angle_) && stamp > last_good_stamp_) {
     const double reach = settings_.plateau.max_rate * toSeconds(stamp - last_good_stamp_) + kAngleSlack;
-    // A few in a row: a glitch. More than backward_persist: the table's angle really is elsewhere
+    // A few in a row: a glitch. More than jump_persist: the table's angle really is elsewhere
     // (the good record kept last was the glitch, or the encoder was re-zeroed); take the new one.
-    if (std::abs(angle - last_good_angle_) > reach && ++bad_angle_run_ <= settings_.backward_persist) {
+    if (std::abs(angle - last_good_angle_) > reach && ++bad_angle_run_ <= settings_.jump_persist) {
       ++counters_.rejected.bad_angle;
       return false;
     }
@@ -102,8 +102,9 @@ bool CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double ra
   }
   // Values first: a glitched record must not move the stamp reference either.
   if (stamp > 0 && !plausible(stamp, angle, rate)) return false;
-  switch (turntable_timeline_.check(stamp)) {
+  switch (turntable_timeline_.check(stamp, wave_timeline_.last())) {
     case StampVerdict::kNext:
+    case StampVerdict::kResumedAhead:  // a gap: the plateau detector sees it
       break;
     case StampVerdict::kNewTimeline:
       restart();
@@ -118,6 +119,10 @@ bool CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double ra
       return false;
     case StampVerdict::kBehind:
       ++counters_.rejected.out_of_order;
+      return false;
+    case StampVerdict::kJumpedBack:
+    case StampVerdict::kJumpedAhead:
+      ++counters_.rejected.stamp_jump;
       return false;
   }
   has_last_good_ = true;
@@ -142,6 +147,7 @@ void CalibrationSession::restart() {
   const TurntableRejects rejected = counters_.rejected;
   const std::uint64_t restarts = counters_.restarts + 1;
   const std::uint64_t out_of_order = counters_.out_of_order;
+  const std::uint64_t wave_jumps = counters_.wave_jumps;
   const std::uint64_t turntable_total = counters_.turntable_total;
   method_ = makeCalibrationMethod(settings_, prior_);
   detector_ = PlateauDetector(settings_.plateau);
@@ -153,6 +159,7 @@ void CalibrationSession::restart() {
   counters_.rejected = rejected;
   counters_.restarts = restarts;
   counters_.out_of_order = out_of_order;
+  counters_.wave_jumps = wave_jumps;
   counters_.turntable_total = turntable_total;
   bad_angle_run_ = 0;
   has_last_good_ = false;
@@ -167,15 +174,22 @@ void CalibrationSession::restart() {
 
 void CalibrationSession::addWave(Nanoseconds stamp, double theta, double frequency, double quadrature_ratio) {
   ++counters_.wave;
-  switch (wave_timeline_.check(stamp)) {
+  switch (wave_timeline_.check(stamp, turntable_timeline_.last())) {
     case StampVerdict::kNext:
+    case StampVerdict::kResumedAhead:
       break;
     case StampVerdict::kNewTimeline:
       restart();
       turntable_timeline_.expectJumpBack(kMaxWait);
       counters_.wave = 1;
       break;
-    default:
+    case StampVerdict::kJumpedBack:
+    case StampVerdict::kJumpedAhead:
+      ++counters_.wave_jumps;
+      return;
+    case StampVerdict::kNonPositive:
+    case StampVerdict::kDuplicate:
+    case StampVerdict::kBehind:
       ++counters_.out_of_order;
       return;
   }
@@ -396,7 +410,11 @@ CalibrationOutcome CalibrationSession::finish() const {
     o.notes.push_back(std::to_string(r.total()) + " glitched turntable records dropped (" + std::to_string(r.bad_rate) +
                       " bad rate, " + std::to_string(r.bad_angle) + " bad angle, " + std::to_string(r.bad_stamp) +
                       " zero stamp, " + std::to_string(r.duplicate) + " duplicate, " + std::to_string(r.out_of_order) +
-                      " out of order)");
+                      " out of order, " + std::to_string(r.stamp_jump) + " stamp jump)");
+  }
+  if (counters_.wave_jumps > 0) {
+    o.notes.push_back(std::to_string(counters_.wave_jumps) +
+                      " wave samples whose stamp jumped (back or ahead: a glitch) were dropped");
   }
   if (counters_.restarts > 0) {
     o.notes.push_back("the stamps went back for good " + std::to_string(counters_.restarts) +

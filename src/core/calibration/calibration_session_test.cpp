@@ -1,7 +1,8 @@
-// The calibration session against glitched turntable records: each kind is dropped and counted, none
-// ends a plateau, and the result matches the same session without them; zero stamps and lone
-// backward stamps do not restart the run, a persisting backward timeline (a bag loop) does. The
-// glitches are injected here into a clean angle-level stream, independently of the simulator.
+// The calibration session against glitched turntable records and wave samples: each kind is dropped
+// and counted, none ends a plateau, and the result matches the same session without them; zero
+// stamps and lone stamps far back or ahead do not restart the run, a persisting backward timeline (a
+// bag loop) does. The glitches are injected here into a clean angle-level stream, independently of
+// the simulator.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -49,14 +50,26 @@ TurntableProfile constantRateProfile() {
   return p;
 }
 
-enum Glitch { kNanRate, kAbsurdRate, kInfAngle, kZeroStamp, kDuplicate, kSlightlyBack, kGlitchKinds };
+enum Glitch {
+  kNanRate,
+  kAbsurdRate,
+  kInfAngle,
+  kZeroStamp,
+  kDuplicate,
+  kSlightlyBack,
+  kFarAhead,
+  kFarBack,
+  kGlitchKinds
+};
 
 struct Injected {
   std::uint64_t count[kGlitchKinds] = {};
+  std::uint64_t wave_jumps = 0;  ///< wave samples stamped 1000 s ahead or 100 s back
 };
 
 // Feeds the session; about one turntable record in `one_in` (random, seeded) is replaced by a glitch,
-// the kinds in turn. The wave samples stay clean.
+// the kinds in turn, and about one wave sample in `one_in` by the same sample stamped 1000 s ahead or
+// 100 s back.
 CalibrationOutcome run(const TurntableProfile& profile, CalibrationMethodKind method, int one_in, Injected* injected,
                        SessionCounters* counters = nullptr) {
   CalibrationSession session(settings(method), prior());
@@ -84,15 +97,31 @@ CalibrationOutcome run(const TurntableProfile& profile, CalibrationMethodKind me
         case kDuplicate:
           session.addTurntable(previous, angle, rate);
           break;
-        default:
+        case kSlightlyBack:
           session.addTurntable(previous - toNanoseconds(0.0005), angle, rate);
+          break;
+        case kFarAhead:
+          session.addTurntable(t + toNanoseconds(100.0), angle, rate);
+          break;
+        default:
+          if (t <= toNanoseconds(100.0)) {  // not a stamp at all this early: a zero-stamp glitch
+            --injected->count[kFarBack];
+            ++injected->count[kZeroStamp];
+          }
+          session.addTurntable(t - toNanoseconds(100.0), angle, rate);
           break;
       }
     } else {
       session.addTurntable(t, angle, rate);
       previous = t;
     }
-    session.addWave(t, theta, NAN);
+    if (one_in > 0 && pick(random) == 0) {
+      const bool back = injected->wave_jumps % 2 == 1 && t > toNanoseconds(100.0);
+      ++injected->wave_jumps;
+      session.addWave(t + toNanoseconds(back ? -100.0 : 1000.0), theta, NAN);
+    } else {
+      session.addWave(t, theta, NAN);
+    }
   });
   if (counters) *counters = session.counters();
   return session.finish();
@@ -126,6 +155,7 @@ void expectCounted(const CalibrationOutcome& o, const Injected& in) {
   EXPECT_EQ(o.turntable_rejected.bad_stamp, in.count[kZeroStamp]);
   EXPECT_EQ(o.turntable_rejected.duplicate, in.count[kDuplicate]);
   EXPECT_EQ(o.turntable_rejected.out_of_order, in.count[kSlightlyBack]);
+  EXPECT_EQ(o.turntable_rejected.stamp_jump, in.count[kFarAhead] + in.count[kFarBack]);
   EXPECT_EQ(o.restarts, 0u);
 }
 
@@ -133,8 +163,11 @@ TEST(CalibrationSessionTest, DualRateIgnoresOneGlitchedTurntableRecordInAThousan
   const TurntableProfile p = testing::dualRateProfile(0.05, -0.05, 120.0);
   Injected none, glitches;
   const CalibrationOutcome clean = run(p, CalibrationMethodKind::kDualRate, 0, &none);
-  const CalibrationOutcome glitched = run(p, CalibrationMethodKind::kDualRate, 1000, &glitches);
-  for (int k = 0; k < kGlitchKinds; ++k) EXPECT_GT(glitches.count[k], 20u) << "kind " << k;
+  SessionCounters counters;
+  const CalibrationOutcome glitched = run(p, CalibrationMethodKind::kDualRate, 1000, &glitches, &counters);
+  for (int k = 0; k < kGlitchKinds; ++k) EXPECT_GT(glitches.count[k], 15u) << "kind " << k;
+  EXPECT_GT(glitches.wave_jumps, 200u);
+  EXPECT_EQ(counters.wave_jumps, glitches.wave_jumps);
   expectCounted(glitched, glitches);
   EXPECT_EQ(glitched.plateaus.size(), clean.plateaus.size());
   expectSameWithin(clean, glitched, 1.0);
@@ -167,7 +200,7 @@ TEST(CalibrationSessionTest, ZeroStampsAndLoneBackwardStampsDoNotRestartTheRun) 
   }
   EXPECT_EQ(session.counters().restarts, 0u);
   EXPECT_EQ(session.counters().rejected.bad_stamp, 20u);
-  EXPECT_EQ(session.counters().rejected.out_of_order, 1u);
+  EXPECT_EQ(session.counters().rejected.stamp_jump, 1u);
   EXPECT_EQ(session.counters().turntable, 3021u);
 }
 
@@ -190,16 +223,16 @@ TEST(CalibrationSessionTest, APersistingBackwardTimelineRestartsTheRun) {
     session.addWave(t, theta, NAN);
   });
   EXPECT_EQ(session.counters().restarts, 1u);
-  // The records of the new timeline before it was recognised (backward_persist - 1) are dropped.
-  EXPECT_EQ(session.counters().rejected.out_of_order, static_cast<std::uint64_t>(s.backward_persist - 1));
+  // The records of the new timeline before it was recognised (jump_persist - 1) are dropped.
+  EXPECT_EQ(session.counters().rejected.stamp_jump, static_cast<std::uint64_t>(s.jump_persist - 1));
   const CalibrationOutcome looped = session.finish();
   EXPECT_EQ(looped.restarts, 1u);
   expectSameWithin(single, looped, 1.0);
 }
 
-TEST(CalibrationSessionTest, BackwardPersistOfOneRestartsOnAnyLongJump) {
+TEST(CalibrationSessionTest, JumpPersistOfOneRestartsOnAnyLongJump) {
   CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
-  s.backward_persist = 1;
+  s.jump_persist = 1;
   CalibrationSession session(s, prior());
   session.addTurntable(toNanoseconds(10.0), 0.0, 0.0);
   session.addTurntable(toNanoseconds(9.8), 0.0, 0.0);  // within backward_reset: a glitch

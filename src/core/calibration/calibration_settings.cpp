@@ -36,9 +36,9 @@ const std::vector<std::string> kFieldKeys = {
     "gain_orders",        "rate",           "turns",        "directions", "rest", "axis_earth_rate", "min_turns",
     "max_excess_scatter", "max_gain_error", "max_drift_std"};
 const std::vector<std::string> kScalarKeys = {
-    "method",         "scale_factor_orders", "drift_orders",    "bins",
-    "window",         "window_span",         "group_tolerance", "auto_finish_idle",
-    "backward_reset", "backward_persist",    "bias_trend_order"};
+    "method",           "scale_factor_orders", "drift_orders",     "bins",           "window",
+    "window_span",      "group_tolerance",     "auto_finish_idle", "backward_reset", "backward_persist",
+    "bias_trend_order", "forward_jump",        "jump_persist"};
 
 double positive(const YamlField& parent, const char* key, double fallback) {
   const double v = parent.getDouble(key, fallback);
@@ -56,6 +56,14 @@ std::vector<std::string> CalibrationSettings::keyPaths() {
   for (const std::string& k : kTableClockKeys) keys.push_back("table_clock/" + k);
   for (const std::string& k : kFieldKeys) keys.push_back("field/" + k);
   return keys;
+}
+
+StampRule CalibrationSettings::stampRule() const {
+  StampRule r;
+  r.backward_reset = backward_reset;
+  r.forward_jump = forward_jump;
+  r.persist = jump_persist;
+  return r;
 }
 
 CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
@@ -83,8 +91,15 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   s.group_tolerance = positive(root, "group_tolerance", s.group_tolerance);
   s.auto_finish_idle = root.getDouble("auto_finish_idle", s.auto_finish_idle);
   s.backward_reset = positive(root, "backward_reset", s.backward_reset);
-  s.backward_persist = static_cast<int>(root.getInteger("backward_persist", s.backward_persist));
-  if (s.backward_persist < 1 || s.backward_persist > 1000) root["backward_persist"].fail("must be in [1, 1000]");
+  s.forward_jump = positive(root, "forward_jump", s.forward_jump);
+  if (s.forward_jump > 600.0) root["forward_jump"].fail("must be at most 600 s");
+  // jump_persist, once backward_persist (before it applied to forward jumps too): either name, not both.
+  const char* persist_key = root.has("backward_persist") ? "backward_persist" : "jump_persist";
+  if (root.has("backward_persist") && root.has("jump_persist")) {
+    root["backward_persist"].fail("is the former name of jump_persist: give one of them");
+  }
+  s.jump_persist = static_cast<int>(root.getInteger(persist_key, s.jump_persist));
+  if (s.jump_persist < 1 || s.jump_persist > 1000) root[persist_key].fail("must be in [1, 1000]");
   if (root.has("plateau")) {
     const YamlField p = root["plateau"];
     p.rejectUnknownKeys(kPlateauKeys);

@@ -13,6 +13,15 @@ namespace core {
 namespace {
 
 const char* const kAxisLetters[3] = {"x", "y", "z"};
+const char* const kStreamNames[kTriadStreamCount] = {"fixture", "table", "axis 0", "axis 1", "axis 2"};
+
+// s of its own stamps a stream may stay on the old timeline after another went back for good.
+constexpr double kFollowGiveUp = 60.0;
+
+std::array<StampTimeline, kTriadStreamCount> makeTimelines(const StampRule& rule) {
+  const StampTimeline t(rule);
+  return {{t, t, t, t, t}};
+}
 
 /// The Earth's rate in the platter's frame (z up along the table axis, x at the table's zero mark
 /// turned by the table angle): the zero mark points at `azimuth` from North towards East, and a
@@ -116,11 +125,87 @@ TriadCalibrationSettings TriadCalibrationSettings::parse(const YamlField& f) {
   return s;
 }
 
+bool acceptFixtureOrientation(FixtureRecord* record) {
+  const double norm = record->body_to_table.norm();
+  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) return false;
+  record->body_to_table.normalize();
+  return true;
+}
+
 TriadCalibration::TriadCalibration(const CalibrationSettings& axis_settings, const TriadCalibrationSettings& settings,
                                    const std::array<GyroParameters, 3>& priors, const TriadParameters& prior_triad)
-    : axis_settings_(axis_settings), settings_(settings), priors_(priors), prior_triad_(prior_triad) {
+    : axis_settings_(axis_settings),
+      settings_(settings),
+      priors_(priors),
+      prior_triad_(prior_triad),
+      timelines_(makeTimelines(axis_settings.stampRule())) {
   axis_settings_.method = CalibrationMethodKind::kDualRate;
   for (int i = 0; i < 3; ++i) sessions_[i] = std::make_unique<CalibrationSession>(axis_settings_, priors_[i]);
+}
+
+bool TriadCalibration::admit(int stream, Nanoseconds stamp) {
+  Nanoseconds others = 0;  // the newest good stamp of the other streams
+  for (int s = 0; s < kTriadStreamCount; ++s) {
+    if (s != stream && timelines_[s].started()) others = std::max(others, timelines_[s].last());
+  }
+  TriadStreamRejects& r = rejects_[stream];
+  switch (timelines_[stream].check(stamp, others)) {
+    case StampVerdict::kNext:
+    case StampVerdict::kResumedAhead:
+      return true;
+    case StampVerdict::kNewTimeline:
+      restart();
+      for (int s = 0; s < kTriadStreamCount; ++s) {
+        if (s != stream) timelines_[s].expectJumpBack(kFollowGiveUp);
+      }
+      return true;
+    case StampVerdict::kNonPositive:
+      ++r.bad_stamp;
+      return false;
+    case StampVerdict::kDuplicate:
+    case StampVerdict::kBehind:
+      ++r.out_of_order;
+      return false;
+    case StampVerdict::kJumpedBack:
+    case StampVerdict::kJumpedAhead:
+      ++r.stamp_jump;
+      return false;
+  }
+  return false;
+}
+
+void TriadCalibration::restart() {
+  ++restarts_;
+  for (int i = 0; i < 3; ++i) {
+    sessions_[i] = std::make_unique<CalibrationSession>(axis_settings_, priors_[i]);
+    waves_[i].clear();
+    wave_blocks_[i] = BlockMean();
+  }
+  fixtures_.clear();
+  table_.clear();
+  table_rates_.clear();
+  table_block_ = BlockMean();
+  table_unwrapped_ = NAN;
+  origin_ = 0;
+}
+
+void TriadCalibration::noteRejects(TriadOutcome* o) const {
+  for (int s = 0; s < kTriadStreamCount; ++s) {
+    const TriadStreamRejects& r = rejects_[s];
+    if (r.total() == 0) continue;
+    const std::string name = s >= kAxisStream0 ? "axis " + prior_triad_.axes[s - kAxisStream0] : kStreamNames[s];
+    std::string what = std::to_string(r.total()) + " " + name + " records dropped (";
+    if (r.bad_value > 0) {
+      what += std::to_string(r.bad_value) + (s == kFixtureStream ? " orientation not a rotation, " : " non-finite, ");
+    }
+    what += std::to_string(r.bad_stamp) + " zero stamp, " + std::to_string(r.out_of_order) + " out of order, " +
+            std::to_string(r.stamp_jump) + " stamp jump)";
+    o->notes.push_back(what);
+  }
+  if (restarts_ > 0) {
+    o->notes.push_back("a stream's stamps went back for good " + std::to_string(restarts_) +
+                       " time(s) (a recording across a restarted driver): the calibration started over");
+  }
 }
 
 const FixtureRecord* TriadCalibration::fixtureAt(Nanoseconds stamp) const {
@@ -137,11 +222,15 @@ int TriadCalibration::verticalSign(const FixtureRecord& fixture, int axis) const
   return 0;
 }
 
-void TriadCalibration::addFixture(const FixtureRecord& record) {
+void TriadCalibration::addFixture(FixtureRecord record) {
+  if (!acceptFixtureOrientation(&record)) {
+    ++rejects_[kFixtureStream].bad_value;
+    return;
+  }
+  if (!admit(kFixtureStream, record.stamp)) return;
   // Only changes are kept: a bench repeats its position every second.
   if (!fixtures_.empty()) {
     const FixtureRecord& last = fixtures_.back();
-    if (record.stamp < last.stamp) return;  // out of order: the timeline keeps its order
     if (last.index == record.index && last.locked == record.locked && last.name == record.name &&
         last.body_to_table.coeffs() == record.body_to_table.coeffs()) {
       return;
@@ -151,6 +240,8 @@ void TriadCalibration::addFixture(const FixtureRecord& record) {
 }
 
 void TriadCalibration::addTurntable(Nanoseconds stamp, double angle, double rate, std::uint64_t sequence) {
+  // A record with a bad rate goes to the sessions, which count it, but moves no stamp.
+  if (std::isfinite(rate) && !admit(kTableStream, stamp)) return;
   if (origin_ == 0 && stamp > 0) origin_ = stamp;
   const FixtureRecord* fixture = fixtureAt(stamp);
   if (fixture && fixture->locked) {
@@ -195,7 +286,12 @@ void TriadCalibration::addToBlock(BlockMean* block, Nanoseconds stamp, double va
 
 void TriadCalibration::addWave(int axis, Nanoseconds stamp, double theta, double frequency) {
   if (axis < 0 || axis > 2) throw std::invalid_argument("triad calibration: axis must be 0, 1 or 2");
-  if (origin_ == 0 && stamp > 0) origin_ = stamp;
+  if (!std::isfinite(theta)) {
+    ++rejects_[kAxisStream0 + axis].bad_value;
+    return;
+  }
+  if (!admit(kAxisStream0 + axis, stamp)) return;
+  if (origin_ == 0) origin_ = stamp;
   const FixtureRecord* fixture = fixtureAt(stamp);
   if (fixture && fixture->locked && verticalSign(*fixture, axis) != 0) {
     sessions_[axis]->addWave(stamp, theta, frequency);
@@ -222,8 +318,17 @@ TriadOutcome TriadCalibration::finish() const {
   TriadOutcome o;
   o.axis_names = prior_triad_.axes;
   o.triad = prior_triad_;
+  noteRejects(&o);
   std::array<GyroParameters, 3> params = priors_;
 
+  // A refusal for want of positions names the fixture records that never counted.
+  const auto fixtureDrops = [this]() -> std::string {
+    const TriadStreamRejects& r = rejects_[kFixtureStream];
+    if (r.total() == 0) return "";
+    return " (" + std::to_string(r.total()) + " fixture records were dropped: " + std::to_string(r.bad_value) +
+           " orientation not a rotation, " + std::to_string(r.stamp_jump + r.out_of_order + r.bad_stamp) +
+           " bad stamp)";
+  };
   // Stage 1: each axis's K(theta) and D(theta).
   for (int i = 0; i < 3; ++i) {
     o.axes[i] = sessions_[i]->finish();
@@ -235,7 +340,7 @@ TriadOutcome TriadCalibration::finish() const {
       o.gate("axis_" + axis, false, 0.0, 1.0,
              "no locked position put axis " + axis + " along the table axis: add a position +" +
                  std::string(kAxisLetters[i]) + " or -" + kAxisLetters[i] + " (axis " + axis +
-                 " up or down) with dual-rate plateaus");
+                 " up or down) with dual-rate plateaus" + fixtureDrops());
       continue;
     }
     o.gate("axis_" + axis, o.axes[i].accepted, o.axes[i].accepted ? 1.0 : 0.0, 1.0,
@@ -465,7 +570,7 @@ TriadOutcome TriadCalibration::finish() const {
                " fixture positions with the table turning: their table axes do not "
                "span the body frame" +
                (missing.empty() ? std::string() : "; missing: a position " + missing) +
-               " (body axis along the table axis)");
+               " (body axis along the table axis)" + fixtureDrops());
     o.decide();
     return o;
   }

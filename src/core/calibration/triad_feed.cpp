@@ -15,19 +15,25 @@ constexpr std::size_t kMaxHeld = 1000000;
 
 constexpr Nanoseconds kNever = std::numeric_limits<Nanoseconds>::max();
 
-}  // namespace
+// s of its own stamps a stream may stay on the old timeline after another went back for good.
+constexpr double kFollowGiveUp = 60.0;
 
-bool acceptFixtureOrientation(FixtureRecord* record) {
-  const double norm = record->body_to_table.norm();
-  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) return false;
-  record->body_to_table.normalize();
-  return true;
+std::array<StampTimeline, TriadFeed::kStreamCount> makeTimelines(const StampRule& rule) {
+  const StampTimeline t(rule);
+  return {{t, t, t, t, t}};
 }
+
+}  // namespace
 
 TriadFeed::TriadFeed(const CalibrationSettings& axis_settings, const TriadCalibrationSettings& settings,
                      const std::array<GyroParameters, 3>& priors, const TriadParameters& prior_triad,
                      const TriadFeedSettings& feed)
-    : axis_settings_(axis_settings), settings_(settings), priors_(priors), prior_triad_(prior_triad), feed_(feed) {
+    : axis_settings_(axis_settings),
+      settings_(settings),
+      priors_(priors),
+      prior_triad_(prior_triad),
+      feed_(feed),
+      timelines_(makeTimelines(feed.stamps)) {
   if (!(feed_.hold >= 0.0)) throw std::invalid_argument("triad feed: the hold must be >= 0 s");
   calibration_ = std::make_unique<TriadCalibration>(axis_settings_, settings_, priors_, prior_triad_);
 }
@@ -40,7 +46,6 @@ void TriadFeed::restart() {
   for (auto& q : items_) q.clear();
   fixtures_.clear();
   for (TriadStreamCounters& c : counters_) c.last_stamp = 0;
-  backward_run_.fill(0);
   newest_ = fed_until_ = first_fed_ = 0;
   has_fixture_ = false;
   fixture_ = FixtureRecord();
@@ -52,25 +57,35 @@ void TriadFeed::restart() {
 bool TriadFeed::admit(int stream, Nanoseconds stamp) {
   TriadStreamCounters& c = counters_[stream];
   ++c.received;
-  if (stamp <= 0) {
-    ++c.bad_stamp;
-    return false;
+  // The newest stamp of the other streams: a stream rejoining them after a silence is no jump.
+  Nanoseconds others = 0;
+  for (int s = 0; s < kStreamCount; ++s) {
+    if (s != stream) others = std::max(others, counters_[s].last_stamp);
   }
-  if (stamp < c.last_stamp) {
-    if (toSeconds(c.last_stamp - stamp) > feed_.backward_reset) {
-      if (++backward_run_[stream] >= feed_.backward_persist) {
-        restart();  // this record is the first of the new timeline
-        c.last_stamp = stamp;
-        newest_ = stamp;
-        return true;
+  switch (timelines_[stream].check(stamp, others)) {
+    case StampVerdict::kNext:
+    case StampVerdict::kResumedAhead:
+      break;
+    case StampVerdict::kNewTimeline:
+      restart();  // this record is the first of the new timeline; the others are about to follow
+      for (int s = 0; s < kStreamCount; ++s) {
+        if (s != stream) timelines_[s].expectJumpBack(kFollowGiveUp);
       }
-    } else {
-      backward_run_[stream] = 0;
-    }
-    ++c.out_of_order;
-    return false;
+      c.last_stamp = stamp;
+      newest_ = stamp;
+      return true;
+    case StampVerdict::kNonPositive:
+      ++c.bad_stamp;
+      return false;
+    case StampVerdict::kDuplicate:
+    case StampVerdict::kBehind:
+      ++c.out_of_order;
+      return false;
+    case StampVerdict::kJumpedBack:
+    case StampVerdict::kJumpedAhead:
+      ++c.stamp_jump;
+      return false;
   }
-  backward_run_[stream] = 0;
   if (stamp < fed_until_) ++c.late;  // fed next, behind later stamps of the other streams
   c.last_stamp = stamp;
   newest_ = std::max(newest_, stamp);

@@ -2,13 +2,17 @@
 // angle_level_triad.h): streams that arrive late relative to each other give the calibration, bit
 // for bit, what it gets from the records in stamp order (what hrg_bag reads from a bag); a stream
 // that lags beyond the hold is fed late, not lost; a missing axis stream delays the others by the
-// hold only and its gate names the axis; bad records are dropped and counted; a stream that goes back
-// for good restarts the run; the auto-finish rule.
+// hold only and its gate names the axis; bad records are dropped and counted; the glitch battery (a
+// record stamped far ahead, far back, slightly back, zero, a duplicate, a bad value) on every stream,
+// live and straight into the calibration, costs those records only; a stream that goes back for good
+// restarts the run; the auto-finish rule.
 #include "hrg_gyro/core/calibration/triad_feed.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -28,6 +32,7 @@ struct Event {
   double a = 0.0, b = 0.0;
   std::uint32_t sequence = 0;
   FixtureRecord fixture;
+  Nanoseconds sent = 0;  ///< when it was sent, if not at its stamp (a glitched stamp)
 };
 
 AngleLevelTriad triad() {
@@ -102,7 +107,8 @@ std::vector<Event> arrival(const std::vector<Event>& events, const std::array<do
   std::vector<std::pair<Nanoseconds, std::size_t>> order;
   order.reserve(events.size());
   for (std::size_t k = 0; k < events.size(); ++k) {
-    order.push_back({events[k].stamp + toNanoseconds(delay[events[k].stream]), k});
+    const Nanoseconds sent = events[k].sent != 0 ? events[k].sent : events[k].stamp;
+    order.push_back({sent + toNanoseconds(delay[events[k].stream]), k});
   }
   std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<Event> out;
@@ -217,8 +223,12 @@ TEST(TriadFeedTest, BadRecordsAreDroppedAndCounted) {
     feed.addTurntable(t, 0.0, 0.0, k);
     for (int i = 0; i < 3; ++i) feed.addWave(i, t, 0.1 * i, NAN);
   }
-  // A record older than its stream's previous one (not far enough back to be a new timeline).
-  feed.addWave(2, toNanoseconds(1.9), 0.2, NAN);
+  // A record older than its stream's previous one (not far enough back to be a jump), and two whose
+  // stamps jump: 1000 s ahead and 100 s back.
+  feed.addWave(2, toNanoseconds(2.9), 0.2, NAN);
+  feed.addTurntable(toNanoseconds(1002.0), 0.0, 0.0, 400);
+  feed.addWave(1, toNanoseconds(1.0), 0.2, NAN);
+  feed.addTurntable(toNanoseconds(3.0), 0.0, 0.0, 401);
   EXPECT_EQ(feed.counters(TriadFeed::kFixture).bad_value, 2u);
   EXPECT_EQ(feed.counters(TriadFeed::kFixture).fed, 1u);
   ASSERT_NE(feed.fixture(), nullptr);
@@ -226,10 +236,131 @@ TEST(TriadFeedTest, BadRecordsAreDroppedAndCounted) {
   EXPECT_EQ(feed.counters(TriadFeed::kAxis0).bad_value, 2u);
   EXPECT_EQ(feed.counters(TriadFeed::kAxis0 + 1).bad_stamp, 1u);
   EXPECT_EQ(feed.counters(TriadFeed::kAxis0 + 2).out_of_order, 1u);
+  EXPECT_EQ(feed.counters(TriadFeed::kTable).stamp_jump, 1u);
+  EXPECT_EQ(feed.counters(TriadFeed::kAxis0 + 1).stamp_jump, 1u);
+  EXPECT_EQ(feed.counters(TriadFeed::kTable).received, 402u);
+  EXPECT_EQ(feed.counters(TriadFeed::kTable).last_stamp, toNanoseconds(3.0)) << "the table goes on after its glitch";
   EXPECT_EQ(feed.restarts(), 0u);
   const TriadOutcome o = feed.finish();  // too little for anything, but no crash and a named refusal
   EXPECT_FALSE(o.accepted);
   EXPECT_FALSE(o.reason.empty());
+}
+
+// The session with one glitch in about every `one_in[stream]` records of each stream, the kinds in
+// turn: a stamp 1000 s ahead, 100 s back, two periods back, zero, the previous record's stamp, and a
+// value that is no measurement (a NaN wave angle, a table rate of NaN, a fixture quaternion of norm
+// 2). The glitch is an extra record sent beside the good one of its instant.
+std::vector<Event> glitched(const std::vector<Event>& events, const std::array<int, TriadFeed::kStreamCount>& one_in,
+                            std::size_t* injected) {
+  std::vector<Event> out;
+  out.reserve(events.size() + events.size() / 100);
+  std::array<Nanoseconds, TriadFeed::kStreamCount> previous{};
+  std::array<int, TriadFeed::kStreamCount> kind{};
+  std::uint64_t state = 12345;
+  for (const Event& e : events) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    if (previous[e.stream] > 0 && (state >> 33) % static_cast<std::uint64_t>(one_in[e.stream]) == 0) {
+      Event g = e;
+      g.sent = e.stamp;
+      switch (kind[e.stream]++ % 6) {
+        case 0:
+          g.stamp += toNanoseconds(1000.0);
+          break;
+        case 1:
+          g.stamp -= toNanoseconds(100.0);
+          break;
+        case 2:
+          g.stamp = previous[e.stream] - 2 * (e.stamp - previous[e.stream]);
+          break;
+        case 3:
+          g.stamp = 0;
+          break;
+        case 4:
+          g.stamp = previous[e.stream];
+          break;
+        default:
+          if (e.stream == TriadFeed::kFixture) {
+            g.fixture.body_to_table.coeffs() *= 2.0;
+          } else if (e.stream == TriadFeed::kTable) {
+            g.b = NAN;
+          } else {
+            g.a = NAN;
+          }
+      }
+      g.fixture.stamp = g.stamp;
+      out.push_back(g);
+      ++*injected;
+    }
+    out.push_back(e);
+    previous[e.stream] = e.stamp;
+  }
+  return out;
+}
+
+void expectSameWithinSigmas(const TriadOutcome& clean, const TriadOutcome& o, double sigmas) {
+  ASSERT_TRUE(o.accepted) << o.reason;
+  double worst = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double sigma = clean.body_to_axis_std(i, j);
+      if (sigma > 0.0) worst = std::max(worst, std::abs(o.body_to_axis(i, j) - clean.body_to_axis(i, j)) / sigma);
+    }
+    const double k0 = clean.axes[i].scale_factor[0].mean, k0_std = clean.axes[i].scale_factor[0].mean_std;
+    worst = std::max(worst, std::abs(o.axes[i].scale_factor[0].mean - k0) / k0_std);
+    for (int j = 0; j < 3; ++j)
+      worst = std::max(worst, std::abs(o.triad.bias(j) - clean.triad.bias(j)) / clean.triad.bias_std(j));
+  }
+  std::printf("[ measured ] glitched against clean: largest difference %.3f sigma (M, K0, bias)\n", worst);
+  EXPECT_LE(worst, sigmas);
+}
+
+TEST(TriadFeedTest, OneGlitchedRecordOnAnyStreamCostsThatRecordOnly) {
+  // About 20 glitches on each stream (the fixture logs once a second, the others at 200 Hz).
+  std::size_t injected = 0;
+  const std::vector<Event> events = glitched(session(), {{40, 8000, 8000, 8000, 8000}}, &injected);
+  EXPECT_GT(injected, 80u);
+  TriadFeed clean = makeFeed();
+  for (const Event& e : session()) deliver(&clean, e);
+  const TriadOutcome reference = clean.finish();
+  ASSERT_TRUE(reference.accepted) << reference.reason;
+
+  // Live, the fixture and an axis late as in the field.
+  TriadFeed feed = makeFeed();
+  for (const Event& e : arrival(events, {{0.9, 0.05, 0.0, 0.3, 0.01}})) deliver(&feed, e);
+  const TriadOutcome live = feed.finish();
+  EXPECT_EQ(feed.restarts(), 0u);
+  std::size_t dropped = 0;
+  for (int s = 0; s < TriadFeed::kStreamCount; ++s) {
+    const TriadStreamCounters& c = feed.counters(s);
+    dropped += c.bad_stamp + c.bad_value + c.out_of_order + c.stamp_jump;
+    EXPECT_GT(c.stamp_jump, 0u) << s;
+  }
+  // The table's NaN rates are the axis sessions' to count (they are values, not stamps).
+  std::size_t nan_rates = 0;
+  for (const Event& e : events) nan_rates += e.stream == TriadFeed::kTable && std::isnan(e.b) ? 1 : 0;
+  EXPECT_GT(nan_rates, 0u);
+  EXPECT_EQ(dropped + nan_rates, injected);
+  expectSameWithinSigmas(reference, live, 0.05);
+
+  // Offline: the records in stamp order straight into the calibration, as hrg_bag calibrate reads a bag.
+  TriadCalibration direct(axisSettings(), triadSettings(), priors(), TriadParameters());
+  for (const Event& e : events) {
+    if (e.stream == TriadFeed::kFixture) direct.addFixture(e.fixture);
+    if (e.stream == TriadFeed::kTable) direct.addTurntable(e.stamp, e.a, e.b, e.sequence);
+    if (e.stream >= TriadFeed::kAxis0) direct.addWave(e.stream - TriadFeed::kAxis0, e.stamp, e.a, e.b);
+  }
+  const TriadOutcome offline = direct.finish();
+  EXPECT_EQ(direct.restarts(), 0u);
+  std::size_t offline_dropped = 0;
+  for (int s = 0; s < kTriadStreamCount; ++s) {
+    const TriadStreamRejects& r = direct.rejects(s);
+    offline_dropped += r.total();
+  }
+  EXPECT_EQ(offline_dropped + nan_rates, injected);
+  expectSameWithinSigmas(reference, offline, 0.05);
+  bool noted = false;
+  for (const std::string& n : offline.notes) noted = noted || n.find("fixture records dropped") != std::string::npos;
+  EXPECT_TRUE(noted);
 }
 
 TEST(TriadFeedTest, AStreamThatGoesBackForGoodRestartsTheRun) {

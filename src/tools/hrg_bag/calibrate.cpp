@@ -178,8 +178,8 @@ int runCalibrate(const CalibrateOptions& o) {
   const core::TurntableRejects& r = outcome.turntable_rejected;
   std::cout << "calibrate: turntable records " << outcome.turntable_records << ", dropped " << r.total()
             << " (bad rate " << r.bad_rate << ", bad angle " << r.bad_angle << ", zero stamp " << r.bad_stamp
-            << ", duplicate " << r.duplicate << ", out of order " << r.out_of_order << "), restarts "
-            << outcome.restarts << "\n";
+            << ", duplicate " << r.duplicate << ", out of order " << r.out_of_order << ", stamp jump " << r.stamp_jump
+            << "), restarts " << outcome.restarts << "\n";
   for (const core::DefectDiagnosis& d : outcome.diagnosis) {
     std::cout << "calibrate: root-cause diagnosis (first order, read against the P in force) " << core::describe(d);
   }

@@ -193,9 +193,7 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
       if (topic == fixture) {
         const FixturePosition::ConstPtr f = m.instantiate<FixturePosition>();
         if (!f) continue;
-        core::FixtureRecord record = fromMessage(*f);
-        if (!core::acceptFixtureOrientation(&record)) continue;  // not a rotation: not used (as live)
-        calibration.addFixture(record);
+        calibration.addFixture(fromMessage(*f));  // checked there: not a rotation, a bad stamp (as live)
         continue;
       }
       for (int i = 0; i < 3; ++i) {

@@ -29,8 +29,9 @@ struct TurntableRejects {
   std::uint64_t bad_angle = 0;     ///< non-finite, or a step from the last good angle beyond max_rate
   std::uint64_t bad_stamp = 0;     ///< zero or negative stamp
   std::uint64_t duplicate = 0;     ///< the stamp of the last good record
-  std::uint64_t out_of_order = 0;  ///< behind the last good stamp (not, or not yet, a new timeline)
-  std::uint64_t total() const { return bad_rate + bad_angle + bad_stamp + duplicate + out_of_order; }
+  std::uint64_t out_of_order = 0;  ///< behind the last good stamp by at most backward_reset
+  std::uint64_t stamp_jump = 0;    ///< further back or ahead: a glitch (or the first of a real jump)
+  std::uint64_t total() const { return bad_rate + bad_angle + bad_stamp + duplicate + out_of_order + stamp_jump; }
 };
 
 /// What the session measured of the table's clock against the gyro's.

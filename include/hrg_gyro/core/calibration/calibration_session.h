@@ -19,10 +19,13 @@
 // outcome and gated (table_clock/max_offset).
 //
 // A glitched turntable record (a non-finite or impossible rate, an infinite angle, a NaN angle or one
-// the rate bound cannot reach in an angle-logging stream, a zero, duplicate or backward stamp) is
-// dropped and counted by reason before the plateau detector sees it, so it cannot end a plateau. A stream whose stamps
-// go back for good (settings backward_reset and backward_persist, a looping bag) restarts the run from the prior: the
-// bins hold the previous pass. The live calibrator and hrg_bag calibrate both rely on this.
+// the rate bound cannot reach in an angle-logging stream, a zero, duplicate or backward stamp, a
+// stamp that jumps back or ahead) is dropped and counted by reason before the plateau detector sees
+// it, so it cannot end a plateau; a wave sample whose stamp jumps is dropped and counted too. Both
+// streams follow the one stamp rule (common/stamp_timeline.h; settings backward_reset, forward_jump,
+// jump_persist), each against its own last stamp and the other stream's. A stream whose stamps go back
+// for good (a looping bag) restarts the run from the prior: the bins hold the previous pass; one that
+// goes ahead for good goes on across the gap. The live calibrator and hrg_bag calibrate both rely on this.
 #pragma once
 
 #include <cmath>
@@ -47,7 +50,8 @@ struct SessionCounters {
   std::uint64_t used = 0;             ///< handed to the method
   std::uint64_t unsettled = 0;        ///< not on a settled plateau (ramps, settling, boundaries)
   std::uint64_t unsynchronized = 0;   ///< no turntable state around the stamp (or too far away)
-  std::uint64_t out_of_order = 0;     ///< wave samples dropped: zero, duplicate or backward stamps
+  std::uint64_t out_of_order = 0;     ///< wave samples dropped: zero, duplicate or slightly backward stamps
+  std::uint64_t wave_jumps = 0;       ///< wave samples dropped: the stamp jumped (a glitch), all runs
   TurntableRejects rejected;          ///< turntable records dropped (glitches), all runs of the session
   std::uint64_t restarts = 0;         ///< a stream went back for good: the run started over
   std::uint64_t turntable_total = 0;  ///< turntable records received, all runs of the session

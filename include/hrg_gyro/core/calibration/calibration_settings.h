@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "hrg_gyro/core/common/stamp_timeline.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/estimation/plateau_detector.h"
 #include "hrg_gyro/core/model/calibration_method_kind.h"
@@ -91,10 +92,14 @@ struct CalibrationSettings {
   double window_span = 0.06;       ///< rad, most wave angle a window may sweep (shortens tau at high rates)
   double group_tolerance = 1e-3;   ///< rad/s: plateaus closer than this in rate form one group
   double auto_finish_idle = 20.0;  ///< s at rest after the data are complete -> finish (<= 0: never)
-  /// A stream whose stamps go back by more than backward_reset s for backward_persist records in a
-  /// row has moved to a new timeline (bag loop): the run restarts. Fewer are dropped as glitches.
+  /// The stamp rule of every stream of the run (common/stamp_timeline.h): a record further back
+  /// than backward_reset, or further ahead than forward_jump (of its stream and of the others), is
+  /// a glitch, dropped; jump_persist records in a row past one jump make it real: going back (bag
+  /// loop) the run restarts, going ahead it goes on across the gap.
   double backward_reset = 0.5;  ///< s
-  int backward_persist = 5;     ///< records
+  double forward_jump = 1.0;    ///< s
+  int jump_persist = 5;         ///< records (the settings key backward_persist is its former name)
+  StampRule stampRule() const;
   PlateauSettings plateau;
   QualityLimits gates;
   ThermalSettings thermal;

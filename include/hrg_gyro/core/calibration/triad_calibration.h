@@ -23,6 +23,12 @@
 // A fixture position off by a small rotation makes u_p, and so the responses of that position, off by
 // it: the error enters A as the least-squares image of the positions' errors (docs/triad.md).
 //
+// Every record goes through its stream's stamp rule first (common/stamp_timeline.h, the axes'
+// settings backward_reset, forward_jump and jump_persist, each stream against its own last stamp and
+// the others' newest): a record whose stamp jumps is dropped and counted, as is a fixture orientation
+// that is no rotation and a non-finite wave angle; the outcome's notes say how many. A stream that
+// goes back for good (a recording across a restarted driver) starts the calibration over.
+//
 // Memory: stage 1 is streamed (the sessions' sums); stages 2 and 3 keep each axis's wave angle and the
 // table's angle as block means at `store_rate`, and the fixture's timeline. No ROS.
 #pragma once
@@ -52,6 +58,18 @@ struct TriadCalibrationSettings {
   static std::vector<std::string> keys();
 };
 
+/// The input streams of a triad calibration, in the order records of equal stamps are taken.
+enum TriadStream : int { kFixtureStream = 0, kTableStream = 1, kAxisStream0 = 2, kTriadStreamCount = 5 };
+
+/// The records of one input stream that were dropped, by reason.
+struct TriadStreamRejects {
+  std::uint64_t bad_stamp = 0;     ///< zero or negative
+  std::uint64_t bad_value = 0;     ///< a non-finite wave angle, or a fixture orientation that is no rotation
+  std::uint64_t out_of_order = 0;  ///< a duplicate, or behind the last good stamp by at most backward_reset
+  std::uint64_t stamp_jump = 0;    ///< further back or ahead: a glitch (or the first records of a real jump)
+  std::uint64_t total() const { return bad_stamp + bad_value + out_of_order + stamp_jump; }
+};
+
 /// The fixture's position as the bench logs it (hrg_gyro/FixturePosition).
 struct FixtureRecord {
   Nanoseconds stamp = 0;
@@ -61,6 +79,11 @@ struct FixtureRecord {
   bool locked = false;
 };
 
+/// The fixture record's orientation checked as a rotation: false when the quaternion is not finite
+/// or its norm is off 1 by more than 1e-3 (not a rotation: the record is not used); otherwise it is
+/// normalised in place.
+bool acceptFixtureOrientation(FixtureRecord* record);
+
 class TriadCalibration {
  public:
   /// `axis_settings`: the dual-rate settings of stage 1 (method is forced to dual_rate); `priors`:
@@ -69,7 +92,8 @@ class TriadCalibration {
   TriadCalibration(const CalibrationSettings& axis_settings, const TriadCalibrationSettings& settings,
                    const std::array<GyroParameters, 3>& priors, const TriadParameters& prior_triad);
 
-  void addFixture(const FixtureRecord& record);
+  /// The orientation is checked (acceptFixtureOrientation): one that is no rotation is dropped.
+  void addFixture(FixtureRecord record);
   /// The table's records (one stream for the whole fixture); sequence as in CalibrationSession.
   void addTurntable(Nanoseconds stamp, double angle, double rate,
                     std::uint64_t sequence = TableStampRegulariser::kNoSequence);
@@ -79,7 +103,19 @@ class TriadCalibration {
   /// Runs the three stages; writes nothing.
   TriadOutcome finish() const;
 
+  /// Records of stream `stream` (TriadStream) dropped so far, this run and earlier ones.
+  const TriadStreamRejects& rejects(int stream) const { return rejects_[stream]; }
+  /// Times a stream went back for good and the calibration started over.
+  std::uint64_t restarts() const { return restarts_; }
+
  private:
+  /// The stamp rule of `stream`; false when the record is dropped (counted). A stream that went
+  /// back for good starts the calibration over, this record first.
+  bool admit(int stream, Nanoseconds stamp);
+  /// Forgets every record: a new timeline.
+  void restart();
+  /// The notes on dropped records and restarts.
+  void noteRejects(TriadOutcome* o) const;
   struct StoredSample {
     Nanoseconds stamp;
     double value;  // the wave angle, or the table angle
@@ -117,6 +153,9 @@ class TriadCalibration {
   BlockMean table_block_;
   double table_unwrapped_ = NAN;  // the last table angle, unwrapped
   Nanoseconds origin_ = 0;        // first stamp seen: the Earth-rate term's time origin
+  std::array<StampTimeline, kTriadStreamCount> timelines_;
+  std::array<TriadStreamRejects, kTriadStreamCount> rejects_;
+  std::uint64_t restarts_ = 0;
 };
 
 }  // namespace core

@@ -16,10 +16,11 @@
 // far ahead of the others (a clock glitch) ends the others' hold early in the same way.
 //
 // Bad input is dropped and counted, never fed: a zero stamp; a non-finite wave angle; a fixture
-// orientation that is not a rotation (acceptFixtureOrientation); a record older than the previous one
-// of its own stream (out of order). A stream whose records lie more than backward_reset s behind its
-// previous one for backward_persist records in a row has moved to a new timeline (a bag loop, a
-// restarted simulator): the run starts over from the priors (restarts counted).
+// orientation that is not a rotation (acceptFixtureOrientation); a record out of order or whose stamp
+// jumps, by the one stamp rule (common/stamp_timeline.h), each stream against its own last record and
+// the newest of the others: a single record stamped far ahead no longer ends the others' hold. A
+// stream that goes back for good (a bag loop, a restarted simulator) has moved to a new timeline: the
+// run starts over from the priors (restarts counted).
 //
 // Auto-finish (shouldFinish): auto_finish_idle > 0, every axis has pointed along the table axis in a
 // locked fixture position (the least an accepted run needs), and the fixture has since been released
@@ -37,18 +38,14 @@
 namespace hrg_gyro {
 namespace core {
 
-/// The fixture record's orientation checked as a rotation: false when the quaternion is not finite
-/// or its norm is off 1 by more than 1e-3 (not a rotation: the record is not used); otherwise it is
-/// normalised in place. hrg_bag calibrate --method triad and the live calibrator both apply it.
-bool acceptFixtureOrientation(FixtureRecord* record);
-
 /// What one input stream has delivered.
 struct TriadStreamCounters {
   std::uint64_t received = 0;      ///< records offered
   std::uint64_t fed = 0;           ///< handed to the calibration
   std::uint64_t bad_stamp = 0;     ///< dropped: zero stamp
   std::uint64_t bad_value = 0;     ///< dropped: a non-finite wave angle, or a fixture orientation that is no rotation
-  std::uint64_t out_of_order = 0;  ///< dropped: older than the stream's previous record
+  std::uint64_t out_of_order = 0;  ///< dropped: a duplicate, or slightly older than the stream's previous record
+  std::uint64_t stamp_jump = 0;    ///< dropped: the stamp jumped back or ahead (a glitch until it persists)
   std::uint64_t late = 0;          ///< fed after later-stamped records of other streams (it lagged beyond the hold)
   Nanoseconds last_stamp = 0;      ///< newest stamp received (0: none yet)
 };
@@ -56,16 +53,20 @@ struct TriadStreamCounters {
 struct TriadFeedSettings {
   double hold = 2.0;              ///< s of stream time a record may wait for the other streams
   double auto_finish_idle = 0.0;  ///< s with the fixture released after full coverage; <= 0: never
-  double backward_reset = 0.5;    ///< s behind what was fed that may be a new timeline
-  int backward_persist = 5;       ///< records in a row that far back restart the run
+  StampRule stamps;               ///< the stamp rule (usually the calibration settings' stampRule())
 };
 
 class TriadFeed {
  public:
   /// The five streams, in the order records of equal stamps are fed (the fixture first).
-  enum Stream { kFixture = 0, kTable = 1, kAxis0 = 2, kStreamCount = 5 };
+  enum Stream {
+    kFixture = kFixtureStream,
+    kTable = kTableStream,
+    kAxis0 = kAxisStream0,
+    kStreamCount = kTriadStreamCount
+  };
 
-  /// The calibration's arguments as TriadCalibration's; `feed` as above (backward_* and
+  /// The calibration's arguments as TriadCalibration's; `feed` as above (stamps and
   /// auto_finish_idle are usually the calibration settings').
   TriadFeed(const CalibrationSettings& axis_settings, const TriadCalibrationSettings& settings,
             const std::array<GyroParameters, 3>& priors, const TriadParameters& prior_triad,
@@ -122,7 +123,7 @@ class TriadFeed {
   std::array<std::deque<Item>, kStreamCount> items_;  // the fixture's slot unused
   std::deque<FixtureRecord> fixtures_;
   std::array<TriadStreamCounters, kStreamCount> counters_;
-  std::array<int, kStreamCount> backward_run_{};
+  std::array<StampTimeline, kStreamCount> timelines_;
   Nanoseconds newest_ = 0;     // newest stamp received on any stream (this timeline)
   Nanoseconds fed_until_ = 0;  // latest stamp fed
   Nanoseconds first_fed_ = 0;
