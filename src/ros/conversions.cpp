@@ -95,7 +95,10 @@ ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::
                                     const std::string& frame_id) {
   ChannelAmplitudes m;
   m.header.seq = seq;
-  m.header.stamp = stamp;
+  // A scheduled stamp glitch moves this message's stamp only (never below 1 ns).
+  m.header.stamp = s.channels_stamp_offset == 0
+                       ? stamp
+                       : toRosTime(std::max<core::Nanoseconds>(1, toNanoseconds(stamp) + s.channels_stamp_offset));
   m.header.frame_id = frame_id;
   m.c_in = s.z[core::kAc];
   m.c_quad = s.z[core::kBc];

@@ -205,10 +205,11 @@ void DriverSimRos::publishSingle(const core::SimulationSample& s, const ros::Tim
     turntable_pub_.publish(boost::make_shared<TurntableState>(toTurntableMessage(r, origin, frame_id_)));
   }
   if (truth_pub_.getNumSubscribers() > 0) {
-    truth_pub_.publish(boost::make_shared<GroundTruth>(toTruthMessage(s, channels->header)));
+    truth_pub_.publish(boost::make_shared<GroundTruth>(toTruthMessage(s, trueHeader(channels->header, stamp))));
   }
   if (has_precession_loop_) {
-    precession_pub_.publish(boost::make_shared<PrecessionState>(toPrecessionStateMessage(s, channels->header)));
+    precession_pub_.publish(
+        boost::make_shared<PrecessionState>(toPrecessionStateMessage(s, trueHeader(channels->header, stamp))));
   }
 }
 
@@ -220,7 +221,8 @@ void DriverSimRos::publishTriad(const core::TriadSample& s, const ros::Time& sta
         toChannelsMessage(axis, stamp, static_cast<std::uint32_t>(axis.index), c.axes[i].name));
     if (axis.channels_delivered) axis_channels_pub_[i].publish(channels);
     if (axis_truth_pub_[i].getNumSubscribers() > 0) {
-      axis_truth_pub_[i].publish(boost::make_shared<GroundTruth>(toTruthMessage(axis, channels->header)));
+      axis_truth_pub_[i].publish(
+          boost::make_shared<GroundTruth>(toTruthMessage(axis, trueHeader(channels->header, stamp))));
     }
   }
   for (const core::TurntableLogRecord& r : s.turntable) {

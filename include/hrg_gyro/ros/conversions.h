@@ -32,6 +32,13 @@ inline core::Nanoseconds toNanoseconds(const ros::Time& t) {
   return static_cast<core::Nanoseconds>(t.sec) * 1000000000LL + static_cast<core::Nanoseconds>(t.nsec);
 }
 
+/// The channel message's header with the sample's true stamp (a scheduled glitch moves the channel
+/// message's stamp only): for the truth and the precession state that go with the sample.
+inline std_msgs::Header trueHeader(std_msgs::Header header, const ros::Time& stamp) {
+  header.stamp = stamp;
+  return header;
+}
+
 inline ros::Time toRosTime(core::Nanoseconds ns) {
   ros::Time t;
   t.fromNSec(static_cast<std::uint64_t>(ns < 0 ? 0 : ns));

@@ -32,7 +32,7 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
         session.addTurntable(record.stamp, record.angle, record.rate, record.index);
     }
     if (!s.channels_delivered) continue;
-    const ProcessorResult r = proc.process({s.stamp, s.z, s.frequency, s.temperature});
+    const ProcessorResult r = proc.process({s.stamp + s.channels_stamp_offset, s.z, s.frequency, s.temperature});
     if (r.has_wave)
       session.addWave(s.stamp, r.wave.theta, s.frequency, quadratureRatio(r.wave.quadrature, r.wave.amplitude));
   }
@@ -59,7 +59,8 @@ std::vector<EvaluationResult> verifyOnSimulation(const SimulationConfig& scenari
   while (sim.next(&s)) {
     if (!s.channels_delivered) continue;
     for (std::size_t i = 0; i < processors.size(); ++i) {
-      const ProcessorResult r = processors[i].process({s.stamp, s.z, s.frequency, s.temperature});
+      const ProcessorResult r =
+          processors[i].process({s.stamp + s.channels_stamp_offset, s.z, s.frequency, s.temperature});
       if (!r.has_output) continue;
       evaluators[i].add(s.stamp, r.increment.theta_mid, r.alpha, s.truth.table_rate, s.truth.inertial_angle,
                         s.truth.inertial_rate);

@@ -26,7 +26,8 @@ OfflineTriadCalibration calibrateOnTriadSimulation(const TriadSimulationConfig& 
     for (int i = 0; i < 3; ++i) {
       const SimulationSample& a = s.axes[i];
       if (!a.channels_delivered) continue;
-      const ProcessorResult r = processors[i]->process({a.stamp, a.z, a.frequency, a.temperature});
+      const ProcessorResult r =
+          processors[i]->process({a.stamp + a.channels_stamp_offset, a.z, a.frequency, a.temperature});
       if (r.has_wave) calibration.addWave(i, a.stamp, r.wave.theta, a.frequency);
     }
     for (const TurntableLogRecord& record : s.turntable)
@@ -120,7 +121,8 @@ std::vector<TriadVerification> verifyTriadOnSimulation(const TriadSimulationConf
       for (std::size_t i = 0; i < 3; ++i) {
         const SimulationSample& a = s.axes[i];
         if (!a.channels_delivered) continue;
-        const ProcessorResult r = chain.processors[i]->process({a.stamp, a.z, a.frequency, a.temperature});
+        const ProcessorResult r =
+            chain.processors[i]->process({a.stamp + a.channels_stamp_offset, a.z, a.frequency, a.temperature});
         if (!r.has_output) continue;
         AxisOutput out;
         out.stamp = a.stamp;

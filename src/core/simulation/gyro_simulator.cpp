@@ -76,6 +76,7 @@ void GyroSimulator::applyPrecessionCommands(SimulationSample* out) {
 void GyroSimulator::logTurntable(double t_center, SimulationSample* out) {
   out->turntable.clear();
   out->channels_delivered = channel_delivery_.delivered(t_center);
+  out->channels_stamp_offset = channel_delivery_.stampOffset(t_center);
   if (input_) return;  // one axis of a triad: the triad logs the table
   const double log_rate = config_.turntable_log.rate;
   if (log_rate == 0.0) {

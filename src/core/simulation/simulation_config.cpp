@@ -153,7 +153,7 @@ TableRippleConfig parseRippleSection(const YamlField& r) {
 
 DeliveryConfig parseChannelDeliverySection(const YamlField& ch) {
   ch.requireMap();
-  ch.rejectUnknownKeys({"drop_probability", "gaps"});
+  ch.rejectUnknownKeys({"drop_probability", "gaps", "stamp_glitches"});
   return DeliveryConfig::parse(ch);
 }
 

@@ -21,7 +21,27 @@ DeliveryConfig DeliveryConfig::parse(const YamlField& section) {
       c.gaps.push_back({g[0], g[1]});
     }
   }
+  if (section.has("stamp_glitches")) {
+    const YamlField glitches = section["stamp_glitches"];
+    glitches.requireSequence();
+    for (std::size_t i = 0; i < glitches.size(); ++i) {
+      const std::vector<double> g = glitches.at(i).asDoubles(2);
+      if (!(std::isfinite(g[0]) && g[0] >= 0.0)) glitches.at(i).fail("the time must be >= 0 s");
+      if (!(std::isfinite(g[1]) && g[1] != 0.0 && std::abs(g[1]) <= 1e6)) {
+        glitches.at(i).fail("the offset must be non-zero and at most 1e6 s either way");
+      }
+      if (!c.stamp_glitches.empty() && g[0] <= c.stamp_glitches.back().at) {
+        glitches.at(i).fail("the times must increase");
+      }
+      c.stamp_glitches.push_back({g[0], g[1]});
+    }
+  }
   return c;
+}
+
+Nanoseconds StreamDelivery::stampOffset(double t) {
+  if (next_glitch_ >= config_.stamp_glitches.size() || t < config_.stamp_glitches[next_glitch_].at) return 0;
+  return toNanoseconds(config_.stamp_glitches[next_glitch_++].offset);
 }
 
 bool StreamDelivery::delivered(double t) {

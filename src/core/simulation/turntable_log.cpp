@@ -52,8 +52,8 @@ double TurntableGlitchRates::total() const { return std::accumulate(per_record.b
 
 TurntableLogConfig TurntableLogConfig::parse(const YamlField& log) {
   log.requireMap();
-  log.rejectUnknownKeys(
-      {"rate", "angle_noise", "angle_resolution", "logged_rate", "drop_probability", "gaps", "glitches", "clock"});
+  log.rejectUnknownKeys({"rate", "angle_noise", "angle_resolution", "logged_rate", "drop_probability", "gaps",
+                         "stamp_glitches", "glitches", "clock"});
   TurntableLogConfig c;
   c.rate = log.getDouble("rate", 0.0);
   if (!(std::isfinite(c.rate) && c.rate >= 0.0)) {
@@ -137,6 +137,7 @@ void TurntableLogger::log(double t, Nanoseconds stamp, double angle, double rate
     ++counters_.lost;
     return;
   }
+  r.stamp += delivery_.stampOffset(t);
   switch (r.glitch) {
     case TurntableGlitch::kNanRate:
       r.rate = std::numeric_limits<double>::quiet_NaN();

@@ -275,6 +275,27 @@ TEST(TurntableLogTest, LostChannelSamplesAreFlaggedAndStillCounted) {
   EXPECT_NEAR(static_cast<double>(lost - in_gap), expected, 5 * std::sqrt(expected));
 }
 
+TEST(TurntableLogTest, AStampGlitchMovesOneMessageOnly) {
+  SimulationConfig c = plateauScenario(0.1, 4.0);
+  c.channels.stamp_glitches = {{1.0, 1000.0}, {2.5, -100.0}};
+  c.turntable_log.delivery.stamp_glitches = {{1.5, 100.0}};
+  GyroSimulator sim(c);
+  SimulationSample s;
+  std::vector<Nanoseconds> moved_channels;
+  std::vector<Nanoseconds> table_offsets;
+  while (sim.next(&s)) {
+    if (s.channels_stamp_offset != 0) moved_channels.push_back(s.channels_stamp_offset);
+    for (const TurntableLogRecord& r : s.turntable) {
+      if (r.stamp != s.stamp) table_offsets.push_back(r.stamp - s.stamp);
+    }
+  }
+  ASSERT_EQ(moved_channels.size(), 2u);
+  EXPECT_EQ(moved_channels[0], toNanoseconds(1000.0));
+  EXPECT_EQ(moved_channels[1], toNanoseconds(-100.0));
+  ASSERT_EQ(table_offsets.size(), 1u);
+  EXPECT_EQ(table_offsets[0], toNanoseconds(100.0));
+}
+
 // Without jitter the controller's stamps are exact: the true time plus the offset, the rate error
 // times the true time and every step taken at or before it (to the nanosecond the stamps round to).
 TEST(TurntableLogTest, ClockOffsetRateErrorAndStepsMoveTheStamps) {
@@ -474,7 +495,9 @@ TEST(TurntableLogTest, ScenarioKeysAreParsedAndBadOnesNamed) {
             "  log: {rate: 100, angle_noise: 2.0e-6, angle_resolution: 1.0e-7, logged_rate: differenced_angle,\n"
             "        drop_probability: 0.001, gaps: [[10, 2]], glitches: {nan_rate: 0.001, backward_stamp: 0.002},\n"
             "        clock: {offset: 0.1, jitter: 0.002, rate_error: -3.0e-6, steps: [[600, 0.05], [900, -0.01]]}}\n"
-            "channels: {drop_probability: 0.01, gaps: [[3, 1], [5, 0.5]]}\n"));
+            "channels: {drop_probability: 0.01, gaps: [[3, 1], [5, 0.5]], stamp_glitches: [[4, 1000], [6, -100]]}\n"));
+  ASSERT_EQ(c.channels.stamp_glitches.size(), 2u);
+  EXPECT_EQ(c.channels.stamp_glitches[1].offset, -100.0);
   EXPECT_EQ(c.ripple.amplitude, 0.002);
   EXPECT_EQ(c.ripple.frequency, 0.37);
   EXPECT_EQ(c.turntable_log.rate, 100.0);
@@ -514,6 +537,9 @@ TEST(TurntableLogTest, ScenarioKeysAreParsedAndBadOnesNamed) {
   EXPECT_EQ(key("  log: {logged_rate: encoder}\n"), "turntable.log.logged_rate");
   EXPECT_EQ(key("  log: {drop_probability: 1.0}\n"), "turntable.log.drop_probability");
   EXPECT_EQ(key("  log: {gaps: [[1, 0]]}\n"), "turntable.log.gaps[0]");
+  EXPECT_EQ(key("  log: {stamp_glitches: [[1, 0]]}\n"), "turntable.log.stamp_glitches[0]");
+  EXPECT_EQ(key("  log: {stamp_glitches: [[2, 1], [1, 1]]}\n"), "turntable.log.stamp_glitches[1]");
+  EXPECT_EQ(key("  log: {stamp_glitches: [[1, .inf]]}\n"), "turntable.log.stamp_glitches[0][1]");
   EXPECT_EQ(key("  log: {glitches: {nan_rate: 2}}\n"), "turntable.log.glitches.nan_rate");
   EXPECT_EQ(key("  log: {glitches: {nan_rate: 0.6, zero_stamp: 0.6}}\n"), "turntable.log.glitches");
   EXPECT_EQ(key("  log: {glitches: {nan: 0.1}}\n"), "turntable.log.glitches.nan");

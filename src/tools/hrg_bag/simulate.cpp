@@ -45,7 +45,7 @@ int runSimulateTriad(const SimulateOptions& o, const YAML::Node& document) {
       const ChannelAmplitudes ch =
           toChannelsMessage(axis, stamp, static_cast<std::uint32_t>(axis.index), config.axes[i].name);
       if (axis.channels_delivered) bag.write(channels_topic[i], stamp, ch);
-      if (truth) bag.write(truth_topic[i], stamp, toTruthMessage(axis, ch.header));
+      if (truth) bag.write(truth_topic[i], stamp, toTruthMessage(axis, trueHeader(ch.header, stamp)));
     }
     for (const core::TurntableLogRecord& r : s.turntable) {
       bag.write("/turntable/state", toRosTime(core::toNanoseconds(config.start_time + r.time)),
@@ -87,14 +87,15 @@ int runSimulate(const SimulateOptions& o) {
       bag.write("/turntable/state", toRosTime(core::toNanoseconds(config.start_time + r.time)),
                 toTurntableMessage(r, 0, o.frame_id));
     }
-    if (truth) bag.write("/truth", stamp, toTruthMessage(s, ch.header));
+    if (truth) bag.write("/truth", stamp, toTruthMessage(s, trueHeader(ch.header, stamp)));
     // A gyro with a precession loop: the schedule's commands as the commanding node would have sent
     // them (at the carrier period that took each up), and what the loop executes, with every sample.
     for (const core::AppliedPrecession& a : s.precession_commands) {
       const ros::Time at = toRosTime(core::toNanoseconds(config.start_time + a.time));
       bag.write("/command/precession", at, toPrecessionCommandMessage(a, at, o.frame_id));
     }
-    if (sim.hasPrecessionLoop()) bag.write("/precession/state", stamp, toPrecessionStateMessage(s, ch.header));
+    if (sim.hasPrecessionLoop())
+      bag.write("/precession/state", stamp, toPrecessionStateMessage(s, trueHeader(ch.header, stamp)));
     progress.update(sim.elapsed(), ++seq);
   }
   bag.commit();

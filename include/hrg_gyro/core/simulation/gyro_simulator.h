@@ -107,6 +107,9 @@ struct SimulationSample {
   TruthState truth;
   /// False: this channel sample was lost on its way (consumers must not see it).
   bool channels_delivered = true;
+  /// Added to the stamp of this channel sample's message only (a scheduled stamp glitch; the truth
+  /// keeps `stamp`).
+  Nanoseconds channels_stamp_offset = 0;
   /// Turntable records logged since the previous sample, up to this one's stamp, in log order.
   std::vector<TurntableLogRecord> turntable;
   /// Averaged resonator only: the precession loop's state, and the commands it took up within this
