@@ -249,9 +249,10 @@ TEST(TriadFeedTest, BadRecordsAreDroppedAndCounted) {
 // The session with one glitch in about every `one_in[stream]` records of each stream, the kinds in
 // turn: a stamp 1000 s ahead, 100 s back, two periods back, zero, the previous record's stamp, and a
 // value that is no measurement (a NaN wave angle, a table rate of NaN, a fixture quaternion of norm
-// 2). The glitch is an extra record sent beside the good one of its instant.
+// 2). A stamp glitch is an extra record sent beside the good one of its instant (a stray, a buffered
+// message); a value glitch replaces it.
 std::vector<Event> glitched(const std::vector<Event>& events, const std::array<int, TriadFeed::kStreamCount>& one_in,
-                            std::size_t* injected) {
+                            std::size_t* injected, std::array<std::size_t, TriadFeed::kStreamCount>* per_stream = nullptr) {
   std::vector<Event> out;
   out.reserve(events.size() + events.size() / 100);
   std::array<Nanoseconds, TriadFeed::kStreamCount> previous{};
@@ -262,7 +263,8 @@ std::vector<Event> glitched(const std::vector<Event>& events, const std::array<i
     if (previous[e.stream] > 0 && (state >> 33) % static_cast<std::uint64_t>(one_in[e.stream]) == 0) {
       Event g = e;
       g.sent = e.stamp;
-      switch (kind[e.stream]++ % 6) {
+      const int k = kind[e.stream]++ % 6;
+      switch (k) {
         case 0:
           g.stamp += toNanoseconds(1000.0);
           break;
@@ -290,6 +292,11 @@ std::vector<Event> glitched(const std::vector<Event>& events, const std::array<i
       g.fixture.stamp = g.stamp;
       out.push_back(g);
       ++*injected;
+      if (per_stream) ++(*per_stream)[e.stream];
+      if (k == 5) {
+        previous[e.stream] = e.stamp;
+        continue;  // the value glitch took the good record's place
+      }
     }
     out.push_back(e);
     previous[e.stream] = e.stamp;
@@ -317,7 +324,11 @@ void expectSameWithinSigmas(const TriadOutcome& clean, const TriadOutcome& o, do
 TEST(TriadFeedTest, OneGlitchedRecordOnAnyStreamCostsThatRecordOnly) {
   // About 20 glitches on each stream (the fixture logs once a second, the others at 200 Hz).
   std::size_t injected = 0;
-  const std::vector<Event> events = glitched(session(), {{40, 8000, 8000, 8000, 8000}}, &injected);
+  std::array<std::size_t, TriadFeed::kStreamCount> per_stream{};
+  const std::vector<Event> events = glitched(session(), {{40, 8000, 8000, 8000, 8000}}, &injected, &per_stream);
+  for (int s = 0; s < TriadFeed::kStreamCount; ++s) {
+    std::printf("[ measured ] stream %d: %zu glitches injected\n", s, per_stream[s]);
+  }
   EXPECT_GT(injected, 80u);
   TriadFeed clean = makeFeed();
   for (const Event& e : session()) deliver(&clean, e);
@@ -334,6 +345,11 @@ TEST(TriadFeedTest, OneGlitchedRecordOnAnyStreamCostsThatRecordOnly) {
     const TriadStreamCounters& c = feed.counters(s);
     dropped += c.bad_stamp + c.bad_value + c.out_of_order + c.stamp_jump;
     EXPECT_GT(c.stamp_jump, 0u) << s;
+    std::printf("[ measured ] stream %d: %llu received, dropped: %llu zero stamp, %llu bad value, %llu out of order, %llu "
+                "stamp jump\n",
+                s, static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.bad_stamp),
+                static_cast<unsigned long long>(c.bad_value), static_cast<unsigned long long>(c.out_of_order),
+                static_cast<unsigned long long>(c.stamp_jump));
   }
   // The table's NaN rates are the axis sessions' to count (they are values, not stamps).
   std::size_t nan_rates = 0;
