@@ -3,6 +3,7 @@
 documented chain simulate -> info -> calibrate -> process on config/scenarios/dual_rate.yaml, and
 bad bags (missing, truncated/unindexed, wrong types, no channels topic) answered by a clear error
 and a non-zero exit, never a crash. Needs no master; run as a rostest for the package environment."""
+import contextlib
 import csv
 import errno
 import filecmp
@@ -70,6 +71,22 @@ def fill(directory, leave_bytes):
     return filler
 
 
+@contextlib.contextmanager
+def small_disk(path, size):
+    """A tmpfs of `size` mounted at `path` (made), unmounted afterwards; None when it cannot be mounted
+    (mounting needs root)."""
+    os.makedirs(path)
+    mount = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=" + size, "tmpfs", path], stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, universal_newlines=True)
+    if mount.returncode != 0:
+        yield None, "cannot mount a %s tmpfs to fill (needs root): %s" % (size, mount.stdout.strip())
+        return
+    try:
+        yield path, ""
+    finally:
+        subprocess.run(["umount", path])
+
+
 class HrgBagCli(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -85,6 +102,32 @@ class HrgBagCli(unittest.TestCase):
 
     def path(self, name):
         return os.path.join(self.work, name)
+
+    def triad_bag(self):
+        """A short triad session (test/scenarios/triad_short.yaml), simulated once for the tests that need it."""
+        bag = self.path("triad_session.bag")
+        if not os.path.exists(bag):
+            code, _, err = hrg_bag("simulate", "--scenario", os.path.join(self.pkg, "test/scenarios/triad_short.yaml"),
+                                   "--out", bag)
+            self.assertEqual(code, 0, err)
+        return bag
+
+    def triad_priors(self, d):
+        """The prior triad file and each axis's prior parameter file in `d`: (triad, {axis: file})."""
+        triad = os.path.join(d, "triad.yaml")
+        shutil.copy(os.path.join(self.pkg, "config/triad.yaml"), triad)
+        axes = {}
+        for a in "xyz":
+            axes[a] = os.path.join(d, a + ".yaml")
+            shutil.copy(self.params, axes[a])
+        return triad, axes
+
+    def triad_calibrate(self, bag, triad, axes, *extra):
+        args = ["calibrate", bag, "--method", "triad", "--config",
+                os.path.join(self.pkg, "test/scenarios/triad_short_calibration.yaml"), "--triad", triad]
+        for a in "xyz":
+            args += ["--axis-params", "%s=%s" % (a, axes[a])]
+        return args + list(extra)
 
     def assertFails(self, result, code, *fragments):
         self.assertEqual(result[0], code, result)
@@ -605,6 +648,97 @@ class HrgBagCli(unittest.TestCase):
             self.assertIn(why, err)
             self.assertEqual(snapshot(d), before)
 
+    def test_triad_outputs_that_are_other_inputs_are_refused_before_any_work(self):
+        # Each output of calibrate --method triad against every input and every other output, by file
+        # identity: only an output naming its own prior (refreshed in place) may be an input.
+        d = self.path("triad_same_file")
+        os.makedirs(os.path.join(d, "sub"))
+        os.makedirs(os.path.join(d, "out"))
+        bag = os.path.join(d, "session.bag")
+        os.link(self.triad_bag(), bag)
+        triad, axes = self.triad_priors(d)
+        shutil.copy(triad, triad + ".bak")
+        os.symlink("x.yaml", os.path.join(d, "link_to_x.yaml"))
+        os.link(axes["y"], os.path.join(d, "hard_y.yaml"))
+        bag_state = os.stat(bag)
+        elsewhere = ["--out", os.path.join(d, "out/triad.yaml")]  # the axis files beside it by default
+        outs = elsewhere + ["--axis-out=%s=%s" % (a, os.path.join(d, "out", a + ".yaml")) for a in "xyz"]
+        before = {n: v for n, v in snapshot(d).items() if n != "session.bag"}
+        cases = [
+            # --out an axis's prior: through its default axis files beside it, and on its own
+            (["--out", axes["x"]], axes["x"], axes["x"]),
+            (["--out", axes["x"]] + outs[2:], axes["x"], axes["x"]),
+            (["--out", os.path.join(d, "link_to_x.yaml")] + outs[2:], "link_to_x.yaml", axes["x"]),
+            # --axis-out the triad prior, another axis's prior (also through a hard link, dir/../), the bag
+            (elsewhere + ["--axis-out", "x=" + triad], triad, triad),
+            (elsewhere + ["--axis-out", "x=" + axes["y"]], axes["y"], axes["y"]),
+            (elsewhere + ["--axis-out", "z=" + os.path.join(d, "hard_y.yaml")], "hard_y.yaml", axes["y"]),
+            (elsewhere + ["--axis-out", "y=" + os.path.join(d, "sub/../z.yaml")], "sub/../z.yaml", axes["z"]),
+            (elsewhere + ["--axis-out", "x=" + bag], bag, bag),
+            # two outputs on one file; a report over a prior
+            (elsewhere + ["--axis-out", "y=" + os.path.join(d, "out/x.yaml")], "out/x.yaml", "out/x.yaml"),
+            (outs + ["--report", axes["z"]], axes["z"], axes["z"]),
+        ]
+        for extra, output, other in cases:
+            args = self.triad_calibrate(bag, triad, axes, *extra)
+            code, _, err = hrg_bag(*args, timeout=60)
+            self.assertEqual(code, 2, "%s -> exit %d\n%s" % (extra, code, err))
+            self.assertIn("same file", err, extra)
+            self.assertIn(output, err, extra)
+            self.assertIn(other, err, extra)
+            self.assertNotIn("terminate called", err, extra)
+            self.assertEqual({n: v for n, v in snapshot(d).items() if n != "session.bag"}, before,
+                             "nothing changed, no .bak, no temporary: %s" % (extra,))
+        # The triad file refreshed from its own backup: writing it would replace that input.
+        args = self.triad_calibrate(bag, triad + ".bak", axes, "--out", triad)
+        code, _, err = hrg_bag(*args, timeout=60)
+        self.assertEqual(code, 2, err)
+        self.assertIn("keeps its previous version as '%s.bak'" % triad, err)
+        self.assertEqual({n: v for n, v in snapshot(d).items() if n != "session.bag"}, before)
+        after = os.stat(bag)
+        self.assertEqual((after.st_ino, after.st_size, after.st_mtime_ns),
+                         (bag_state.st_ino, bag_state.st_size, bag_state.st_mtime_ns))
+
+    def test_triad_calibration_refreshes_its_four_files_in_place_and_a_full_disk_replaces_none(self):
+        # The four outputs are one set: on a full disk (none fits, or the first two would) none is
+        # replaced, every old file and its .bak stay as they were, and no temporary is left.
+        bag = self.triad_bag()
+        with small_disk(self.path("triad_disk"), "256k") as (disk, why):
+            d = disk or self.path("triad_in_place")
+            os.makedirs(d, exist_ok=True)
+            triad, axes = self.triad_priors(d)
+            priors = snapshot(d)
+            args = self.triad_calibrate(bag, triad, axes, "--out", triad, "--report",
+                                        self.path("triad_in_place.report.yaml"))
+            code, out, err = hrg_bag(*args)
+            self.assertEqual(code, 0, out + err)
+            refreshed = snapshot(d)
+            self.assertEqual(sorted(refreshed), sorted(list(priors) + [n + ".bak" for n in priors]))
+            for name, content in priors.items():
+                self.assertEqual(refreshed[name + ".bak"], content, "the prior kept as %s.bak" % name)
+                self.assertNotEqual(refreshed[name], content, name)
+            for a in "xyz":
+                with open(axes[a]) as f:
+                    self.assertEqual(yaml.safe_load(f)["calibration"]["method"], "triad")
+            if disk is None:
+                self.skipTest(why)
+            sizes = sorted(os.path.getsize(axes[a]) for a in "xyz")
+            # Nothing free; then room for two axis files at most (tmpfs gives each file whole pages).
+            page = os.statvfs(disk).f_frsize
+            two = 2 * page * -(-sizes[-1] // page)
+            for leave in (0, two):
+                filler = fill(disk, leave)
+                before = snapshot(disk)
+                code, out, err = hrg_bag(*args)
+                self.assertEqual(code, 3, "%d bytes free -> exit %d\n%s" % (leave, code, out + err))
+                self.assertIn("No space left on device", err)
+                self.assertIn("nothing of the set was replaced", err)
+                self.assertNotIn("wrote", out)
+                self.assertNotIn("terminate called", err)
+                self.assertEqual(snapshot(disk), before, "%d bytes free: the old set and its backups as they were,"
+                                 " no temporary" % leave)
+                os.remove(filler)
+
     def test_fifos_devices_and_directories_are_refused_as_inputs_without_blocking(self):
         # A FIFO without a writer blocks an ordinary open forever: every input is checked before it is
         # opened, so each case ends at once (the short timeout turns a regression into a failure).
@@ -682,13 +816,9 @@ class HrgBagCli(unittest.TestCase):
         self.assertEqual(sorted(n for n in os.listdir(d) if "allan.png" in n), ["allan.png"])
 
     def test_a_full_disk_fails_with_exit_3_and_leaves_the_target_as_it_was(self):
-        disk = self.path("full_disk")
-        os.makedirs(disk)
-        mount = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", disk], stdout=subprocess.PIPE,
-                               stderr=subprocess.STDOUT, universal_newlines=True)
-        if mount.returncode != 0:
-            self.skipTest("cannot mount a 64 KiB tmpfs to fill (needs root): " + mount.stdout.strip())
-        try:
+        with small_disk(self.path("full_disk"), "64k") as (disk, why):
+            if disk is None:
+                self.skipTest(why)
             existing = {n: os.path.join(disk, n) for n in ("old.bag", "old.csv", "old.report.yaml", "old_allan.csv")}
             for p in existing.values():
                 with open(p, "w") as f:
@@ -720,8 +850,6 @@ class HrgBagCli(unittest.TestCase):
                     self.assertNotIn("terminate called", err)
                     self.assertEqual(snapshot(disk), before, "target untouched, no temporary: %s" % (args,))
                 os.remove(filler)
-        finally:
-            subprocess.run(["umount", disk])
 
 
 if __name__ == "__main__":

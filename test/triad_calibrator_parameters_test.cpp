@@ -1,9 +1,9 @@
 // The calibrator in triad mode (TriadCalibratorRos) on bad parameters: a missing triad file or axis
 // parameter file is refused with the key named; an axis map that lacks an axis or names one the
-// triad does not have, an unreadable axis file, two axes on one file, a file to write outside
-// ~output_directory (also through a link) are refused; so is an unknown key, at the top level or in
-// the triad section (as the single-axis calibrator refuses its unknown keys); ~method chooses the
-// wrapper.
+// triad does not have, an unreadable axis file, two axes on one file, an axis file that is the triad
+// file's .bak, a file to write outside ~output_directory (also through a link) are refused; so is an
+// unknown key, at the top level or in the triad section (as the single-axis calibrator refuses its
+// unknown keys); ~method chooses the wrapper.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <unistd.h>
@@ -124,6 +124,18 @@ TEST_F(TriadCalibratorParameters, MissingAxisFilesAreRefusedNamingTheKey) {
   pnh.setParam("axis_parameter_files", shared);
   const std::string same = refusal("no_axis_files");
   EXPECT_NE(same.find("must be distinct"), std::string::npos) << same;
+
+  // An axis's file that is where the triad file keeps its previous version: a write would replace it.
+  fs::copy_file(dir_ + "/y.yaml", dir_ + "/triad.yaml.bak");
+  Files backup = axisFiles();
+  backup["y"] = dir_ + "/triad.yaml.bak";
+  pnh.deleteParam("axis_parameter_files");
+  pnh.setParam("axis_parameter_files", backup);
+  const std::string bak = refusal("no_axis_files");
+  EXPECT_NE(bak.find("'" + dir_ + "/triad.yaml' keeps its previous version as '" + dir_ + "/triad.yaml.bak'"),
+            std::string::npos)
+      << bak;
+  fs::remove(dir_ + "/triad.yaml.bak");
 }
 
 TEST_F(TriadCalibratorParameters, FilesOutsideTheOutputDirectoryAreRefused) {

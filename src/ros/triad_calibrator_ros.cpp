@@ -155,7 +155,10 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     }
   }
   try {
-    core::checkDistinct({}, outputs);  // two axes on one file, the report over a parameter file
+    // Each file is the prior it refreshes, so the outputs are the inputs: they must be distinct (two
+    // axes on one file, the report over a parameter file), and no file's .bak another of them.
+    const core::TriadResultPaths files{triad_file_, axis_files_};
+    core::checkTriadPaths(files, files, {}, {report_file_}, write_);
   } catch (const std::runtime_error& e) {
     throw error(std::string("the files to write must be distinct: ") + e.what());
   }
@@ -362,13 +365,19 @@ bool TriadCalibratorRos::finishRun(std::string* message) {
     core::TriadResultPaths paths;
     paths.triad = triad_file_;
     paths.axes = axis_files_;
+    const std::string set = axis_files_[0] + ", " + axis_files_[1] + ", " + axis_files_[2] + ", " + triad_file_;
     try {
       r.files_written = core::saveTriadResult(o, paths, true);
       written = true;
-      *message = "accepted and written (" + axis_files_[0] + ", " + axis_files_[1] + ", " + axis_files_[2] + ", " +
-                 triad_file_ + ")";
+      *message = "accepted and written (" + set + ")";
+    } catch (const core::BackupNotKept& e) {
+      // The new set is in place (the processors are to reload it); a previous version was lost.
+      r.files_written = {axis_files_[0], axis_files_[1], axis_files_[2], triad_file_};
+      written = true;
+      *message = "accepted and written (" + set + "), but: " + e.what();
+      r.reason = *message;
     } catch (const std::exception& e) {
-      // saveTriadResult names the files already replaced, if any.
+      // Nothing replaced: saveTriadResult put back any file already renamed, or names it.
       *message = std::string("accepted but not written: ") + e.what();
       r.reason = *message;
     }

@@ -208,11 +208,13 @@ std::string prepareBackup(const std::string& target) {
 /// after the target's rename so that a failed write never changes <target>.bak either.
 void finishBackup(const std::string& target, const std::string& temporary) {
   const std::string backup = target + ".bak";
-  const int error = ::rename(temporary.c_str(), backup.c_str()) == 0 ? 0 : errno;
+  int error = injectedFault(OutputFileStep::kKeepBackup, target);
+  if (error == 0 && ::rename(temporary.c_str(), backup.c_str()) != 0) error = errno;
   // rename() between two links of one file succeeds without removing the source: remove it here.
   ::unlink(temporary.c_str());
   if (error != 0) {
-    fail("'" + target + "' was written, but its previous version could not be kept as '" + backup + "'", error);
+    throw BackupNotKept("'" + target + "' was written, but its previous version could not be kept as '" + backup +
+                        "': " + errnoText(error));
   }
 }
 
@@ -326,40 +328,163 @@ void AtomicOutputFile::discard() noexcept {
   finished_ = true;
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
-  if (!temporary_path_.empty()) ::unlink(temporary_path_.c_str());
+  if (!published_ && !temporary_path_.empty()) ::unlink(temporary_path_.c_str());
+  if (!previous_.empty()) ::unlink(previous_.c_str());
+  previous_.clear();
 }
 
+std::string AtomicOutputFile::unchanged() const { return target_existed_ ? " (the existing file is unchanged)" : ""; }
+
 void AtomicOutputFile::commit(const Verifier& verify) {
-  if (finished_)
+  prepare(verify, options_.keep_backup);
+  publish();
+  complete();
+}
+
+void AtomicOutputFile::prepare(const Verifier& verify, bool keep_previous) {
+  if (finished_ || published_)
     throw std::logic_error("AtomicOutputFile for '" + target_path_ + "' is already committed or discarded");
-  const std::string unchanged = target_existed_ ? " (the existing file is unchanged)" : "";
-  std::string backup_temporary;
   try {
     if (!buffer_->finish() || !*stream_) {
-      fail("cannot write '" + target_path_ + "'" + unchanged, buffer_->error() != 0 ? buffer_->error() : EIO);
+      fail("cannot write '" + target_path_ + "'" + unchanged(), buffer_->error() != 0 ? buffer_->error() : EIO);
     }
     const int metadata_error = target_existed_ ? copyMetadata(fd_, target_uid_, target_gid_, target_mode_)
                                                : (::fchmod(fd_, kNewOutputFileMode & ~processUmask()) == 0 ? 0 : errno);
-    if (metadata_error != 0) fail("cannot set the mode of '" + temporary_path_ + "'" + unchanged, metadata_error);
+    if (metadata_error != 0) fail("cannot set the mode of '" + temporary_path_ + "'" + unchanged(), metadata_error);
     int sync_error = injectedFault(OutputFileStep::kSync, target_path_);
     if (sync_error == 0 && ::fsync(fd_) != 0) sync_error = errno;
-    if (sync_error != 0) fail("cannot sync '" + temporary_path_ + "'" + unchanged, sync_error);
+    if (sync_error != 0) fail("cannot sync '" + temporary_path_ + "'" + unchanged(), sync_error);
     if (verify) verify(temporary_path_);
-    if (options_.keep_backup) backup_temporary = prepareBackup(target_path_);
-    int rename_error = injectedFault(OutputFileStep::kRename, target_path_);
-    if (rename_error == 0 && ::rename(temporary_path_.c_str(), target_path_.c_str()) != 0) rename_error = errno;
-    if (rename_error != 0)
-      fail("cannot rename '" + temporary_path_ + "' over '" + target_path_ + "'" + unchanged, rename_error);
+    if (keep_previous) previous_ = prepareBackup(target_path_);
   } catch (...) {
-    if (!backup_temporary.empty()) ::unlink(backup_temporary.c_str());
     discard();
     throw;
   }
-  finished_ = true;
+}
+
+void AtomicOutputFile::publish() {
+  int rename_error = injectedFault(OutputFileStep::kRename, target_path_);
+  if (rename_error == 0 && ::rename(temporary_path_.c_str(), target_path_.c_str()) != 0) rename_error = errno;
+  if (rename_error != 0) {
+    discard();
+    fail("cannot rename '" + temporary_path_ + "' over '" + target_path_ + "'" + unchanged(), rename_error);
+  }
+  published_ = true;
   ::close(fd_);
   fd_ = -1;
-  if (!backup_temporary.empty()) finishBackup(target_path_, backup_temporary);
+}
+
+void AtomicOutputFile::restore() {
+  finished_ = true;
+  const std::string previous = previous_;
+  previous_.clear();
+  int error = injectedFault(OutputFileStep::kRestore, target_path_);
+  if (previous.empty()) {  // there was no file: the new one goes
+    if (error == 0 && ::unlink(target_path_.c_str()) != 0 && errno != ENOENT) error = errno;
+    if (error != 0) fail("could not remove the new '" + target_path_ + "' (there was none before)", error);
+  } else {
+    if (error == 0 && ::rename(previous.c_str(), target_path_.c_str()) != 0) error = errno;
+    if (error != 0) {
+      fail("could not put back the previous '" + target_path_ + "' (it holds the new version; the previous one is '" +
+               previous + "')",
+           error);
+    }
+  }
   syncDirectory(directoryOf(target_path_));
+}
+
+void AtomicOutputFile::complete() {
+  finished_ = true;
+  const std::string previous = previous_;
+  previous_.clear();
+  try {
+    if (!previous.empty() && options_.keep_backup) finishBackup(target_path_, previous);
+    if (!previous.empty() && !options_.keep_backup) ::unlink(previous.c_str());
+  } catch (...) {
+    syncDirectory(directoryOf(target_path_));
+    throw;
+  }
+  syncDirectory(directoryOf(target_path_));
+}
+
+// ---------------------------------------------------------------------------------------------
+
+AtomicOutputFile& AtomicOutputSet::add(const std::string& path, const OutputFileOptions& options,
+                                       AtomicOutputFile::Verifier verify) {
+  if (committed_) throw std::logic_error("AtomicOutputSet: '" + path + "' added after the commit");
+  for (const Member& m : members_) {
+    const std::string& other = m.file->requestedPath();
+    if (sameFile(path, other)) {
+      throw std::runtime_error("outputs '" + other + "' and '" + path + "' are the same file");
+    }
+    if (options.keep_backup && sameFile(backupPathOf(path), other)) {
+      throw std::runtime_error("output '" + path + "' keeps its previous version as '" + backupPathOf(path) +
+                               "', the same file as output '" + other + "'");
+    }
+    if (m.file->options_.keep_backup && sameFile(backupPathOf(other), path)) {
+      throw std::runtime_error("output '" + other + "' keeps its previous version as '" + backupPathOf(other) +
+                               "', the same file as output '" + path + "'");
+    }
+  }
+  members_.push_back({std::make_unique<AtomicOutputFile>(path, options), std::move(verify)});
+  return *members_.back().file;
+}
+
+std::string AtomicOutputSet::names() const {
+  std::string list;
+  for (const Member& m : members_) list += (list.empty() ? "" : ", ") + m.file->requestedPath();
+  return list;
+}
+
+void AtomicOutputSet::commit() {
+  if (committed_) throw std::logic_error("AtomicOutputSet committed twice");
+  committed_ = true;
+  const std::size_t n = members_.size();
+  // 1. Every member complete, synced, verified and its current version linked aside.
+  for (std::size_t k = 0; k < n; ++k) {
+    try {
+      members_[k].file->prepare(members_[k].verify, true);
+    } catch (const std::exception& e) {
+      for (Member& m : members_) m.file->discard();
+      throw std::runtime_error(std::string(e.what()) + "; nothing of the set was replaced (" + names() + ")");
+    }
+  }
+  // 2. The renames; a failed one puts back those already renamed, the last first.
+  for (std::size_t k = 0; k < n; ++k) {
+    try {
+      members_[k].file->publish();
+    } catch (const std::exception& e) {
+      std::string restored, not_restored;
+      for (std::size_t j = k; j-- > 0;) {
+        try {
+          members_[j].file->restore();
+          restored += (restored.empty() ? "" : ", ") + members_[j].file->requestedPath();
+        } catch (const std::exception& r) {
+          not_restored += std::string("; ") + r.what();
+        }
+      }
+      for (std::size_t j = k; j < n; ++j) members_[j].file->discard();
+      std::string outcome;
+      if (not_restored.empty()) {
+        outcome = restored.empty() ? "; nothing of the set was replaced (" + names() + ")"
+                                   : "; the files already replaced were put back (" + restored +
+                                         "): the set is as it was (" + names() + ")";
+      } else {
+        outcome = "; the set is mixed" + not_restored + (restored.empty() ? "" : "; put back: " + restored);
+      }
+      throw std::runtime_error(std::string(e.what()) + outcome);
+    }
+  }
+  // 3. The backups; the new set is in place whatever happens here.
+  std::string not_kept;
+  for (Member& m : members_) {
+    try {
+      m.file->complete();
+    } catch (const std::exception& e) {
+      not_kept += std::string(not_kept.empty() ? "" : "; ") + e.what();
+    }
+  }
+  if (!not_kept.empty()) throw BackupNotKept("the set was written (" + names() + "), but " + not_kept);
 }
 
 void writeFileAtomically(const std::string& path, const std::string& contents, const OutputFileOptions& options,
@@ -420,6 +545,10 @@ FileIdentity identify(const std::string& path) {
 }
 
 }  // namespace
+
+std::string backupPathOf(const std::string& path) { return resolveOutputTarget(path) + ".bak"; }
+
+bool sameFile(const std::string& a, const std::string& b) { return identify(a).sameAs(identify(b)); }
 
 void checkDistinct(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs) {
   std::vector<FileIdentity> input_ids, output_ids;

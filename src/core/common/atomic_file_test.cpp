@@ -1,6 +1,7 @@
 // The output-file facility: whole-or-nothing replacement that keeps the replaced file's mode,
 // owner and symbolic link, unique temporaries for concurrent writers, stale temporaries cleaned,
-// failures at every step leaving the old file intact; checkDistinct; the bounded reader.
+// failures at every step leaving the old file intact; sets of files (AtomicOutputSet: their members;
+// the triad's set is tested in triad_result_files_test.cpp); checkDistinct; the bounded reader.
 #include "hrg_gyro/core/common/atomic_file.h"
 
 #include <fcntl.h>
@@ -373,6 +374,50 @@ TEST_F(AtomicFileTest, DirectOutputKeepsEveryByteWhateverTheSizes) {
     EXPECT_EQ(readText(path), content) << size;
     EXPECT_EQ(listing(), (std::set<std::string>{"session.csv"})) << size;
   }
+}
+
+// The last step, <file>.bak, fails after the rename: reported as such (BackupNotKept), the new file
+// in place and the earlier backup kept.
+TEST_F(AtomicFileTest, ABackupThatCannotBeKeptIsReportedAfterTheNewFileIsInPlace) {
+  const std::string path = at("params.yaml");
+  writeText(path, "old content\n");
+  writeText(path + ".bak", "older content\n");
+  fault_injection::setOutputFileFault(
+      [](OutputFileStep step, const std::string&) { return step == OutputFileStep::kKeepBackup ? EIO : 0; });
+  try {
+    writeFileAtomically(path, "new content\n", kKeepBackup);
+    ADD_FAILURE() << "the backup's failure was not reported";
+  } catch (const BackupNotKept& e) {
+    EXPECT_NE(std::string(e.what()).find("could not be kept as '" + path + ".bak'"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(readText(path), "new content\n");
+  EXPECT_EQ(readText(path + ".bak"), "older content\n");
+  EXPECT_EQ(listing(), (std::set<std::string>{"params.yaml", "params.yaml.bak"}));
+}
+
+// A set's members: never two on one file, nor one on another's backup (its rollback and its .bak
+// would overwrite each other); refused when added, nothing created.
+TEST_F(AtomicFileTest, ASetRefusesMembersThatAreOneFileOrAnothersBackup) {
+  writeText(at("a.yaml"), "a\n");
+  fs::create_symlink("a.yaml", at("link.yaml"));
+  {
+    AtomicOutputSet set;
+    set.add(at("a.yaml"), kKeepBackup).write("new a\n");
+    EXPECT_THROW(set.add(at("link.yaml"), kKeepBackup), std::runtime_error);
+    EXPECT_THROW(set.add(at("a.yaml.bak"), {}), std::runtime_error);
+    set.add(at("b.yaml"), {}).write("b\n");
+    EXPECT_THROW(set.add(dir_ + "/./b.yaml", {}), std::runtime_error);
+  }  // abandoned: nothing written
+  EXPECT_EQ(readText(at("a.yaml")), "a\n");
+  EXPECT_EQ(listing(), (std::set<std::string>{"a.yaml", "link.yaml"}));
+  AtomicOutputSet set;
+  set.add(at("a.yaml"), kKeepBackup).write("new a\n");
+  set.add(at("b.yaml"), {}).write("b\n");
+  set.commit();
+  EXPECT_EQ(readText(at("a.yaml")), "new a\n");
+  EXPECT_EQ(readText(at("a.yaml.bak")), "a\n");
+  EXPECT_EQ(readText(at("b.yaml")), "b\n");
+  EXPECT_EQ(listing(), (std::set<std::string>{"a.yaml", "a.yaml.bak", "b.yaml", "link.yaml"}));
 }
 
 TEST_F(AtomicFileTest, DirectOutputThatFailsLeavesTheOldFileIntact) {

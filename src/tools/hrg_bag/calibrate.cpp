@@ -268,10 +268,12 @@ Command addCalibrateCommand(CLI::App& root) {
       "Field (docs/field_calibration.md): a still gyro whose precession loop turned the wave both ways; reads\n"
       "the loop's state (hrg_gyro/PrecessionState) in place of the table, refreshes D(theta) and keeps K.\n"
       "Triad (docs/triad.md): each axis's channels through its own processor, the table and the fixture's\n"
-      "positions; writes each axis's parameter file and the triad file, all or none checked before the first.\n"
+      "positions; writes each axis's parameter file and the triad file as one set: all four written,\n"
+      "synced and read back before the first is replaced, none replaced on a failure.\n"
       "Every output replaces its path only when complete; an output that is the same file as an input\n"
-      "or another output is refused before anything runs, but for --out naming the --params file: the\n"
-      "prior is then refreshed in place when the calibration is accepted (the old file kept as .bak).\n"
+      "or another output is refused before anything runs, but for --out naming the --params file (triad:\n"
+      "--out the --triad file, --axis-out NAME=F the --axis-params NAME=F file): the prior is then\n"
+      "refreshed in place when the calibration is accepted (the old file kept as .bak).\n"
       "Exit 0 accepted, 1 refused by a gate, 2 bad usage or unreadable input, 3 an output could not\n"
       "be written (nothing left at its path, an existing file unchanged).");
   return [o] { return runCalibrate(*o); };

@@ -21,9 +21,9 @@ namespace hrg_gyro {
 namespace bag_tools {
 namespace {
 
-/// NAME=VALUE items of a per-axis option: each name one of the triad's axes, given once.
-std::map<std::string, std::string> perAxis(const std::vector<std::string>& items,
-                                           const std::array<std::string, 3>& axes, const std::string& option) {
+/// NAME=VALUE items of a per-axis option, each name given once (whether the names are the triad's
+/// axes is checked once the triad file is read: checkAxisNames).
+std::map<std::string, std::string> perAxis(const std::vector<std::string>& items, const std::string& option) {
   std::map<std::string, std::string> out;
   for (const std::string& item : items) {
     const std::size_t eq = item.find('=');
@@ -32,13 +32,52 @@ std::map<std::string, std::string> perAxis(const std::vector<std::string>& items
     if (name.empty() || value.empty()) {
       throw UsageError("--" + option + " expects NAME=VALUE with NAME an axis of the triad, got '" + item + "'");
     }
-    if (name != axes[0] && name != axes[1] && name != axes[2]) {
-      throw UsageError("--" + option + " " + item + ": '" + name +
-                       "' is not an axis of the triad (its axes: " + axes[0] + ", " + axes[1] + ", " + axes[2] + ")");
-    }
     if (!out.emplace(name, value).second) throw UsageError("--" + option + " gives axis " + name + " twice");
   }
   return out;
+}
+
+/// Each name of a per-axis option one of the triad's axes.
+void checkAxisNames(const std::map<std::string, std::string>& given, const std::array<std::string, 3>& axes,
+                    const std::string& option) {
+  for (const auto& kv : given) {
+    const std::string& name = kv.first;
+    if (name != axes[0] && name != axes[1] && name != axes[2]) {
+      throw UsageError("--" + option + " " + name + "=" + kv.second + ": '" + name +
+                       "' is not an axis of the triad (its axes: " + axes[0] + ", " + axes[1] + ", " + axes[2] + ")");
+    }
+  }
+}
+
+/// Every path against every other before anything is read (core::checkTriadPaths): an output may be
+/// its own prior only (--out the --triad file, --axis-out NAME=F the --axis-params NAME=F file),
+/// never another input or another output. The axes are the names --axis-params gives; should they
+/// not be three, the triad file's names refuse them next, before anything else is read.
+void checkPaths(const TriadCalibrateOptions& o, const std::map<std::string, std::string>& params,
+                const std::map<std::string, std::string>& outs) {
+  std::vector<std::string> outputs{o.out, o.report};
+  for (const auto& kv : outs) outputs.push_back(kv.second);
+  checkOutputPaths({}, outputs);  // none a directory, none twice
+  if (params.size() != 3) return;
+  core::TriadResultPaths out_paths, prior_paths;
+  out_paths.triad = o.out;
+  prior_paths.triad = o.triad;
+  std::vector<std::string> unpaired;  // an --axis-out of a name that is no axis: refused with the names
+  int slot = 0;
+  for (const auto& kv : params) {
+    prior_paths.axes[slot] = kv.second;
+    out_paths.axes[slot] = outs.at(kv.first);
+    ++slot;
+  }
+  for (const auto& kv : outs) {
+    if (!params.count(kv.first)) unpaired.push_back(kv.second);
+  }
+  unpaired.push_back(o.report);
+  try {
+    core::checkTriadPaths(out_paths, prior_paths, {o.bag, o.config}, unpaired);
+  } catch (const std::runtime_error& e) {
+    throw UsageError(std::string("refused: ") + e.what());
+  }
 }
 
 /// The settings file: the dual-rate settings of the axes' stage, and its `triad` section.
@@ -94,6 +133,15 @@ std::string findTopic(const rosbag::Bag& bag, const std::string& topic, const st
 
 int runTriadCalibrate(const TriadCalibrateOptions& o) {
   checkProcessorConfig(o.processor);
+  const std::map<std::string, std::string> params = perAxis(o.axis_params, "axis-params");
+  std::map<std::string, std::string> outs = perAxis(o.axis_out, "axis-out");
+  const std::map<std::string, std::string> channels = perAxis(o.axis_channels, "axis-channels");
+  for (const auto& kv : params) {
+    // By default each axis's file lies beside the triad file, named after the axis.
+    if (!outs.count(kv.first)) outs[kv.first] = core::directoryOf(o.out) + "/" + kv.first + ".yaml";
+  }
+  checkPaths(o, params, outs);
+
   const core::TriadParameters prior_triad = [&] {
     if (o.triad.empty()) return core::TriadParameters();
     try {
@@ -103,33 +151,13 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
     }
   }();
   const std::array<std::string, 3>& axes = prior_triad.axes;
-  const std::map<std::string, std::string> params = perAxis(o.axis_params, axes, "axis-params");
-  std::map<std::string, std::string> outs = perAxis(o.axis_out, axes, "axis-out");
-  const std::map<std::string, std::string> channels = perAxis(o.axis_channels, axes, "axis-channels");
+  checkAxisNames(params, axes, "axis-params");
+  checkAxisNames(outs, axes, "axis-out");
+  checkAxisNames(channels, axes, "axis-channels");
   for (const std::string& a : axes) {
     if (!params.count(a)) {
       throw UsageError("--axis-params " + a + "=FILE missing: each axis's prior parameter file is needed (its P is " +
                        "kept, and its latitude places the Earth's rate)");
-    }
-    // By default each axis's file lies beside the triad file, named after the axis.
-    if (!outs.count(a)) outs[a] = core::directoryOf(o.out) + "/" + a + ".yaml";
-  }
-
-  // Inputs may be refreshed in place (an axis's prior named as its output, --triad as --out: each
-  // kept as .bak, as the single-axis calibrate does); the report never replaces an input.
-  std::vector<std::string> inputs{o.bag, o.config};
-  std::vector<std::string> priors{o.triad};
-  std::vector<std::string> outputs{o.out, o.report};
-  for (const std::string& a : axes) {
-    priors.push_back(params.at(a));
-    outputs.push_back(outs.at(a));
-  }
-  checkOutputPaths(inputs, outputs);
-  checkOutputPaths(priors, {o.report});
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      // An axis's output over another axis's prior would lose that prior before it is read again.
-      if (i != j) checkOutputPaths({params.at(axes[j])}, {outs.at(axes[i])});
     }
   }
 
@@ -248,10 +276,13 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
   core::TriadResultPaths paths;
   paths.triad = o.out;
   for (int i = 0; i < 3; ++i) paths.axes[i] = outs.at(axes[i]);
+  const std::vector<std::string> set{paths.axes[0], paths.axes[1], paths.axes[2], paths.triad};
   try {
-    for (const std::string& written : core::saveTriadResult(outcome, paths)) {
-      std::cout << "calibrate: wrote " << written << "\n";
-    }
+    core::saveTriadResult(outcome, paths);
+    for (const std::string& written : set) std::cout << "calibrate: wrote " << written << "\n";
+  } catch (const core::BackupNotKept& e) {
+    for (const std::string& written : set) std::cout << "calibrate: wrote " << written << "\n";
+    throw OutputError(std::string("the calibration was accepted and written, but: ") + e.what());
   } catch (const std::exception& e) {
     throw OutputError(std::string("the calibration was accepted but not written: ") + e.what());
   }

@@ -7,6 +7,9 @@
 // a symbolic link is followed: the file the link points to is replaced and the link stays a link.
 // The replaced file keeps its mode (and, where the writer may set them, its owner and group).
 // Temporaries that a killed writer left behind are removed by the next write of the same file.
+// AtomicOutputSet replaces several files as one set: every file complete, synced and verified, and
+// every current version linked aside, before the first rename; a rename that fails puts back those
+// already renamed.
 //
 // readBoundedRegularFile is the matching reader for configuration: regular files only (no FIFO,
 // device or directory), never more than a stated number of bytes. openRegularFileForReading is its
@@ -20,6 +23,7 @@
 #include <functional>
 #include <memory>
 #include <ostream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -41,6 +45,14 @@ struct OutputFileOptions {
   /// would only hold a second copy; filling it costs system time, and the sync then waits for all of
   /// it at once.
   bool direct_io = false;
+};
+
+class AtomicOutputSet;
+
+/// Thrown when every file was replaced but a previous version could not be kept as <file>.bak (the
+/// last step of a commit): the new content is in place.
+struct BackupNotKept : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 class AtomicOutputFile {
@@ -67,7 +79,8 @@ class AtomicOutputFile {
   /// it, runs `verify`, links the old file under a backup temporary if asked, renames the
   /// temporary over the target, then the backup temporary to <target>.bak, and syncs the
   /// directory. Throws std::runtime_error on any failure, after removing the temporaries; up to
-  /// the target's rename the target and its backup are untouched.
+  /// the target's rename the target and its backup are untouched. A failure of the last step
+  /// (<target>.bak) is a BackupNotKept: the target is then already replaced.
   void commit(const Verifier& verify = {});
   /// Drops the temporary; the target is untouched. Safe to call more than once.
   void discard() noexcept;
@@ -78,18 +91,79 @@ class AtomicOutputFile {
   const std::string& temporaryPath() const { return temporary_path_; }
 
  private:
+  friend class AtomicOutputSet;
   class Buffer;
 
+  // commit()'s steps, which AtomicOutputSet runs file by file across the set.
+  /// Every step before the rename: flush, mode, sync, `verify`, and with `keep_previous` the current
+  /// target linked under the backup's temporary name. On failure the temporaries are removed.
+  void prepare(const Verifier& verify, bool keep_previous);
+  /// The temporary renamed over the target. On failure the temporaries are removed.
+  void publish();
+  /// After publish(): the previous version renamed back over the target (or the new file removed
+  /// where there was none). On failure the previous version stays under its temporary name, which
+  /// the message gives.
+  void restore();
+  /// After publish(): the previous version becomes <target>.bak (keep_backup) or is dropped, and the
+  /// directory is synced. Throws BackupNotKept.
+  void complete();
+  /// " (the existing file is unchanged)" when there was one.
+  std::string unchanged() const;
+
   std::string requested_path_, target_path_, temporary_path_;
+  std::string previous_;  // the current target's link (or copy) under the backup's temporary name
   OutputFileOptions options_;
   bool target_existed_ = false;
   mode_t target_mode_ = 0;
   uid_t target_uid_ = 0;
   gid_t target_gid_ = 0;
   int fd_ = -1;
-  bool finished_ = false;  // committed or discarded
+  bool published_ = false;  // renamed over the target
+  bool finished_ = false;   // committed, restored or discarded
   std::unique_ptr<Buffer> buffer_;
   std::unique_ptr<std::ostream> stream_;
+};
+
+/// Several files replaced as one set (a calibration's parameter files and the file that ties them
+/// together). Each member is written through its AtomicOutputFile; commit() then
+///   1. prepares every member: flushed, synced, verified (read back by its verifier), and its current
+///      file hard-linked aside under the backup's temporary name (also without keep_backup);
+///   2. renames each member over its target, in the order added;
+///   3. moves each kept version to <target>.bak (keep_backup) or drops it, and syncs the directories.
+/// A failure in step 1 (a full disk, a failed sync, a refused read-back, a failed backup link)
+/// changes nothing: every target and every .bak as it was, no temporary left. A rename that fails in
+/// step 2 puts back the members already renamed, each from its linked-aside version (a member that
+/// did not exist is removed): again every target and .bak as it was. Should putting one back fail
+/// too, the message names it and where its previous version was left. A failure in step 3 leaves
+/// the whole new set in place and throws BackupNotKept naming the backups not kept. What no process
+/// can guarantee: a kill or a power cut between the first and the last rename (microseconds) leaves
+/// some members new and others old, each file whole.
+class AtomicOutputSet {
+ public:
+  AtomicOutputSet() = default;
+  /// Not committed: every temporary removed, every target as it was.
+  ~AtomicOutputSet() = default;
+  AtomicOutputSet(const AtomicOutputSet&) = delete;
+  AtomicOutputSet& operator=(const AtomicOutputSet&) = delete;
+
+  /// Adds a member and returns its file, to be filled through stream() or write() (not committed on
+  /// its own). `verify` checks its complete temporary (see AtomicOutputFile::Verifier). Refuses
+  /// (std::runtime_error) a member that is the same file as another (checkDistinct's rule), or whose
+  /// backup would be another member. Throws as AtomicOutputFile's constructor does.
+  AtomicOutputFile& add(const std::string& path, const OutputFileOptions& options = {},
+                        AtomicOutputFile::Verifier verify = {});
+  /// Steps 1 to 3 above. Throws std::runtime_error (BackupNotKept after step 2), naming the files.
+  void commit();
+
+ private:
+  struct Member {
+    std::unique_ptr<AtomicOutputFile> file;
+    AtomicOutputFile::Verifier verify;
+  };
+  /// The members' requested paths, comma-separated.
+  std::string names() const;
+  std::vector<Member> members_;
+  bool committed_ = false;
 };
 
 /// The whole content at once (see AtomicOutputFile).
@@ -100,6 +174,13 @@ void writeFileAtomically(const std::string& path, const std::string& contents, c
 /// targets taken relative to the link's directory. A path that does not exist (or a dangling link's
 /// missing target) is returned as is: that is where a new file would be created.
 std::string resolveOutputTarget(const std::string& path);
+
+/// Where a write of `path` with keep_backup keeps the previous version: its link-resolved target
+/// followed by ".bak". Throws as resolveOutputTarget does.
+std::string backupPathOf(const std::string& path);
+
+/// Whether two paths name the same file, by checkDistinct's rule below.
+bool sameFile(const std::string& a, const std::string& b);
 
 /// Refuses (std::runtime_error, naming both paths) an output that is the same file as one of the
 /// inputs or as another output: same device and inode after following links for existing files,
@@ -123,10 +204,12 @@ std::string readBoundedRegularFile(const std::string& path, std::size_t max_byte
 /// Fault injection for the tests: the steps at which an AtomicOutputFile can fail.
 namespace fault_injection {
 enum class OutputFileStep {
-  kWrite,   ///< writing the temporary (a full disk)
-  kSync,    ///< fsync of the temporary
-  kBackup,  ///< linking the current target under the backup's temporary name
-  kRename,  ///< renaming the temporary over the target (the backup's temporary link exists)
+  kWrite,       ///< writing the temporary (a full disk)
+  kSync,        ///< fsync of the temporary
+  kBackup,      ///< linking the current target under the backup's temporary name
+  kRename,      ///< renaming the temporary over the target (the backup's temporary link exists)
+  kKeepBackup,  ///< renaming the backup's temporary to <target>.bak, after the target's rename
+  kRestore,     ///< AtomicOutputSet: putting a member's previous version back after a failed rename
 };
 /// Called at each step with the target path; a non-zero return is taken as that step's errno.
 /// An empty function (the default) injects nothing. Not thread-safe: set it only in tests.
