@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """imu/data_raw follows REP-145: no orientation (covariance[0] = -1), no acceleration, z the
 compensated inertial rate agreeing with GyroOutput.rate, x and y unmeasured (huge variance),
-frame_id as configured."""
+frame_id as configured. The unmeasured fields hold zeros, as docs/ros_api.md's table of what the
+message carries says (a filter that needs an accelerometer gets none from it)."""
 import os
 import sys
 import unittest
@@ -34,6 +35,12 @@ class ImuMessage(unittest.TestCase):
         for i in matched:
             self.assertEqual(i.angular_velocity.z, rates[i.header.stamp])
             self.assertEqual(i.angular_velocity.x, 0.0)
+        for i in imu.all:
+            self.assertEqual(i.orientation_covariance[0], -1.0)
+            self.assertEqual(i.linear_acceleration_covariance[0], -1.0)
+            self.assertEqual((i.orientation.x, i.orientation.y, i.orientation.z, i.orientation.w), (0.0, 0.0, 0.0, 0.0))
+            self.assertEqual((i.linear_acceleration.x, i.linear_acceleration.y, i.linear_acceleration.z),
+                             (0.0, 0.0, 0.0))
 
 
 if __name__ == "__main__":

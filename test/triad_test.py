@@ -152,6 +152,9 @@ class Triad(unittest.TestCase):
             self.assertEqual(m.header.frame_id, "imu_link")
             self.assertEqual(m.orientation_covariance[0], -1.0)
             self.assertEqual(m.linear_acceleration_covariance[0], -1.0)
+            # what the message carries (docs/ros_api.md): no orientation, no acceleration, zeros
+            self.assertEqual(vector(m.linear_acceleration).tolist(), [0.0, 0.0, 0.0])
+            self.assertEqual((m.orientation.x, m.orientation.y, m.orientation.z, m.orientation.w), (0.0, 0.0, 0.0, 0.0))
             for a in AXES:
                 self.assertIn(stamp, self.by_stamp[a], "an Imu at a stamp axis %s has no output for" % a)
             outs = [self.by_stamp[a][stamp] for a in AXES]

@@ -231,6 +231,9 @@ bool CalibratorRos::startRun(bool restart, std::string* reason) {
     field_next_ = 0;
     field_start_ = ros::Time();
     if (fieldRun()) {
+      // Nothing is commanded for a plan that cannot run or cannot pass (too long; a loop lag at the
+      // rate above field/max_drift_std for a gyro whose resonator is given).
+      core::checkFieldPlan(session()->settings());
       field_plan_ = core::fieldCommandPlan(session()->settings());
       ROS_INFO(
           "calibrator: field: %zu segments at %g rad/s planned over %.1f s of stream time, from the first "

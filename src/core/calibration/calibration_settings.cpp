@@ -4,7 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "hrg_gyro/core/calibration/field_command_plan.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/resonator/first_order_model.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -32,9 +34,10 @@ const std::vector<std::string> kGateKeys = {
 const std::vector<std::string> kTableClockKeys = {"offset", "regularise", "window", "max_jitter", "max_offset"};
 const std::vector<std::string> kThermalKeys = {"frequency_nodes", "node_count", "interpolation", "slice_width",
                                                "max_slices"};
-const std::vector<std::string> kFieldKeys = {
-    "gain_orders",        "rate",           "turns",        "directions", "rest", "axis_earth_rate", "min_turns",
-    "max_excess_scatter", "max_gain_error", "max_drift_std"};
+const std::vector<std::string> kFieldKeys = {"gain_orders",    "rate",         "turns",
+                                             "directions",     "rest",         "axis_earth_rate",
+                                             "resonator",      "min_turns",    "max_excess_scatter",
+                                             "max_gain_error", "max_drift_std"};
 const std::vector<std::string> kScalarKeys = {
     "method",           "scale_factor_orders", "drift_orders",     "bins",           "window",
     "window_span",      "group_tolerance",     "auto_finish_idle", "backward_reset", "backward_persist",
@@ -44,6 +47,57 @@ double positive(const YamlField& parent, const char* key, double fallback) {
   const double v = parent.getDouble(key, fallback);
   if (!(v > 0.0)) parent[key].fail("must be positive");
   return v;
+}
+
+// field/resonator: 'unknown', or the gyro's shell, loops and drive under the names of a scenario's
+// dynamics section (which may be pasted whole: its other keys are read and checked too). Every value
+// the lag's prediction uses is required, so that nothing unknown is taken for zero.
+std::optional<FieldResonator> parseFieldResonator(const YamlField& r, double rate) {
+  if (r.node().IsScalar() && r.node().Scalar() == "unknown") return std::nullopt;
+  if (!r.isMap()) r.fail("must be 'unknown' or a map of shell, loops and drive (as in a scenario's dynamics section)");
+  r.rejectUnknownKeys({"shell", "loops", "drive"});
+  FieldResonator g;
+  struct Key {
+    const char* name;
+    double* value;
+    bool required;
+  };
+  const auto read = [&r](const char* section, std::initializer_list<Key> keys) {
+    const YamlField m = r[section];
+    m.requireMap();
+    std::vector<std::string> names;
+    for (const Key& k : keys) names.push_back(k.name);
+    m.rejectUnknownKeys(names);
+    for (const Key& k : keys) *k.value = k.required ? m[k.name].asDouble() : m.getDouble(k.name, *k.value);
+    return m;
+  };
+  const YamlField shell = read("shell", {{"frequency_split", &g.shell.frequency_split, true},
+                                         {"frequency_axis", &g.shell.frequency_axis, true},
+                                         {"damping_anisotropy", &g.shell.damping_anisotropy, true},
+                                         {"damping_axis", &g.shell.damping_axis, true},
+                                         {"bryan_factor", &g.shell.bryan_factor, false},
+                                         {"damping_time", &g.shell.damping_time, false}});
+  const YamlField loops = read("loops", {{"quadrature_bandwidth", &g.loops.quadrature_bandwidth, true},
+                                         {"energy_bandwidth", &g.loops.energy_bandwidth, true},
+                                         {"damping_ratio", &g.loops.damping_ratio, true},
+                                         {"control_rate", &g.loops.control_rate, true},
+                                         {"phase_bandwidth", &g.loops.phase_bandwidth, false}});
+  const YamlField drive = read("drive", {{"gain_error_c", &g.drive.gain_error_c, true},
+                                         {"gain_error_s", &g.drive.gain_error_s, true},
+                                         {"phase_error", &g.drive.phase_error, true},
+                                         {"virtual_rate_gain_error", &g.drive.virtual_rate_gain_error, false}});
+  const auto check = [](const YamlField& where, const auto& validate) {
+    try {
+      validate();
+    } catch (const std::invalid_argument& e) {
+      where.fail(e.what());
+    }
+  };
+  check(shell, [&] { g.shell.validate(); });
+  check(loops, [&] { g.loops.validate(); });
+  check(drive, [&] { g.drive.validate(); });
+  check(r, [&] { precessionLagDrift(g.shell, g.loops, g.drive, rate); });
+  return g;
 }
 
 }  // namespace
@@ -162,9 +216,12 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
     f.rejectUnknownKeys(kFieldKeys);
     FieldSettings& fs = s.field;
     if (f.has("gain_orders")) fs.gain_orders = parseEvenOrders(f["gain_orders"]);
-    fs.rate = positive(f, "rate", fs.rate);
-    if (fs.rate > 10.0) f["rate"].fail("must be at most 10 rad/s (electrical)");
-    fs.turns = positive(f, "turns", fs.turns);
+    fs.rate = f.getDouble("rate", fs.rate);
+    if (!(fs.rate >= FieldSettings::kMinRate && fs.rate <= FieldSettings::kMaxRate))
+      f["rate"].fail("must be in [0.01, 10] rad/s (electrical)");
+    fs.turns = f.getDouble("turns", fs.turns);
+    if (!(fs.turns > 0.0 && fs.turns <= FieldSettings::kMaxTurns))
+      f["turns"].fail("must be in (0, 100] full turns per segment");
     if (f.has("directions")) {
       const YamlField d = f["directions"];
       const auto raw = d.asIntegers();
@@ -173,6 +230,7 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
         if (raw[i] != 1 && raw[i] != -1) d.at(i).fail("must be 1 or -1 (the sign of the commanded rate)");
         fs.directions.push_back(static_cast<int>(raw[i]));
       }
+      if (fs.directions.size() > FieldSettings::kMaxDirections) d.fail("at most 16 segments");
       if (std::find(fs.directions.begin(), fs.directions.end(), 1) == fs.directions.end() ||
           std::find(fs.directions.begin(), fs.directions.end(), -1) == fs.directions.end()) {
         d.fail("need both signs (1 and -1): the two directions separate D from the gain, one alone is refused");
@@ -193,13 +251,19 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
       }
     }
     fs.rest = f.getDouble("rest", fs.rest);
-    if (!(fs.rest >= 0.0)) f["rest"].fail("must be >= 0 (s)");
+    if (!(fs.rest >= 0.0 && fs.rest <= FieldSettings::kMaxRest)) f["rest"].fail("must be in [0, 600] s");
+    if (f.has("resonator")) fs.resonator = parseFieldResonator(f["resonator"], fs.rate);
     fs.min_turns = f.getDouble("min_turns", fs.min_turns);
     if (!(fs.min_turns >= 0.0)) f["min_turns"].fail("must be >= 0");
     fs.max_excess_scatter = f.getDouble("max_excess_scatter", fs.max_excess_scatter);
     if (!(fs.max_excess_scatter >= 1.0)) f["max_excess_scatter"].fail("must be >= 1 (a ratio of scatters)");
     fs.max_gain_error = positive(f, "max_gain_error", fs.max_gain_error);
     fs.max_drift_std = positive(f, "max_drift_std", fs.max_drift_std);
+  }
+  // The plan's keys are each bounded; so is the whole plan (with the plateau's settle time) when it will run.
+  if (s.method == CalibrationMethodKind::kField) {
+    const std::string problem = fieldPlanLengthProblem(s);
+    if (!problem.empty()) throw ConfigError("field", problem);
   }
   if (root.has("thermal")) {
     const YamlField t = root["thermal"];

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -81,10 +82,82 @@ TEST(CalibrationSettingsTest, TheFieldMethodsKeysAreReadAndChecked) {
   EXPECT_EQ(refusedKey("field: 1"), "field");
 }
 
+// Every key that sets the plan's length is bounded and refused by name beyond its bound, so that no
+// plan runs for ever (turns: 1e308 did); within the bounds, a plan longer than a day is refused too
+// when the field method is the one that will run it (the plateau's settle time counts).
+TEST(CalibrationSettingsTest, TheFieldPlansLengthIsBoundedKeyByKeyAndWhole) {
+  EXPECT_EQ(refusedKey("field: {turns: 1e308}"), "field.turns");
+  EXPECT_EQ(refusedKey("field: {turns: 100.5}"), "field.turns");
+  EXPECT_EQ(refusedKey("field: {turns: 0}"), "field.turns");
+  EXPECT_EQ(refusedKey("field: {turns: .inf}"), "field.turns");
+  EXPECT_EQ(refusedKey("field: {rest: 1e308}"), "field.rest");
+  EXPECT_EQ(refusedKey("field: {rest: 601}"), "field.rest");
+  EXPECT_EQ(refusedKey("field: {rate: 1e-300}"), "field.rate");
+  EXPECT_EQ(refusedKey("field: {rate: 0.009}"), "field.rate");
+  EXPECT_EQ(refusedKey("field: {directions: [1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1]}"),
+            "field.directions");
+  EXPECT_EQ(refusedKey("field: {turns: 100, rate: 10, rest: 600, directions: [1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, "
+                       "-1, 1, -1, 1, -1]}"),
+            "");  // every bound reached, 16 x 66 s
+  // Each key within its bound, the plan not: 2 segments of 100 turns at 0.01 rad/s are 35 h.
+  EXPECT_EQ(refusedKey("method: field\nfield: {rate: 0.01, turns: 100, directions: [1, -1]}"), "field");
+  EXPECT_EQ(refusedKey("method: dual_rate\nfield: {rate: 0.01, turns: 100, directions: [1, -1]}"), "");
+  EXPECT_EQ(refusedKey("method: field\nfield: {rate: 0.01, turns: 50, directions: [1, -1]}"), "");  // 17.5 h
+  EXPECT_EQ(refusedKey("method: field\nplateau: {settle_time: 1e308}"), "field");
+  try {
+    parse("method: field\nfield: {rate: 0.01, turns: 100, directions: [1, -1]}");
+  } catch (const ConfigError& e) {
+    std::printf("[ refused ] %s\n", e.what());
+    EXPECT_NE(std::string(e.what()).find("more than 86400 s"), std::string::npos) << e.what();
+  }
+}
+
+// field/resonator: 'unknown' (the default), or the gyro's shell, loops and drive under the names of
+// a scenario's dynamics section, every value the lag's prediction uses required.
+TEST(CalibrationSettingsTest, TheGyrosResonatorIsUnknownOrGivenWithEveryValueThePredictionUses) {
+  EXPECT_FALSE(parse("{}").field.resonator.has_value());
+  EXPECT_FALSE(parse("field: {resonator: unknown}").field.resonator.has_value());
+  const std::string shell =
+      "shell: {bryan_factor: 0.28, damping_time: 600.0, damping_anisotropy: 4.0e-5, damping_axis: 0.4, "
+      "frequency_split: 0.031416, frequency_axis: -0.7}";
+  const std::string loops =
+      "loops: {energy_bandwidth: 5.0, quadrature_bandwidth: 20.0, phase_bandwidth: 20.0, damping_ratio: 0.7071, "
+      "control_rate: 5000.0}";
+  const std::string drive =
+      "drive: {gain_error_c: 2.0e-3, gain_error_s: -1.0e-3, phase_error: 1.0e-3, virtual_rate_gain_error: 3.0e-3}";
+  const auto with = [](const std::string& resonator) { return "field: {resonator: {" + resonator + "}}"; };
+  const std::optional<FieldResonator> r = parse(with(shell + ", " + loops + ", " + drive)).field.resonator;
+  ASSERT_TRUE(r.has_value());
+  EXPECT_DOUBLE_EQ(r->shell.frequency_split, 0.031416);
+  EXPECT_DOUBLE_EQ(r->shell.frequency_axis, -0.7);
+  EXPECT_DOUBLE_EQ(r->shell.damping_anisotropy, 4e-5);
+  EXPECT_DOUBLE_EQ(r->shell.damping_axis, 0.4);
+  EXPECT_DOUBLE_EQ(r->loops.quadrature_bandwidth, 20.0);
+  EXPECT_DOUBLE_EQ(r->loops.energy_bandwidth, 5.0);
+  EXPECT_DOUBLE_EQ(r->loops.damping_ratio, 0.7071);
+  EXPECT_DOUBLE_EQ(r->loops.control_rate, 5000.0);
+  EXPECT_DOUBLE_EQ(r->drive.gain_error_c, 2e-3);
+  EXPECT_DOUBLE_EQ(r->drive.gain_error_s, -1e-3);
+  EXPECT_DOUBLE_EQ(r->drive.phase_error, 1e-3);
+  EXPECT_EQ(refusedKey("field: {resonator: known}"), "field.resonator");
+  EXPECT_EQ(refusedKey(with(shell + ", " + loops)), "field.resonator.drive");
+  EXPECT_EQ(refusedKey(with(shell + ", " + loops + ", " + drive + ", pickoff: {}")), "field.resonator.pickoff");
+  EXPECT_EQ(refusedKey(with("shell: {frequency_split: 0.03, frequency_axis: 0, damping_anisotropy: 0}, " + loops +
+                            ", " + drive)),
+            "field.resonator.shell.damping_axis");  // nothing unknown is taken for zero
+  EXPECT_EQ(refusedKey(with(shell + ", " + loops + ", drive: {gain_error_c: 0, gain_error_s: 0, phase_error: 2}")),
+            "field.resonator.drive");  // |phase| < pi/2
+  EXPECT_EQ(refusedKey(with(shell +
+                            ", loops: {energy_bandwidth: 5, quadrature_bandwidth: 0, damping_ratio: 0.7, "
+                            "control_rate: 5000}, " +
+                            drive)),
+            "field.resonator");  // a split with the quadrature loop open: nothing settles
+}
+
 TEST(CalibrationSettingsTest, KeyPathsListEveryKeyOnce) {
   const std::vector<std::string> keys = CalibrationSettings::keyPaths();
   for (const char* k : {"bias_trend_order", "gates/max_trend_inflation", "gates/max_trend_k0_std", "field/rate",
-                        "field/directions", "field/gain_orders"}) {
+                        "field/directions", "field/gain_orders", "field/resonator"}) {
     EXPECT_EQ(std::count(keys.begin(), keys.end(), k), 1) << k;
   }
 }

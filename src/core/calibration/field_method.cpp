@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "hrg_gyro/core/calibration/field_command_plan.h"
 #include "hrg_gyro/core/common/units.h"
 
 namespace hrg_gyro {
@@ -222,6 +223,22 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
   const double worst = largestStd(d);
   o.gate("drift_std", worst <= fs.max_drift_std, worst, fs.max_drift_std,
          "largest standard error of a D term " + formatShort(worst, 3) + " rad/s");
+  // The loops trail the precessed wave; what they leave that keeps its sign in both directions is
+  // fitted as D (precessionLagDrift). Predicted where the gyro's resonator is known, at the faster
+  // direction's commanded rate, and allowed up to D's own standard error.
+  const double lag_rate = std::max(std::abs(r.positive_rate), std::abs(r.negative_rate));
+  const double lag = fieldLoopLag(fs, lag_rate);
+  if (std::isnan(lag)) {
+    o.notes.push_back("the loops' lag at " + formatShort(lag_rate, 3) +
+                      " rad/s adds a drift that keeps its sign in both directions, so it is fitted as part of D; "
+                      "it grows as the rate squared and faster; not predicted here (field/resonator unknown)");
+  } else {
+    o.gate("loop_lag", lag <= worst, lag, worst,
+           "the loops' lag at " + formatShort(lag_rate, 3) + " rad/s adds up to " + formatShort(lag, 3) +
+               " rad/s to D (predicted for the gyro of field/resonator), " + formatShort(lag / worst, 3) +
+               " times the largest standard error of a D term" +
+               (lag <= worst ? std::string() : ": command a slower field/rate"));
+  }
   if (e.trend.order > 0) {
     const BiasTrendFit& t = e.trend;
     const double g0_std = e.k.mean_std / std::abs(e.k.mean);

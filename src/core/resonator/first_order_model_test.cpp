@@ -283,6 +283,82 @@ TEST(ResonatorFirstOrderModel, ModeReversalByAQuarterTurnFlipsTheOrderTwoDrift) 
   EXPECT_GT(std::abs(r1 - r2), 1e-5);
 }
 
+// The drift the loops' lag adds under precession, against the closed-loop resonator: precessed both
+// ways at 0.2 to 10 rad/s, half the sum of the two runs' harmonics less the settled drift at rest is
+// the part even in the rate, which a field calibration takes for D. Four gyros: the realistic one,
+// the same with a 10 mHz split, a 50 mHz split with a 5 Hz quadrature loop and an ideal drive (the
+// split's term alone, the rate up to the loop's bandwidth), and one with every lag term large (10 Hz
+// and 2 Hz loops, 3 mrad drive lag, forcers 3e-3 apart: the energy loop is outrun above 3 rad/s).
+// Tolerance: 2 % of the predicted terms' root sum square, plus 5e-12 rad/s. The formula takes the
+// loops as continuous (their sampling delay, half a control period, moves the terms by about 1 %)
+// and leaves out second-order products (gamma^2 h_c w^2: ~3e-9 rad/s of D0 and of the order-4 terms
+// at 10 rad/s, about 0.5 % of the terms there); 5e-12 covers the rest drift's and the fit's rounding
+// (the settled drift matches the resonator to 2e-12 rad/s, PredictsTheDriftOfAWaveHeldStill).
+TEST(ResonatorFirstOrderModel, PrecessionLagDriftMatchesTheClosedLoopResonator) {
+  struct Case {
+    const char* name;
+    ResonatorCase gyro;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"realistic (5 mHz split)", testing::realisticResonator()});
+  cases.push_back({"realistic, 10 mHz split", testing::realisticResonator()});
+  cases.back().gyro.shell.frequency_split = kTwoPi * 10e-3;
+  ResonatorCase split_only;
+  split_only.shell.frequency_split = kTwoPi * 50e-3;
+  split_only.shell.frequency_axis = -0.7;
+  split_only.loops.quadrature_bandwidth = 5.0;
+  cases.push_back({"50 mHz split, 5 Hz quadrature loop, ideal drive", split_only});
+  ResonatorCase slow = testing::realisticResonator();
+  slow.shell.frequency_split = kTwoPi * 10e-3;
+  slow.loops.quadrature_bandwidth = 10.0;
+  slow.loops.energy_bandwidth = 2.0;
+  slow.drive.phase_error = 3e-3;
+  slow.drive.gain_error_c = 3e-3;
+  slow.drive.gain_error_s = -3e-3;
+  cases.push_back({"10 mHz split, 10 Hz and 2 Hz loops, 3 mrad lag, forcers 6e-3 apart", slow});
+  const std::vector<int> orders = {2, 4, 6, 8};
+  for (const Case& k : cases) {
+    const ResonatorCase& c = k.gyro;
+    const SteadyStateResponse steady(c.shell, c.loops, c.drive);
+    // The settled drift's coefficients (exact projection on a dense grid).
+    std::vector<RateSample> rest;
+    for (int i = 0; i < 4096; ++i) {
+      const double theta = kTwoPi * i / 4096;
+      rest.push_back({theta, steady.drift(theta), 0.0});
+    }
+    const HarmonicFitResult at_rest = fitRates(rest, orders);
+    std::printf("%s:\n", k.name);
+    for (double rate : {0.2, 1.0, 2.0, 5.0, 10.0}) {
+      const HarmonicModel lag = precessionLagDrift(c.shell, c.loops, c.drive, rate);
+      EXPECT_EQ(lag, precessionLagDrift(c.shell, c.loops, c.drive, -rate));  // even in the rate, bit for bit
+      const HarmonicFitResult up = fitRates(sweep(c, 0.0, rate), orders);
+      const HarmonicFitResult down = fitRates(sweep(c, 0.0, -rate), orders);
+      double rss = 0.0;
+      for (int order : {2, 4}) {
+        for (bool cosine : {true, false}) rss += std::pow(coefficient(lag, order, cosine), 2);
+      }
+      const double tolerance = 0.02 * std::sqrt(rss) + 5e-12;
+      std::printf("  %5.1f rad/s: peak %.3e rad/s (tolerance %.1e)\n", rate, lag.peakDeviation(), tolerance);
+      expectCoefficients(
+          "D_lag", lag,
+          [&](int order, bool cosine) {
+            return 0.5 * (coefficient(up, order, cosine) + coefficient(down, order, cosine)) -
+                   coefficient(at_rest, order, cosine);
+          },
+          tolerance);
+    }
+  }
+}
+
+TEST(ResonatorFirstOrderModel, PrecessionLagDriftNeedsAFiniteRate) {
+  const ResonatorCase c = testing::realisticResonator();
+  EXPECT_THROW(precessionLagDrift(c.shell, c.loops, c.drive, NAN), std::invalid_argument);
+  EXPECT_EQ(precessionLagDrift(c.shell, c.loops, c.drive, 0.0).peakDeviation(), 0.0);  // no sweep, no lag
+  ResonatorCase open = c;
+  open.loops.quadrature_bandwidth = 0.0;
+  EXPECT_THROW(precessionLagDrift(open.shell, open.loops, open.drive, 0.2), std::invalid_argument);
+}
+
 TEST(ResonatorFirstOrderModel, RefusesASplitWithoutTheQuadratureLoop) {
   ResonatorCase c = testing::realisticResonator();
   c.loops.quadrature_bandwidth = 0.0;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,9 @@
 #include "hrg_gyro/core/estimation/plateau_detector.h"
 #include "hrg_gyro/core/model/calibration_method_kind.h"
 #include "hrg_gyro/core/model/frequency_interpolator.h"
+#include "hrg_gyro/core/resonator/control_loops.h"
+#include "hrg_gyro/core/resonator/drive_chain.h"
+#include "hrg_gyro/core/resonator/resonator_parameters.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -59,15 +63,29 @@ struct TableClockSettings {
   double max_offset = 0.5;   ///< s: an estimated offset beyond this (3 sigma included) is refused
 };
 
+/// The gyro's resonator, loops and drive, as far as they set the drift the loops' lag adds to a
+/// precessed wave (precessionLagDrift in resonator/first_order_model.h): from the gyro's maker, or
+/// a simulated gyro's scenario (its dynamics section's shell, loops and drive).
+struct FieldResonator {
+  ResonatorParameters shell;
+  LoopSettings loops;
+  DriveChainErrors drive;
+};
+
 /// The field method (field_method.h): a still gyro whose precession loop turns the wave both ways.
 /// `rate`, `turns`, `directions` and `rest` plan the virtual rotation the live calibrator commands
 /// (fieldCommandPlan); the rest are the estimator's orders and the method's own gates.
 struct FieldSettings {
-  std::vector<int> gain_orders{2, 4};         ///< harmonic orders of the virtual rate's gain G_v(theta)
-  double rate = 0.2;                          ///< rad/s (electrical), |commanded virtual rate|
-  double turns = 2.0;                         ///< full turns of theta (2 pi) per segment
+  std::vector<int> gain_orders{2, 4};  ///< harmonic orders of the virtual rate's gain G_v(theta)
+  /// rad/s (electrical), |commanded virtual rate|, in [kMinRate, kMaxRate]. Faster, the loops' lag
+  /// adds more drift (as the rate squared and faster): see `resonator` and the loop_lag gate.
+  double rate = 0.2;
+  double turns = 2.0;                         ///< full turns of theta (2 pi) per segment, at most kMaxTurns
   std::vector<int> directions{1, -1, -1, 1};  ///< the segments' signs, in order (+ - - +: a linear bias trend cancels)
-  double rest = 5.0;                          ///< s at rest (commanded 0) before the first segment
+  double rest = 5.0;                          ///< s at rest (commanded 0) before the first segment, at most kMaxRest
+  /// The gyro's resonator where known: the drift the loops' lag adds at the commanded rate is then
+  /// predicted, noted and gated (loop_lag); empty ('unknown'): it is not predicted, a note says so.
+  std::optional<FieldResonator> resonator;
   /// rad/s, the Earth's rate about the sensitive axis where the gyro stands (Omega_E . u, from the
   /// vehicle's attitude and latitude), taken off with K to leave D0; NaN ('vertical'): the vertical
   /// component at the prior's latitude, for an axis that points up
@@ -78,6 +96,13 @@ struct FieldSettings {
   double max_excess_scatter = 3.0;
   double max_gain_error = 0.05;  ///< gate: |G_v0 - 1|, a loop that does not realise the command
   double max_drift_std = 1e-7;   ///< gate: rad/s, the largest standard error of a D term
+
+  /// Bounds of the plan's keys (each refused by name beyond them); the whole plan is bounded by
+  /// kMaxFieldPlanDuration (field_command_plan.h).
+  static constexpr double kMinRate = 0.01, kMaxRate = 10.0;  ///< rad/s
+  static constexpr double kMaxTurns = 100.0;
+  static constexpr double kMaxRest = 600.0;  ///< s
+  static constexpr std::size_t kMaxDirections = 16;
 };
 
 struct CalibrationSettings {
