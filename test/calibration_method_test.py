@@ -2,8 +2,9 @@
 """Each calibration method live on its matching profile (separate nodes, sim time): the calibrator
 finishes by itself, accepts, writes the parameter file and reloads the processor; the estimates
 show what each method is known to get right (and, for constant rate, its known drift leak). The field
-method commands its own virtual rotation: the driver must have executed the calibrator's plan, and a
-calibrator interrupted mid-plan must stop it."""
+method commands its own virtual rotation: the driver must have executed the calibrator's plan, a
+calibrator interrupted mid-plan must stop it, a run that sees another node's command must abort with
+nothing written, and the rate a killed calibrator leaves in force must be flagged by the processor."""
 import os
 import signal
 import sys
@@ -15,7 +16,9 @@ import rosnode
 import rospy
 import rostest
 
-from hrg_gyro.msg import CalibrationResult, ModelInfo, PrecessionState
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+
+from hrg_gyro.msg import CalibrationResult, GyroOutput, ModelInfo, PrecessionCommand, PrecessionState
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hrg_test_util as util  # noqa: E402
@@ -126,6 +129,81 @@ class CalibrationMethod(unittest.TestCase):
             self.assertEqual(self.precession.msg.rate, 0.0, "the wave left turning")
             util.wait_for(lambda: not rosnode.rosnode_ping("/calibrator", max_count=1), 20, "the calibrator to exit")
             self.assertEqual(self.results.count, 0, "no result from an interrupted run")
+            with open(rospy.get_param("~parameter_file")) as f:
+                self.assertEqual(f.read(), before, "the parameter file untouched")
+        elif self.case == "field_foreign":
+            # While the plan turns the wave (+0.2 rad/s), this node -- no calibrator -- commands rate 0.
+            with open(rospy.get_param("~parameter_file")) as f:
+                before = f.read()
+            report = os.path.splitext(rospy.get_param("~parameter_file"))[0] + ".field.report.yaml"
+            diagnostics = util.Latest("/diagnostics", DiagnosticArray, keep_all=True)
+            pub = rospy.Publisher("/command/precession", PrecessionCommand, queue_size=10)
+            util.wait_for(lambda: self.precession.msg is not None and self.precession.msg.commands == 2 and
+                          self.precession.msg.rate > 0.0 and pub.get_num_connections() >= 1, 120,
+                          "the first segment of the virtual rotation, the driver listening")
+            self.assertEqual(self.precession.msg.source, "/calibrator")
+            msg = PrecessionCommand()
+            msg.rate = 0.0
+            pub.publish(msg)
+            r = self.final_result(1)
+            me = rospy.get_name()
+            self.assertFalse(r.accepted)
+            self.assertFalse(r.written)
+            self.assertEqual(r.method, "field")
+            self.assertTrue(r.reason.startswith("precession_command: "), r.reason)
+            self.assertIn("command from %s, not from this calibrator (/calibrator)" % me, r.reason)
+            self.assertEqual([(g.name, g.passed) for g in r.gates], [("precession_command", False)])
+            # Aborted at once: the stranger's command was the driver's third, and the calibrator's stop
+            # (rate 0, the plan had the wave turning) its fourth and last.
+            util.wait_for(lambda: self.precession.msg.commands == 4, 30, "the calibrator's stop command")
+            self.assertEqual(self.precession.msg.rate, 0.0)
+            self.assertEqual(self.precession.msg.source, "/calibrator")
+
+            def aborted():
+                for d in list(diagnostics.all):
+                    for s in d.status:
+                        if s.name.endswith("calibrator: calibration") and "aborted, nothing written" in s.message:
+                            return s
+                return None
+            status = util.wait_for(aborted, 30, "the calibrator's diagnostic saying the run was aborted")
+            self.assertEqual(status.level, DiagnosticStatus.WARN)
+            self.assertIn(me, status.message)
+            with open(rospy.get_param("~parameter_file")) as f:
+                self.assertEqual(f.read(), before, "the parameter file untouched")
+            self.assertFalse(os.path.exists(report), "no report of an aborted run")
+            self.assertEqual(self.results.count, 1)
+        elif self.case == "field_killed":
+            # SIGKILL while the plan turns the wave at +0.2 rad/s: the calibrator cannot stop it.
+            with open(rospy.get_param("~parameter_file")) as f:
+                before = f.read()
+            outputs = util.Latest("/output", GyroOutput, keep_all=True)
+            diagnostics = util.Latest("/diagnostics", DiagnosticArray, keep_all=True)
+            util.wait_for(lambda: self.precession.msg is not None and self.precession.msg.commands == 2 and
+                          self.precession.msg.rate > 0.0, 120, "the first segment of the virtual rotation")
+            pid = ServerProxy(rosgraph.Master("/calibration_method_test").lookupNode("/calibrator")).getPid("/test")[2]
+            os.kill(pid, signal.SIGKILL)
+            util.wait_for(lambda: not rosnode.rosnode_ping("/calibrator", max_count=1), 20, "the calibrator to die")
+            killed = self.precession.msg.header.stamp.to_nsec()
+            # 3 s of simulated time with the rate left in force, out of the processor.
+            util.wait_for(lambda: outputs.msg is not None and outputs.msg.header.stamp.to_nsec() > killed + 3000000000,
+                          60, "3 s of outputs after the kill")
+            self.assertEqual((self.precession.msg.rate, self.precession.msg.commands), (0.2, 2), "left in force")
+            after = [o for o in list(outputs.all) if o.header.stamp.to_nsec() > killed]
+            self.assertGreater(len(after), 300)
+            unflagged = [o.header.stamp.to_nsec() for o in after if not o.flags & GyroOutput.FLAG_PRECESSING]
+            self.assertEqual(unflagged, [], "outputs of the turning wave not flagged")
+            # ... and they read as a body rate of 0.2 / K0 (K0 -0.56): what a filter must not fuse.
+            self.assertGreater(min(abs(o.rate) for o in after), 0.3)
+
+            def warned():
+                for d in list(diagnostics.all):
+                    for s in d.status:
+                        if s.name.endswith("processor: precession") and s.level == DiagnosticStatus.WARN and \
+                                "0.2 rad/s in force, commanded by /calibrator" in s.message:
+                            return s
+                return None
+            util.wait_for(warned, 30, "the processor's precession WARN naming /calibrator")
+            self.assertEqual(self.results.count, 0, "no result from a killed run")
             with open(rospy.get_param("~parameter_file")) as f:
                 self.assertEqual(f.read(), before, "the parameter file untouched")
         else:

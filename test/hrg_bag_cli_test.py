@@ -237,6 +237,62 @@ class HrgBagCli(unittest.TestCase):
         self.assertEqual((last.rate, last.commands), (-0.2, 2))
         # At the last sample's centre (4.9975 s): 0.4 rad/s for 2 s, then -0.2 rad/s for 1.9975 s.
         self.assertAlmostEqual(last.angle, 0.4 * 2.0 - 0.2 * 1.9975, delta=1e-9)
+        # Who commanded the rate in force: nobody before the first command, then the scenario's schedule.
+        self.assertEqual({m.source for m in states if m.commands == 0}, {""})
+        self.assertEqual({m.source for m in states if m.commands > 0}, {"schedule"})
+
+    def test_process_flags_the_precessed_outputs_also_from_an_older_bag(self):
+        # The loop turns the wave at 0.4 rad/s from 1 s to 3 s: hrg_bag process reads the precession
+        # state beside the channels and flags exactly the outputs the documented rule flags (a rate
+        # other than 0 at either end of the output's interval, or a commanded angle that moved), which
+        # read as about 0.7 rad/s of body rate. A bag recorded before PrecessionState had `source` (its
+        # earlier MD5 sum) gives the same flags.
+        with open(os.path.join(self.pkg, "test/scenarios/precession_short.yaml")) as f:
+            scenario = f.read()
+        scenario = scenario.replace("  commands: []", "  commands: [{time: 1.0, rate: 0.4}, {time: 3.0, rate: 0.0}]")
+        scenario = scenario.replace("duration: 90.0", "duration: 5.0")
+        path, bag_path = self.path("precessed.yaml"), self.path("precessed.bag")
+        with open(path, "w") as f:
+            f.write(scenario)
+        code, _, err = hrg_bag("simulate", "--scenario", path, "--out", bag_path, "--no-truth")
+        self.assertEqual(code, 0, err)
+        # The same bag with the state in the earlier layout (no `source`).
+        import genpy.dynamic
+        from hrg_gyro.msg import PrecessionState
+        old_text = PrecessionState._full_text.replace("string source", "# (no source)")
+        OldState = genpy.dynamic.generate_dynamic("hrg_gyro/PrecessionState", old_text)["hrg_gyro/PrecessionState"]
+        self.assertEqual(OldState._md5sum, "a072295d8b564159c1f704b73deafe65")  # the constant hrg_bag knows
+        self.assertNotEqual(PrecessionState._md5sum, OldState._md5sum)
+        old_bag = self.path("precessed_old.bag")
+        with rosbag.Bag(bag_path) as bag, rosbag.Bag(old_bag, "w") as out:
+            for topic, m, t in bag.read_messages():
+                if topic == "/precession/state":
+                    m = OldState(header=m.header, rate=m.rate, angle=m.angle, commands=m.commands)
+                out.write(topic, m, t)
+        flags = {}
+        for name, source in (("new", bag_path), ("old", old_bag)):
+            out_bag = self.path("precessed_%s_out.bag" % name)
+            code, _, err = hrg_bag("process", source, "--params", self.params, "--out", out_bag)
+            self.assertEqual(code, 0, err)
+            self.assertRegex(err, r"precession state from /precession/state: 1000 records \(0 dropped\), \d+ outputs "
+                                  r"flagged PRECESSING \(0 of them with the state unknown\)")
+            with rosbag.Bag(out_bag) as bag:
+                outputs = [m for _, m, _ in bag.read_messages(topics=["/output"])]
+            flags[name] = [(o.header.stamp.to_nsec(), o.flags) for o in outputs]
+        self.assertEqual(flags["new"], flags["old"])
+        with rosbag.Bag(bag_path) as bag:
+            states = {m.header.stamp.to_nsec(): m for _, m, _ in bag.read_messages(topics=["/precession/state"])}
+        stamps = sorted(states)
+        expected = []
+        for previous, stamp in zip(stamps, stamps[1:]):
+            a, b = states[previous], states[stamp]
+            expected.append((stamp, 16 if (a.rate != 0.0 or b.rate != 0.0 or a.angle != b.angle) else 0))
+        self.assertEqual([(t, f & 16) for t, f in flags["new"]], expected)
+        flagged = [t for t, f in expected if f]
+        # 2 s at 200 Hz, with the samples at either switch.
+        self.assertGreaterEqual(len(flagged), 400)
+        self.assertLessEqual(len(flagged), 402)
+        self.assertTrue(all(0.99e9 < t - 1e9 < 3.01e9 for t in flagged), flagged[:3] + flagged[-3:])  # start_time 1 s
 
     def test_simulate_writes_a_triads_topics(self):
         # A triad scenario: exactly each axis's channels and truth under its name, the table, the

@@ -3,7 +3,8 @@
 (with the live processor's outputs), playback.launch replays the bag with --clock through a fresh
 processor, and `hrg_bag process` runs the same bag offline. The replayed and the offline outputs
 must equal the live ones bit for bit; a looping playback must reset the processor and restart the
-calibrator instead of integrating across the jump back.
+calibrator instead of integrating across the jump back. The same holds for a gyro whose precession
+loop turns the wave: the outputs' PRECESSING flags live, replayed and offline are the same.
 
 Each launch runs on a private master (its own port), as a user would run it from a shell."""
 import math
@@ -149,6 +150,41 @@ class RecordedSession(unittest.TestCase):
         self.assertGreaterEqual(resets, 1, "the processor must reset at the loop")
         self.assertGreaterEqual(restarts, 1, "the calibrator must restart its run at the loop")
         self.assertIn("time went backwards", log)
+
+    def test_5_the_precession_flags_are_the_live_ones_replayed_and_offline(self):
+        # A gyro with a precession loop whose schedule turns the wave (0.3 rad/s from 4 to 7 s, -0.3 from
+        # 12 to 15 s, 0.5 rad/s for 1 ms at 9.0005 s): the live processor flags the outputs PRECESSING
+        # from precession/state; the replay (which plays the state with the channels) and hrg_bag process
+        # (which reads it from the bag) must give every output, flags included, bit for bit.
+        scenario = os.path.join(os.path.dirname(rospy.get_param("~scenario")), "precession_recorded.yaml")
+        live, replay, offline = (os.path.join(self.work, n) for n in ("precession_live.bag",
+                                                                       "precession_replay.bag",
+                                                                       "precession_offline.bag"))
+        code, log = roslaunch(["record.launch", "bag:=" + live, "simulate:=true", "record_outputs:=true",
+                               "time_scale:=1.0", "scenario:=" + scenario, "parameter_file:=" + self.params],
+                              timeout=240)
+        self.assertTrue(os.path.exists(live), log[-3000:])
+        code, replay_log = roslaunch(["playback.launch", "bag:=" + live, "parameter_file:=" + self.params,
+                                      "record_to:=" + replay], timeout=240)
+        process = subprocess.run([HRG_BAG, "process", live, "--params", self.params, "--out", offline],
+                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
+                                 timeout=120)
+        self.assertEqual(process.returncode, 0, process.stdout)
+        self.assertIn("outputs flagged PRECESSING", process.stdout)
+        live_out = by_stamp(live, "/output")
+        states = by_stamp(live, "/precession/state")
+        self.assertGreater(len(states), 0.99 * len(live_out))
+        start = 1.0  # the scenario's start_time: stamps are 1 s ahead of its schedule's times
+        flagged = sorted(t * 1e-9 - start for t, o in live_out.items() if o.flags & 16)
+        # 3 s at 200 Hz twice (and a sample at either switch), and the 1 ms command's one sample.
+        self.assertGreater(len(flagged), 2 * 590)
+        self.assertLess(len(flagged), 2 * 610)
+        self.assertTrue(all(3.99 < t < 7.02 or 11.99 < t < 15.02 or abs(t - 9.0025) < 1e-6 for t in flagged), flagged)
+        pulse = [t for t in flagged if 8.0 < t < 11.0]
+        self.assertEqual(len(pulse), 1, "the 1 ms command flags exactly its own sample: %s" % pulse)
+        self.assertTrue(os.path.exists(replay), replay_log[-3000:])
+        self.assert_outputs_equal(live_out, by_stamp(replay, "/output"), "precession replay", 0.99)
+        self.assert_outputs_equal(live_out, by_stamp(offline, "/output"), "precession hrg_bag process", 1.0)
 
 
 if __name__ == "__main__":

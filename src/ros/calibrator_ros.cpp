@@ -227,19 +227,18 @@ bool CalibratorRos::startRun(bool restart, std::string* reason) {
     skip_waves_until_ = ros::Time();
     sweep_end_ = last_channels_stamp_ = ros::Time();
     pairing_.clear();
-    field_plan_.clear();
-    field_next_ = 0;
-    field_start_ = ros::Time();
+    field_run_ = core::FieldPlanRun();
+    last_wave_stamp_ = ros::Time();
     if (fieldRun()) {
       // Nothing is commanded for a plan that cannot run or cannot pass (too long; a loop lag at the
       // rate above field/max_drift_std for a gyro whose resonator is given).
       core::checkFieldPlan(session()->settings());
-      field_plan_ = core::fieldCommandPlan(session()->settings());
+      field_run_ = core::FieldPlanRun(session()->settings(), ros::this_node::getName());
       ROS_INFO(
           "calibrator: field: %zu segments at %g rad/s planned over %.1f s of stream time, from the first "
           "precession state while the driver listens on %s",
-          session()->settings().field.directions.size(), session()->settings().field.rate, field_plan_.back().time,
-          command_pub_.getTopic().c_str());
+          session()->settings().field.directions.size(), session()->settings().field.rate,
+          field_run_.plan().back().time, command_pub_.getTopic().c_str());
     }
     ROS_INFO("calibrator: %s run started (prior %s)", method.c_str(), parameter_file_.c_str());
     return true;
@@ -261,11 +260,11 @@ void CalibratorRos::noteRestart(std::uint64_t restarts_before) {
   skip_waves_until_ = ros::Time();
   sweep_end_ = last_channels_stamp_ = ros::Time();
   pairing_.clear();
-  if (!field_plan_.empty()) {
+  if (!field_run_.empty()) {
     // The field plan starts over with the run, from the next precession state.
     stopFieldPlan("its run restarted");
-    field_next_ = 0;
-    field_start_ = ros::Time();
+    field_run_ = core::FieldPlanRun(session()->settings(), ros::this_node::getName());
+    last_wave_stamp_ = ros::Time();
   }
 }
 
@@ -277,19 +276,18 @@ void CalibratorRos::publishPrecession(double rate) {
   ++field_commands_sent_;
 }
 
-void CalibratorRos::advanceFieldPlan(const ros::Time& now) {
-  if (field_plan_.empty() || field_next_ >= field_plan_.size()) return;
-  if (field_start_.isZero()) {
+void CalibratorRos::advanceFieldPlan(const core::PrecessionReport& state) {
+  if (field_run_.empty()) return;
+  if (!field_run_.started()) {
     // Commands sent before the driver listens would be lost: the plan waits for it.
     if (command_pub_.getNumSubscribers() == 0) return;
-    field_start_ = now;
+    field_run_.start(state);
   }
-  const double elapsed = (now - field_start_).toSec();
-  while (field_next_ < field_plan_.size() && field_plan_[field_next_].time <= elapsed) {
-    const core::PlannedPrecession& p = field_plan_[field_next_++];
+  core::PlannedPrecession p;
+  while (field_run_.nextDue(state.stamp, &p)) {
     publishPrecession(p.rate);
     ROS_INFO("calibrator: field: virtual rotation at %g rad/s commanded (%zu of %zu, %.1f s into the plan)", p.rate,
-             field_next_, field_plan_.size(), elapsed);
+             field_run_.sent(), field_run_.plan().size(), p.time);
   }
 }
 
@@ -300,10 +298,20 @@ void CalibratorRos::stopVirtualRotation(const char* why) {
 
 void CalibratorRos::stopFieldPlan(const char* why) {
   // Between its first and its last command the plan has the wave turning: stop it.
-  if (field_next_ == 0 || field_next_ >= field_plan_.size()) return;
+  if (!field_run_.midway()) return;
   publishPrecession(0.0);
-  field_next_ = field_plan_.size();
+  field_run_.stop();
   ROS_WARN("calibrator: field: virtual rotation stopped (rate 0 commanded): %s before the plan's end", why);
+}
+
+void CalibratorRos::abortFieldRun(core::CalibrationOutcome outcome) {
+  stopFieldPlan("the run was aborted");
+  calibration_->abort();
+  result_pub_.publish(toMessage(outcome, false, parameter_file_, ros::Time::now()));
+  ++runs_;
+  last_accepted_ = false;
+  last_result_ = "aborted, nothing written: " + outcome.reason;
+  ROS_ERROR("calibrator: field run aborted, nothing written: %s", outcome.reason.c_str());
 }
 
 void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
@@ -324,7 +332,26 @@ void CalibratorRos::onPrecession(const PrecessionState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!fieldRun()) return;
   addRotationRecord(msg->header.stamp, msg->angle, msg->rate, msg->header.seq);
-  if (session()) advanceFieldPlan(msg->header.stamp);
+  if (!session()) return;  // finished on this record
+  const core::PrecessionReport state{toNanoseconds(msg->header.stamp), msg->rate, msg->commands, msg->source};
+  const std::string foreign = field_run_.check(state);
+  if (!foreign.empty()) {
+    // Someone else turns the wave: the run's data are no longer what its plan made them.
+    core::CalibrationOutcome o;
+    o.method = session()->settings().method;
+    core::refuseFieldRun(&o, "precession_command", foreign);
+    abortFieldRun(o);
+    return;
+  }
+  advanceFieldPlan(state);
+  if (session()->complete()) return;
+  const std::string overdue =
+      field_run_.overdue(state.stamp, toNanoseconds(last_wave_stamp_), session()->progress().summary);
+  if (!overdue.empty()) {
+    bool written = false;
+    std::string message;
+    finishRun(&written, &message, {"plan", overdue});
+  }
 }
 
 void CalibratorRos::addRotationRecord(const ros::Time& stamp, double angle, double rate, std::uint32_t seq) {
@@ -345,6 +372,7 @@ void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
     return;
   }
   if (session()) {
+    if (msg->header.stamp > last_wave_stamp_) last_wave_stamp_ = msg->header.stamp;
     const std::uint64_t restarts = session()->counters().restarts;
     session()->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency,
                        core::quadratureRatio(msg->quadrature, msg->amplitude));
@@ -387,9 +415,11 @@ void CalibratorRos::endGeneratorSweep() {
   }
 }
 
-core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* message) {
+core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* message,
+                                                  const std::pair<std::string, std::string>& refusal) {
   stopFieldPlan("the run finished");
   core::CalibrationOutcome o = calibration_->finishStage();
+  if (!refusal.first.empty()) core::refuseFieldRun(&o, refusal.first, refusal.second);
   *written = false;
   if (o.accepted && write_) {
     try {
@@ -524,10 +554,10 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
     stat.add("turntable dropped (duplicate stamp)", c.rejected.duplicate);
     stat.add("turntable dropped (out-of-order stamp)", c.rejected.out_of_order);
     stat.add("turntable dropped (stamp jump)", c.rejected.stamp_jump);
-    if (!field_plan_.empty()) {
+    if (!field_run_.empty()) {
       stat.add("field commands sent", field_commands_sent_);
-      stat.add("field commands planned", field_plan_.size());
-      stat.add("field plan started", !field_start_.isZero());
+      stat.add("field commands planned", field_run_.plan().size());
+      stat.add("field plan started", field_run_.started());
     }
   } else if (runs_ > 0 && !last_accepted_) {
     stat.summary(DiagnosticStatus::WARN, "idle; last run " + last_result_);

@@ -140,12 +140,22 @@ GroundTruth toTruthMessage(const core::SimulationSample& s, const std_msgs::Head
   return t;
 }
 
-PrecessionState toPrecessionStateMessage(const core::SimulationSample& s, const std_msgs::Header& header) {
+const char* const kScheduledPrecessionSource = "schedule";
+
+void updatePrecessionSource(const core::SimulationSample& s, const std::string& commander, std::string* source) {
+  for (const core::AppliedPrecession& a : s.precession_commands) {
+    *source = a.scheduled ? kScheduledPrecessionSource : commander;
+  }
+}
+
+PrecessionState toPrecessionStateMessage(const core::SimulationSample& s, const std_msgs::Header& header,
+                                         const std::string& source) {
   PrecessionState m;
   m.header = header;
   m.rate = s.precession.rate;
   m.angle = s.precession.angle;
   m.commands = static_cast<std::uint32_t>(s.precession.commands);
+  m.source = source;
   return m;
 }
 

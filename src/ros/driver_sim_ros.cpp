@@ -127,7 +127,8 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   worker_ = std::thread(&DriverSimRos::run, this);
 }
 
-void DriverSimRos::onPrecessionCommand(const PrecessionCommand::ConstPtr& msg) {
+void DriverSimRos::onPrecessionCommand(const ros::MessageEvent<PrecessionCommand const>& event) {
+  const PrecessionCommand::ConstPtr& msg = event.getMessage();
   if (!has_precession_loop_) {
     // Throttled on the wall clock: under sim time the clock may stand still or start near 0.
     const ros::WallTime now = ros::WallTime::now();
@@ -147,18 +148,20 @@ void DriverSimRos::onPrecessionCommand(const PrecessionCommand::ConstPtr& msg) {
     return;
   }
   std::lock_guard<std::mutex> lock(command_mutex_);
-  pending_command_ = msg->rate;
+  pending_command_ = Command{msg->rate, event.getPublisherName()};
 }
 
 void DriverSimRos::takeCommand(core::GyroSimulator& sim) {
-  std::optional<double> rate;
+  std::optional<Command> command;
   {
     std::lock_guard<std::mutex> lock(command_mutex_);
-    rate.swap(pending_command_);
+    command.swap(pending_command_);
   }
-  if (!rate) return;
-  sim.commandVirtualRate(*rate);
-  ROS_INFO("driver_sim: precession at %g rad/s from %.3f s of the scenario", *rate, sim.elapsed());
+  if (!command) return;
+  sim.commandVirtualRate(command->rate);
+  handed_source_ = command->publisher;
+  ROS_INFO("driver_sim: precession at %g rad/s from %.3f s of the scenario, commanded by %s", command->rate,
+           sim.elapsed(), command->publisher.c_str());
 }
 
 DriverSimRos::~DriverSimRos() {
@@ -208,8 +211,9 @@ void DriverSimRos::publishSingle(const core::SimulationSample& s, const ros::Tim
     truth_pub_.publish(boost::make_shared<GroundTruth>(toTruthMessage(s, trueHeader(channels->header, stamp))));
   }
   if (has_precession_loop_) {
+    updatePrecessionSource(s, handed_source_, &precession_source_);
     precession_pub_.publish(
-        boost::make_shared<PrecessionState>(toPrecessionStateMessage(s, trueHeader(channels->header, stamp))));
+        boost::make_shared<PrecessionState>(toPrecessionStateMessage(s, trueHeader(channels->header, stamp), precession_source_)));
   }
 }
 

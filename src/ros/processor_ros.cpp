@@ -43,6 +43,18 @@ core::ProcessorConfig processorConfig(ParameterReader& params) {
   return c;
 }
 
+core::PrecessionWatchSettings precessionWatchSettings(ParameterReader& params, const core::ProcessorConfig& config) {
+  core::PrecessionWatchSettings w;
+  w.hold = params.get("precession_hold", w.hold);
+  w.backward_reset = config.backward_reset;  // the stamps' rule, as for the channels
+  try {
+    w.validate();  // the same rules as hrg_bag process
+  } catch (const core::ConfigError& e) {
+    throw std::invalid_argument("processor: ~" + e.key() + ": " + e.problem());
+  }
+  return w;
+}
+
 core::BiasCaptureSettings biasCaptureSettings(ParameterReader& params) {
   core::BiasCaptureSettings b;
   b.duration = params.get("bias_capture/duration", b.duration);
@@ -61,6 +73,7 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   if (parameter_file_.empty()) throw std::invalid_argument("processor: ~parameter_file is required (the gyro model)");
   auto params = std::make_shared<const core::GyroParameters>(core::loadParameterFile(parameter_file_));
   processor_ = std::make_unique<core::GyroProcessor>(processorConfig(params_), params);
+  precession_ = core::PrecessionWatch(precessionWatchSettings(params_, processor_->config()));
   frame_id_ = params_.get<std::string>("frame_id", "gyro_link");
   publish_imu_ = params_.get("publish_imu", publish_imu_);
   core::RateNoiseSettings noise;
@@ -108,10 +121,14 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   updater_.add("input", this, &ProcessorRos::diagnoseInput);
   updater_.add("wave", this, &ProcessorRos::diagnoseWave);
   updater_.add("model", this, &ProcessorRos::diagnoseModel);
+  updater_.add("precession", this, &ProcessorRos::diagnosePrecession);
   addProcessHeapDiagnostic(updater_, heap_trim_period);
   params_.warnAboutUnknownKeys();
   channels_sub_ = input_.handle(nh_).subscribe("channels", queue_size, &ProcessorRos::onChannels, this,
                                                ros::TransportHints().tcpNoDelay());
+  // On the same thread as the channels: the two are handled in the order they arrive.
+  precession_sub_ = input_.handle(nh_).subscribe("precession/state", queue_size, &ProcessorRos::onPrecession, this,
+                                                 ros::TransportHints().tcpNoDelay());
   input_.start();
   diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
   ROS_INFO("processor: %s (K0 %.6f, %zu K harmonics, calibration %s)", parameter_file_.c_str(),
@@ -121,6 +138,7 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 
 ProcessorRos::~ProcessorRos() {
   channels_sub_.shutdown();
+  precession_sub_.shutdown();
   input_.stop();
 }
 
@@ -177,31 +195,76 @@ void ProcessorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   if (!r.has_wave) return;
   last_wave_ = r.wave;
   has_wave_ = true;
+  // An output covers (the previous accepted stamp, this one]; a first sample only starts the next.
+  const core::Nanoseconds from = previous_accepted_;
+  previous_accepted_ = in.stamp;
 
   auto wave = boost::make_shared<WaveState>(toWaveMessage(*msg, r.wave, frame_id_));
   wave_pub_.publish(wave);
   if (!r.has_output) return;
   last_flags_ = r.flags;
+  precession_.addOutput(from, in.stamp);
+  pending_.push_back({boost::make_shared<GyroOutput>(toOutputMessage(wave->header, r)), r.increment});
+  releaseOutputs();
+}
 
-  const core::AngleIncrement& inc = r.increment;
-  auto out = boost::make_shared<GyroOutput>(toOutputMessage(wave->header, r));
-  output_pub_.publish(out);
+void ProcessorRos::onPrecession(const PrecessionState::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (precession_.addState({toNanoseconds(msg->header.stamp), msg->rate, msg->angle})) {
+    last_precession_ = *msg;
+  } else {
+    ROS_WARN_THROTTLE(5.0, "processor: dropped a precession state (non-finite, zero, duplicate or out-of-order stamp)");
+  }
+  releaseOutputs();
+}
 
-  if (capture_ && !capture_->finished() && capture_->add(inc, r.flags)) capture_cv_.notify_all();
+void ProcessorRos::releaseOutputs() {
+  core::PrecessionDecision d;
+  while (precession_.next(&d)) {
+    const PendingOutput p = std::move(pending_.front());
+    pending_.pop_front();
+    GyroOutput& out = *p.output;
+    if (d.flagged()) out.flags |= core::kFlagPrecessing;
+    if (d.flagged() != precessing_) {
+      precessing_ = d.flagged();
+      const char* by =
+          last_precession_.source.empty() ? "a node the driver does not name" : last_precession_.source.c_str();
+      if (d.verdict == core::PrecessionVerdict::kUnknown) {
+        ROS_WARN(
+            "processor: the precession state stopped short of the output (more than ~precession_hold behind): "
+            "outputs flagged PRECESSING from %.3f s, the wave may be turning",
+            out.header.stamp.toSec());
+      } else if (precessing_) {
+        ROS_WARN(
+            "processor: the wave is being turned on command (%g rad/s, commanded by %s): outputs flagged "
+            "PRECESSING from %.3f s; they are not the body's rate",
+            d.rate, by, out.header.stamp.toSec());
+      } else {
+        ROS_INFO("processor: the wave is no longer turned on command: outputs unflagged from %.3f s",
+                 out.header.stamp.toSec());
+      }
+    }
+    output_pub_.publish(p.output);
 
-  rate_noise_.add(r.alpha, inc.dt, r.flags);
-  const bool continuous = !(r.flags & (core::kFlagGap | core::kFlagReset));
-  if (!publish_imu_ || !continuous) return;
-  auto imu = boost::make_shared<sensor_msgs::Imu>();
-  imu->header = wave->header;
-  // REP-145: no orientation and no acceleration from this sensor.
-  imu->orientation_covariance[0] = -1.0;
-  imu->linear_acceleration_covariance[0] = -1.0;
-  imu->angular_velocity.z = out->rate;
-  imu->angular_velocity_covariance[0] = kUnmeasuredVariance;
-  imu->angular_velocity_covariance[4] = kUnmeasuredVariance;
-  imu->angular_velocity_covariance[8] = rate_noise_.variance();
-  imu_pub_.publish(imu);
+    if (capture_ && !capture_->finished() && capture_->add(p.increment, out.flags)) capture_cv_.notify_all();
+
+    rate_noise_.add(out.alpha, out.dt, out.flags);
+    const bool continuous = !(out.flags & (core::kFlagGap | core::kFlagReset));
+    if (!publish_imu_ || !continuous) continue;
+    auto imu = boost::make_shared<sensor_msgs::Imu>();
+    imu->header = out.header;
+    // REP-145: no orientation and no acceleration from this sensor.
+    imu->orientation_covariance[0] = -1.0;
+    imu->linear_acceleration_covariance[0] = -1.0;
+    imu->angular_velocity.z = out.rate;
+    imu->angular_velocity_covariance[0] = kUnmeasuredVariance;
+    imu->angular_velocity_covariance[4] = kUnmeasuredVariance;
+    // A precessed sample's rate is the wave's, not the body's: REP-145 has no flag, so it is marked
+    // as not measured, as x and y are (a filter that weighs by covariance ignores it).
+    imu->angular_velocity_covariance[8] =
+        (out.flags & core::kFlagPrecessing) ? kUnmeasuredVariance : rate_noise_.variance();
+    imu_pub_.publish(imu);
+  }
 }
 
 bool ProcessorRos::onReload(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -398,6 +461,47 @@ void ProcessorRos::diagnoseModel(diagnostic_updater::DiagnosticStatusWrapper& st
   stat.add("refused reloads", failed_reloads_);
   stat.add("bias captures", bias_captures_);
   stat.add("last bias capture", last_bias_capture_);
+}
+
+void ProcessorRos::diagnosePrecession(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const core::PrecessionWatchCounters& c = precession_.counters();
+  const std::uint64_t precessing = c.precessing - reported_precession_.precessing;
+  const std::uint64_t unknown = c.unknown - reported_precession_.unknown;
+  const std::uint64_t dropped = c.dropped_states - reported_precession_.dropped_states;
+  const PrecessionState& s = last_precession_;
+  const std::string by = s.commands == 0    ? "nobody (no command executed)"
+                         : s.source.empty() ? "a node the driver does not name"
+                                            : s.source;
+  if (!precession_.seenState()) {
+    stat.summary(DiagnosticStatus::OK, "no precession state received: a gyro without a precession loop");
+  } else if (unknown > 0) {
+    stat.summaryf(DiagnosticStatus::WARN,
+                  "precession state stopped short of the outputs: %lu outputs flagged PRECESSING (the wave may be "
+                  "turning)",
+                  static_cast<unsigned long>(unknown));
+  } else if (precessing > 0 || s.rate != 0.0) {
+    stat.summaryf(DiagnosticStatus::WARN,
+                  "wave turned on command: %lu outputs flagged PRECESSING since the last report; %g rad/s in force, "
+                  "commanded by %s",
+                  static_cast<unsigned long>(precessing), s.rate, by.c_str());
+  } else if (dropped > 0) {
+    stat.summaryf(DiagnosticStatus::WARN, "%lu precession states dropped (non-finite, zero or out-of-order stamps)",
+                  static_cast<unsigned long>(dropped));
+  } else {
+    stat.summary(DiagnosticStatus::OK, "wave not turned on command (0 rad/s in force)");
+  }
+  stat.add("commanded rate (rad/s)", s.rate);
+  stat.add("commanded by", by);
+  stat.add("commands executed", s.commands);
+  stat.add("state stamp", s.header.stamp.toSec());
+  stat.add("outputs flagged precessing", c.precessing);
+  stat.add("outputs flagged (state unknown)", c.unknown);
+  stat.add("outputs waiting for the precession state", precession_.waiting());
+  stat.add("precession states", c.states);
+  stat.add("precession states dropped", c.dropped_states);
+  stat.add("precession timelines", c.timelines);
+  reported_precession_ = c;
 }
 
 }  // namespace hrg_gyro

@@ -13,7 +13,9 @@
 // The field method (a still gyro, no table) reads `precession/state` in place of `turntable/state`
 // and commands the virtual rotation itself: it publishes core::fieldCommandPlan's commands on
 // `command/precession` as the gyro's own stream time (the precession state's stamps) passes, and a
-// rate of 0 when the run ends before the plan does.
+// rate of 0 when the run ends before the plan does. core::FieldPlanRun judges each precession state:
+// a command this run did not send aborts the run (nothing written, the reason on ~result), and a plan
+// that is over without complete data refuses it instead of waiting.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -27,6 +29,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "hrg_gyro/ChannelAmplitudes.h"
@@ -61,9 +64,11 @@ class CalibratorRos {
   void onPrecession(const PrecessionState::ConstPtr& msg);
   /// Feeds a table (or, for the field method, precession loop) record and finishes when complete.
   void addRotationRecord(const ros::Time& stamp, double angle, double rate, std::uint32_t seq);
-  /// Field method: publishes the planned commands whose time has come at stream time `now` (the
+  /// Field method: publishes the planned commands whose time has come at the state's stamp (the
   /// plan's clock starts at the first precession state seen while the driver listens).
-  void advanceFieldPlan(const ros::Time& now);
+  void advanceFieldPlan(const core::PrecessionReport& state);
+  /// Field method: the run is aborted, nothing written (no file, no report), `outcome` published.
+  void abortFieldRun(core::CalibrationOutcome outcome);
   /// Field method: a run that ends (finished, aborted, restarted) before its plan stops the rotation.
   void stopFieldPlan(const char* why);
   void publishPrecession(double rate);
@@ -83,8 +88,10 @@ class CalibratorRos {
   /// parameter file as prior; false + reason on failure (then no stage is left).
   bool startRun(bool restart, std::string* reason);
   core::CalibrationSession* session() { return calibration_->session(); }
-  /// Fits, gates, writes, publishes, reloads; returns the outcome. Caller holds the mutex.
-  core::CalibrationOutcome finishRun(bool* written, std::string* message);
+  /// Fits, gates, writes, publishes, reloads; returns the outcome. Caller holds the mutex. With a
+  /// `refusal` (gate, message), the run is refused for it whatever the fit's gates say.
+  core::CalibrationOutcome finishRun(bool* written, std::string* message,
+                                     const std::pair<std::string, std::string>& refusal = {});
   /// The sweep is over and every raw channel of it has arrived (or given up on): fit, maybe finish.
   void endGeneratorSweep();
   /// The reload worker: calls the processor's ~reload off the callback threads, then starts the
@@ -115,11 +122,11 @@ class CalibratorRos {
   ros::Publisher result_pub_;
   ros::Publisher command_pub_;  // command/precession, the field method's virtual rotation
 
-  // The field method's plan (under mutex_): commands, the next to send, the stream time it started.
-  std::vector<core::PlannedPrecession> field_plan_;
-  std::size_t field_next_ = 0;
-  ros::Time field_start_;
+  // The field method's plan under way (under mutex_), and the newest wave stamp (the plan waits for
+  // the wave of its last segment before judging the data incomplete).
+  core::FieldPlanRun field_run_;
   std::uint64_t field_commands_sent_ = 0;
+  ros::Time last_wave_stamp_;
   ros::ServiceServer start_srv_, finish_srv_, abort_srv_;
   diagnostic_updater::Updater updater_;
   ros::WallTimer diagnostics_timer_;

@@ -67,8 +67,16 @@ ChannelAmplitudes toChannelsMessage(const core::SimulationSample& s, const ros::
 TurntableState toTurntableMessage(const core::TurntableLogRecord& r, core::Nanoseconds origin,
                                   const std::string& frame_id);
 GroundTruth toTruthMessage(const core::SimulationSample& s, const std_msgs::Header& header);
-/// The precession loop's state at a sample (averaged resonator): stamped with the sample.
-PrecessionState toPrecessionStateMessage(const core::SimulationSample& s, const std_msgs::Header& header);
+/// The name PrecessionState.source gives the scenario's own schedule (dynamics.commands).
+extern const char* const kScheduledPrecessionSource;
+/// Who commanded the rate in force once `s`'s commands are taken up: each command applied in its window
+/// replaces *source, by kScheduledPrecessionSource for the schedule's and by `commander` (the node
+/// that published it) for one taken from command/precession.
+void updatePrecessionSource(const core::SimulationSample& s, const std::string& commander, std::string* source);
+/// The precession loop's state at a sample (averaged resonator): stamped with the sample; `source`
+/// who commanded the rate in force.
+PrecessionState toPrecessionStateMessage(const core::SimulationSample& s, const std_msgs::Header& header,
+                                         const std::string& source);
 /// A command the loop took up, as the commanding node would have issued it (`hrg_bag simulate` writes
 /// the scenario's schedule so); stamped at `stamp`.
 PrecessionCommand toPrecessionCommandMessage(const core::AppliedPrecession& command, const ros::Time& stamp,

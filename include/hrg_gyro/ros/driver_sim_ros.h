@@ -18,8 +18,9 @@
 // A gyro with a precession loop (dynamics.model: averaged, core::DynamicsConfig) also takes commands
 // of its virtual rotation on `command/precession` (hrg_gyro/PrecessionCommand), executed from the
 // next carrier period as its electronics would, beside the scenario's own schedule, and publishes what
-// the loop executes on `precession/state` (hrg_gyro/PrecessionState) with every sample. A command to
-// a gyro without the loop is ignored with a warning naming why.
+// the loop executes on `precession/state` (hrg_gyro/PrecessionState) with every sample, `source` the
+// node that published the command in force (its caller id as this driver saw it; "schedule" for the
+// scenario's own). A command to a gyro without the loop is ignored with a warning naming why.
 #pragma once
 
 #include <ros/ros.h>
@@ -58,7 +59,7 @@ class DriverSimRos {
   void publishSingle(const core::SimulationSample& s, const ros::Time& stamp, core::Nanoseconds origin);
   void publishTriad(const core::TriadSample& s, const ros::Time& stamp, core::Nanoseconds origin);
   bool waitForSubscribers();
-  void onPrecessionCommand(const PrecessionCommand::ConstPtr& msg);
+  void onPrecessionCommand(const ros::MessageEvent<PrecessionCommand const>& event);
   /// Hands the last command received to the simulator (worker thread, before each sample).
   void takeCommand(core::GyroSimulator& sim);
   void takeCommand(core::TriadSimulator&) {}
@@ -78,7 +79,13 @@ class DriverSimRos {
   ros::Publisher precession_pub_;  // a gyro with a precession loop only
   ros::Subscriber command_sub_;
   std::mutex command_mutex_;
-  std::optional<double> pending_command_;  // under command_mutex_: received, not yet taken up
+  struct Command {
+    double rate;
+    std::string publisher;  // the caller id of the node that published it
+  };
+  std::optional<Command> pending_command_;  // under command_mutex_: received, not yet taken up
+  std::string handed_source_;               // worker thread: the publisher of the last command handed over
+  std::string precession_source_;           // worker thread: who commanded the rate in force
   bool has_precession_loop_ = false;
   std::uint64_t ignored_commands_ = 0;  // commands to a gyro without the loop (callback thread only)
   ros::WallTime last_ignored_warning_;

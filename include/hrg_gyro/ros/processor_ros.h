@@ -2,7 +2,11 @@
 //
 // Subscribes `channels`, runs core::GyroProcessor (the same object `hrg_bag process` runs, hence
 // identical numbers) and publishes `wave` (WaveState), `output` (GyroOutput) and `imu/data_raw`
-// (sensor_msgs/Imu, REP-145). `~reload` (std_srvs/Trigger) re-reads and validates
+// (sensor_msgs/Imu, REP-145). It also subscribes `precession/state` (PrecessionState, from a driver
+// whose gyro has a precession loop): core::PrecessionWatch, the rule `hrg_bag process` applies too,
+// flags the outputs over which the loop turned the wave (FLAG_PRECESSING; their Imu carries the
+// "not measured" z variance), holding an output until that stream has reached its stamp. `~reload` (std_srvs/Trigger)
+// re-reads and validates
 // `~parameter_file` and swaps the model between two samples; a bad file is refused with the reason
 // and the old model stays. `~capture_bias` (std_srvs/Trigger) averages the output of a still gyro
 // and refreshes D0 (core::BiasCapture), optionally writing the file. Health goes to /diagnostics
@@ -16,13 +20,17 @@
 #include <std_srvs/Trigger.h>
 
 #include <condition_variable>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <string>
 
 #include "hrg_gyro/ChannelAmplitudes.h"
+#include "hrg_gyro/GyroOutput.h"
+#include "hrg_gyro/PrecessionState.h"
 #include "hrg_gyro/core/processing/bias_capture.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
+#include "hrg_gyro/core/processing/precession_watch.h"
 #include "hrg_gyro/core/processing/rate_noise_estimator.h"
 #include "hrg_gyro/ros/input_thread.h"
 #include "hrg_gyro/ros/parameter_reader.h"
@@ -40,11 +48,15 @@ class ProcessorRos {
 
  private:
   void onChannels(const ChannelAmplitudes::ConstPtr& msg);
+  void onPrecession(const PrecessionState::ConstPtr& msg);
+  /// Publishes, in order, the outputs the precession watch has decided (caller holds the mutex).
+  void releaseOutputs();
   bool onReload(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool onCaptureBias(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   void diagnoseInput(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseWave(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseModel(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  void diagnosePrecession(diagnostic_updater::DiagnosticStatusWrapper& stat);
   /// Publishes ~model for the model now in force; `since` is the last stamp of the previous one.
   void publishModel(const ros::Time& since);
 
@@ -59,8 +71,8 @@ class ProcessorRos {
   double stall_timeout_ = 0.5;
   double quadrature_warn_ = 0.1;
 
-  InputThread input_;  // serves channels_sub_
-  ros::Subscriber channels_sub_;
+  InputThread input_;  // serves channels_sub_ and precession_sub_ (one thread: in arrival order)
+  ros::Subscriber channels_sub_, precession_sub_;
   ros::Publisher wave_pub_, output_pub_, imu_pub_, model_pub_;
   ros::Time last_stamp_;
   ros::ServiceServer reload_srv_, capture_srv_;
@@ -93,6 +105,18 @@ class ProcessorRos {
   core::WaveState last_wave_;
   bool has_wave_ = false;
   std::uint8_t last_flags_ = 0;
+
+  // The precession loop's state and the outputs waiting for it (all under mutex_).
+  core::PrecessionWatch precession_;
+  struct PendingOutput {
+    GyroOutput::Ptr output;
+    core::AngleIncrement increment;
+  };
+  std::deque<PendingOutput> pending_;        // in the watch's order
+  core::Nanoseconds previous_accepted_ = 0;  // the processor's previous accepted stamp: an output's start
+  PrecessionState last_precession_;          // the latest record taken, for the diagnostic
+  core::PrecessionWatchCounters reported_precession_;
+  bool precessing_ = false;  // the last output decided was flagged (for the log's transitions)
 };
 
 }  // namespace hrg_gyro

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "hrg_gyro/core/calibration/calibration_outcome.h"
 #include "hrg_gyro/core/common/units.h"
@@ -61,6 +62,107 @@ void checkFieldPlan(const CalibrationSettings& s) {
         " rad/s to D for the gyro of field/resonator, more than field/max_drift_std " +
         formatShort(f.max_drift_std, 3) + " rad/s; the loop_lag gate would refuse the result: command a slower rate");
   }
+}
+
+double FieldPlanRun::overdueMargin(const CalibrationSettings& s) {
+  return s.plateau.settle_time + s.plateau.smoothing_span + 1.0;
+}
+
+FieldPlanRun::FieldPlanRun(const CalibrationSettings& settings, std::string self)
+    : plan_(fieldCommandPlan(settings)),
+      margin_(overdueMargin(settings)),
+      self_(std::move(self)),
+      needed_("coverage " + formatShort(100 * settings.gates.min_coverage, 3) + " % and " +
+              formatShort(settings.field.min_turns, 3) + " turns") {}
+
+void FieldPlanRun::start(const PrecessionReport& report) {
+  started_ = true;
+  start_ = report.stamp;
+  base_commands_ = report.commands;
+  last_checked_ = report.stamp;
+}
+
+bool FieldPlanRun::nextDue(Nanoseconds now, PlannedPrecession* command) {
+  if (!started_ || next_ >= plan_.size()) return false;
+  if (toSeconds(now - start_) < plan_[next_].time) return false;
+  *command = plan_[next_++];
+  sent_rates_.push_back(command->rate);
+  return true;
+}
+
+void FieldPlanRun::stop() {
+  sent_rates_.push_back(0.0);
+  next_ = plan_.size();
+}
+
+namespace {
+
+bool sameRate(double a, double b) { return std::abs(a - b) <= 1e-12 + FieldPlanRun::kRateTolerance * std::abs(b); }
+
+}  // namespace
+
+std::string FieldPlanRun::check(const PrecessionReport& r) {
+  if (!started_ || r.stamp <= last_checked_) return std::string();
+  last_checked_ = r.stamp;
+  // Until the driver executes a command after the plan began, the rate in force is the one before
+  // it (the plan's first command, rate 0, replaces it).
+  if (r.commands == base_commands_ || sent_rates_.empty()) return std::string();
+  if (!r.source.empty() && r.source != self_) {
+    return "the precession loop executed a command from " + r.source + ", not from this calibrator (" + self_ +
+           "): " + formatShort(r.rate, 6) + " rad/s in force";
+  }
+  // The rate in force is the last command's; until the driver has executed as many commands as the
+  // run sent, the last may still be on its way and the one before it in force. A count that went
+  // back (a restarted driver) says nothing of what it executed.
+  const bool went_back = r.commands < base_commands_;
+  const double last = sent_rates_.back();
+  bool ours = sameRate(r.rate, last);
+  if (!ours && !went_back && r.commands - base_commands_ < sent_rates_.size() && sent_rates_.size() >= 2) {
+    ours = sameRate(r.rate, sent_rates_.end()[-2]);
+  }
+  if (!ours) {
+    std::string why = "the precession state shows " + formatShort(r.rate, 6) +
+                      " rad/s in force, which this run did not command (its last command: " + formatShort(last, 6) +
+                      " rad/s)";
+    if (went_back) {
+      why += "; the driver's command count went back from " + std::to_string(base_commands_) + " to " +
+             std::to_string(r.commands) + " (a restarted driver?)";
+    }
+    return why;
+  }
+  // A driver that names nobody: a command of the same rate from another node shows in the count only.
+  // (A driver that names this calibrator may also have executed its latched command again on reconnecting.)
+  if (r.source.empty() && r.commands > base_commands_ && r.commands - base_commands_ > sent_rates_.size()) {
+    return "the driver executed " + std::to_string(r.commands - base_commands_) +
+           " commands since the plan began and this run sent " + std::to_string(sent_rates_.size()) +
+           ": another node commanded the precession loop";
+  }
+  return std::string();
+}
+
+std::string FieldPlanRun::overdue(Nanoseconds state_now, Nanoseconds wave_now, const std::string& progress) const {
+  if (!started_ || next_ < plan_.size() || plan_.empty()) return std::string();
+  const Nanoseconds end = start_ + toNanoseconds(plan_.back().time);
+  const Nanoseconds due = end + toNanoseconds(margin_);
+  if (state_now < due) return std::string();
+  // The wave of the plan's last segment may still be on its way: wait for that stream too, unless
+  // it has stopped.
+  if (wave_now < due && state_now < due + toNanoseconds(kWaveStreamWait)) return std::string();
+  std::string why = "the plan's last command is " + formatShort(toSeconds(state_now - end), 3) +
+                    " s of stream time past and the data are incomplete: " + progress + " (each direction needs " +
+                    needed_ + ")";
+  if (wave_now == 0) {
+    why += "; no wave sample received (is the processor running?)";
+  } else if (wave_now < due) {
+    why += "; the wave stream stopped " + formatShort(toSeconds(wave_now - start_), 4) + " s into the plan";
+  }
+  return why;
+}
+
+void refuseFieldRun(CalibrationOutcome* o, const std::string& gate, const std::string& message) {
+  o->gates.insert(o->gates.begin(), GateResult{gate, false, 1.0, 0.0, message});
+  o->reason = gate + ": " + message;
+  o->accepted = false;
 }
 
 }  // namespace core

@@ -1,6 +1,8 @@
 // The virtual rotation a field calibration commands: a rest at 0, one segment per direction long
 // enough for `turns` full turns of settled data, then 0; the shipped scenario's schedule is checked
-// against it in field_calibration_test.
+// against it in field_calibration_test. The plan under way: its commands due on the precession
+// state's stamps; a command it did not send (another node's, a rate it did not command, more commands
+// than it sent) ends it with the reason, and so does a plan that is over without complete data.
 #include "hrg_gyro/core/calibration/field_command_plan.h"
 
 #include <gtest/gtest.h>
@@ -90,6 +92,159 @@ TEST(FieldCommandPlanTest, TheLoopsLagAtThePlannedRateIsPredictedForAKnownGyro) 
     EXPECT_EQ(std::string(e.what()).rfind("field/rate", 0), 0u) << e.what();
   }
   EXPECT_NO_THROW(fieldCommandPlan(s));  // the plan itself can be made (a simulation may want it)
+}
+
+// The shipped settings with two short segments: rest 5 s, +0.2 and -0.2 rad/s.
+CalibrationSettings twoSegments() {
+  CalibrationSettings s;
+  s.field.directions = {1, -1};
+  s.field.turns = 1.5;
+  return s;
+}
+
+constexpr Nanoseconds kT0 = 1000000000;
+Nanoseconds at(double seconds) { return kT0 + toNanoseconds(seconds); }
+
+PrecessionReport state(double seconds, double rate, std::uint64_t commands, const std::string& source) {
+  return {at(seconds), rate, commands, source};
+}
+
+TEST(FieldPlanRunTest, CommandsFallDueOnTheStreamTime) {
+  const CalibrationSettings s = twoSegments();
+  FieldPlanRun run(s, "/calibrator");
+  PlannedPrecession p;
+  EXPECT_FALSE(run.nextDue(at(0.0), &p)) << "nothing before the plan's clock starts";
+  EXPECT_FALSE(run.midway());
+  run.start(state(0.0, -0.2, 7, "/calibrator"));  // a previous run's rate still in force
+  ASSERT_TRUE(run.nextDue(at(0.0), &p));
+  EXPECT_EQ(p.rate, 0.0);
+  EXPECT_FALSE(run.nextDue(at(0.0), &p));
+  EXPECT_TRUE(run.midway()) << "from its first command on, a run that ends commands 0";
+  EXPECT_FALSE(run.nextDue(at(4.999), &p));
+  ASSERT_TRUE(run.nextDue(at(5.0), &p));
+  EXPECT_EQ(p.rate, 0.2);
+  EXPECT_TRUE(run.midway());
+  const double segment = fieldSegmentDuration(s);
+  ASSERT_TRUE(run.nextDue(at(5.0 + segment), &p));
+  EXPECT_EQ(p.rate, -0.2);
+  // A stream that jumps far ahead takes up the commands due in order.
+  ASSERT_TRUE(run.nextDue(at(100.0 + 2 * segment), &p));
+  EXPECT_EQ(p.rate, 0.0);
+  EXPECT_FALSE(run.nextDue(at(1000.0), &p));
+  EXPECT_FALSE(run.midway());
+  EXPECT_EQ(run.sent(), 4u);
+}
+
+// The plan started on a state with `commands` executed; its first two commands sent (0, then +0.2 at 5 s).
+FieldPlanRun runningPlan(std::uint64_t commands) {
+  FieldPlanRun run(twoSegments(), "/calibrator");
+  run.start(state(0.0, 0.0, commands, ""));
+  PlannedPrecession p;
+  while (run.nextDue(at(5.0), &p)) {
+  }
+  return run;
+}
+
+TEST(FieldPlanRunTest, ItsOwnCommandsAreWhatItExpects) {
+  FieldPlanRun run = runningPlan(3);
+  EXPECT_EQ(run.check(state(0.1, 0.0, 3, "")), "") << "none of its commands executed yet";
+  EXPECT_EQ(run.check(state(0.2, 0.0, 4, "/calibrator")), "");
+  EXPECT_EQ(run.check(state(5.1, 0.0, 4, "/calibrator")), "") << "+0.2 sent, not yet taken up";
+  EXPECT_EQ(run.check(state(5.2, 0.2, 5, "/calibrator")), "");
+  EXPECT_EQ(run.check(state(5.3, 0.2 * (1 + 1e-8), 5, "/calibrator")), "") << "a rate reported in single precision";
+  // A driver that names this calibrator may execute its latched command again when it reconnects.
+  EXPECT_EQ(run.check(state(5.4, 0.2, 6, "/calibrator")), "");
+}
+
+TEST(FieldPlanRunTest, ARateInForceBeforeItsFirstCommandIsNoStrangers) {
+  // A calibrator killed mid-plan left -0.2 rad/s from /old_calibrator in force: this run's first
+  // command (rate 0) replaces it; until the driver executes that, nothing is judged.
+  FieldPlanRun run(twoSegments(), "/calibrator");
+  run.start(state(0.0, -0.2, 2, "/old_calibrator"));
+  PlannedPrecession p;
+  ASSERT_TRUE(run.nextDue(at(0.0), &p));
+  EXPECT_EQ(run.check(state(0.005, -0.2, 2, "/old_calibrator")), "");
+  EXPECT_EQ(run.check(state(0.010, 0.0, 3, "/calibrator")), "");
+}
+
+TEST(FieldPlanRunTest, AnotherNodesCommandEndsTheRunNamingIt) {
+  FieldPlanRun run = runningPlan(3);
+  EXPECT_EQ(run.check(state(5.2, 0.2, 5, "/calibrator")), "");
+  const std::string why = run.check(state(20.0, 0.0, 6, "/teleop"));
+  EXPECT_EQ(why,
+            "the precession loop executed a command from /teleop, not from this calibrator (/calibrator): 0 rad/s "
+            "in force");
+  // Even at the very rate the plan commands.
+  FieldPlanRun same = runningPlan(3);
+  EXPECT_NE(same.check(state(20.0, 0.2, 6, "/teleop")), "");
+}
+
+TEST(FieldPlanRunTest, ARateItDidNotCommandEndsTheRun) {
+  // A driver that names nobody: the rate and the count tell.
+  FieldPlanRun run = runningPlan(3);
+  EXPECT_EQ(run.check(state(5.2, 0.2, 5, "")), "");
+  EXPECT_EQ(run.check(state(20.0, 0.5, 6, "")),
+            "the precession state shows 0.5 rad/s in force, which this run did not command (its last command: 0.2 "
+            "rad/s)");
+  FieldPlanRun counted = runningPlan(3);
+  EXPECT_EQ(counted.check(state(20.0, 0.2, 6, "")),
+            "the driver executed 3 commands since the plan began and this run sent 2: another node commanded the "
+            "precession loop");
+  // A restarted driver (its count back at 0, no rate in force) cannot be this run's either.
+  FieldPlanRun restarted = runningPlan(3);
+  EXPECT_EQ(restarted.check(state(5.2, 0.2, 5, "/calibrator")), "");
+  const std::string why = restarted.check(state(20.0, 0.0, 0, ""));
+  EXPECT_NE(why.find("did not command"), std::string::npos) << why;
+  EXPECT_NE(why.find("went back from 3 to 0"), std::string::npos) << why;
+}
+
+TEST(FieldPlanRunTest, RecordsThatGoBackAreTheSessionsToJudge) {
+  FieldPlanRun run = runningPlan(3);
+  EXPECT_EQ(run.check(state(20.0, 0.2, 5, "/calibrator")), "");
+  // A looping bag or a restarted simulator: the session restarts the run (and the plan) after a few.
+  EXPECT_EQ(run.check(state(0.5, 0.0, 0, "")), "");
+  EXPECT_EQ(run.check(state(20.0, 0.0, 0, "")), "") << "not after the last record judged";
+}
+
+TEST(FieldPlanRunTest, APlanOverWithoutItsDataEndsTheRunSayingWhatItHolds) {
+  const CalibrationSettings s = twoSegments();
+  FieldPlanRun run(s, "/calibrator");
+  run.start(state(0.0, 0.0, 0, ""));
+  PlannedPrecession p;
+  const double end = run.plan().back().time;
+  while (run.nextDue(at(end), &p)) {
+  }
+  const std::string progress = "field: 0.2 rad/s: 1.5 turns, coverage 100 %; -0.2 rad/s: 0.7 turns, coverage 70 %;";
+  const double margin = FieldPlanRun::overdueMargin(s);
+  EXPECT_EQ(margin, 4.0);  // settle 2 s, smoothing span 1 s, 1 s
+  EXPECT_EQ(run.overdue(at(end + margin - 0.01), at(end + margin), progress), "");
+  // The wave stream behind (a busy processor): waited for, 30 s more of the state's stream.
+  EXPECT_EQ(run.overdue(at(end + margin), at(end), progress), "");
+  EXPECT_EQ(run.overdue(at(end + margin + 29.0), at(end), progress), "");
+  const std::string why = run.overdue(at(end + margin), at(end + margin), progress);
+  EXPECT_EQ(why, "the plan's last command is 4 s of stream time past and the data are incomplete: " + progress +
+                     " (each direction needs coverage 95 % and 1 turns)");
+  const std::string stopped = run.overdue(at(end + margin + 30.0), at(end - 10.0), progress);
+  EXPECT_NE(stopped.find("the wave stream stopped"), std::string::npos) << stopped;
+  const std::string none = run.overdue(at(end + margin + 30.0), 0, progress);
+  EXPECT_NE(none.find("no wave sample received"), std::string::npos) << none;
+  // Not before the plan is over, nor for a plan that never started.
+  FieldPlanRun waiting(s, "/calibrator");
+  EXPECT_EQ(waiting.overdue(at(1000.0), at(1000.0), progress), "");
+}
+
+TEST(FieldPlanRunTest, ARefusalComesFirstAndIsTheReason) {
+  CalibrationOutcome o;
+  o.gate("coverage", false, 0.7, 0.95, "70 % of the bins");
+  o.gate("samples", true, 5000, 1000, "enough");
+  o.decide();
+  refuseFieldRun(&o, "plan", "the plan is over");
+  EXPECT_FALSE(o.accepted);
+  EXPECT_EQ(o.reason, "plan: the plan is over");
+  ASSERT_EQ(o.gates.size(), 3u);
+  EXPECT_EQ(o.gates[0].name, "plan");
+  EXPECT_FALSE(o.gates[0].passed);
+  EXPECT_EQ(o.gates[1].name, "coverage");
 }
 
 }  // namespace

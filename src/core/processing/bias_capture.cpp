@@ -59,6 +59,11 @@ bool BiasCapture::add(const AngleIncrement& increment, std::uint8_t flags) {
     abort(flags & kFlagReset ? "time went backwards during the capture" : "gap in the input during the capture");
     return true;
   }
+  if (flags & kFlagPrecessing) {
+    // The wave turned on command: its rate is not the still gyro's.
+    abort("the wave was turned on command (precession loop) during the capture");
+    return true;
+  }
   const double dt = increment.dt;
   if (!(dt > 0.0)) return false;
   sum_dt_ += dt;

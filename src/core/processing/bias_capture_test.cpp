@@ -1,6 +1,6 @@
 // Turn-on bias capture against a wave integrated from a known gyro at rest: the captured D0 is the
 // true one (harmonics of D and K and the Earth rate accounted for), and motion, constant rotation,
-// gaps and bad settings are refused with a reason.
+// gaps, a wave turned on command and bad settings are refused with a reason.
 #include "hrg_gyro/core/processing/bias_capture.h"
 
 #include <gtest/gtest.h>
@@ -117,7 +117,7 @@ TEST(BiasCaptureTest, RefusesConstantRotation) {
   EXPECT_NE(r.reason.find("turning"), std::string::npos) << r.reason;
 }
 
-TEST(BiasCaptureTest, RefusesGapsResetsAndAborts) {
+TEST(BiasCaptureTest, RefusesGapsResetsPrecessionAndAborts) {
   const GyroParameters real = truth(1e-4);
   BiasCaptureSettings settings;
   AngleIncrement inc;
@@ -130,6 +130,11 @@ TEST(BiasCaptureTest, RefusesGapsResetsAndAborts) {
   BiasCapture reset(settings, real);
   EXPECT_TRUE(reset.add(inc, kFlagReset));
   EXPECT_FALSE(reset.result().accepted);
+  BiasCapture precessed(settings, real);
+  EXPECT_FALSE(precessed.add(inc, 0));
+  EXPECT_TRUE(precessed.add(inc, kFlagPrecessing));
+  EXPECT_FALSE(precessed.result().accepted);
+  EXPECT_NE(precessed.result().reason.find("turned on command"), std::string::npos) << precessed.result().reason;
   BiasCapture aborted(settings, real);
   aborted.abort("model reloaded during the capture");
   EXPECT_TRUE(aborted.finished());

@@ -24,7 +24,8 @@ RateNoiseEstimator::RateNoiseEstimator(const RateNoiseSettings& settings) : sett
 }
 
 void RateNoiseEstimator::add(double alpha, double dt, std::uint8_t flags) {
-  if (flags & (kFlagGap | kFlagReset)) {
+  // A precessed sample's alpha turns with the commanded rate: its steps are not the gyro's noise.
+  if (flags & (kFlagGap | kFlagReset | kFlagPrecessing)) {
     history_ = 0;
     return;
   }

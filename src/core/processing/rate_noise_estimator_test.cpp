@@ -1,6 +1,7 @@
 // The rate variance the processor reports: the configured value when there is one, the initial
 // one until the estimate has settled, then 2 s^2 / dt^2 for white angle noise of variance s^2
-// whatever the rate, floored, and a gap breaks the run of alphas without losing the estimate.
+// whatever the rate, floored, and a gap (or an output flagged PRECESSING) breaks the run of alphas
+// without losing the estimate.
 #include "hrg_gyro/core/processing/rate_noise_estimator.h"
 
 #include <gtest/gtest.h>
@@ -69,6 +70,28 @@ TEST(RateNoiseEstimatorTest, AGapStartsANewRunOfAlphas) {
   EXPECT_EQ(e.secondDifferences(), before + 1);
   e.add(0.0, 0.001, kFlagReset);
   EXPECT_EQ(e.secondDifferences(), before + 1);
+}
+
+TEST(RateNoiseEstimatorTest, PrecessedOutputsAreNoNoiseOfTheGyro) {
+  // The wave turned on command at 0.36 rad/s of apparent body rate from the 300th to the 600th
+  // output: the two steps of alpha's slope would raise the estimate several times over (the second
+  // run, without the flag).
+  const double sigma = 2e-6, dt = 0.005;
+  auto run = [&](bool flagged) {
+    RateNoiseEstimator e;
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> noise(0.0, sigma);
+    double alpha = 0.0;
+    for (int i = 0; i < 3000; ++i) {
+      const bool precessing = i >= 300 && i < 600;
+      if (precessing) alpha += 0.36 * dt;
+      e.add(alpha + noise(rng), dt, precessing && flagged ? kFlagPrecessing : 0);
+    }
+    return e.variance();
+  };
+  const double expected = 2.0 * sigma * sigma / (dt * dt);
+  EXPECT_NEAR(run(true), expected, 0.15 * expected);
+  EXPECT_GT(run(false), 3.0 * expected);
 }
 
 TEST(RateNoiseEstimatorTest, RefusesAPerfectGyroAndNamesTheParameter) {

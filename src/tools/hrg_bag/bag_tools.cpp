@@ -216,7 +216,7 @@ void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_t
 }
 
 GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable,
-                      bool need_precession) {
+                      TopicNeed precession) {
   rosbag::View all(bag);
   std::map<std::string, std::string> types;
   for (const rosbag::ConnectionInfo* c : all.getConnections()) types[c->topic] = c->datatype;
@@ -250,10 +250,54 @@ GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool nee
   t.turntable =
       pick(chosen.turntable, "turntable-topic", ros::message_traits::datatype<TurntableState>(), need_turntable);
   t.truth = pick(chosen.truth, "truth-topic", ros::message_traits::datatype<GroundTruth>(), false);
-  if (need_precession) {
-    t.precession = pick(chosen.precession, "precession-topic", ros::message_traits::datatype<PrecessionState>(), true);
+  if (precession != TopicNeed::kNo) {
+    t.precession = pick(chosen.precession, "precession-topic", ros::message_traits::datatype<PrecessionState>(),
+                        precession == TopicNeed::kRequired);
   }
   return t;
+}
+
+namespace {
+
+// The MD5 sum of hrg_gyro/PrecessionState before `source` was appended (header, rate, angle,
+// commands): the same bytes up to where `source` begins.
+constexpr const char* kPrecessionStateWithoutSourceMd5 = "a072295d8b564159c1f704b73deafe65";
+
+}  // namespace
+
+struct PrecessionStateReader::Impl {
+  ReusedMessageReader<PrecessionState> current;
+  std::vector<std::uint8_t> bytes;
+  const std::string* checked_md5sum = nullptr;
+  bool legacy = false;
+  // The output-stream interface rosbag::MessageInstance::write fills.
+  std::uint8_t* advance(std::uint32_t length) {
+    const std::size_t at = bytes.size();
+    bytes.resize(at + length);
+    return bytes.data() + at;
+  }
+};
+
+PrecessionStateReader::PrecessionStateReader() : impl_(std::make_unique<Impl>()) {}
+PrecessionStateReader::~PrecessionStateReader() = default;
+
+bool PrecessionStateReader::read(const rosbag::MessageInstance& instance, PrecessionState* message) {
+  Impl& d = *impl_;
+  const std::string& md5sum = instance.getMD5Sum();
+  if (&md5sum != d.checked_md5sum) {
+    d.checked_md5sum = &md5sum;
+    d.legacy = md5sum == kPrecessionStateWithoutSourceMd5;
+  }
+  if (!d.legacy) return d.current.read(instance, message);
+  d.bytes.clear();
+  instance.write(d);
+  ros::serialization::IStream stream(d.bytes.data(), static_cast<std::uint32_t>(d.bytes.size()));
+  stream.next(message->header);
+  stream.next(message->rate);
+  stream.next(message->angle);
+  stream.next(message->commands);
+  message->source.clear();
+  return true;
 }
 
 Progress::Progress(std::string what, double total)
@@ -327,14 +371,22 @@ struct ReplayBlock {
   std::vector<core::ChannelSample> samples = std::vector<core::ChannelSample>(kSize);
   std::vector<core::ProcessorResult> results = std::vector<core::ProcessorResult>(kSize);
   std::size_t count = 0;
+  // Precession states read among these messages: each goes to the sink before message `before[i]`
+  // (count: after the last). Reused from block to block.
+  std::vector<PrecessionState> states;
+  std::vector<std::size_t> before;
+  std::size_t state_count = 0;
 };
 
 }  // namespace
 
 std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, core::GyroProcessor& processor,
                              const std::function<void(const ChannelAmplitudes&, const core::ProcessorResult&)>& sink,
-                             const std::string& progress_label) {
-  rosbag::View view(bag, rosbag::TopicQuery(topic));
+                             const std::string& progress_label, const std::string& precession_topic,
+                             const std::function<void(const PrecessionState&)>& state_sink) {
+  std::vector<std::string> topics{topic};
+  if (!precession_topic.empty()) topics.push_back(precession_topic);
+  rosbag::View view(bag, rosbag::TopicQuery(topics));
   Progress progress(progress_label, view.size());
   // Two stages on two threads: this one reads the bag (the part no faster way of the rosbag API
   // avoids) into blocks of reused messages; the worker processes each block with processBatch (bit
@@ -344,28 +396,45 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
   std::array<ReplayBlock, 3> blocks;
   SerialWorker worker(1);  // declared after the blocks: stopped before they go
   const auto submit = [&](ReplayBlock* block) {
-    worker.submit([block, &processor, &sink] {
+    worker.submit([block, &processor, &sink, &state_sink] {
       for (std::size_t i = 0; i < block->count; ++i) block->samples[i] = fromMessage(block->messages[i]);
       processor.processBatch(block->samples.data(), block->count, block->results.data());
-      for (std::size_t i = 0; i < block->count; ++i) sink(block->messages[i], block->results[i]);
+      std::size_t state = 0;
+      for (std::size_t i = 0; i < block->count; ++i) {
+        for (; state < block->state_count && block->before[state] == i; ++state) state_sink(block->states[state]);
+        sink(block->messages[i], block->results[i]);
+      }
+      for (; state < block->state_count; ++state) state_sink(block->states[state]);
     });
   };
   ReusedMessageReader<ChannelAmplitudes> reader;
+  PrecessionStateReader state_reader;
   std::size_t filling = 0;
-  std::uint64_t n = 0;
+  std::uint64_t n = 0, read = 0;  // channel messages; every message of the view
   try {
     for (const rosbag::MessageInstance& m : view) {
+      ++read;
       ReplayBlock& block = blocks[filling];
+      if (!precession_topic.empty() && m.getTopic() == precession_topic) {
+        if (block.state_count == block.states.size()) {
+          block.states.emplace_back();
+          block.before.push_back(0);
+        }
+        if (!state_reader.read(m, &block.states[block.state_count])) continue;
+        block.before[block.state_count++] = block.count;
+        continue;
+      }
       if (!reader.read(m, &block.messages[block.count])) continue;
       ++n;
       if (++block.count == ReplayBlock::kSize) {
         submit(&block);
         filling = (filling + 1) % blocks.size();
         blocks[filling].count = 0;
-        progress.update(n, n);
+        blocks[filling].state_count = 0;
+        progress.update(read, n);
       }
     }
-    if (blocks[filling].count > 0) submit(&blocks[filling]);
+    if (blocks[filling].count > 0 || blocks[filling].state_count > 0) submit(&blocks[filling]);
     worker.finish();  // rethrows what the processing or the sink threw
   } catch (const rosbag::BagException& e) {
     throw UsageError(std::string("bag read error after ") + std::to_string(n) + " samples (truncated?): " + e.what());

@@ -17,6 +17,7 @@
 
 #include "bag_file_writer.h"
 #include "hrg_gyro/ChannelAmplitudes.h"
+#include "hrg_gyro/PrecessionState.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
 
@@ -68,11 +69,28 @@ struct GyroTopics {
 CLI::Validator topicName();
 /// Adds --channels-topic and, when asked, --turntable-topic and --truth-topic.
 void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_truth);
+/// Whether a subcommand looks for a topic: not at all, when the bag has one, or as a requirement.
+enum class TopicNeed { kNo, kIfPresent, kRequired };
 /// Explicit topics win; otherwise the single topic of the right type is taken. Throws UsageError
 /// when a required topic is missing, ambiguous or of the wrong type. The precession state is looked
-/// for only when needed.
+/// for only when asked (empty when not found and not required).
 GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable,
-                      bool need_precession = false);
+                      TopicNeed precession = TopicNeed::kNo);
+
+/// Reads hrg_gyro/PrecessionState records, also those of bags recorded before the message had its
+/// `source` field (an earlier MD5 sum; `source` is then empty). Like ReusedMessageReader, without a
+/// heap allocation per message once warm.
+class PrecessionStateReader {
+ public:
+  PrecessionStateReader();
+  ~PrecessionStateReader();
+  /// False (message untouched) when the record is of neither layout.
+  bool read(const rosbag::MessageInstance& instance, PrecessionState* message);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /// Percentage and rate on stderr, at most twice a second.
 class Progress {
@@ -153,9 +171,12 @@ class OutputText {
 /// Replays the channels topic of `bag` in record order through `processor`, calling `sink` with
 /// every input message and its result, in order, on a second thread (while this one reads on): the
 /// sink may keep its own state but must not share it with the caller until the call returns.
+/// With a `precession_topic`, that topic's PrecessionState records are read too and handed to
+/// `state_sink`, on the sink's thread, in their record order among the channels.
 std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, core::GyroProcessor& processor,
                              const std::function<void(const ChannelAmplitudes&, const core::ProcessorResult&)>& sink,
-                             const std::string& progress_label);
+                             const std::string& progress_label, const std::string& precession_topic = std::string(),
+                             const std::function<void(const PrecessionState&)>& state_sink = {});
 
 /// The package's Python script `name`: installed beside hrg_bag (lib/hrg_gyro, devel and install
 /// space alike); a source checkout without that copy falls back to the package's scripts/.

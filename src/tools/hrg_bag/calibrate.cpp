@@ -106,7 +106,8 @@ int runCalibrate(const CalibrateOptions& o) {
   const auto prior = std::make_shared<const core::GyroParameters>(o.params.empty() ? core::GyroParameters()
                                                                                    : core::loadParameterFile(o.params));
   const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
-  const GyroTopics topics = findTopics(*bag, o.topics, true, method.needs_turntable, method.virtual_rotation);
+  const GyroTopics topics = findTopics(*bag, o.topics, true, method.needs_turntable,
+                                       method.virtual_rotation ? TopicNeed::kRequired : TopicNeed::kNo);
   if (method.uses_generator_pairs && topics.truth.empty()) {
     throw UsageError(std::string(method.name) + " needs the generator reference (a GroundTruth topic)");
   }
@@ -127,6 +128,8 @@ int runCalibrate(const CalibrateOptions& o) {
   if (!topics.truth.empty()) wanted.push_back(topics.truth);
   rosbag::View view(*bag, rosbag::TopicQuery(wanted));
   Progress progress("calibrate", view.size());
+  PrecessionStateReader precession_reader;  // also a bag recorded before PrecessionState.source
+  PrecessionState precession;
   std::uint64_t n = 0;
   try {
     for (const rosbag::MessageInstance& m : view) {
@@ -146,8 +149,10 @@ int runCalibrate(const CalibrateOptions& o) {
                           core::quadratureRatio(r.wave.quadrature, r.wave.amplitude));
         }
       } else if (m.getTopic() == topics.precession) {
-        const PrecessionState::ConstPtr p = m.instantiate<PrecessionState>();
-        if (p) session.addTurntable(toNanoseconds(p->header.stamp), p->angle, p->rate, p->header.seq);
+        if (precession_reader.read(m, &precession)) {
+          session.addTurntable(toNanoseconds(precession.header.stamp), precession.angle, precession.rate,
+                               precession.header.seq);
+        }
       } else if (m.getTopic() == topics.turntable) {
         const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
         if (t) session.addTurntable(toNanoseconds(t->header.stamp), t->angle, t->rate, t->header.seq);

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <condition_variable>
 #include <cstdio>
+#include <deque>
 #include <iostream>
 #include <memory>
 #include <mutex>
@@ -12,7 +13,9 @@
 #include "../cli_checks.h"
 #include "bag_tools.h"
 #include "csv_text.h"
+#include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/processing/precession_watch.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "process_triad.h"
 #include "serial_worker.h"
@@ -178,6 +181,7 @@ class CsvOutput {
 
 struct ProcessOptions {
   std::string bag, params, out, csv, frame_id = "gyro_link", compression = "lz4";
+  double precession_hold = core::PrecessionWatchSettings().hold;  ///< s, the node's ~precession_hold
   bag_tools::GyroTopics topics;
   core::ProcessorConfig processor;
   bag_tools::TriadOptions triad;
@@ -196,10 +200,17 @@ int runProcess(const ProcessOptions& o) {
     throw UsageError("--params is required (the gyro's parameter file; for a triad, --triad with --axis-params)");
   }
   checkProcessorConfig(o.processor);
+  try {
+    core::PrecessionWatchSettings w;
+    w.hold = o.precession_hold;
+    w.validate();
+  } catch (const core::ConfigError& e) {
+    throw UsageError("--precession-hold: " + e.problem());
+  }
   checkOutputPaths({o.bag, o.params}, {o.out, o.csv});
   const auto params = std::make_shared<const core::GyroParameters>(core::loadParameterFile(o.params));
   const std::unique_ptr<rosbag::Bag> in = openBag(o.bag);
-  const GyroTopics topics = findTopics(*in, o.topics, true, false);
+  const GyroTopics topics = findTopics(*in, o.topics, true, false, TopicNeed::kIfPresent);
   // Both outputs are temporaries until the whole bag has been processed.
   std::unique_ptr<OutputBag> out;
   if (!o.out.empty()) out = std::make_unique<OutputBag>(o.out, o.compression);
@@ -213,45 +224,115 @@ int runProcess(const ProcessOptions& o) {
     row = std::make_unique<CsvOutput>(csv_file->stream());
   }
   core::GyroProcessor processor(o.processor, params);
-  std::uint64_t outputs = 0;
+  // The processor node's rule for the precession loop's state (~precession_hold, backward_reset).
+  core::PrecessionWatchSettings watch_settings;
+  watch_settings.hold = o.precession_hold;
+  watch_settings.backward_reset = o.processor.backward_reset;
+  core::PrecessionWatch watch(watch_settings);
+  std::uint64_t outputs = 0, precessed = 0;
   const std::string wave_topic = "/wave", output_topic = "/output";
+  // One input sample's messages and row. An output waits, as in the node, until the precession state
+  // has reached its stamp; the samples behind it wait too, so the bag and the CSV keep the input's order.
+  struct Sample {
+    ros::Time stamp;
+    std::uint32_t seq = 0;
+    const char* status = "";
+    bool has_wave = false, has_output = false;
+    double alpha = 0.0;
+    WaveState wave;
+    GyroOutput output;
+  };
+  std::deque<Sample> held;
+  Sample current;
+  core::Nanoseconds previous_accepted = 0;  // an output covers (the previous accepted stamp, its own]
+  const bool dry_run = !out && !row;        // the summary only
+  const auto write = [&](const Sample& x) {
+    if (x.has_output && (x.output.flags & core::kFlagPrecessing)) ++precessed;
+    if (dry_run) return;
+    if (out && x.has_wave) out->write(wave_topic, x.stamp, x.wave);
+    if (out && x.has_output) out->write(output_topic, x.stamp, x.output);
+    if (row) {
+      const GyroOutput& output = x.output;
+      CsvRow& c = row->next();
+      c.sec = x.stamp.sec;
+      c.nsec = x.stamp.nsec;
+      c.seq = x.seq;
+      c.status = x.status;
+      c.has_output = x.has_output;
+      c.has_wave = x.has_wave;
+      c.dt = output.dt;
+      c.dtheta = output.dtheta;
+      c.dalpha = output.dalpha;
+      c.dalpha_earth_fixed = output.dalpha_earth_fixed;
+      c.rate = output.rate;
+      c.theta_mid = output.theta_mid;
+      c.frequency = output.frequency;
+      c.scale_factor = output.scale_factor;
+      c.drift = output.drift;
+      c.rejected_before = output.rejected_before;
+      c.flags = output.flags;
+      c.alpha = x.alpha;
+      c.theta = x.wave.theta;
+      c.amplitude = x.wave.amplitude;
+      c.quadrature = x.wave.quadrature;
+      c.phase = x.wave.phase;
+      row->endRow();
+    }
+  };
+  // Writes the held samples the watch has decided, in order.
+  const auto drain = [&] {
+    core::PrecessionDecision d;
+    while (!held.empty()) {
+      Sample& x = held.front();
+      if (x.has_output) {
+        if (!watch.next(&d)) return;
+        if (d.flagged()) x.output.flags |= core::kFlagPrecessing;
+      }
+      write(x);
+      held.pop_front();
+    }
+  };
   replayChannels(
       *in, topics.channels, processor,
       [&](const ChannelAmplitudes& msg, const core::ProcessorResult& r) {
         outputs += r.has_output ? 1 : 0;
-        if (!out && !row) return;  // a dry run: the summary only
-        const WaveState wave = toWaveMessage(msg, r.wave, o.frame_id);
-        const GyroOutput output = toOutputMessage(wave.header, r);
-        if (out && r.has_wave) out->write(wave_topic, msg.header.stamp, wave);
-        if (out && r.has_output) out->write(output_topic, msg.header.stamp, output);
-        if (row) {
-          CsvRow& c = row->next();
-          c.sec = msg.header.stamp.sec;
-          c.nsec = msg.header.stamp.nsec;
-          c.seq = msg.header.seq;
-          c.status = verdictName(r);
-          c.has_output = r.has_output;
-          c.has_wave = r.has_wave;
-          c.dt = output.dt;
-          c.dtheta = output.dtheta;
-          c.dalpha = output.dalpha;
-          c.dalpha_earth_fixed = output.dalpha_earth_fixed;
-          c.rate = output.rate;
-          c.theta_mid = output.theta_mid;
-          c.frequency = output.frequency;
-          c.scale_factor = output.scale_factor;
-          c.drift = output.drift;
-          c.rejected_before = output.rejected_before;
-          c.flags = output.flags;
-          c.alpha = r.alpha;
-          c.theta = wave.theta;
-          c.amplitude = wave.amplitude;
-          c.quadrature = wave.quadrature;
-          c.phase = wave.phase;
-          row->endRow();
+        Sample& x = current;
+        x.stamp = msg.header.stamp;
+        x.has_wave = r.has_wave;
+        x.has_output = r.has_output;
+        if (r.has_wave) {
+          const core::Nanoseconds stamp = toNanoseconds(msg.header.stamp);
+          if (r.has_output) watch.addOutput(previous_accepted, stamp);
+          previous_accepted = stamp;
         }
+        if (!dry_run) {
+          x.seq = msg.header.seq;
+          x.status = verdictName(r);
+          x.alpha = r.alpha;
+          x.wave = toWaveMessage(msg, r.wave, o.frame_id);
+          x.output = toOutputMessage(x.wave.header, r);
+        } else if (r.has_output) {
+          x.output.flags = r.flags;
+        }
+        if (held.empty()) {
+          // Nothing waits: a sample without an output, or one decided at once, goes straight out.
+          core::PrecessionDecision d;
+          if (!x.has_output) return write(x);
+          if (watch.next(&d)) {
+            if (d.flagged()) x.output.flags |= core::kFlagPrecessing;
+            return write(x);
+          }
+        }
+        held.push_back(x);
+        drain();
       },
-      "process");
+      "process", topics.precession,
+      [&](const PrecessionState& state) {
+        watch.addState({toNanoseconds(state.header.stamp), state.rate, state.angle});
+        drain();
+      });
+  watch.finish();  // the bag has ended: what still waits is decided with the records it holds
+  drain();
   if (csv_file) {
     row->finish();
     csv_file->commit();
@@ -260,6 +341,12 @@ int runProcess(const ProcessOptions& o) {
   const core::ProcessorCounters& c = processor.counters();
   std::cerr << "process: " << c.received << " samples, " << outputs << " outputs, " << c.rejected() << " rejected, "
             << c.gaps << " gaps, " << c.resets << " resets, " << c.stamp_jumps << " stamp jumps dropped\n";
+  if (!topics.precession.empty()) {
+    const core::PrecessionWatchCounters& p = watch.counters();
+    std::cerr << "process: precession state from " << topics.precession << ": " << p.states << " records ("
+              << p.dropped_states << " dropped), " << precessed << " outputs flagged PRECESSING (" << p.unknown
+              << " of them with the state unknown)\n";
+  }
   if (c.accepted == 0) {
     // Nothing usable: an output file of rejections only is not a successful run.
     std::cerr << "process: no sample accepted (" << c.non_finite << " non-finite, " << c.no_signal << " no signal, "
@@ -291,14 +378,26 @@ Command addProcessCommand(CLI::App& root) {
                               ->capture_default_str();
   addCompressionOption(*cmd, &o->compression);
   addTopicOptions(*cmd, &o->topics, false);
+  cmd->add_option("--precession-topic", o->topics.precession,
+                  "hrg_gyro/PrecessionState topic of a gyro with a precession loop (default: the only one in the "
+                  "bag, if any): outputs over which the loop turned the wave are flagged PRECESSING")
+      ->check(tools::notEmpty());
   addProcessorOptions(*cmd, &o->processor);
+  cmd->add_option("--precession-hold", o->precession_hold,
+                  "s, > 0: the processor node's ~precession_hold (how long an output waits for the precession "
+                  "state of its stamp)")
+      ->transform(tools::finiteNumber())
+      ->capture_default_str()
+      ->group("Processor limits (the processor node's parameters; same rules)");
   CLI::Option* triad = addTriadOptions(*cmd, &o->triad);
   // The triad's frame is its file's, each axis's channels topic /AXIS/channels.
   triad->excludes(frame_id);
   triad->excludes(cmd->get_option("--channels-topic"));
   cmd->footer(
       "Runs the processor on the bag's channels. Numbers in the CSV are in the shortest form that reads\n"
-      "back exactly. With neither --out nor --csv, only the summary (a dry run).\n"
+      "back exactly. With neither --out nor --csv, only the summary (a dry run). When the bag holds the\n"
+      "precession loop's state (hrg_gyro/PrecessionState), the outputs over which the loop turned the wave\n"
+      "carry FLAG_PRECESSING (16) as the live node's do.\n"
       "Outputs are written to temporaries and renamed over --out/--csv only when complete; an output\n"
       "that is the same file as an input or as the other output is refused.\n"
       "With --triad FILE, the bag holds three gyros' channels, /NAME/channels for each axis of the triad\n"

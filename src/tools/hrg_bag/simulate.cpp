@@ -75,6 +75,7 @@ int runSimulate(const SimulateOptions& o) {
   Progress progress("simulate", sim.duration());
   core::SimulationSample s;
   std::uint32_t seq = 0;
+  std::string precession_source;  // every command here is the schedule's
   while (sim.next(&s)) {
     const ros::Time stamp = toRosTime(s.stamp);
     // The channel sequence number is the sample's index, so a lost sample leaves a gap in it.
@@ -94,8 +95,10 @@ int runSimulate(const SimulateOptions& o) {
       const ros::Time at = toRosTime(core::toNanoseconds(config.start_time + a.time));
       bag.write("/command/precession", at, toPrecessionCommandMessage(a, at, o.frame_id));
     }
-    if (sim.hasPrecessionLoop())
-      bag.write("/precession/state", stamp, toPrecessionStateMessage(s, trueHeader(ch.header, stamp)));
+    updatePrecessionSource(s, std::string(), &precession_source);
+    if (sim.hasPrecessionLoop()) {
+      bag.write("/precession/state", stamp, toPrecessionStateMessage(s, trueHeader(ch.header, stamp), precession_source));
+    }
     progress.update(sim.elapsed(), ++seq);
   }
   bag.commit();

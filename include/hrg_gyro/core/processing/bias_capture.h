@@ -12,7 +12,8 @@
 // Stillness is judged on the compensated rate, in blocks of `block` seconds: the capture is
 // refused when a block's mean rate leaves the capture's mean by more than `max_motion`, when the
 // mean itself is further than `max_bias` from the Earth rate (a turntable at constant rate), when
-// the input has a gap or a reset, or when the model changes during the capture.
+// the input has a gap or a reset, when the precession loop turns the wave (an output flagged
+// PRECESSING), or when the model changes during the capture.
 #pragma once
 
 #include <cstdint>

@@ -60,6 +60,7 @@ enum OutputFlags : std::uint8_t {
   kFlagReset = 2,
   kFlagFrequencyOutOfRange = 4,
   kFlagFrequencyUnknown = 8,
+  kFlagPrecessing = 16,
 };
 
 enum class SampleVerdict : std::uint8_t {

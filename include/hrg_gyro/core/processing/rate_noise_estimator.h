@@ -35,7 +35,8 @@ class RateNoiseEstimator {
   explicit RateNoiseEstimator(const RateNoiseSettings& settings = RateNoiseSettings());
 
   /// One output of the processor: its integrated alpha (rad), dt (s) and flags (GyroOutput's).
-  /// A gap or reset breaks the run of continuous alphas.
+  /// A gap or reset breaks the run of continuous alphas, and so does an output flagged PRECESSING
+  /// (alpha then turns with the commanded rate, whose steps are no noise of the gyro's).
   void add(double alpha, double dt, std::uint8_t flags);
   /// The variance of the rate of the latest output, (rad/s)^2: never 0, never NaN.
   double variance() const;
