@@ -4,10 +4,16 @@ finishes by itself, accepts, writes the parameter file and reloads the processor
 show what each method is known to get right (and, for constant rate, its known drift leak). The field
 method commands its own virtual rotation: the driver must have executed the calibrator's plan, a
 calibrator interrupted mid-plan must stop it, a run that sees another node's command must abort with
-nothing written, and the rate a killed calibrator leaves in force must be flagged by the processor."""
+nothing written, and the rate a killed calibrator leaves in force must be flagged by the processor.
+With glitched stamps (one channel sample and one table record far ahead, one of each far back), the
+constant-rate run is accepted as the clean session calibrated offline, each glitch dropped and
+counted."""
+import glob
 import os
 import signal
+import subprocess
 import sys
+import tempfile
 import unittest
 from xmlrpc.client import ServerProxy
 
@@ -35,6 +41,19 @@ INTRINSIC_COS2, INTRINSIC_SIN2 = -2.0e-4, 1.5e-4
 # loops' share).
 FIELD_D0 = 9.9733e-06
 FIELD_GAIN = 1.0035038
+
+
+def clean_offline_report(scenario, prior, method):
+    """The same scenario, without glitches, simulated and calibrated by hrg_bag: its report."""
+    hrg_bag = subprocess.check_output(["catkin_find", "--first-only", "--libexec", "hrg_gyro", "hrg_bag"],
+                                      universal_newlines=True).strip()
+    work = tempfile.mkdtemp(prefix="hrg_clean_")
+    bag, report = os.path.join(work, "clean.bag"), os.path.join(work, "clean.report.yaml")
+    subprocess.run([hrg_bag, "simulate", "--scenario", scenario, "--out", bag], check=True,
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=600)
+    subprocess.run([hrg_bag, "calibrate", bag, "--method", method, "--params", prior, "--report", report],
+                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=600)
+    return util.load_yaml(report)
 
 
 def coefficient(estimate, kind, order):
@@ -71,6 +90,36 @@ class CalibrationMethod(unittest.TestCase):
             c4, _ = coefficient(k, "cos", 4)
             self.assertAlmostEqual(c4, K_COS4, delta=5e-6)  # D has no 4 theta term: unbiased
             self.assertAlmostEqual(k.mean, -0.56, delta=1e-3)  # D(theta_dwell) vs mean D leaks here
+        elif self.case == "constant_rate_glitched":
+            statuses = {}
+
+            def on_diagnostics(msg):
+                for s in msg.status:
+                    statuses[s.name] = {kv.key: kv.value for kv in s.values}
+            rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics, queue_size=100)
+            r = self.final_result(1)
+            self.check_written(r, "constant_rate")
+            # Each glitch was dropped and counted, and the run never restarted.
+            report_path = [p for p in glob.glob(os.path.join(os.path.dirname(rospy.get_param("~parameter_file")),
+                                                             "*.report.yaml"))][0]
+            report = util.load_yaml(report_path)
+            self.assertEqual(report["turntable_rejected"]["stamp_jump"], 2, report["turntable_rejected"])
+            self.assertEqual(report["restarts"], 0)
+            util.wait_for(lambda: any("stamp jumps dropped" in v for v in statuses.values()), 30,
+                          "the processor's input diagnostics")
+            processor = [v for v in statuses.values() if "stamp jumps dropped" in v][0]
+            self.assertEqual(int(processor["stamp jumps dropped"]), 2)
+            self.assertEqual(int(processor["resets (time went backwards)"]), 0)
+            # The same estimates as the clean session's, offline: within a tenth of their sigmas.
+            clean = clean_offline_report(rospy.get_param("~scenario"), rospy.get_param("~prior_file"),
+                                         "constant_rate")["scale_factor"][0]
+            k = r.scale_factor[0]
+            worst = abs(k.mean - clean["mean"]) / k.mean_std
+            for kind in ("cos", "sin"):
+                for value, std, other in zip(getattr(k, kind), getattr(k, kind + "_std"), clean[kind]):
+                    worst = max(worst, abs(value - other) / std)
+            print("glitched live against clean offline: largest difference %.3f sigma" % worst)
+            self.assertLess(worst, 0.1)
         elif self.case == "step":
             r = self.final_result(1)
             self.check_written(r, "step")

@@ -10,7 +10,11 @@ through three live processors into the calibrator. Once the calibrator's diagnos
 record of the bag's streams has arrived, ~finish; the result must be accepted, written (the three
 axis files then the triad file), each processor reloaded (its ModelInfo says triad), the files must
 hold what ~result says and the replaced ones their .bak, and M, the bias and each axis's K must be
-the offline ones (tolerances below, with why)."""
+the offline ones (tolerances below, with why). Two stray fixture records, published by the test once
+the session runs (the last position stamped 1000 s ahead and 100 s back, as a bench's clock glitch or
+a buffered message makes them), are dropped and counted: the run never restarts and the result is
+the offline one all the same."""
+import copy
 import math
 import os
 import shutil
@@ -25,7 +29,7 @@ import rostest
 from diagnostic_msgs.msg import DiagnosticArray
 from std_srvs.srv import Trigger
 
-from hrg_gyro.msg import ModelInfo, TriadCalibrationResult, TurntableState
+from hrg_gyro.msg import FixturePosition, ModelInfo, TriadCalibrationResult, TurntableState
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hrg_test_util as util  # noqa: E402
@@ -94,14 +98,29 @@ class TriadCalibrationLive(unittest.TestCase):
                       self.status.get("turntable received", "0") != "0", 120, "the session to start")
         gate.unregister()
 
+        # Two stray fixture records: the position in force, stamped 1000 s ahead and 100 s back.
+        fixture = util.Latest("/fixture/position", FixturePosition)
+        stray = rospy.Publisher("/fixture/position", FixturePosition, queue_size=2)
+        util.wait_for(lambda: fixture.msg is not None and rospy.get_rostime().to_sec() > 120.0, 300,
+                      "a fixture record past 120 s of the session")
+        util.wait_for(lambda: stray.get_num_connections() >= 2, 30, "the calibrator's subscription to the strays")
+        for offset in (1000.0, -100.0):
+            m = copy.deepcopy(fixture.msg)
+            m.header.stamp = rospy.Time.from_sec(m.header.stamp.to_sec() + offset)
+            stray.publish(m)
+            rospy.sleep(rospy.Duration(0.5))
+        counts["fixture"] += 2
+
         def arrived():
             return all(self.status.get(k + " received") == str(n) for k, n in counts.items())
         util.wait_for(arrived, 400, "every record at the calibrator: %r (diagnostic: %r)" % (counts, self.status))
         late = {}
         for key in ["axis x", "axis y", "axis z", "turntable", "fixture"]:
-            for drop in ("dropped (zero stamp)", "dropped (out of order)"):
-                self.assertEqual(self.status.get("%s %s" % (key, drop)), "0", key + " " + drop)
+            for drop in ("dropped (zero stamp)", "dropped (out of order)", "dropped (stamp jump)"):
+                expected = "2" if (key, drop) == ("fixture", "dropped (stamp jump)") else "0"
+                self.assertEqual(self.status.get("%s %s" % (key, drop)), expected, key + " " + drop)
             late[key] = self.status.get(key + " fed late (behind later stamps)")
+        self.assertEqual(self.status.get("restarts (time went backwards)"), "0")
         print("records fed late (a stream lagged beyond ~stream_hold): %r" % late)
 
         finish = rospy.ServiceProxy("/calibrator/finish", Trigger)

@@ -271,6 +271,9 @@ void TriadRos::diagnoseTriad(diagnostic_updater::DiagnosticStatusWrapper& stat) 
   } else if (gaps > 0) {
     stat.summaryf(DiagnosticStatus::WARN, "%lu of %lu samples are gaps (an axis missing or flagged)",
                   static_cast<unsigned long>(gaps), static_cast<unsigned long>(samples));
+  } else if (c.precessing > reported_.precessing) {
+    stat.summary(DiagnosticStatus::WARN,
+                 "an axis's wave is turned on command (FLAG_PRECESSING): its rate is not the body's, do not fuse");
   } else if (c.axis_flagged > reported_.axis_flagged) {
     stat.summary(DiagnosticStatus::WARN, "an axis's output carries a frequency flag");
   } else {
@@ -281,6 +284,7 @@ void TriadRos::diagnoseTriad(diagnostic_updater::DiagnosticStatusWrapper& stat) 
   stat.add("gaps", c.gaps);
   stat.add("resets", c.resets);
   stat.add("axis flagged", c.axis_flagged);
+  stat.add("precessing (an axis's wave turned on command)", c.precessing);
   stat.add("waited out (an axis too late)", c.timeouts);
   stat.add("overflowed (emitted as gaps)", c.non_finite);
   stat.add("stamps skipped by an axis (carried into the next)", c.carried);

@@ -313,6 +313,7 @@ void TriadCombiner::emitHeads(const std::array<const Held*, 3>& heads, std::uint
   if (out.flags & kTriadFlagGap) ++counters_.gaps;
   if (out.flags & kTriadFlagReset) ++counters_.resets;
   if (out.flags & kTriadFlagAxisFlagged) ++counters_.axis_flagged;
+  if (out.flags & kTriadFlagPrecessing) ++counters_.precessing;
 }
 
 void TriadCombiner::takeVariance(std::size_t axis, const Held& h) {
@@ -361,6 +362,7 @@ void TriadCombiner::combineAligned(const Held& h0, const Held& h1, const Held& h
     if (axis_flags & kFlagGap) flags |= kTriadFlagGap;
     if (axis_flags & kFlagReset) flags |= kTriadFlagReset;
     if (axis_flags & (kFlagFrequencyOutOfRange | kFlagFrequencyUnknown)) flags |= kTriadFlagAxisFlagged;
+    if (axis_flags & kFlagPrecessing) flags |= kTriadFlagPrecessing;
   }
   const double smallest_dt = std::min(h0.dt, std::min(h1.dt, h2.dt));
   // The same interval on every axis: an axis that missed the stamp before spans two.
@@ -412,6 +414,7 @@ void TriadCombiner::combinePartial(const std::array<const Held*, 3>& heads, Tria
     takeVariance(a, *h);
     if (h->flags & kFlagReset) flags |= kTriadFlagReset;
     if (h->flags & (kFlagFrequencyOutOfRange | kFlagFrequencyUnknown)) flags |= kTriadFlagAxisFlagged;
+    if (h->flags & kFlagPrecessing) flags |= kTriadFlagPrecessing;
     smallest_dt = std::min(smallest_dt, h->dt);
   }
   writeCovariance(out);

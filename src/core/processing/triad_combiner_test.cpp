@@ -218,8 +218,9 @@ TEST(TriadCombinerTest, AnAxisWhoseIntervalDoesNotMatchIsAGapNeverAMix) {
 TEST(TriadCombinerTest, AnAxisFlagIsTheTriadsFlag) {
   TriadCombiner combiner(TriadCombinerSettings(), misalignedTriad());
   std::vector<TriadBodySample> out;
-  const std::uint8_t flags[4] = {kFlagGap, kFlagReset, kFlagFrequencyUnknown, kFlagFrequencyOutOfRange};
-  for (std::int64_t i = 0; i < 4; ++i) {
+  const std::uint8_t flags[5] = {kFlagGap, kFlagReset, kFlagFrequencyUnknown, kFlagFrequencyOutOfRange,
+                                 kFlagPrecessing};
+  for (std::int64_t i = 0; i < 5; ++i) {
     for (std::size_t a = 0; a < 3; ++a) {
       AxisOutput o = output(a, i);
       if (a == 1) o.flags = flags[i];
@@ -227,7 +228,7 @@ TEST(TriadCombinerTest, AnAxisFlagIsTheTriadsFlag) {
       combiner.add(a, o, &out);
     }
   }
-  ASSERT_EQ(out.size(), 4u);
+  ASSERT_EQ(out.size(), 5u);
   EXPECT_EQ(out[0].flags, kTriadFlagGap);
   EXPECT_EQ(out[1].flags, kTriadFlagReset);
   EXPECT_FALSE(out[0].integrated());
@@ -238,7 +239,11 @@ TEST(TriadCombinerTest, AnAxisFlagIsTheTriadsFlag) {
   EXPECT_EQ(out[3].flags, kTriadFlagAxisFlagged);
   EXPECT_TRUE(out[2].integrated());
   EXPECT_NE(out[2].delta_angle, Eigen::Vector3d::Zero());
-  EXPECT_EQ(combiner.counters().axes[1].flagged, 4u);
+  // A wave turned on command: combined as measured and flagged (its axis's variance says the rest).
+  EXPECT_EQ(out[4].flags, kTriadFlagPrecessing);
+  EXPECT_TRUE(out[4].integrated());
+  EXPECT_EQ(combiner.counters().precessing, 1u);
+  EXPECT_EQ(combiner.counters().axes[1].flagged, 5u);
 }
 
 TEST(TriadCombinerTest, StampsWithinTheToleranceAreOneInstant) {

@@ -72,6 +72,7 @@ enum TriadFlags : std::uint8_t {
   kTriadFlagGap = 1,          ///< an axis lacked this stamp, its interval differed, or it flagged a gap
   kTriadFlagReset = 2,        ///< an axis reset, or the stamps went back for good (a new epoch)
   kTriadFlagAxisFlagged = 4,  ///< an axis's output carried a frequency flag (values still combined)
+  kTriadFlagPrecessing = 8,   ///< an axis's wave was turned on command: its rate is not the body's
 };
 
 struct TriadBodySample {
@@ -134,6 +135,7 @@ struct TriadCounters {
   std::uint64_t gaps = 0;          ///< with FLAG_GAP
   std::uint64_t resets = 0;        ///< with FLAG_RESET
   std::uint64_t axis_flagged = 0;  ///< with FLAG_AXIS_FLAGGED
+  std::uint64_t precessing = 0;    ///< with FLAG_PRECESSING
   std::uint64_t timeouts = 0;      ///< emitted because an axis was waited for too long (max_wait, max_pending)
   std::uint64_t non_finite = 0;    ///< combinations that overflowed (emitted as gaps)
   /// Stamps not emitted: an axis delivered them after a later stamp had gone out (as a gap, once its
