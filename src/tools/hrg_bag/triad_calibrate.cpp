@@ -106,6 +106,11 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
   const std::map<std::string, std::string> params = perAxis(o.axis_params, axes, "axis-params");
   std::map<std::string, std::string> outs = perAxis(o.axis_out, axes, "axis-out");
   const std::map<std::string, std::string> channels = perAxis(o.axis_channels, axes, "axis-channels");
+  std::array<std::string, 3> channel_topics;
+  for (int i = 0; i < 3; ++i) {
+    channel_topics[i] = channels.count(axes[i]) ? channels.at(axes[i]) : "/" + axes[i] + "/channels";
+  }
+  checkDistinctAxisTopics(axes, channel_topics);
   for (const std::string& a : axes) {
     if (!params.count(a)) {
       throw UsageError("--axis-params " + a + "=FILE missing: each axis's prior parameter file is needed (its P is " +
@@ -156,9 +161,7 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
       findTopic(*bag, o.turntable_topic, ros::message_traits::datatype<TurntableState>(), "turntable-topic");
   const std::string fixture =
       findTopic(*bag, o.fixture_topic, ros::message_traits::datatype<FixturePosition>(), "fixture-topic");
-  std::array<std::string, 3> channel_topics;
   for (int i = 0; i < 3; ++i) {
-    channel_topics[i] = channels.count(axes[i]) ? channels.at(axes[i]) : "/" + axes[i] + "/channels";
     const std::string type = topicType(*bag, channel_topics[i]);
     const std::string wanted = ros::message_traits::datatype<ChannelAmplitudes>();
     if (type.empty()) {
