@@ -432,7 +432,9 @@ TEST(CalibrationSessionTest, AFieldRunCallsItsStreamThePrecessionState) {
     EXPECT_NE(dropped, "") << nameOf(method);
     EXPECT_EQ(numberAfter(dropped, ""), static_cast<double>(glitched.turntable_rejected.total()));
     EXPECT_GT(glitched.turntable_rejected.bad_rate, 0u);
-    if (field) EXPECT_FALSE(mentions(glitched, "turntable")) << glitched.reason;
+    if (field) {
+      EXPECT_FALSE(mentions(glitched, "turntable")) << glitched.reason;
+    }
   }
 }
 

@@ -112,7 +112,7 @@ TEST(TriadParametersTest, AxisNamesAreRosNameComponents) {
     EXPECT_NE(e.problem().find("'y\\x1B[2J'"), std::string::npos) << e.problem();
     EXPECT_EQ(e.problem().find('\x1b'), std::string::npos);
   }
-  for (const std::string& good : {"y", "Y", "gyro_2", "y2", "axis_B_10"}) {
+  for (const char* good : {"y", "Y", "gyro_2", "y2", "axis_B_10"}) {
     EXPECT_EQ(parseTriadParameters(YAML::Load(axes(good))).axes[1], good);
   }
   EXPECT_TRUE(isValidAxisName("x"));
