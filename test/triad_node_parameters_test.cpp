@@ -35,10 +35,15 @@ class TriadNodeParameters : public ::testing::Test {
   }
 
   /// `key` set to `value` alone is refused, the message naming the key and `expected` text.
+  /// A namespace no case has used yet (one counter for every instantiation of expectRefused).
+  static std::string freshName() {
+    static int n = 0;
+    return "bad_" + std::to_string(++n);
+  }
+
   template <typename T>
   static void expectRefused(const std::string& key, const T& value, const std::string& expected) {
-    static int n = 0;
-    const std::string name = "bad_" + std::to_string(++n);
+    const std::string name = freshName();
     node(name).setParam(key, value);
     const std::string message = refusal(name);
     EXPECT_NE(message.find("triad: ~" + key), std::string::npos) << key << " = " << value << ": " << message;
@@ -56,11 +61,13 @@ TEST_F(TriadNodeParameters, AValidSetStartsOnTheEdgesOfEachRule) {
   pnh.setParam("diagnostic_period", 3600.0);
   pnh.setParam("stall_timeout", 1e-3);
   pnh.setParam("expected_rate", 1e-3);
-  TriadRos triad(ros::NodeHandle("edges"), pnh);
-  EXPECT_EQ(triad.parameters().unknownKeys(), Keys{});
+  {
+    TriadRos triad(ros::NodeHandle("edges"), pnh);
+    EXPECT_EQ(triad.parameters().unknownKeys(), Keys{});
+  }
   pnh.setParam("rate_tolerance", 1.0);
   pnh.setParam("diagnostic_period", 1e-3);
-  TriadRos again(ros::NodeHandle("edges"), pnh);
+  EXPECT_EQ(refusal("edges"), "");
 }
 
 TEST_F(TriadNodeParameters, QueuesAndCountsMustHoldOne) {
