@@ -103,7 +103,9 @@ class TriadDiagnostics(unittest.TestCase):
                         return r
             return None
         try:
-            return util.wait_for(found, WAIT, "a combination status at level %d saying %s" % (level, texts))
+            r = util.wait_for(found, WAIT, "a combination status at level %d saying %s" % (level, texts))
+            print("[ measured ] level %d: %s" % (r[0], r[1]))
+            return r
         except AssertionError:
             with self.lock:
                 seen = sorted(set((r[0], r[1]) for r in self.reports[start:]))
