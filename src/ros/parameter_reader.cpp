@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 
 namespace hrg_gyro {
@@ -21,15 +22,16 @@ void flatten(XmlRpc::XmlRpcValue& value, const std::string& prefix, std::vector<
   }
 }
 
-/// A value for a message: shortest form that reads back ("nan", "inf", "0.5").
+/// A value for a message: the shortest form that reads back ("nan", "inf", "0.5", "60"), in
+/// exponent form only for very large or small magnitudes.
 std::string numberText(double v) {
+  const bool exponent_ok = std::abs(v) >= 1e6 || (v != 0.0 && std::abs(v) < 1e-4);
   char text[32];
-  std::snprintf(text, sizeof text, "%.17g", v);
-  for (int precision = 1; precision < 17; ++precision) {
-    char shorter[32];
-    std::snprintf(shorter, sizeof shorter, "%.*g", precision, v);
-    if (std::strtod(shorter, nullptr) == v) return shorter;
+  for (int precision = 1; precision <= 17; ++precision) {
+    std::snprintf(text, sizeof text, "%.*g", precision, v);
+    if (std::strtod(text, nullptr) == v && (exponent_ok || std::strchr(text, 'e') == nullptr)) return text;
   }
+  std::snprintf(text, sizeof text, "%.17g", v);
   return text;
 }
 
