@@ -21,6 +21,7 @@ import rosgraph
 import rosnode
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 
@@ -67,6 +68,14 @@ class CalibrationMethod(unittest.TestCase):
         self.results = util.Latest("/calibrator/result", CalibrationResult, keep_all=True)
         self.model = util.Latest("/processor/model", ModelInfo, keep_all=True)
         self.precession = util.Latest("/precession/state", PrecessionState)
+        self.run_keys = set()  # keys of the calibrator's status while a run was in progress
+        rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics, queue_size=100)
+
+    def on_diagnostics(self, msg):
+        for s in msg.status:
+            values = {kv.key: kv.value for kv in s.values}
+            if s.name.endswith(": calibration") and "progress" in values:
+                self.run_keys.update(values)
 
     def final_result(self, count):
         util.wait_for(lambda: self.results.count >= count, rospy.get_param("~timeout", 300.0),
@@ -166,6 +175,11 @@ class CalibrationMethod(unittest.TestCase):
                           "the driver to have executed the four planned commands")
             self.assertEqual(self.precession.msg.commands, 4)
             self.assertEqual(self.precession.msg.rate, 0.0)
+            # The run's diagnostics count the stream it reads: precession states, not turntable records.
+            self.assertIn("precession states", self.run_keys)
+            self.assertIn("precession dropped (bad rate)", self.run_keys)
+            self.assertIn("without precession state", self.run_keys)
+            self.assertEqual([k for k in self.run_keys if "turntable" in k], [])
         elif self.case == "field_interrupted":
             # SIGINT while the wave turns at the plan's +0.2 rad/s: the calibrator commands 0 before it exits.
             with open(rospy.get_param("~parameter_file")) as f:

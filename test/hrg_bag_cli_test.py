@@ -18,7 +18,7 @@ import rosbag
 import rospy
 import rostest
 import yaml
-from hrg_gyro.msg import TurntableState
+from hrg_gyro.msg import ChannelAmplitudes, TurntableState
 from std_msgs.msg import String
 
 
@@ -428,6 +428,33 @@ class HrgBagCli(unittest.TestCase):
             args = ["process", self.short, "--params", self.params] + extra
             self.assertRefused(hrg_bag(*args), option, "requires --triad", args)
         self.assertFalse(os.path.exists(out), "a refused process writes nothing")
+
+    def test_triad_axes_reading_one_channels_topic_are_refused(self):
+        # --axis-channels y=/x/channels: y would read x's channels, which x reads by default. Both
+        # process --triad and calibrate --method triad refuse it (exit 2) naming both axes and the topic.
+        bag_path = self.path("three_axes.bag")
+        with rosbag.Bag(bag_path, "w") as bag:
+            for a in ("x", "y", "z", "w"):
+                m = ChannelAmplitudes()
+                m.header.stamp = rospy.Time(1)
+                bag.write("/%s/channels" % a, m, rospy.Time(1))
+        triad = os.path.join(self.pkg, "config/triad.yaml")
+        every = ["--axis-params", "x=" + self.params, "--axis-params", "y=" + self.params,
+                 "--axis-params", "z=" + self.params]
+        out, csv_out = self.path("one_topic.yaml"), self.path("one_topic.csv")
+        commands = (["process", bag_path, "--triad", triad, "--csv", csv_out],
+                    ["calibrate", bag_path, "--method", "triad", "--triad", triad, "--out", out])
+        cases = [
+            (["--axis-channels", "y=/x/channels"], "axes x and y both read the channels topic /x/channels"),
+            (["--axis-channels", "x=/z/channels"], "axes x and z both read the channels topic /z/channels"),
+            (["--axis-channels", "y=/w/channels", "--axis-channels", "z=/w/channels"],
+             "axes y and z both read the channels topic /w/channels"),
+        ]
+        for command in commands:
+            for extra, why in cases:
+                args = command + every + extra
+                self.assertRefused(hrg_bag(*args), "--axis-channels", why, args)
+        self.assertFalse(os.path.exists(out) or os.path.exists(csv_out), "a refused run writes nothing")
 
     def test_calibrate_refuses_what_the_gates_refuse(self):
         out, report = self.path("refused.yaml"), self.path("refused.report.yaml")

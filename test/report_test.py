@@ -195,6 +195,9 @@ class ReportTest(unittest.TestCase):
         code, out, err = run(HRG_BAG, "calibrate", bag, "--method", "field", "--params", self.prior, "--out", params,
                              "--report", report_path)
         self.assertEqual(code, 0, out + err)
+        # The field method's stream is the precession loop's state, and the tool counts it as such.
+        self.assertRegex(out, r"calibrate: precession states [1-9][0-9]*, dropped 0 ")
+        self.assertNotIn("turntable records", out)
         html_path = self.path("field.html")
         code, stdout, err = run("/usr/bin/python3", self.script, report_path, "--out", html_path)
         self.assertEqual(code, 0, err)
@@ -220,6 +223,10 @@ class ReportTest(unittest.TestCase):
                     "field.negative_turns", "field.excess_scatter"):
             self.assertIn(key, page.by_q)
         self.assertIn("K was kept from the table calibration", page.by_id["k-kept"])
+        with open(html_path) as f:
+            html = f.read()
+        self.assertIn("Precession states <span data-q=\"turntable_records\">", html)
+        self.assertNotIn("Turntable records", html)
         self.assertNotIn("harmonics-scale_factor", page.by_id, "no K table: K was not estimated")
         # The page says the gain the simulated drive realised (1 + virtual_rate_gain_error = 1.003, within
         # the loop's theta-dependent part) and the prior's K0 it kept.

@@ -3,11 +3,13 @@
 // triad does not have, an unreadable axis file, two axes on one file, an axis file that is the triad
 // file's .bak, a file to write outside ~output_directory (also through a link) are refused; so is an
 // unknown key, at the top level or in the triad section (as the single-axis calibrator refuses its
-// unknown keys); ~method chooses the wrapper.
+// unknown keys); so is a bad number of the node's own (queue, hold, periods), with the key and the
+// value named; ~method chooses the wrapper.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -188,6 +190,47 @@ TEST_F(TriadCalibratorParameters, SingleAxisKeysAreRefusedWhereTheyWouldMislead)
   pnh.setParam("stream_hold", -1.0);
   const std::string hold = refusal("stages");
   EXPECT_NE(hold.find("~stream_hold"), std::string::npos) << hold;
+}
+
+TEST_F(TriadCalibratorParameters, BadNumbersAreRefusedNamingTheKey) {
+  // The node's own numbers (the calibration settings are the core parser's, tested there): never a
+  // queue of 0, a NaN hold or an infinite period started silently.
+  struct Case {
+    const char* key;
+    double value;
+    const char* expected;
+  };
+  const std::vector<Case> cases = {
+      {"stream_hold", NAN, "must be in [0, 60] s, not nan"},
+      {"stream_hold", -1.0, "not -1"},
+      {"stream_hold", 61.0, "not 61"},
+      {"heap_trim_period", NAN, "must be a finite number (s; <= 0: never), not nan"},
+      {"heap_trim_period", INFINITY, "not inf"},
+      {"diagnostic_period", 0.0, "must be in (0, 3600] s, not 0"},
+      {"diagnostic_period", NAN, "not nan"},
+      {"diagnostic_period", INFINITY, "not inf"},
+  };
+  int n = 0;
+  for (const Case& c : cases) {
+    const std::string name = "number_" + std::to_string(++n);
+    node(name).setParam(c.key, c.value);
+    const std::string message = refusal(name);
+    EXPECT_NE(message.find(std::string("calibrator (triad): ~") + c.key), std::string::npos)
+        << c.key << ": " << message;
+    EXPECT_NE(message.find(c.expected), std::string::npos) << c.key << ": " << message;
+  }
+  for (const int queue : {0, -1}) {
+    const std::string name = "queue_" + std::to_string(-queue);
+    node(name).setParam("queue_size", queue);
+    const std::string message = refusal(name);
+    EXPECT_NE(
+        message.find("calibrator (triad): ~queue_size must be at least 1 (messages), not " + std::to_string(queue)),
+        std::string::npos)
+        << message;
+  }
+  // A negative trim period is the documented "never": accepted.
+  node("never_trim").setParam("heap_trim_period", -1.0);
+  EXPECT_EQ(refusal("never_trim"), "");
 }
 
 }  // namespace

@@ -43,10 +43,9 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
       pairing_([this](core::Nanoseconds t, const core::ChannelVector& raw, const core::ChannelVector& reference) {
         session()->addGeneratorPair(t, raw, reference);
       }),
-      updater_(nh, pnh, pnh.getNamespace()) {
+      updater_(nh, params_.checkDiagnosticPeriod(), pnh.getNamespace()) {
   base_settings_ = core::CalibrationSettings::parse(core::YamlField(privateParameters(pnh_), ""), nodeOnlyKeys());
   params_.claim(core::CalibrationSettings::keyPaths());
-  params_.claim({"diagnostic_period"});  // read by diagnostic_updater itself
   // The triad mode's keys (TriadCalibratorRos reads them): shared template, not used by one axis.
   std::vector<std::string> triad_keys{"triad_file", "reload_services", "stream_hold"};
   for (const std::string& k : core::TriadCalibrationSettings::keys()) triad_keys.push_back("triad/" + k);
@@ -93,8 +92,9 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     }
   }
   calibration_ = std::make_unique<core::StagedCalibration>(base_settings_, stages);
-  const int queue_size = params_.get("queue_size", 50000);  // as the processor's: seconds of backlog at 10 kHz
-  const double heap_trim_period = params_.get("heap_trim_period", 10.0);  // s of wall time; <= 0: never
+  // As the processor's: seconds of backlog at 10 kHz.
+  const int queue_size = params_.getAtLeast("queue_size", 50000, 1, "messages");
+  const double heap_trim_period = params_.getFinite("heap_trim_period", 10.0, "s; <= 0: never");
   const bool autostart = params_.get("autostart", true);
   params_.warnAboutUnknownKeys();
 
@@ -540,20 +540,22 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
     }
     stat.add("method", core::nameOf(session()->settings().method));
     stat.add("progress", p.fraction);
-    stat.add("turntable states", c.turntable);
+    // The table's stream: a field run's is the precession loop's state.
+    const std::string stream = fieldRun() ? "precession" : "turntable";
+    stat.add(stream + " states", c.turntable);
     stat.add("wave samples", c.wave);
     stat.add("used", c.used);
     stat.add("not on a settled plateau", c.unsettled);
-    stat.add("without turntable state", c.unsynchronized);
+    stat.add("without " + stream + " state", c.unsynchronized);
     stat.add("dropped (out-of-order stamps)", c.out_of_order);
     stat.add("dropped (stamp jumps)", c.wave_jumps);
-    // Glitched turntable records, dropped before the plateau detector (all runs of this session).
-    stat.add("turntable dropped (bad rate)", c.rejected.bad_rate);
-    stat.add("turntable dropped (bad angle)", c.rejected.bad_angle);
-    stat.add("turntable dropped (zero stamp)", c.rejected.bad_stamp);
-    stat.add("turntable dropped (duplicate stamp)", c.rejected.duplicate);
-    stat.add("turntable dropped (out-of-order stamp)", c.rejected.out_of_order);
-    stat.add("turntable dropped (stamp jump)", c.rejected.stamp_jump);
+    // Glitched records of that stream, dropped before the plateau detector (all runs of this session).
+    stat.add(stream + " dropped (bad rate)", c.rejected.bad_rate);
+    stat.add(stream + " dropped (bad angle)", c.rejected.bad_angle);
+    stat.add(stream + " dropped (zero stamp)", c.rejected.bad_stamp);
+    stat.add(stream + " dropped (duplicate stamp)", c.rejected.duplicate);
+    stat.add(stream + " dropped (out-of-order stamp)", c.rejected.out_of_order);
+    stat.add(stream + " dropped (stamp jump)", c.rejected.stamp_jump);
     if (!field_run_.empty()) {
       stat.add("field commands sent", field_commands_sent_);
       stat.add("field commands planned", field_run_.plan().size());

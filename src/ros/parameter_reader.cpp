@@ -2,6 +2,10 @@
 
 #include <ros/console.h>
 
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 
 namespace hrg_gyro {
@@ -17,6 +21,21 @@ void flatten(XmlRpc::XmlRpcValue& value, const std::string& prefix, std::vector<
     flatten(it->second, prefix.empty() ? it->first : prefix + "/" + it->first, out);
   }
 }
+
+/// A value for a message: the shortest form that reads back ("nan", "inf", "0.5", "60"), in
+/// exponent form only for very large or small magnitudes.
+std::string numberText(double v) {
+  const bool exponent_ok = std::abs(v) >= 1e6 || (v != 0.0 && std::abs(v) < 1e-4);
+  char text[32];
+  for (int precision = 1; precision <= 17; ++precision) {
+    std::snprintf(text, sizeof text, "%.*g", precision, v);
+    if (std::strtod(text, nullptr) == v && (exponent_ok || std::strchr(text, 'e') == nullptr)) return text;
+  }
+  std::snprintf(text, sizeof text, "%.17g", v);
+  return text;
+}
+
+std::string unitText(const std::string& unit) { return unit.empty() ? std::string() : " " + unit; }
 
 }  // namespace
 
@@ -60,6 +79,52 @@ std::vector<std::string> ParameterReader::unknownKeys() const {
     if (!known) unknown.push_back(key);
   }
   return unknown;
+}
+
+void ParameterReader::failRule(const std::string& key, const std::string& rule, const std::string& value) const {
+  throw std::invalid_argument(node_ + ": ~" + key + " must be " + rule + ", not " + value);
+}
+
+double ParameterReader::getPositive(const std::string& key, double fallback, const std::string& unit) {
+  double v = fallback;
+  if (getOptional(key, &v) && !(v > 0.0 && std::isfinite(v))) {
+    failRule(key, "a positive finite number" + (unit.empty() ? std::string() : " (" + unit + ")"), numberText(v));
+  }
+  return v;
+}
+
+double ParameterReader::getInRange(const std::string& key, double fallback, double low, double high,
+                                   const std::string& unit) {
+  double v = fallback;
+  if (getOptional(key, &v) && !(v >= low && v <= high && std::isfinite(v))) {
+    failRule(key, "in [" + numberText(low) + ", " + numberText(high) + "]" + unitText(unit), numberText(v));
+  }
+  return v;
+}
+
+double ParameterReader::getFinite(const std::string& key, double fallback, const std::string& unit) {
+  double v = fallback;
+  if (getOptional(key, &v) && !std::isfinite(v)) {
+    failRule(key, "a finite number" + (unit.empty() ? std::string() : " (" + unit + ")"), numberText(v));
+  }
+  return v;
+}
+
+const ros::NodeHandle& ParameterReader::checkDiagnosticPeriod() {
+  double period = 1.0;
+  if (getOptional("diagnostic_period", &period) && !(period > 0.0 && period <= 3600.0)) {
+    failRule("diagnostic_period", "in (0, 3600] s", numberText(period));
+  }
+  return pnh_;
+}
+
+int ParameterReader::getAtLeast(const std::string& key, int fallback, int low, const std::string& unit) {
+  int v = fallback;
+  if (getOptional(key, &v) && v < low) {
+    failRule(key, "at least " + std::to_string(low) + (unit.empty() ? std::string() : " (" + unit + ")"),
+             std::to_string(v));
+  }
+  return v;
 }
 
 std::size_t ParameterReader::warnAboutUnknownKeys() const {

@@ -27,7 +27,8 @@ bool trimProcessHeap(double period) {
   if (!(period > 0.0)) return false;
   const std::int64_t now = steadyNowNs();
   std::int64_t last = last_trim_ns.load();
-  if (last != 0 && now - last < static_cast<std::int64_t>(period * 1e9)) return false;
+  // Compared in seconds: a huge period (1e300 s: never in practice) must not overflow a conversion.
+  if (last != 0 && 1e-9 * static_cast<double>(now - last) < period) return false;
   // One caller wins the period; the others see the new stamp and return.
   if (!last_trim_ns.compare_exchange_strong(last, now)) return false;
   malloc_trim(0);

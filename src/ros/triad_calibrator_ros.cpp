@@ -64,7 +64,7 @@ bool TriadCalibratorRos::selected(const ros::NodeHandle& pnh) {
 }
 
 TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
-    : nh_(nh), pnh_(pnh), params_(pnh, "calibrator"), updater_(nh, pnh, pnh.getNamespace()) {
+    : nh_(nh), pnh_(pnh), params_(pnh, kNode), updater_(nh, params_.checkDiagnosticPeriod(), pnh.getNamespace()) {
   // The calibration settings, as the single-axis calibrator and hrg_bag calibrate read them.
   const YAML::Node tree = privateParameters(pnh_);
   const core::YamlField root(tree, "");
@@ -77,8 +77,7 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   std::vector<std::string> triad_keys;
   for (const std::string& k : core::TriadCalibrationSettings::keys()) triad_keys.push_back("triad/" + k);
   params_.claim(triad_keys);
-  params_.claim({"triad"}, true);        // the core's parser refuses what it does not know in the section
-  params_.claim({"diagnostic_period"});  // read by diagnostic_updater itself
+  params_.claim({"triad"}, true);  // the core's parser refuses what it does not know in the section
 
   // Keys of the single-axis methods: accepted in the shared template, not used here (and said so).
   const std::string single_axis_file = params_.get<std::string>("parameter_file", "");
@@ -180,12 +179,11 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
       reload_services_.push_back(name);
     }
   }
-  feed_settings_.hold = params_.get("stream_hold", feed_settings_.hold);
-  if (!(feed_settings_.hold >= 0.0) || feed_settings_.hold > 60.0) throw error("~stream_hold must be in [0, 60] s");
+  feed_settings_.hold = params_.getInRange("stream_hold", feed_settings_.hold, 0.0, 60.0, "s");
   feed_settings_.auto_finish_idle = axis_settings_.auto_finish_idle;
   feed_settings_.stamps = axis_settings_.stampRule();
-  const int queue_size = params_.get("queue_size", 50000);
-  const double heap_trim_period = params_.get("heap_trim_period", 10.0);
+  const int queue_size = params_.getAtLeast("queue_size", 50000, 1, "messages");
+  const double heap_trim_period = params_.getFinite("heap_trim_period", 10.0, "s; <= 0: never");
   const bool autostart = params_.get("autostart", true);
   params_.warnAboutUnknownKeys();
 

@@ -19,9 +19,8 @@ core::TriadCombinerSettings combinerSettings(ParameterReader& params) {
   core::TriadCombinerSettings s;
   s.stamp_tolerance = params.get("stamp_tolerance", s.stamp_tolerance);
   s.max_wait = params.get("max_wait", s.max_wait);
-  const int max_pending = params.get("max_pending", static_cast<int>(s.max_pending));
-  if (max_pending < 1) throw std::invalid_argument("triad: ~max_pending must be at least 1 (samples per axis)");
-  s.max_pending = static_cast<std::size_t>(max_pending);
+  s.max_pending = static_cast<std::size_t>(
+      params.getAtLeast("max_pending", static_cast<int>(s.max_pending), 1, "samples per axis"));
   s.initial_rate_variance = params.get("initial_angular_velocity_variance", s.initial_rate_variance);
   s.max_rate = params.get("max_rate", s.max_rate);
   s.backward_reset = params.get("backward_reset", s.backward_reset);
@@ -53,7 +52,7 @@ std::string describe(const std::string& path, const core::TriadParameters& t) {
 }  // namespace
 
 TriadRos::TriadRos(ros::NodeHandle nh, ros::NodeHandle pnh)
-    : nh_(nh), pnh_(pnh), params_(pnh, "triad"), updater_(nh, pnh, pnh.getNamespace()) {
+    : nh_(nh), pnh_(pnh), params_(pnh, "triad"), updater_(nh, params_.checkDiagnosticPeriod(), pnh.getNamespace()) {
   triad_file_ = params_.get<std::string>("triad_file", "");
   if (triad_file_.empty())
     throw std::invalid_argument("triad: ~triad_file is required (the triad file: M, bias, axes)");
@@ -70,19 +69,16 @@ TriadRos::TriadRos(ros::NodeHandle nh, ros::NodeHandle pnh)
         "triad: ~angular_velocity_variance must be positive ((rad/s)^2, for every axis), or negative for each "
         "axis's own from its imu/data_raw; 0 would claim perfect gyros");
   }
-  const int max_unpaired = params_.get("max_unpaired", 1000);
-  if (max_unpaired < 1) throw std::invalid_argument("triad: ~max_unpaired must be at least 1");
+  const int max_unpaired = params_.getAtLeast("max_unpaired", 1000, 1, "outputs per axis");
   for (core::RateVariancePairing& p : pairings_) p = core::RateVariancePairing(static_cast<std::size_t>(max_unpaired));
-  stall_timeout_ = params_.get("stall_timeout", stall_timeout_);
-  expected_rate_ = params_.get("expected_rate", expected_rate_);
-  if (!(expected_rate_ > 0.0)) throw std::invalid_argument("triad: ~expected_rate must be positive (Hz)");
-  const double tolerance = params_.get("rate_tolerance", 0.1);
+  stall_timeout_ = params_.getPositive("stall_timeout", stall_timeout_, "s");
+  expected_rate_ = params_.getPositive("expected_rate", expected_rate_, "Hz");
+  const double tolerance = params_.getInRange("rate_tolerance", 0.1, 0.0, 1.0, "(relative)");
   min_rate_ = expected_rate_ * (1.0 - tolerance);
   max_rate_ = expected_rate_ * (1.0 + tolerance);
   // 5 s of 10 kHz per topic, as the processor's: a descheduled host delays samples, loses none.
-  const int queue_size = params_.get("queue_size", 50000);
+  const int queue_size = params_.getAtLeast("queue_size", 50000, 1, "messages");
   const std::string hardware_id = params_.get<std::string>("hardware_id", "hrg_gyro_triad");
-  params_.claim({"diagnostic_period"});  // read by diagnostic_updater itself
 
   output_pub_ = nh_.advertise<TriadOutput>("triad/output", queue_size);
   imu_pub_ = nh_.advertise<sensor_msgs::Imu>("imu/data_raw", queue_size);
@@ -99,6 +95,7 @@ TriadRos::TriadRos(ros::NodeHandle nh, ros::NodeHandle pnh)
                  [this, a](diagnostic_updater::DiagnosticStatusWrapper& stat) { diagnoseAxis(a, stat); });
     health_[a].reported_wall = ros::WallTime::now();
   }
+  reported_wall_ = ros::WallTime::now();
   params_.warnAboutUnknownKeys();
   ready_.reserve(64);
   completed_.reserve(64);
@@ -259,18 +256,88 @@ void TriadRos::diagnoseAxis(std::size_t axis, diagnostic_updater::DiagnosticStat
   h.reported_wall = now;
 }
 
+std::string TriadRos::whyNotCombined(const std::array<std::uint64_t, 3>& arrived) const {
+  const core::TriadCounters& c = combiner_->counters();
+  const std::array<std::string, 3>& names = combiner_->parameters().axes;
+  const ros::WallTime now = ros::WallTime::now();
+  std::string why;
+  auto add = [&why](const std::string& text) { why += (why.empty() ? "" : "; ") + text; };
+  std::size_t missing_axes = 0;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const core::TriadAxisCounters& now_c = c.axes[a];
+    const core::TriadAxisCounters& then = reported_.axes[a];
+    const std::string& name = names[a];
+    if (arrived[a] == 0) {
+      if (health_[a].seen) {
+        char seconds[32];
+        std::snprintf(seconds, sizeof seconds, "%.2f s", (now - health_[a].last_wall).toSec());
+        add("axis " + name + " sent nothing for " + seconds);
+      } else {
+        add("axis " + name + " sent nothing yet on " + nh_.resolveName(name + "/output"));
+      }
+      continue;
+    }
+    if (now_c.received == then.received) {
+      add("axis " + name + ": " + std::to_string(arrived[a]) + " outputs held waiting for their variance on " +
+          nh_.resolveName(name + "/imu/data_raw"));
+      continue;
+    }
+    const std::uint64_t missing = now_c.missing - then.missing;
+    const std::uint64_t mismatched = now_c.mismatched - then.mismatched;
+    const std::uint64_t flagged = now_c.flagged - then.flagged;
+    const std::uint64_t dropped = now_c.invalid - then.invalid + now_c.duplicate - then.duplicate;
+    if (missing > 0) ++missing_axes;
+    if (missing + mismatched + flagged + dropped == 0) continue;
+    std::string parts;
+    auto part = [&parts](std::uint64_t n, const char* what) {
+      if (n > 0) parts += (parts.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+    };
+    part(missing, "stamps missing");
+    part(mismatched, "intervals mismatched");
+    part(flagged, "flagged outputs");
+    part(dropped, "outputs dropped (invalid or duplicate stamp)");
+    add("axis " + name + ": " + parts);
+  }
+  // Every axis delivers, yet two or more lack the stamps the others have: their clocks differ.
+  if (missing_axes >= 2 && arrived[0] > 0 && arrived[1] > 0 && arrived[2] > 0) {
+    why = "the axes' stamps do not coincide (within ~stamp_tolerance): " + why;
+  }
+  return why;
+}
+
 void TriadRos::diagnoseTriad(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   std::lock_guard<std::mutex> lock(mutex_);
   const core::TriadCounters& c = combiner_->counters();
+  const ros::WallTime now = ros::WallTime::now();
+  const double window = (now - reported_wall_).toSec();
   const std::uint64_t samples = c.samples - reported_.samples;
+  const std::uint64_t integrated = c.integrated - reported_.integrated;
   const std::uint64_t gaps = c.gaps - reported_.gaps;
-  if (c.samples == 0) {
+  std::array<std::uint64_t, 3> arrived{};
+  double quiet = INFINITY;  // s since the newest output of any axis
+  for (std::size_t a = 0; a < 3; ++a) {
+    arrived[a] = health_[a].outputs - reported_outputs_[a];
+    if (health_[a].seen) quiet = std::min(quiet, (now - health_[a].last_wall).toSec());
+  }
+  const bool inputs = arrived[0] + arrived[1] + arrived[2] > 0;
+  if (inputs && integrated == 0) {
+    // Outputs arrive but no body sample is published: the IMU is down, whatever each axis says.
+    std::string why = whyNotCombined(arrived);
+    if (why.empty()) why = "their samples are held, waiting for an axis (~max_wait)";
+    char head[96];
+    std::snprintf(head, sizeof head, "nothing combined in the last %.1f s while axis outputs arrive: ", window);
+    stat.summary(DiagnosticStatus::ERROR, head + why);
+  } else if (c.samples == 0) {
     stat.summary(DiagnosticStatus::ERROR, "no triad sample yet (waiting for all three axes)");
+  } else if (!inputs && quiet > stall_timeout_) {
+    stat.summaryf(DiagnosticStatus::ERROR, "stalled: no axis output for %.2f s, nothing combined", quiet);
   } else if (c.resets > reported_.resets) {
     stat.summary(DiagnosticStatus::WARN, "time went backwards: the triad restarted");
   } else if (gaps > 0) {
-    stat.summaryf(DiagnosticStatus::WARN, "%lu of %lu samples are gaps (an axis missing or flagged)",
-                  static_cast<unsigned long>(gaps), static_cast<unsigned long>(samples));
+    const std::string why = whyNotCombined(arrived);
+    stat.summary(DiagnosticStatus::WARN, std::to_string(gaps) + " of " + std::to_string(samples) +
+                                             " samples are gaps (" +
+                                             (why.empty() ? "an axis missing or flagged" : why) + ")");
   } else if (c.precessing > reported_.precessing) {
     stat.summary(DiagnosticStatus::WARN,
                  "an axis's wave is turned on command (FLAG_PRECESSING): its rate is not the body's, do not fuse");
@@ -281,6 +348,7 @@ void TriadRos::diagnoseTriad(diagnostic_updater::DiagnosticStatusWrapper& stat) 
   }
   stat.add("samples", c.samples);
   stat.add("combined", c.integrated);
+  stat.add("combined since the last report", integrated);
   stat.add("gaps", c.gaps);
   stat.add("resets", c.resets);
   stat.add("axis flagged", c.axis_flagged);
@@ -291,6 +359,8 @@ void TriadRos::diagnoseTriad(diagnostic_updater::DiagnosticStatusWrapper& stat) 
   stat.add("late (after their stamp went out)", c.late);
   stat.add("last stamp", last_stamp_.toSec());
   reported_ = c;
+  for (std::size_t a = 0; a < 3; ++a) reported_outputs_[a] = health_[a].outputs;
+  reported_wall_ = now;
 }
 
 void TriadRos::diagnoseFile(diagnostic_updater::DiagnosticStatusWrapper& stat) {

@@ -39,6 +39,26 @@ class ParameterReader {
     return set;
   }
 
+  // Numbers with a rule, checked at start-up: a value that breaks it (NaN, an infinity, 0 for a
+  // queue, a negative period) throws std::invalid_argument naming the node, the key, the rule and
+  // the value, as a core parser's ConfigError names its key; `unit` ("s", "Hz", "messages") is said
+  // in the message. Unset keys take `fallback` (not checked: the node's own default).
+
+  /// A finite number > 0.
+  double getPositive(const std::string& key, double fallback, const std::string& unit);
+  /// A finite number in [low, high].
+  double getInRange(const std::string& key, double fallback, double low, double high, const std::string& unit);
+  /// A finite number of either sign (a rule such as "<= 0: never" gives the sign its meaning).
+  double getFinite(const std::string& key, double fallback, const std::string& unit);
+  /// An integer >= low.
+  int getAtLeast(const std::string& key, int fallback, int low, const std::string& unit);
+
+  /// ~diagnostic_period, which diagnostic_updater::Updater reads itself when it is constructed (and
+  /// again at each update): checked first, in (0, 3600] s, so that a bad one is refused naming the
+  /// key (the updater would throw an unnamed "Duration is out of dual 32-bit range" on NaN or inf,
+  /// and publish at every chance on 0). Returns the private handle to construct the updater with.
+  const ros::NodeHandle& checkDiagnosticPeriod();
+
   /// Keys read by someone else (a core parser, diagnostic_updater): "a/b" names a leaf, and with
   /// `subtree` every key below it counts as read (a section whose keys the parser checks itself).
   void claim(const std::vector<std::string>& keys, bool subtree = false);
@@ -56,6 +76,7 @@ class ParameterReader {
  private:
   void note(const std::string& key, bool set);
   [[noreturn]] void failWrongType(const std::string& key) const;
+  [[noreturn]] void failRule(const std::string& key, const std::string& rule, const std::string& value) const;
 
   ros::NodeHandle pnh_;
   std::string node_;

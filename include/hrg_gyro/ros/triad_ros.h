@@ -61,6 +61,10 @@ class TriadRos {
   bool onReload(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   void diagnoseAxis(std::size_t axis, diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseTriad(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  /// Why the axes' outputs since the last triad report gave no (or not only) combined samples: each
+  /// axis that sent nothing, waits for its variance, lacks stamps, or has mismatched, flagged or
+  /// dropped outputs, by name. "" when no axis shows a cause.
+  std::string whyNotCombined(const std::array<std::uint64_t, 3>& arrived) const;
   void diagnoseFile(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   ros::NodeHandle nh_, pnh_;
@@ -85,7 +89,9 @@ class TriadRos {
   double min_rate_ = 0.0, max_rate_ = 0.0;
   std::unique_ptr<diagnostic_updater::FrequencyStatus> frequency_;
   std::array<AxisHealth, 3> health_;
-  core::TriadCounters reported_;
+  core::TriadCounters reported_;                     // the combiner's counters at the last triad report
+  std::array<std::uint64_t, 3> reported_outputs_{};  // each axis's outputs received then
+  ros::WallTime reported_wall_;                      // and when
   std::uint64_t reloads_ = 0, failed_reloads_ = 0;
   std::string last_reload_error_;
   ros::Time last_stamp_;

@@ -137,8 +137,12 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
     out << YAML::EndMap;
   }
   out << YAML::Key << "quadrature_ratio" << YAML::Value << formatDouble(o.quadrature_ratio);
-  // Glitched turntable records dropped before the plateau detector, and bag-loop restarts.
+  // The records of the table's stream (a field run's: the precession loop's states), the glitched ones
+  // dropped before the plateau detector, and bag-loop restarts.
   out << YAML::Key << "turntable_records" << YAML::Value << o.turntable_records;
+  if (traitsOf(o.method).virtual_rotation) {
+    out << YAML::Comment("precession states (the field method's stream), and their glitches below");
+  }
   out << YAML::Key << "turntable_rejected" << YAML::Value << YAML::Flow << YAML::BeginMap;
   out << YAML::Key << "bad_rate" << YAML::Value << o.turntable_rejected.bad_rate;
   out << YAML::Key << "bad_angle" << YAML::Value << o.turntable_rejected.bad_angle;

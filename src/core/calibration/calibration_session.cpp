@@ -285,10 +285,9 @@ std::string CalibrationSession::plateauDiagnosis(bool* names_a_cause) const {
            " records, no wave sample)";
   }
   if (c.unsynchronized > c.used + c.unsettled) {
-    return std::to_string(c.unsynchronized) + " of " + std::to_string(c.wave) +
-           " wave samples had no turntable record around their stamp: the two streams' stamps do not overlap, "
-           "or the turntable records are more than plateau/max_gap (" +
-           seconds(ps.max_gap) + ") apart";
+    return std::to_string(c.unsynchronized) + " of " + std::to_string(c.wave) + " wave samples had no " + stream +
+           " record around their stamp: the two streams' stamps do not overlap, or the " + stream +
+           " records are more than plateau/max_gap (" + seconds(ps.max_gap) + ") apart";
   }
   if (st.scatter_blocks > 0 && st.spurious_breaks >= kMinSpuriousBreaks &&
       st.spurious_breaks >= kSpuriousShare * st.breaks) {
@@ -407,10 +406,11 @@ CalibrationOutcome CalibrationSession::finish() const {
   o.restarts = counters_.restarts;
   if (counters_.rejected.total() > 0) {
     const TurntableRejects& r = counters_.rejected;
-    o.notes.push_back(std::to_string(r.total()) + " glitched turntable records dropped (" + std::to_string(r.bad_rate) +
-                      " bad rate, " + std::to_string(r.bad_angle) + " bad angle, " + std::to_string(r.bad_stamp) +
-                      " zero stamp, " + std::to_string(r.duplicate) + " duplicate, " + std::to_string(r.out_of_order) +
-                      " out of order, " + std::to_string(r.stamp_jump) + " stamp jump)");
+    o.notes.push_back(std::to_string(r.total()) + " glitched " +
+                      (traits.virtual_rotation ? "precession states" : "turntable records") + " dropped (" +
+                      std::to_string(r.bad_rate) + " bad rate, " + std::to_string(r.bad_angle) + " bad angle, " +
+                      std::to_string(r.bad_stamp) + " zero stamp, " + std::to_string(r.duplicate) + " duplicate, " +
+                      std::to_string(r.out_of_order) + " out of order, " + std::to_string(r.stamp_jump) + " stamp jump)");
   }
   if (counters_.wave_jumps > 0) {
     o.notes.push_back(std::to_string(counters_.wave_jumps) +
@@ -421,8 +421,8 @@ CalibrationOutcome CalibrationSession::finish() const {
                       " time(s) (bag loop): the run restarted from the prior");
   }
   if (counters_.unsynchronized > 0) {
-    o.notes.push_back(std::to_string(counters_.unsynchronized) +
-                      " wave samples had no turntable state around them and were not used");
+    o.notes.push_back(std::to_string(counters_.unsynchronized) + " wave samples had no " +
+                      (traits.virtual_rotation ? "precession" : "turntable") + " state around them and were not used");
   }
   return o;
 }

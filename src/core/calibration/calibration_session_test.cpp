@@ -416,6 +416,61 @@ TEST(CalibrationSessionTest, StepMethodOnARateOnlyStreamUsesTheRateIntegral) {
   expectSameWithin(with_angle, without, 5.0);
 }
 
+// A field run's table stream is the precession loop's state: what the session says of that stream
+// (glitches dropped, wave samples without it, the plateau cause) names it so, never "turntable".
+TEST(CalibrationSessionTest, AFieldRunCallsItsStreamThePrecessionState) {
+  auto note = [](const CalibrationOutcome& o, const std::string& part) {
+    for (const std::string& n : o.notes) {
+      if (contains(n, part)) return n;
+    }
+    return std::string();
+  };
+  auto mentions = [](const CalibrationOutcome& o, const std::string& word) {
+    bool found = contains(o.reason, word);
+    for (const std::string& n : o.notes) found = found || contains(n, word);
+    return found;
+  };
+  const TurntableProfile p = testing::dualRateProfile(0.2, -0.2, 30.0);
+  for (const CalibrationMethodKind method : {CalibrationMethodKind::kField, CalibrationMethodKind::kDualRate}) {
+    const bool field = method == CalibrationMethodKind::kField;
+    // The wave 1000 s after the stream: no sample has the stream around it.
+    const CalibrationOutcome late =
+        runLogged(noisyReferenceGyro(), p, settings(method), TableLog(), nullptr, true, 1000.0);
+    ASSERT_FALSE(late.accepted);
+    std::printf("[ measured ] %s: %s\n", nameOf(method).c_str(), late.reason.c_str());
+    EXPECT_NE(note(late, field ? " wave samples had no precession state around them and were not used"
+                               : " wave samples had no turntable state around them and were not used"),
+              "");
+    EXPECT_TRUE(contains(late.reason, field ? "had no precession state record around their stamp"
+                                            : "had no turntable record around their stamp"))
+        << late.reason;
+    EXPECT_EQ(mentions(late, "turntable"), !field);
+    // The report keeps its key (turntable_records) and says what it counts in a field run.
+    const std::string report = emitCalibrationReport(late);
+    const std::size_t key = report.find("\nturntable_records: ");
+    ASSERT_NE(key, std::string::npos) << report;
+    const std::string line = report.substr(key + 1, report.find('\n', key + 1) - key - 1);
+    EXPECT_EQ(contains(line, "# precession states (the field method's stream)"), field) << line;
+
+    // One record in a hundred has a NaN rate: dropped and counted under the stream's name.
+    CalibrationSession session(settings(method), prior());
+    long i = 0;
+    testing::runAngleLevel(noisyReferenceGyro(), p, [&](Nanoseconds t, double angle, double rate, double theta) {
+      session.addTurntable(t, angle, ++i % 100 == 0 ? NAN : rate);
+      session.addWave(t, theta, NAN);
+    });
+    const CalibrationOutcome glitched = session.finish();
+    const std::string dropped =
+        note(glitched, field ? " glitched precession states dropped (" : " glitched turntable records dropped (");
+    EXPECT_NE(dropped, "") << nameOf(method);
+    EXPECT_EQ(numberAfter(dropped, ""), static_cast<double>(glitched.turntable_rejected.total()));
+    EXPECT_GT(glitched.turntable_rejected.bad_rate, 0u);
+    if (field) {
+      EXPECT_FALSE(mentions(glitched, "turntable")) << glitched.reason;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace hrg_gyro

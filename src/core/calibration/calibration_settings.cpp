@@ -206,7 +206,7 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
     if (!(std::abs(tc.offset) <= 3600.0)) c["offset"].fail("must be a finite number of seconds, |offset| <= 3600");
     tc.regularise = c.getBool("regularise", tc.regularise);
     tc.window = c.getDouble("window", tc.window);
-    if (!(tc.window >= 1.0 && tc.window <= 3600.0)) c["window"].fail("must be in [1, 600] s");
+    if (!(tc.window >= 1.0 && tc.window <= 600.0)) c["window"].fail("must be in [1, 600] s");
     tc.max_jitter = positive(c, "max_jitter", tc.max_jitter);
     tc.max_offset = positive(c, "max_offset", tc.max_offset);
   }

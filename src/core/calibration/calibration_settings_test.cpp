@@ -162,6 +162,38 @@ TEST(CalibrationSettingsTest, KeyPathsListEveryKeyOnce) {
   }
 }
 
+// Each range check says the range it applies: the bounds of the message are accepted, a step beyond
+// them refused with the key named.
+TEST(CalibrationSettingsTest, RangeChecksMatchTheirMessages) {
+  EXPECT_DOUBLE_EQ(parse("table_clock: {window: 1}").table_clock.window, 1.0);
+  EXPECT_DOUBLE_EQ(parse("table_clock: {window: 600}").table_clock.window, 600.0);
+  EXPECT_EQ(refusedKey("table_clock: {window: 0.999}"), "table_clock.window");
+  EXPECT_EQ(refusedKey("table_clock: {window: 600.001}"), "table_clock.window");
+  EXPECT_EQ(refusedKey("table_clock: {window: 1000}"), "table_clock.window");
+  try {
+    parse("table_clock: {window: 1000}");
+  } catch (const ConfigError& e) {
+    EXPECT_NE(e.problem().find("[1, 600] s"), std::string::npos) << e.what();
+  }
+  EXPECT_DOUBLE_EQ(parse("table_clock: {offset: -3600}").table_clock.offset, -3600.0);
+  EXPECT_EQ(refusedKey("table_clock: {offset: 3600.5}"), "table_clock.offset");
+  EXPECT_EQ(parse("bins: 8").bins, 8);
+  EXPECT_EQ(parse("bins: 4096").bins, 4096);
+  EXPECT_EQ(refusedKey("bins: 4097"), "bins");
+  EXPECT_EQ(parse("backward_persist: 1000").backward_persist, 1000);
+  EXPECT_EQ(refusedKey("backward_persist: 1001"), "backward_persist");
+  EXPECT_DOUBLE_EQ(parse("plateau: {smoothing_span: 20}").plateau.smoothing_span, 20.0);
+  EXPECT_EQ(refusedKey("plateau: {smoothing_span: 20.5}"), "plateau.smoothing_span");
+  EXPECT_DOUBLE_EQ(parse("gates: {min_coverage: 1}").gates.min_coverage, 1.0);
+  EXPECT_EQ(refusedKey("gates: {min_coverage: 1.01}"), "gates.min_coverage");
+  EXPECT_DOUBLE_EQ(parse("field: {rate: 10}").field.rate, 10.0);
+  EXPECT_EQ(refusedKey("field: {rate: 10.5}"), "field.rate");
+  EXPECT_EQ(parse("thermal: {node_count: 32}").thermal.node_count, 32);
+  EXPECT_EQ(refusedKey("thermal: {node_count: 33}"), "thermal.node_count");
+  EXPECT_EQ(parse("thermal: {max_slices: 100000}").thermal.max_slices, 100000);
+  EXPECT_EQ(refusedKey("thermal: {max_slices: 100001}"), "thermal.max_slices");
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace hrg_gyro

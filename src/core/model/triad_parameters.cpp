@@ -48,16 +48,42 @@ void emitVector(YAML::Emitter& out, const Eigen::Vector3d& v) {
   out << YAML::EndSeq;
 }
 
-/// A frame id as tf2 takes it: not empty, no leading '/', no blanks or control characters.
-bool validFrameId(const std::string& id) {
-  if (id.empty() || id.front() == '/') return false;
-  for (unsigned char c : id) {
-    if (c <= ' ' || c == 0x7f) return false;
+bool isAsciiLetter(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); }
+
+/// `name` quoted for a message: its first 40 bytes, control characters as \xNN.
+std::string quotedName(const std::string& name) {
+  constexpr std::size_t kShown = 40;
+  std::string out = "'";
+  for (std::size_t i = 0; i < name.size() && i < kShown; ++i) {
+    const unsigned char c = static_cast<unsigned char>(name[i]);
+    if (c < 0x20 || c == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02X", c);
+      out += hex;
+    } else {
+      out += name[i];
+    }
+  }
+  return out + (name.size() > kShown ? "...'" : "'");
+}
+
+}  // namespace
+
+bool isValidAxisName(const std::string& name) {
+  if (name.empty() || !isAsciiLetter(name.front())) return false;
+  for (const char c : name) {
+    if (!isAsciiLetter(c) && !(c >= '0' && c <= '9') && c != '_') return false;
   }
   return true;
 }
 
-}  // namespace
+bool isValidFrameId(const std::string& id) {
+  if (id.empty() || id.front() == '/') return false;
+  for (const unsigned char c : id) {
+    if (c <= ' ' || c == 0x7f) return false;
+  }
+  return true;
+}
 
 Eigen::Matrix3d TriadParameters::bodyToAxis() const { return axis_to_body.inverse(); }
 
@@ -72,15 +98,18 @@ TriadParameters parseTriadParameters(const YAML::Node& root) {
   doc.rejectUnknownKeys({"frame_id", "axes", "axis_to_body", "axis_to_body_std", "bias", "bias_std", "calibration"});
   TriadParameters t;
   t.frame_id = doc["frame_id"].asString();
-  if (!validFrameId(t.frame_id)) doc["frame_id"].fail("must be a frame id: not empty, no leading '/', no blanks");
+  if (!isValidFrameId(t.frame_id)) doc["frame_id"].fail("must be a frame id: not empty, no leading '/', no blanks");
   const YamlField axes = doc["axes"];
   axes.requireSequence();
   if (axes.size() != 3) axes.fail("must name 3 axes, names " + std::to_string(axes.size()));
   std::set<std::string> seen;
   for (std::size_t i = 0; i < 3; ++i) {
     t.axes[i] = axes.at(i).asString();
-    if (t.axes[i].empty() || t.axes[i].find_first_of(" /\t\n") != std::string::npos) {
-      axes.at(i).fail("an axis name is a single word (it is a namespace)");
+    if (!isValidAxisName(t.axes[i])) {
+      // Quoted as the YAML reader gives it; control characters and blanks shown as escapes.
+      axes.at(i).fail(quotedName(t.axes[i]) +
+                      " is not an axis name: its topics and namespace are made from it, so it is a ROS name "
+                      "component, a letter, then letters, digits or '_'");
     }
     if (!seen.insert(t.axes[i]).second) axes.at(i).fail("axis '" + t.axes[i] + "' is named twice");
   }

@@ -80,6 +80,48 @@ TEST(TriadParametersTest, EveryBadKeyIsNamed) {
   EXPECT_EQ(refusedKey(with("calibration", "{method: magic}")), "calibration.method");
 }
 
+// The triad node subscribes `<axis>/output` and a launch puts each axis's processor in the namespace
+// `<axis>`: a name that is no ROS name component would kill the node when it makes the topic.
+TEST(TriadParametersTest, AxisNamesAreRosNameComponents) {
+  auto axes = [](const std::string& second) {
+    YAML::Node n = YAML::Load(kValid);
+    n["axes"][1] = second;
+    YAML::Emitter e;
+    e << n;
+    return std::string(e.c_str());
+  };
+  for (const std::string& bad :
+       {std::string(".."), std::string("~y"), std::string("y:z"), std::string("y z"), std::string(" y"),
+        std::string("y\t"), std::string("y\x01"), std::string("y\x7f"), std::string("y/z"), std::string("/y"),
+        std::string("1y"), std::string("_y"), std::string("y-z"), std::string("y.z"), std::string("\xc3\xbf"),
+        std::string("y\xc3\xbf"), std::string("")}) {
+    try {
+      parseTriadParameters(YAML::Load(axes(bad)));
+      ADD_FAILURE() << "axis name '" << bad << "' accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), "axes[1]") << bad;
+      EXPECT_NE(std::string(e.what()).find("axes[1]: "), std::string::npos) << e.what();
+      EXPECT_NE(e.problem().find("a letter, then letters, digits or '_'"), std::string::npos) << e.what();
+    }
+  }
+  // Control characters are shown escaped, never written raw into a log line.
+  try {
+    parseTriadParameters(YAML::Load(axes("y\x1b[2J")));
+    ADD_FAILURE() << "an escape sequence accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(e.problem().find("'y\\x1B[2J'"), std::string::npos) << e.problem();
+    EXPECT_EQ(e.problem().find('\x1b'), std::string::npos);
+  }
+  for (const char* good : {"y", "Y", "gyro_2", "y2", "axis_B_10"}) {
+    EXPECT_EQ(parseTriadParameters(YAML::Load(axes(good))).axes[1], good);
+  }
+  EXPECT_TRUE(isValidAxisName("x"));
+  EXPECT_FALSE(isValidAxisName("x."));
+  // Distinct, as written (ROS names are case-sensitive).
+  EXPECT_EQ(refusedKey(axes("x")), "axes[1]");
+  EXPECT_EQ(parseTriadParameters(YAML::Load(axes("X"))).axes[1], "X");
+}
+
 TEST(TriadParametersTest, SavedAtomicallyAndLoadedBack) {
   const std::string dir = ::testing::TempDir();
   const std::string path = dir + "/triad_parameters_test.yaml";

@@ -1,7 +1,6 @@
 #include "hrg_gyro/core/simulation/triad_simulation_config.h"
 
 #include <Eigen/Geometry>
-#include <cctype>
 #include <cmath>
 #include <set>
 
@@ -31,24 +30,6 @@ std::uint64_t axisSeed(std::uint64_t seed, int axis) {
   return z ^ (z >> 31);
 }
 
-/// An axis name is a topic namespace: a letter, then letters, digits or underscores.
-bool validAxisName(const std::string& name) {
-  if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0]))) return false;
-  for (const unsigned char c : name) {
-    if (!std::isalnum(c) && c != '_') return false;
-  }
-  return true;
-}
-
-/// A frame id as tf2 takes it: not empty, no leading '/', no blanks or control characters.
-bool validFrameId(const std::string& id) {
-  if (id.empty() || id.front() == '/') return false;
-  for (const unsigned char c : id) {
-    if (c <= ' ' || c == 0x7f) return false;
-  }
-  return true;
-}
-
 double finite(const YamlField& section, const char* key, double fallback, const char* unit) {
   const double v = section.getDouble(key, fallback);
   if (!std::isfinite(v)) section[key].fail(std::string("must be finite (") + unit + ")");
@@ -60,7 +41,7 @@ TriadAxisConfig parseAxis(const YamlField& a) {
   a.rejectUnknownKeys({"name", "resonator", "pickoff", "channels", "misalignment", "scale"});
   TriadAxisConfig c;
   c.name = a["name"].asString();
-  if (!validAxisName(c.name)) {
+  if (!isValidAxisName(c.name)) {
     a["name"].fail("'" + c.name + "' is not a namespace: a letter, then letters, digits or '_'");
   }
   if (a.has("resonator")) c.resonator = parseResonatorSection(a["resonator"]);
@@ -266,7 +247,7 @@ TriadSimulationConfig TriadSimulationConfig::parse(const YamlField& root, const 
   t.requireMap();
   t.rejectUnknownKeys({"frame_id", "axes", "turntable", "positions", "fixture_error_std"});
   c.frame_id = t.getString("frame_id", c.frame_id);
-  if (!validFrameId(c.frame_id)) t["frame_id"].fail("must be a frame id: not empty, no leading '/', no blanks");
+  if (!isValidFrameId(c.frame_id)) t["frame_id"].fail("must be a frame id: not empty, no leading '/', no blanks");
 
   const YamlField axes = t["axes"];
   axes.requireSequence();

@@ -60,6 +60,16 @@ core::AtomicOutputFile& openOutput(std::unique_ptr<core::AtomicOutputFile>* file
 
 }  // namespace
 
+void checkDistinctAxisTopics(const std::array<std::string, 3>& axes, const std::array<std::string, 3>& topics) {
+  for (std::size_t i = 0; i < 3; ++i) {
+    for (std::size_t j = i + 1; j < 3; ++j) {
+      if (topics[i] != topics[j]) continue;
+      throw UsageError("axes " + axes[i] + " and " + axes[j] + " both read the channels topic " + topics[i] +
+                       " (--axis-channels): each axis needs its own, /NAME/channels by default");
+    }
+  }
+}
+
 void checkOutputPaths(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs) {
   std::vector<std::string> given_inputs, given_outputs;
   for (const std::string& p : inputs) {

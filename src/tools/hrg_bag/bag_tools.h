@@ -7,6 +7,7 @@
 #include <rosbag/view.h>
 
 #include <CLI/CLI.hpp>
+#include <array>
 #include <cerrno>
 #include <cstdint>
 #include <functional>
@@ -121,6 +122,10 @@ void addCompressionOption(CLI::App& command, std::string* compression);
 /// links followed, hard links, other spellings), or one that exists and is not a regular file (a
 /// directory). Empty paths (options not given) are skipped.
 void checkOutputPaths(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
+
+/// A triad's axes each read their own channels: two axes given one topic (--axis-channels y=/x/channels,
+/// which /x/channels also serves by default) is a UsageError (exit 2) naming both axes and the topic.
+void checkDistinctAxisTopics(const std::array<std::string, 3>& axes, const std::array<std::string, 3>& topics);
 
 /// A bag written whole or not at all: a BagFileWriter (whole chunks, no per-message system call)
 /// writes a temporary beside `path` (core::AtomicOutputFile), and commit() closes it and renames it

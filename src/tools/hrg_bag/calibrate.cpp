@@ -181,10 +181,12 @@ int runCalibrate(const CalibrateOptions& o) {
   }
   for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
   const core::TurntableRejects& r = outcome.turntable_rejected;
-  std::cout << "calibrate: turntable records " << outcome.turntable_records << ", dropped " << r.total()
-            << " (bad rate " << r.bad_rate << ", bad angle " << r.bad_angle << ", zero stamp " << r.bad_stamp
-            << ", duplicate " << r.duplicate << ", out of order " << r.out_of_order << ", stamp jump " << r.stamp_jump
-            << "), restarts " << outcome.restarts << "\n";
+  // A field run's table stream is the precession loop's state.
+  std::cout << "calibrate: "
+            << (core::traitsOf(outcome.method).virtual_rotation ? "precession states " : "turntable records ")
+            << outcome.turntable_records << ", dropped " << r.total() << " (bad rate " << r.bad_rate << ", bad angle "
+            << r.bad_angle << ", zero stamp " << r.bad_stamp << ", duplicate " << r.duplicate << ", out of order "
+            << r.out_of_order << ", stamp jump " << r.stamp_jump << "), restarts " << outcome.restarts << "\n";
   for (const core::DefectDiagnosis& d : outcome.diagnosis) {
     std::cout << "calibrate: root-cause diagnosis (first order, read against the P in force) " << core::describe(d);
   }

@@ -210,6 +210,7 @@ int runTriadProcess(const std::string& bag_path, const std::string& out_path, co
     topics.push_back(axes[a].topic);
     axis_of_topic[axes[a].topic] = a;
   }
+  checkDistinctAxisTopics(triad->axes, {{axes[0].topic, axes[1].topic, axes[2].topic}});
   std::unique_ptr<OutputBag> out;
   if (!out_path.empty()) out = std::make_unique<OutputBag>(out_path, compression);
   std::unique_ptr<OutputText> csv;

@@ -154,6 +154,11 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
   checkAxisNames(params, axes, "axis-params");
   checkAxisNames(outs, axes, "axis-out");
   checkAxisNames(channels, axes, "axis-channels");
+  std::array<std::string, 3> channel_topics;
+  for (int i = 0; i < 3; ++i) {
+    channel_topics[i] = channels.count(axes[i]) ? channels.at(axes[i]) : "/" + axes[i] + "/channels";
+  }
+  checkDistinctAxisTopics(axes, channel_topics);
   for (const std::string& a : axes) {
     if (!params.count(a)) {
       throw UsageError("--axis-params " + a + "=FILE missing: each axis's prior parameter file is needed (its P is " +
@@ -184,9 +189,7 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
       findTopic(*bag, o.turntable_topic, ros::message_traits::datatype<TurntableState>(), "turntable-topic");
   const std::string fixture =
       findTopic(*bag, o.fixture_topic, ros::message_traits::datatype<FixturePosition>(), "fixture-topic");
-  std::array<std::string, 3> channel_topics;
   for (int i = 0; i < 3; ++i) {
-    channel_topics[i] = channels.count(axes[i]) ? channels.at(axes[i]) : "/" + axes[i] + "/channels";
     const std::string type = topicType(*bag, channel_topics[i]);
     const std::string wanted = ros::message_traits::datatype<ChannelAmplitudes>();
     if (type.empty()) {

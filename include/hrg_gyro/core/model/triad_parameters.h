@@ -31,7 +31,7 @@ namespace core {
 
 struct TriadParameters {
   /// The three axes, in the order of M's columns: each axis's name, which is also the namespace of
-  /// its processor (and of its parameter file) in a launch.
+  /// its processor (and of its parameter file) in a launch; distinct, each isValidAxisName().
   std::array<std::string, 3> axes{{"x", "y", "z"}};
   std::string frame_id = "imu_link";                           ///< the body frame
   Eigen::Matrix3d axis_to_body = Eigen::Matrix3d::Identity();  ///< M, dimensionless
@@ -50,6 +50,13 @@ struct TriadParameters {
 /// Largest |M_ij - I_ij| accepted: beyond it the axes are not the nominal body axes (a wrong axis
 /// order or sign, a unit slip), which a calibration refuses to write and the loader to read.
 constexpr double kMaxTriadMisalignment = 0.1;
+
+/// Whether `name` can name an axis: the triad node makes topics (`<axis>/output`) and a launch
+/// namespaces from it, so it must be one ROS graph name component: an ASCII letter first, then
+/// letters, digits or '_' (no '/', '~', '.', ':', blank or control character).
+bool isValidAxisName(const std::string& name);
+/// A frame id as tf2 takes it: not empty, no leading '/', no blanks or control characters.
+bool isValidFrameId(const std::string& id);
 
 /// Validates and converts a parsed triad document. Throws ConfigError naming the key.
 TriadParameters parseTriadParameters(const YAML::Node& root);
