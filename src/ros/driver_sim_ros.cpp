@@ -174,20 +174,31 @@ std::uint32_t DriverSimRos::channelSubscribers() const {
 }
 
 bool DriverSimRos::waitForSubscribers() {
-  const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(wait_timeout_);
+  // wait_timeout <= 0: as long as it takes (a pipeline whose listeners are all part of the launch
+  // must not lose its first samples because the host started them slowly); said every 10 s.
+  const bool limited = wait_timeout_ > 0.0;
+  const ros::WallTime start = ros::WallTime::now();
+  ros::WallTime next_note = start + ros::WallDuration(10.0);
   while (!stop_ && ros::ok()) {
     if (static_cast<int>(channelSubscribers()) >= wait_channels_ &&
         static_cast<int>(turntable_pub_.getNumSubscribers()) >= wait_turntable_ &&
         static_cast<int>(truth_pub_.getNumSubscribers()) >= wait_truth_) {
       return true;
     }
-    if (ros::WallTime::now() > until) {
+    const ros::WallTime now = ros::WallTime::now();
+    if (limited && (now - start).toSec() > wait_timeout_) {
       ROS_WARN(
           "driver_sim: starting after %.1f s without all expected subscribers (channels %u/%d, "
           "turntable %u/%d, truth %u/%d)",
           wait_timeout_, channelSubscribers(), wait_channels_, turntable_pub_.getNumSubscribers(), wait_turntable_,
           truth_pub_.getNumSubscribers(), wait_truth_);
       return true;
+    }
+    if (!limited && now > next_note) {
+      next_note = now + ros::WallDuration(10.0);
+      ROS_WARN("driver_sim: still waiting after %.0f s for subscribers (channels %u/%d, turntable %u/%d, truth %u/%d)",
+               (now - start).toSec(), channelSubscribers(), wait_channels_, turntable_pub_.getNumSubscribers(),
+               wait_turntable_, truth_pub_.getNumSubscribers(), wait_truth_);
     }
     ros::WallDuration(0.01).sleep();
   }
