@@ -100,8 +100,8 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 
   result_pub_ = pnh_.advertise<CalibrationResult>("result", 1, true);
   ros::NodeHandle in = input_.handle(nh_);
-  turntable_sub_ = in.subscribe("turntable/state", queue_size, &CalibratorRos::onTurntable, this,
-                                ros::TransportHints().tcpNoDelay());
+  // The wave first: a driver waiting for a turntable listener then starts after this subscription
+  // exists (in a nodelet manager the two are a poll of the driver apart).
   wave_sub_ = in.subscribe("wave", queue_size, &CalibratorRos::onWave, this, ros::TransportHints().tcpNoDelay());
   // The field method's streams: the precession loop's state in, its commands out (for every method,
   // since ~start may choose field; a driver without the loop publishes no state).
@@ -114,6 +114,8 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
         in.subscribe("channels", queue_size, &CalibratorRos::onChannels, this, ros::TransportHints().tcpNoDelay());
     truth_sub_ = in.subscribe("truth", queue_size, &CalibratorRos::onTruth, this, ros::TransportHints().tcpNoDelay());
   }
+  turntable_sub_ = in.subscribe("turntable/state", queue_size, &CalibratorRos::onTurntable, this,
+                                ros::TransportHints().tcpNoDelay());
   if (!reload_service_.empty()) {
     // The processor's model topic sits beside its reload service (processor/reload -> processor/model).
     std::string model_topic = reload_service_;
