@@ -262,13 +262,42 @@ void DriverSimRos::play(Simulator& sim, Sample* sample, const Publish& publish) 
   Sample& s = *sample;
   double next_clock = 0.0;
   std::uint32_t seq = 0;
+  // Under sim time with another source driving /clock (~publish_clock false: a second driver of the
+  // same graph, a bag played with --clock), a sample goes out when /clock reaches its stamp: every
+  // driver keeps that one clock's pace, so two drivers' stamps cannot drift apart by what the host
+  // denied one of them (each pacing itself against the wall clock, a driver that was run late fell
+  // behind the clock for good). While the clock stands still (its source not started yet, or done)
+  // the driver goes on at its own ~time_scale, and waits again once the clock runs behind it.
+  const bool follow_clock = use_sim_time_ && clock_pub_.getTopic().empty() && time_scale_ > 0.0;
+  ros::Time clock_seen = ros::Time::now();
+  ros::WallTime clock_moved = ros::WallTime::now();
+  std::uint64_t on_clock = 0;
   for (;;) {
     if (stop_ || !ros::ok()) break;
     takeCommand(sim);
     if (!sim.next(&s)) break;
     const ros::Time stamp = toRosTime(origin + s.stamp);
+    bool reached = false;
+    while (follow_clock && !stop_ && ros::ok()) {
+      const ros::Time now = ros::Time::now();
+      const ros::WallTime wall = ros::WallTime::now();
+      if (now != clock_seen) {
+        clock_seen = now;
+        clock_moved = wall;
+      }
+      if (now >= stamp) {
+        reached = true;
+        // This sample is due now: if the clock stops, the own schedule goes on from here.
+        schedule.start(wall.toSec() - sim.elapsed() / time_scale_);
+        break;
+      }
+      if ((wall - clock_moved).toSec() > kStillClock) break;
+      ros::WallDuration(0.0005).sleep();
+    }
+    if (stop_ || !ros::ok()) break;
+    on_clock += reached ? 1 : 0;
     double late = 0.0;
-    const double wait = schedule.waitFor(sim.elapsed(), ros::WallTime::now().toSec(), &late);
+    const double wait = reached ? 0.0 : schedule.waitFor(sim.elapsed(), ros::WallTime::now().toSec(), &late);
     if (wait > 0.0) {
       ros::WallDuration(wait).sleep();
     } else if (late > 0.1 && !use_sim_time_) {
@@ -298,6 +327,9 @@ void DriverSimRos::play(Simulator& sim, Sample* sample, const Publish& publish) 
   char lateness[128] = "";
   if (time_scale_ > 0.0 && !use_sim_time_) {
     std::snprintf(lateness, sizeof lateness, ", at most %.3f s behind schedule", schedule.maxLateness());
+  } else if (follow_clock) {
+    std::snprintf(lateness, sizeof lateness, ", %llu samples paced by /clock, the others by the schedule",
+                  static_cast<unsigned long long>(on_clock));
   } else if (time_scale_ > 0.0) {
     std::snprintf(lateness, sizeof lateness, ", the schedule let go %.3f s in %llu pauses", schedule.slid(),
                   static_cast<unsigned long long>(schedule.slides()));

@@ -5,7 +5,9 @@
 // sample: `channels` (ChannelAmplitudes), `turntable/state` (TurntableState) and `truth`
 // (GroundTruth). With /use_sim_time it also drives /clock, `~time_scale` times faster than real
 // time (a lag beyond `~max_lag` slows the simulated clock instead of being chased, see
-// core::PlaybackSchedule); without it, stamps follow the wall clock from the start and a late
+// core::PlaybackSchedule), or, when another source drives /clock (`~publish_clock` false), follows
+// that clock: a sample goes out when /clock reaches its stamp; without it, stamps follow the wall
+// clock from the start and a late
 // thread catches up. `~done` (std_msgs/Bool, latched)
 // turns true when the scenario is over.
 //
@@ -90,6 +92,9 @@ class DriverSimRos {
   double clock_period_ = 0.0;
   static constexpr double kFinestAutoClockPeriod = 1e-3;  // s: "auto" publishes at most 1 kHz
   static constexpr double kMaxPrecessionRate = 10.0;      // rad/s: the scenario schedule's bound too
+  // s of wall time a /clock driven by another source may stand still before this driver, following
+  // it, goes on at its own time_scale (the source not started yet, or done)
+  static constexpr double kStillClock = 2.0;
   std::string frame_id_ = "gyro_link";
   bool use_sim_time_ = false;
   bool publish_clock_ = true;
