@@ -37,6 +37,11 @@ def watch(source):
     return source
 
 
+def unwatch(source):
+    """Removes a source added by `watch`."""
+    _sources.remove(source)
+
+
 def progress():
     """What this node can see of the session moving on: sim time, messages received, watched sources."""
     token = [sum(s.count for s in _latest)]
