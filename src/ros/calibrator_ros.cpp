@@ -228,6 +228,8 @@ bool CalibratorRos::startRun(bool restart, std::string* reason) {
     }
     skip_waves_until_ = ros::Time();
     sweep_end_ = last_channels_stamp_ = ros::Time();
+    last_rotation_stamp_ = ros::Time();
+    waves_reached_rotation_ = true;
     pairing_.clear();
     field_plan_.clear();
     field_next_ = 0;
@@ -259,6 +261,8 @@ void CalibratorRos::noteRestart(std::uint64_t restarts_before) {
            base_settings_.backward_persist, core::nameOf(session()->settings().method).c_str());
   skip_waves_until_ = ros::Time();
   sweep_end_ = last_channels_stamp_ = ros::Time();
+  last_rotation_stamp_ = ros::Time();
+  waves_reached_rotation_ = true;
   pairing_.clear();
   if (!field_plan_.empty()) {
     // The field plan starts over with the run, from the next precession state.
@@ -334,6 +338,23 @@ void CalibratorRos::addRotationRecord(const ros::Time& stamp, double angle, doub
     bool written = false;
     std::string message;
     finishRun(&written, &message);
+    return;
+  }
+  last_rotation_stamp_ = stamp;
+  waves_reached_rotation_ = false;
+}
+
+void CalibratorRos::checkFinishAfterWave(const ros::Time& stamp) {
+  // The auto-finish rule needs both streams: the rest seen in the rotation records and the data
+  // complete from the waves. Checked on a rotation record only, a run whose waves came later than
+  // the table's (a hop more through the processor, run late on a busy host) never finished once the
+  // table had said its last; so it is checked again when the waves reach the latest record's stamp.
+  if (!session() || waves_reached_rotation_ || stamp < last_rotation_stamp_) return;
+  waves_reached_rotation_ = true;
+  if (session()->shouldFinish()) {
+    bool written = false;
+    std::string message;
+    finishRun(&written, &message);
   }
 }
 
@@ -348,6 +369,7 @@ void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
     session()->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency,
                        core::quadratureRatio(msg->quadrature, msg->amplitude));
     noteRestart(restarts);
+    checkFinishAfterWave(msg->header.stamp);
   }
 }
 

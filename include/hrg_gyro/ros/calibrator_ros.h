@@ -61,6 +61,8 @@ class CalibratorRos {
   void onPrecession(const PrecessionState::ConstPtr& msg);
   /// Feeds a table (or, for the field method, precession loop) record and finishes when complete.
   void addRotationRecord(const ros::Time& stamp, double angle, double rate, std::uint32_t seq);
+  /// The auto-finish check again once the waves reach the latest rotation record (the waves may lag it).
+  void checkFinishAfterWave(const ros::Time& stamp);
   /// Field method: publishes the planned commands whose time has come at stream time `now` (the
   /// plan's clock starts at the first precession state seen while the driver listens).
   void advanceFieldPlan(const ros::Time& now);
@@ -138,6 +140,10 @@ class CalibratorRos {
   ros::Time model_since_;
   std::condition_variable model_cv_;
   ros::Time skip_waves_until_;  // under mutex_
+  // The latest rotation record (turntable or precession state) that did not finish the run, and
+  // whether the waves have reached its stamp since (checkFinishAfterWave); under mutex_.
+  ros::Time last_rotation_stamp_;
+  bool waves_reached_rotation_ = true;
   std::uint64_t skipped_old_model_ = 0;
   bool stopping_ = false;
   std::thread reload_worker_;
