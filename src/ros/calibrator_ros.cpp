@@ -1,5 +1,7 @@
 #include "hrg_gyro/ros/calibrator_ros.h"
 
+#include <std_msgs/Time.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -99,6 +101,7 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   params_.warnAboutUnknownKeys();
 
   result_pub_ = pnh_.advertise<CalibrationResult>("result", 1, true);
+  progress_pub_ = pnh_.advertise<std_msgs::Time>("progress", 10);
   ros::NodeHandle in = input_.handle(nh_);
   // The wave first: a driver waiting for a turntable listener then starts after this subscription
   // exists (in a nodelet manager the two are a poll of the driver apart).
@@ -191,6 +194,11 @@ void CalibratorRos::reloadLoop() {
         ROS_ERROR("calibrator: could not call %s", service.c_str());
       }
     }
+    if (!(start_next && reloaded)) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      --pending_reloads_;
+      publishProgress();  // the driver may be waiting for it with no data left in flight
+    }
     if (start_next && reloaded) {
       // Waves already queued (here or in transit) went through the previous model: the next stage
       // must not see them. The processor's ModelInfo for this file says up to which stamp.
@@ -213,6 +221,8 @@ void CalibratorRos::reloadLoop() {
       if (calibration_->hasNextStage() && startRun(false, &reason) && known) {
         skip_waves_until_ = since;
       }
+      --pending_reloads_;
+      publishProgress();
     }
   }
 }
@@ -311,6 +321,7 @@ void CalibratorRos::stopFieldPlan(const char* why) {
 
 void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  ProgressGuard progress(this, &last_rotation_in_, msg->header.stamp);
   if (!session() || fieldRun()) return;  // the field method's rotation is the precession loop's
   if (!sweep_end_.isZero() && (msg->header.stamp - sweep_end_).toSec() > kSweepChannelsWait) {
     ROS_WARN(
@@ -325,6 +336,7 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
 
 void CalibratorRos::onPrecession(const PrecessionState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  ProgressGuard progress(this, &last_rotation_in_, msg->header.stamp);
   if (!fieldRun()) return;
   addRotationRecord(msg->header.stamp, msg->angle, msg->rate, msg->header.seq);
   if (session()) advanceFieldPlan(msg->header.stamp);
@@ -360,6 +372,7 @@ void CalibratorRos::checkFinishAfterWave(const ros::Time& stamp) {
 
 void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  ProgressGuard progress(this, &last_wave_in_, msg->header.stamp);
   if (session() && !skip_waves_until_.isZero() && msg->header.stamp <= skip_waves_until_) {
     ++skipped_old_model_;
     return;
@@ -459,8 +472,22 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
       reload_requests_.push_back({more, o.parameters.calibration.method.name() + " " + o.parameters.calibration.time});
     }
     reload_cv_.notify_one();
+    ++pending_reloads_;  // ~progress holds until the processor runs the new file
   }
   return o;
+}
+
+void CalibratorRos::publishProgress() {
+  // Up to where both streams are taken in (the waves come a hop later, through the processor), at
+  // most every 50 ms of stamps; held while the processor is being reloaded, so that a driver pacing
+  // itself on it (driver_sim's ~pace_topic) lets no data through the previous model meanwhile.
+  if (pending_reloads_ > 0 || last_wave_in_.isZero() || last_rotation_in_.isZero()) return;
+  const ros::Time until = std::min(last_wave_in_, last_rotation_in_);
+  if (!last_progress_.isZero() && until >= last_progress_ && until < last_progress_ + ros::Duration(0.05)) return;
+  last_progress_ = until;
+  std_msgs::Time t;
+  t.data = until;
+  progress_pub_.publish(t);
 }
 
 bool CalibratorRos::onStart(StartCalibration::Request& req, StartCalibration::Response& res) {

@@ -2,6 +2,7 @@
 
 #include <rosgraph_msgs/Clock.h>
 #include <std_msgs/Bool.h>
+#include <std_msgs/Time.h>
 
 #include <algorithm>
 #include <cmath>
@@ -73,6 +74,9 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   wait_turntable_ = params_.get("wait_for_subscribers/turntable", 0);
   wait_truth_ = params_.get("wait_for_subscribers/truth", 0);
   wait_timeout_ = params_.get("wait_timeout", wait_timeout_);
+  pace_topic_ = params_.get<std::string>("pace_topic", pace_topic_);
+  max_lead_ = params_.get("max_lead", max_lead_);
+  pace_timeout_ = params_.get("pace_timeout", pace_timeout_);
   const int queue_size = params_.get("queue_size", 20000);
   params_.warnAboutUnknownKeys();
   if (!(clock_period_ > 0.0) || !std::isfinite(clock_period_)) {
@@ -85,6 +89,7 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
         clock_period_, output_period_, clock_period_);
   }
   if (!(max_lag_ > 0.0)) throw std::invalid_argument("~max_lag must be positive (s)");
+  if (!(max_lead_ >= 0.0) || !std::isfinite(max_lead_)) throw std::invalid_argument("~max_lead must be >= 0 (s)");
   // Wall-clock stamps are due times, so a late thread catches up; under sim time the clock is ours.
   // Built here so that a bad ~time_scale is refused at start-up, not thrown in the worker thread.
   schedule_.emplace(time_scale_, use_sim_time_ ? max_lag_ : INFINITY);
@@ -109,6 +114,15 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   }
   // Subscribed either way: a command to a gyro without the loop is answered with a warning.
   command_sub_ = nh_.subscribe("command/precession", 10, &DriverSimRos::onPrecessionCommand, this);
+  if (!pace_topic_.empty() && use_sim_time_) {
+    pace_sub_ = nh_.subscribe<std_msgs::Time>(pace_topic_, 10, [this](const std_msgs::Time::ConstPtr& m) {
+      paced_until_ = toNanoseconds(m->data);
+      paced_wall_ = ros::WallTime::now().toSec();
+    });
+  } else if (!pace_topic_.empty()) {
+    ROS_WARN("driver_sim: ~pace_topic '%s' ignored without /use_sim_time (real time waits for no one)",
+             pace_topic_.c_str());
+  }
   done_pub_ = pnh_.advertise<std_msgs::Bool>("done", 1, true);
   if (use_sim_time_ && publish_clock_) clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 100);
   std_msgs::Bool done;
@@ -201,6 +215,36 @@ bool DriverSimRos::waitForSubscribers() {
                wait_turntable_, truth_pub_.getNumSubscribers(), wait_truth_);
     }
     ros::WallDuration(0.01).sleep();
+  }
+  return false;
+}
+
+bool DriverSimRos::waitForConsumer(core::Nanoseconds stamp) {
+  const core::Nanoseconds lead = core::toNanoseconds(max_lead_);
+  const double since = ros::WallTime::now().toSec();
+  bool noted = false;
+  while (!stop_ && ros::ok()) {
+    if (pace_first_ == kNoPace) pace_first_ = stamp;
+    // Before the consumer's first word: the lead from the first sample (it needs data to speak).
+    const core::Nanoseconds until =
+        paced_until_ == kNoPace ? pace_first_ : static_cast<core::Nanoseconds>(paced_until_);
+    if (stamp <= until + lead) return true;
+    if (pace_given_up_) return true;
+    // Whichever came last, the start of this wait or the consumer's last word, the timeout counts from.
+    const double now = ros::WallTime::now().toSec();
+    const double quiet = now - std::max(since, static_cast<double>(paced_wall_));
+    if (pace_timeout_ > 0.0 && quiet > pace_timeout_) {
+      pace_given_up_ = true;
+      ROS_WARN("driver_sim: nothing on ~pace_topic %s for %.0f s of wall time: going on without it",
+               pace_sub_.getTopic().c_str(), quiet);
+      return true;
+    }
+    if (!noted && now - since > 10.0) {
+      noted = true;
+      ROS_INFO("driver_sim: waiting for the consumer on %s (at %.3f s, this sample %.3f s)",
+               pace_sub_.getTopic().c_str(), core::toSeconds(until), core::toSeconds(stamp));
+    }
+    ros::WallDuration(0.0005).sleep();
   }
   return false;
 }
@@ -311,6 +355,7 @@ void DriverSimRos::play(Simulator& sim, Sample* sample, const Publish& publish) 
                         "~time_scale (%.1f s let go so far)",
                         late, schedule.slid());
     }
+    if (pace_sub_ && !waitForConsumer(origin + s.stamp)) break;
     if (!clock_pub_.getTopic().empty() && sim.elapsed() >= next_clock) {
       rosgraph_msgs::Clock c;
       c.clock = stamp;

@@ -115,6 +115,17 @@ class CalibratorRos {
   InputThread input_;  // serves the four subscriptions below
   ros::Subscriber turntable_sub_, wave_sub_, channels_sub_, truth_sub_, precession_sub_;
   ros::Publisher result_pub_;
+  // ~progress (std_msgs/Time): up to which stamp both streams are taken in (publishProgress); under
+  // mutex_. A callback notes its record's stamp and publishes on the way out (ProgressGuard).
+  ros::Publisher progress_pub_;
+  ros::Time last_wave_in_, last_rotation_in_, last_progress_;
+  int pending_reloads_ = 0;  // written results whose processor reload is not done yet
+  void publishProgress();
+  struct ProgressGuard {
+    ProgressGuard(CalibratorRos* c, ros::Time* latest, const ros::Time& stamp) : calibrator(c) { *latest = stamp; }
+    ~ProgressGuard() { calibrator->publishProgress(); }
+    CalibratorRos* calibrator;
+  };
   ros::Publisher command_pub_;  // command/precession, the field method's virtual rotation
 
   // The field method's plan (under mutex_): commands, the next to send, the stream time it started.

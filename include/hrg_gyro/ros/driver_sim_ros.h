@@ -79,6 +79,22 @@ class DriverSimRos {
   ros::Publisher fixture_pub_;
   ros::Publisher precession_pub_;  // a gyro with a precession loop only
   ros::Subscriber command_sub_;
+  // ~pace_topic (sim time only): a consumer's std_msgs/Time saying up to which stamp it has taken
+  // the data in; a sample more than ~max_lead past it waits (a calibrator fitting, or reloading the
+  // processor, holds the session instead of letting it run on). After ~pace_timeout s of wall time
+  // without a word from it, the driver goes on without it (<= 0: never).
+  std::string pace_topic_;
+  double max_lead_ = 1.0;       // s of stamps
+  double pace_timeout_ = 60.0;  // s of wall time
+  ros::Subscriber pace_sub_;
+  static constexpr core::Nanoseconds kNoPace = INT64_MIN;
+  std::atomic<core::Nanoseconds> paced_until_{kNoPace};
+  std::atomic<double> paced_wall_{0.0};
+  bool pace_given_up_ = false;              // worker thread only
+  core::Nanoseconds pace_first_ = kNoPace;  // the first sample's stamp (worker thread only)
+  /// Waits until the consumer on ~pace_topic has taken the data in up to `stamp` - ~max_lead; false
+  /// when stopping.
+  bool waitForConsumer(core::Nanoseconds stamp);
   std::mutex command_mutex_;
   std::optional<double> pending_command_;  // under command_mutex_: received, not yet taken up
   bool has_precession_loop_ = false;
