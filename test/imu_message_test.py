@@ -21,7 +21,7 @@ class ImuMessage(unittest.TestCase):
     def test_rep145(self):
         imu = util.Latest("/gyro/imu/data_raw", Imu, keep_all=True)
         out = util.Latest("/gyro/output", GyroOutput, keep_all=True)
-        util.wait_for(lambda: imu.count > 50 and out.count > 50, 30, "imu and output messages")
+        util.wait_for(lambda: imu.count > 50 and out.count > 50, "imu and output messages")
         m = imu.all[-1]
         self.assertEqual(m.header.frame_id, "gyro_link")
         self.assertEqual(m.orientation_covariance[0], -1.0)

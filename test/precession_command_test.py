@@ -52,7 +52,7 @@ class PrecessionCommandTest(unittest.TestCase):
         # (rospy connects a node's publisher to its own subscriber). Waiting for two let the first
         # command go out before a recorder that started late under load: it then never saw its
         # three messages and never closed its bag.
-        util.wait_for(lambda: truth.count > 100 and state.count > 100 and pub.get_num_connections() >= 3, 60,
+        util.wait_for(lambda: truth.count > 100 and state.count > 100 and pub.get_num_connections() >= 3,
                       "the driver's truth, its precession state, and the driver, the recorder and this test "
                       "subscribed to the commands")
         self.assertEqual(state.msg.rate, 0.0)
@@ -67,11 +67,11 @@ class PrecessionCommandTest(unittest.TestCase):
             msg.header.stamp = rospy.Time.now()
             msg.rate = rate
             pub.publish(msg)
-            util.wait_for(lambda: state.msg.rate == rate, 20, "precession/state at %g rad/s" % rate)
+            util.wait_for(lambda: state.msg.rate == rate, "precession/state at %g rad/s" % rate)
             since = state.msg.header.stamp.to_sec()
             if rate != 0.0:
                 # A full turn of theta at 0.5 rad/s is 12.6 s; the loops take well under a second.
-                util.wait_for(lambda: truth.msg.header.stamp.to_sec() > since + 15.0, 30, "15 s of the wave")
+                util.wait_for(lambda: truth.msg.header.stamp.to_sec() > since + 15.0, "15 s of the wave")
             segments.append((rate, since))
         for s in (truth, state, commands):
             s.sub.unregister()
@@ -92,7 +92,7 @@ class PrecessionCommandTest(unittest.TestCase):
         self.assertEqual([m.rate for m in commands.all], [W, -W, 0.0])
 
         # The recorder stopped after the three commands and closed its bag.
-        util.wait_for(lambda: os.path.exists(path), 20, "the recorded bag " + path)
+        util.wait_for(lambda: os.path.exists(path), "the recorded bag " + path)
         with rosbag.Bag(path) as bag:
             recorded = [m.rate for _, m, _ in bag.read_messages(topics=["/field/command/precession"])]
         self.assertEqual(recorded, [W, -W, 0.0])
@@ -101,14 +101,14 @@ class PrecessionCommandTest(unittest.TestCase):
         warnings = util.Latest("/rosout", Log, keep_all=True)
         channels = util.Latest("/plain/channels", ChannelAmplitudes)
         pub = rospy.Publisher("/plain/command/precession", PrecessionCommand, queue_size=10)
-        util.wait_for(lambda: channels.count > 10 and pub.get_num_connections() >= 1, 60, "the plain driver")
+        util.wait_for(lambda: channels.count > 10 and pub.get_num_connections() >= 1, "the plain driver")
         msg = PrecessionCommand()
         msg.rate = W
         pub.publish(msg)
-        util.wait_for(lambda: any("no precession loop" in m.msg and m.level == Log.WARN for m in warnings.all), 20,
+        util.wait_for(lambda: any("no precession loop" in m.msg and m.level == Log.WARN for m in warnings.all),
                       "driver_sim's warning")
         before = channels.count
-        util.wait_for(lambda: channels.count > before + 10, 20, "channels after the command")
+        util.wait_for(lambda: channels.count > before + 10, "channels after the command")
         self.assertEqual(rospy.get_published_topics().count(["/plain/precession/state", "hrg_gyro/PrecessionState"]),
                          0)
 

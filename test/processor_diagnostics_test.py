@@ -33,7 +33,7 @@ class Diagnostics(unittest.TestCase):
         rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diag)
         rospy.Subscriber("/output", GyroOutput, self.on_output)
         self.pub = rospy.Publisher("/channels", ChannelAmplitudes, queue_size=100)
-        util.wait_for(lambda: self.pub.get_num_connections() > 0, 30, "the processor to subscribe")
+        util.wait_for(lambda: self.pub.get_num_connections() > 0, "the processor to subscribe")
         self.seq = 0
         self.t = time.time()
 
@@ -69,7 +69,7 @@ class Diagnostics(unittest.TestCase):
         def fresh():
             s = self.statuses.get(name)
             return s if s and s[2] > since else None
-        return util.wait_for(fresh, 10, "a diagnostic '%s'" % name)
+        return util.wait_for(fresh, "a diagnostic '%s'" % name)
 
     def test_good_bad_stalled_recovered(self):
         self.feed(2.5)
@@ -132,7 +132,7 @@ class Diagnostics(unittest.TestCase):
         self.assertEqual(level, DiagnosticStatus.OK, message)
 
     def test_calibrator_refuses_start_while_a_run_is_in_progress(self):
-        rospy.wait_for_service("/cal/calibrator/start", 30)
+        util.wait_for_service("/cal/calibrator/start")
         start = rospy.ServiceProxy("/cal/calibrator/start", StartCalibration)
         abort = rospy.ServiceProxy("/cal/calibrator/abort", Trigger)
         r = start(method="")  # the autostarted run is in progress
@@ -157,7 +157,7 @@ class Diagnostics(unittest.TestCase):
             manager = subprocess.Popen(["rosrun", "nodelet", "nodelet", "manager", "__name:=test_manager"],
                                        stdout=log, stderr=subprocess.STDOUT)
         try:
-            rospy.wait_for_service("/test_manager/load_nodelet", 30)
+            util.wait_for_service("/test_manager/load_nodelet")
             load = subprocess.run(["rosrun", "nodelet", "nodelet", "load", "hrg_gyro/Processor", "/test_manager",
                                    "__name:=broken_processor", "--no-bond"], stdout=subprocess.PIPE,
                                   stderr=subprocess.STDOUT, universal_newlines=True, timeout=60)
@@ -166,7 +166,7 @@ class Diagnostics(unittest.TestCase):
             def fatal_line():
                 with open(log_path) as f:
                     return [l for l in f if "FATAL" in l and "broken_processor failed to start" in l]
-            lines = util.wait_for(fatal_line, 20, "the manager to log why the nodelet failed")
+            lines = util.wait_for(fatal_line, "the manager to log why the nodelet failed")
             self.assertIn(missing, lines[0], "the reason is in the log")
         finally:
             manager.terminate()
@@ -177,14 +177,14 @@ class Diagnostics(unittest.TestCase):
         # A processor of its own (namespace fresh), so that its very first outputs are seen.
         imu = util.Latest("/fresh/imu/data_raw", Imu, keep_all=True)
         pub = rospy.Publisher("/fresh/channels", ChannelAmplitudes, queue_size=1000)
-        util.wait_for(lambda: pub.get_num_connections() > 0 and imu.sub.get_num_connections() > 0, 30,
+        util.wait_for(lambda: pub.get_num_connections() > 0 and imu.sub.get_num_connections() > 0,
                       "the fresh processor")
         t = time.time()
         for seq in range(1, 401):
             t += 0.005
             pub.publish(channels(seq, t, 0.2 - 0.028 * (t % 100)))
             time.sleep(0.004)
-        util.wait_for(lambda: imu.count >= 390, 20, "the fresh processor's Imu messages")
+        util.wait_for(lambda: imu.count >= 390, "the fresh processor's Imu messages")
         variances = [m.angular_velocity_covariance[8] for m in imu.all]
         self.assertTrue(all(v > 0.0 for v in variances), "a zero or negative variance: %s" % variances[:5])
         # The first ones carry the documented start-up value, later ones the measured noise (this

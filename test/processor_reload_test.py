@@ -43,9 +43,9 @@ class Reload(unittest.TestCase):
         self.pub = rospy.Publisher("/channels", ChannelAmplitudes, queue_size=100)
         self.outputs = util.Latest("/output", GyroOutput)
         self.model = util.Latest("/processor/model", ModelInfo)
-        rospy.wait_for_service("/processor/reload", timeout=30)
+        util.wait_for_service("/processor/reload")
         self.reload = rospy.ServiceProxy("/processor/reload", Trigger)
-        util.wait_for(lambda: self.pub.get_num_connections() > 0, 30, "the processor to subscribe")
+        util.wait_for(lambda: self.pub.get_num_connections() > 0, "the processor to subscribe")
         self.seq = 0
         self.t = time.time()
 
@@ -57,10 +57,10 @@ class Reload(unittest.TestCase):
             time.sleep(0.005)
 
     def test_good_then_bad_file(self):
-        util.wait_for(lambda: self.model.msg, 10, "~model")
+        util.wait_for(lambda: self.model.msg, "~model")
         self.assertEqual(self.model.msg.calibration_method, "none")
         self.feed(20)
-        util.wait_for(lambda: self.outputs.msg, 10, "an output")
+        util.wait_for(lambda: self.outputs.msg, "an output")
         self.assertAlmostEqual(self.outputs.msg.scale_factor, -0.56, places=12)
 
         # A good file with another K0 and provenance.
@@ -70,10 +70,10 @@ class Reload(unittest.TestCase):
         r = self.reload()
         self.assertTrue(r.success, r.message)
         self.assertIn("-0.57", r.message)
-        util.wait_for(lambda: self.model.msg.calibration_method == "manual", 10, "~model after reload")
+        util.wait_for(lambda: self.model.msg.calibration_method == "manual", "~model after reload")
         self.assertGreater(self.model.msg.header.stamp.to_sec(), 0.0)
         self.feed(20)
-        util.wait_for(lambda: abs(self.outputs.msg.scale_factor + 0.57) < 1e-12, 10, "outputs with the new K0")
+        util.wait_for(lambda: abs(self.outputs.msg.scale_factor + 0.57) < 1e-12, "outputs with the new K0")
 
         # A bad file: an odd harmonic order. Refused, named, old model kept.
         with open(self.file, "w") as f:

@@ -35,7 +35,7 @@ class TimeFaults(unittest.TestCase):
         self.clock = rospy.Publisher("/clock", Clock, queue_size=1000)
         self.pub = rospy.Publisher("/channels", ChannelAmplitudes, queue_size=1000)
         util.wait_for(lambda: self.pub.get_num_connections() > 0 and self.clock.get_num_connections() > 0,
-                      30, "the processor to subscribe")
+                      "the processor to subscribe")
         self.seq = 0
         self.t = 100.0
         self.theta = 0.1
@@ -72,7 +72,7 @@ class TimeFaults(unittest.TestCase):
         self.t -= 50.0                      # /clock and stamps jump back 50 s (a bag loop)
         self.good(20)                       # first sample re-anchors, 19 outputs, the first flagged RESET
         expected = 39 + 20 + 20 + 19
-        util.wait_for(lambda: len(self.outputs) >= expected, 20, "%d outputs" % expected)
+        util.wait_for(lambda: len(self.outputs) >= expected, "%d outputs" % expected)
         # Keep sim time moving so that the diagnostics publish the final counters.
         deadline = time.time() + 20
         while time.time() < deadline:
@@ -120,7 +120,7 @@ class TimeFaults(unittest.TestCase):
         def stalled():
             s = self.input_summary
             return s if s and s[2] > stop + 5.0 and "stalled" in s[1] else None
-        level, message, when = util.wait_for(stalled, deadline - time.time(), "'input stalled' with /clock stopped")
+        level, message, when = util.wait_wall(stalled, deadline - time.time(), "'input stalled' with /clock stopped")
         self.assertEqual(level, DiagnosticStatus.ERROR, message)
         self.assertLess(when - stop, 8.0, "reported within ~stall_timeout plus two diagnostic periods")
 

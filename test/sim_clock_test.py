@@ -2,6 +2,8 @@
 """driver_sim drives /clock with every output sample by default (its template says clock_period:
 auto), so a consumer's timer under sim time runs at its own rate: a 50 Hz timer fires 50 times per
 simulated second."""
+import os
+import sys
 import threading
 import unittest
 
@@ -10,6 +12,9 @@ import rostest
 from rosgraph_msgs.msg import Clock
 
 from hrg_gyro.msg import ChannelAmplitudes
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import hrg_test_util as util  # noqa: E402
 
 
 class SimClock(unittest.TestCase):
@@ -26,9 +31,11 @@ class SimClock(unittest.TestCase):
                 state["channels"] += 1
 
         rospy.Subscriber("/clock", Clock, on_clock, queue_size=1000)
-        rospy.Subscriber("/gyro/channels", ChannelAmplitudes, on_channels, queue_size=1000)
-        while rospy.get_rostime() <= rospy.Time(2.0):  # the session starts at 1 s; let it run
-            rospy.sleep(0.1)
+        # The driver starts once this test listens to its channels.
+        channels_sub = rospy.Subscriber("/gyro/channels", ChannelAmplitudes, on_channels, queue_size=1000)
+        util.watch(lambda: state["channels"])
+        # The session starts at 1 s; let it run (however long the session takes in wall time).
+        util.wait_for(lambda: rospy.get_rostime() > rospy.Time(2.0), "2 s of sim time")
         with lock:
             base = dict(state)
 
@@ -38,9 +45,9 @@ class SimClock(unittest.TestCase):
 
         start = rospy.get_rostime()
         timer = rospy.Timer(rospy.Duration(0.02), on_tick)
-        while rospy.get_rostime() < start + rospy.Duration(10.0):
-            rospy.sleep(0.1)
+        util.wait_for(lambda: rospy.get_rostime() >= start + rospy.Duration(10.0), "10 s more of sim time")
         timer.shutdown()
+        channels_sub.unregister()
         with lock:
             ticks, clocks = state["ticks"], state["clocks"] - base["clocks"]
             channels = state["channels"] - base["channels"]

@@ -36,7 +36,7 @@ class TriadInputs(unittest.TestCase):
         self.table = rospy.Publisher("/turntable/state", TurntableState, queue_size=5000)
         self.fixture = rospy.Publisher("/fixture/position", FixturePosition, queue_size=100)
         for p in self.waves + [self.table, self.fixture]:
-            util.wait_for(lambda: p.get_num_connections() > 0, 30, "the calibrator to subscribe to " + p.name)
+            util.wait_for(lambda: p.get_num_connections() > 0, "the calibrator to subscribe to " + p.name)
 
     def on_diagnostics(self, msg):
         for s in msg.status:
@@ -91,7 +91,7 @@ class TriadInputs(unittest.TestCase):
                     and v.get("fixture dropped (orientation not a rotation)") == str(bad_fixtures)
                     and v.get("axis y dropped (out of order)") == "1"
                     and v.get("turntable dropped (zero stamp)") == "1")
-        util.wait_for(counted, 30, "the diagnostic to count the bad records (last: %r)" % (self.status,))
+        util.wait_for(counted, "the diagnostic to count the bad records (last: %r)" % (self.status,))
         level, message, values = self.status
         self.assertEqual(level, 1, message)  # WARN
         self.assertIn("no wave from axis z", message)
@@ -111,7 +111,7 @@ class TriadInputs(unittest.TestCase):
         finish = rospy.ServiceProxy("/calibrator/finish", Trigger)
         r = finish()
         self.assertFalse(r.success, r.message)
-        util.wait_for(lambda: self.result.msg is not None, 30, "~result")
+        util.wait_for(lambda: self.result.msg is not None, "~result")
         res = self.result.msg
         self.assertFalse(res.accepted)
         self.assertFalse(res.written)
@@ -126,7 +126,7 @@ class TriadInputs(unittest.TestCase):
         self.assertFalse(report["accepted"])
         for name in ("triad.yaml", "x.yaml", "y.yaml", "z.yaml"):
             self.assertFalse(os.path.exists(os.path.join(self.work, name + ".bak")), name)
-        util.wait_for(lambda: self.status and self.status[2].get("run") == "idle", 10, "the idle diagnostic")
+        util.wait_for(lambda: self.status and self.status[2].get("run") == "idle", "the idle diagnostic")
 
         # Idle now: a new run starts, and aborts without writing.
         self.assertTrue(start("triad").success)

@@ -28,7 +28,7 @@ class TriadDriverSim(unittest.TestCase):
         fixture = util.Latest("/%s/fixture/position" % ns, FixturePosition, keep_all=True)
         body = util.Latest("/%s/truth" % ns, BodyTruth, keep_all=True)
         util.wait_for(lambda: fixture.count >= 3 and all(c.count > 400 for c in channels.values()) and
-                      body.count > 400 and all(t.count > 400 for t in truth.values()), 60, ns + " triad topics")
+                      body.count > 400 and all(t.count > 400 for t in truth.values()), ns + " triad topics")
         for s in list(channels.values()) + list(truth.values()) + [table, fixture, body]:
             s.sub.unregister()
         for a in AXES:

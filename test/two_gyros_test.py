@@ -19,9 +19,9 @@ class TwoGyros(unittest.TestCase):
     def test_side_by_side(self):
         out = {g: util.Latest("/%s/output" % g, GyroOutput, keep_all=True) for g in ("gyro_a", "gyro_b")}
         model = {g: util.Latest("/%s/processor/model" % g, ModelInfo) for g in ("gyro_a", "gyro_b")}
-        util.wait_for(lambda: all(o.count > 200 for o in out.values()) and all(m.msg for m in model.values()), 60,
+        util.wait_for(lambda: all(o.count > 200 for o in out.values()) and all(m.msg for m in model.values()),
                       "outputs and models of both gyros")
-        rospy.wait_for_service("/gyros_manager/list", timeout=30)
+        util.wait_for_service("/gyros_manager/list")
         loaded = rospy.ServiceProxy("/gyros_manager/list", NodeletList)().nodelets
         for name in ("/gyro_a/processor", "/gyro_b/processor", "/gyro_a/driver_sim", "/gyro_b/driver_sim"):
             self.assertIn(name, loaded)

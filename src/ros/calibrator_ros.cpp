@@ -1,5 +1,7 @@
 #include "hrg_gyro/ros/calibrator_ros.h"
 
+#include <std_msgs/Time.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -99,9 +101,10 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   params_.warnAboutUnknownKeys();
 
   result_pub_ = pnh_.advertise<CalibrationResult>("result", 1, true);
+  progress_pub_ = pnh_.advertise<std_msgs::Time>("progress", 10);
   ros::NodeHandle in = input_.handle(nh_);
-  turntable_sub_ = in.subscribe("turntable/state", queue_size, &CalibratorRos::onTurntable, this,
-                                ros::TransportHints().tcpNoDelay());
+  // The wave first: a driver waiting for a turntable listener then starts after this subscription
+  // exists (in a nodelet manager the two are a poll of the driver apart).
   wave_sub_ = in.subscribe("wave", queue_size, &CalibratorRos::onWave, this, ros::TransportHints().tcpNoDelay());
   // The field method's streams: the precession loop's state in, its commands out (for every method,
   // since ~start may choose field; a driver without the loop publishes no state).
@@ -114,6 +117,8 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
         in.subscribe("channels", queue_size, &CalibratorRos::onChannels, this, ros::TransportHints().tcpNoDelay());
     truth_sub_ = in.subscribe("truth", queue_size, &CalibratorRos::onTruth, this, ros::TransportHints().tcpNoDelay());
   }
+  turntable_sub_ = in.subscribe("turntable/state", queue_size, &CalibratorRos::onTurntable, this,
+                                ros::TransportHints().tcpNoDelay());
   if (!reload_service_.empty()) {
     // The processor's model topic sits beside its reload service (processor/reload -> processor/model).
     std::string model_topic = reload_service_;
@@ -189,6 +194,11 @@ void CalibratorRos::reloadLoop() {
         ROS_ERROR("calibrator: could not call %s", service.c_str());
       }
     }
+    if (!(start_next && reloaded)) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      --pending_reloads_;
+      publishProgress();  // the driver may be waiting for it with no data left in flight
+    }
     if (start_next && reloaded) {
       // Waves already queued (here or in transit) went through the previous model: the next stage
       // must not see them. The processor's ModelInfo for this file says up to which stamp.
@@ -211,6 +221,8 @@ void CalibratorRos::reloadLoop() {
       if (calibration_->hasNextStage() && startRun(false, &reason) && known) {
         skip_waves_until_ = since;
       }
+      --pending_reloads_;
+      publishProgress();
     }
   }
 }
@@ -226,6 +238,8 @@ bool CalibratorRos::startRun(bool restart, std::string* reason) {
     }
     skip_waves_until_ = ros::Time();
     sweep_end_ = last_channels_stamp_ = ros::Time();
+    last_rotation_stamp_ = ros::Time();
+    waves_reached_rotation_ = true;
     pairing_.clear();
     field_run_ = core::FieldPlanRun();
     last_wave_stamp_ = ros::Time();
@@ -259,6 +273,8 @@ void CalibratorRos::noteRestart(std::uint64_t restarts_before) {
            base_settings_.jump_persist, core::nameOf(session()->settings().method).c_str());
   skip_waves_until_ = ros::Time();
   sweep_end_ = last_channels_stamp_ = ros::Time();
+  last_rotation_stamp_ = ros::Time();
+  waves_reached_rotation_ = true;
   pairing_.clear();
   if (!field_run_.empty()) {
     // The field plan starts over with the run, from the next precession state.
@@ -316,6 +332,7 @@ void CalibratorRos::abortFieldRun(core::CalibrationOutcome outcome) {
 
 void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  ProgressGuard progress(this, &last_rotation_in_, msg->header.stamp);
   if (!session() || fieldRun()) return;  // the field method's rotation is the precession loop's
   if (!sweep_end_.isZero() && (msg->header.stamp - sweep_end_).toSec() > kSweepChannelsWait) {
     ROS_WARN(
@@ -330,6 +347,7 @@ void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
 
 void CalibratorRos::onPrecession(const PrecessionState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  ProgressGuard progress(this, &last_rotation_in_, msg->header.stamp);
   if (!fieldRun()) return;
   addRotationRecord(msg->header.stamp, msg->angle, msg->rate, msg->header.seq);
   if (!session()) return;  // finished on this record
@@ -362,11 +380,29 @@ void CalibratorRos::addRotationRecord(const ros::Time& stamp, double angle, doub
     bool written = false;
     std::string message;
     finishRun(&written, &message);
+    return;
+  }
+  last_rotation_stamp_ = stamp;
+  waves_reached_rotation_ = false;
+}
+
+void CalibratorRos::checkFinishAfterWave(const ros::Time& stamp) {
+  // The auto-finish rule needs both streams: the rest seen in the rotation records and the data
+  // complete from the waves. Checked on a rotation record only, a run whose waves came later than
+  // the table's (a hop more through the processor, run late on a busy host) never finished once the
+  // table had said its last; so it is checked again when the waves reach the latest record's stamp.
+  if (!session() || waves_reached_rotation_ || stamp < last_rotation_stamp_) return;
+  waves_reached_rotation_ = true;
+  if (session()->shouldFinish()) {
+    bool written = false;
+    std::string message;
+    finishRun(&written, &message);
   }
 }
 
 void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  ProgressGuard progress(this, &last_wave_in_, msg->header.stamp);
   if (session() && !skip_waves_until_.isZero() && msg->header.stamp <= skip_waves_until_) {
     ++skipped_old_model_;
     return;
@@ -377,6 +413,7 @@ void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
     session()->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency,
                        core::quadratureRatio(msg->quadrature, msg->amplitude));
     noteRestart(restarts);
+    checkFinishAfterWave(msg->header.stamp);
   }
 }
 
@@ -468,8 +505,22 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
       reload_requests_.push_back({more, o.parameters.calibration.method.name() + " " + o.parameters.calibration.time});
     }
     reload_cv_.notify_one();
+    ++pending_reloads_;  // ~progress holds until the processor runs the new file
   }
   return o;
+}
+
+void CalibratorRos::publishProgress() {
+  // Up to where both streams are taken in (the waves come a hop later, through the processor), at
+  // most every 50 ms of stamps; held while the processor is being reloaded, so that a driver pacing
+  // itself on it (driver_sim's ~pace_topic) lets no data through the previous model meanwhile.
+  if (pending_reloads_ > 0 || last_wave_in_.isZero() || last_rotation_in_.isZero()) return;
+  const ros::Time until = std::min(last_wave_in_, last_rotation_in_);
+  if (!last_progress_.isZero() && until >= last_progress_ && until < last_progress_ + ros::Duration(0.05)) return;
+  last_progress_ = until;
+  std_msgs::Time t;
+  t.data = until;
+  progress_pub_.publish(t);
 }
 
 bool CalibratorRos::onStart(StartCalibration::Request& req, StartCalibration::Response& res) {

@@ -2,6 +2,7 @@
 
 #include <rosgraph_msgs/Clock.h>
 #include <std_msgs/Bool.h>
+#include <std_msgs/Time.h>
 
 #include <algorithm>
 #include <cmath>
@@ -73,6 +74,9 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   wait_turntable_ = params_.get("wait_for_subscribers/turntable", 0);
   wait_truth_ = params_.get("wait_for_subscribers/truth", 0);
   wait_timeout_ = params_.get("wait_timeout", wait_timeout_);
+  pace_topic_ = params_.get<std::string>("pace_topic", pace_topic_);
+  max_lead_ = params_.get("max_lead", max_lead_);
+  pace_timeout_ = params_.get("pace_timeout", pace_timeout_);
   const int queue_size = params_.get("queue_size", 20000);
   params_.warnAboutUnknownKeys();
   if (!(clock_period_ > 0.0) || !std::isfinite(clock_period_)) {
@@ -85,6 +89,7 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
         clock_period_, output_period_, clock_period_);
   }
   if (!(max_lag_ > 0.0)) throw std::invalid_argument("~max_lag must be positive (s)");
+  if (!(max_lead_ >= 0.0) || !std::isfinite(max_lead_)) throw std::invalid_argument("~max_lead must be >= 0 (s)");
   // Wall-clock stamps are due times, so a late thread catches up; under sim time the clock is ours.
   // Built here so that a bad ~time_scale is refused at start-up, not thrown in the worker thread.
   schedule_.emplace(time_scale_, use_sim_time_ ? max_lag_ : INFINITY);
@@ -109,6 +114,15 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   }
   // Subscribed either way: a command to a gyro without the loop is answered with a warning.
   command_sub_ = nh_.subscribe("command/precession", 10, &DriverSimRos::onPrecessionCommand, this);
+  if (!pace_topic_.empty() && use_sim_time_) {
+    pace_sub_ = nh_.subscribe<std_msgs::Time>(pace_topic_, 10, [this](const std_msgs::Time::ConstPtr& m) {
+      paced_until_ = toNanoseconds(m->data);
+      paced_wall_ = ros::WallTime::now().toSec();
+    });
+  } else if (!pace_topic_.empty()) {
+    ROS_WARN("driver_sim: ~pace_topic '%s' ignored without /use_sim_time (real time waits for no one)",
+             pace_topic_.c_str());
+  }
   done_pub_ = pnh_.advertise<std_msgs::Bool>("done", 1, true);
   if (use_sim_time_ && publish_clock_) clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 100);
   std_msgs::Bool done;
@@ -177,14 +191,19 @@ std::uint32_t DriverSimRos::channelSubscribers() const {
 }
 
 bool DriverSimRos::waitForSubscribers() {
-  const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(wait_timeout_);
+  // wait_timeout <= 0: as long as it takes (a pipeline whose listeners are all part of the launch
+  // must not lose its first samples because the host started them slowly); said every 10 s.
+  const bool limited = wait_timeout_ > 0.0;
+  const ros::WallTime start = ros::WallTime::now();
+  ros::WallTime next_note = start + ros::WallDuration(10.0);
   while (!stop_ && ros::ok()) {
     if (static_cast<int>(channelSubscribers()) >= wait_channels_ &&
         static_cast<int>(turntable_pub_.getNumSubscribers()) >= wait_turntable_ &&
         static_cast<int>(truth_pub_.getNumSubscribers()) >= wait_truth_) {
       return true;
     }
-    if (ros::WallTime::now() > until) {
+    const ros::WallTime now = ros::WallTime::now();
+    if (limited && (now - start).toSec() > wait_timeout_) {
       ROS_WARN(
           "driver_sim: starting after %.1f s without all expected subscribers (channels %u/%d, "
           "turntable %u/%d, truth %u/%d)",
@@ -192,7 +211,43 @@ bool DriverSimRos::waitForSubscribers() {
           truth_pub_.getNumSubscribers(), wait_truth_);
       return true;
     }
+    if (!limited && now > next_note) {
+      next_note = now + ros::WallDuration(10.0);
+      ROS_WARN("driver_sim: still waiting after %.0f s for subscribers (channels %u/%d, turntable %u/%d, truth %u/%d)",
+               (now - start).toSec(), channelSubscribers(), wait_channels_, turntable_pub_.getNumSubscribers(),
+               wait_turntable_, truth_pub_.getNumSubscribers(), wait_truth_);
+    }
     ros::WallDuration(0.01).sleep();
+  }
+  return false;
+}
+
+bool DriverSimRos::waitForConsumer(core::Nanoseconds stamp) {
+  const core::Nanoseconds lead = core::toNanoseconds(max_lead_);
+  const double since = ros::WallTime::now().toSec();
+  bool noted = false;
+  while (!stop_ && ros::ok()) {
+    if (pace_first_ == kNoPace) pace_first_ = stamp;
+    // Before the consumer's first word: the lead from the first sample (it needs data to speak).
+    const core::Nanoseconds until =
+        paced_until_ == kNoPace ? pace_first_ : static_cast<core::Nanoseconds>(paced_until_);
+    if (stamp <= until + lead) return true;
+    if (pace_given_up_) return true;
+    // Whichever came last, the start of this wait or the consumer's last word, the timeout counts from.
+    const double now = ros::WallTime::now().toSec();
+    const double quiet = now - std::max(since, static_cast<double>(paced_wall_));
+    if (pace_timeout_ > 0.0 && quiet > pace_timeout_) {
+      pace_given_up_ = true;
+      ROS_WARN("driver_sim: nothing on ~pace_topic %s for %.0f s of wall time: going on without it",
+               pace_sub_.getTopic().c_str(), quiet);
+      return true;
+    }
+    if (!noted && now - since > 10.0) {
+      noted = true;
+      ROS_INFO("driver_sim: waiting for the consumer on %s (at %.3f s, this sample %.3f s)",
+               pace_sub_.getTopic().c_str(), core::toSeconds(until), core::toSeconds(stamp));
+    }
+    ros::WallDuration(0.0005).sleep();
   }
   return false;
 }
@@ -257,13 +312,42 @@ void DriverSimRos::play(Simulator& sim, Sample* sample, const Publish& publish) 
   Sample& s = *sample;
   double next_clock = 0.0;
   std::uint32_t seq = 0;
+  // Under sim time with another source driving /clock (~publish_clock false: a second driver of the
+  // same graph, a bag played with --clock), a sample goes out when /clock reaches its stamp: every
+  // driver keeps that one clock's pace, so two drivers' stamps cannot drift apart by what the host
+  // denied one of them (each pacing itself against the wall clock, a driver that was run late fell
+  // behind the clock for good). While the clock stands still (its source not started yet, or done)
+  // the driver goes on at its own ~time_scale, and waits again once the clock runs behind it.
+  const bool follow_clock = use_sim_time_ && clock_pub_.getTopic().empty() && time_scale_ > 0.0;
+  ros::Time clock_seen = ros::Time::now();
+  ros::WallTime clock_moved = ros::WallTime::now();
+  std::uint64_t on_clock = 0;
   for (;;) {
     if (stop_ || !ros::ok()) break;
     takeCommand(sim);
     if (!sim.next(&s)) break;
     const ros::Time stamp = toRosTime(origin + s.stamp);
+    bool reached = false;
+    while (follow_clock && !stop_ && ros::ok()) {
+      const ros::Time now = ros::Time::now();
+      const ros::WallTime wall = ros::WallTime::now();
+      if (now != clock_seen) {
+        clock_seen = now;
+        clock_moved = wall;
+      }
+      if (now >= stamp) {
+        reached = true;
+        // This sample is due now: if the clock stops, the own schedule goes on from here.
+        schedule.start(wall.toSec() - sim.elapsed() / time_scale_);
+        break;
+      }
+      if ((wall - clock_moved).toSec() > kStillClock) break;
+      ros::WallDuration(0.0005).sleep();
+    }
+    if (stop_ || !ros::ok()) break;
+    on_clock += reached ? 1 : 0;
     double late = 0.0;
-    const double wait = schedule.waitFor(sim.elapsed(), ros::WallTime::now().toSec(), &late);
+    const double wait = reached ? 0.0 : schedule.waitFor(sim.elapsed(), ros::WallTime::now().toSec(), &late);
     if (wait > 0.0) {
       ros::WallDuration(wait).sleep();
     } else if (late > 0.1 && !use_sim_time_) {
@@ -277,6 +361,7 @@ void DriverSimRos::play(Simulator& sim, Sample* sample, const Publish& publish) 
                         "~time_scale (%.1f s let go so far)",
                         late, schedule.slid());
     }
+    if (pace_sub_ && !waitForConsumer(origin + s.stamp)) break;
     if (!clock_pub_.getTopic().empty() && sim.elapsed() >= next_clock) {
       rosgraph_msgs::Clock c;
       c.clock = stamp;
@@ -293,6 +378,9 @@ void DriverSimRos::play(Simulator& sim, Sample* sample, const Publish& publish) 
   char lateness[128] = "";
   if (time_scale_ > 0.0 && !use_sim_time_) {
     std::snprintf(lateness, sizeof lateness, ", at most %.3f s behind schedule", schedule.maxLateness());
+  } else if (follow_clock) {
+    std::snprintf(lateness, sizeof lateness, ", %llu samples paced by /clock, the others by the schedule",
+                  static_cast<unsigned long long>(on_clock));
   } else if (time_scale_ > 0.0) {
     std::snprintf(lateness, sizeof lateness, ", the schedule let go %.3f s in %llu pauses", schedule.slid(),
                   static_cast<unsigned long long>(schedule.slides()));

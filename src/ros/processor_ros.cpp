@@ -123,23 +123,69 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   updater_.add("model", this, &ProcessorRos::diagnoseModel);
   updater_.add("precession", this, &ProcessorRos::diagnosePrecession);
   addProcessHeapDiagnostic(updater_, heap_trim_period);
+  // Listen to the channels only once the outputs have their listeners: a driver that waits for this
+  // node's subscription then waits for the whole chain (a calibrator that connected to wave late
+  // lost the first seconds of a session at 40x sim time on a loaded host).
+  wait_wave_ = params_.get("wait_for_subscribers/wave", 0);
+  wait_output_ = params_.get("wait_for_subscribers/output", 0);
+  wait_timeout_ = params_.get("wait_timeout", 0.0);
   params_.warnAboutUnknownKeys();
-  channels_sub_ = input_.handle(nh_).subscribe("channels", queue_size, &ProcessorRos::onChannels, this,
-                                               ros::TransportHints().tcpNoDelay());
-  // On the same thread as the channels: the two are handled in the order they arrive.
-  precession_sub_ = input_.handle(nh_).subscribe("precession/state", queue_size, &ProcessorRos::onPrecession, this,
-                                                 ros::TransportHints().tcpNoDelay());
+  queue_size_ = queue_size;
   input_.start();
   diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
+  if (outputsListened()) {
+    subscribeChannels();
+  } else {
+    wait_start_ = ros::WallTime::now();
+    wait_timer_ = nh_.createWallTimer(ros::WallDuration(0.01), &ProcessorRos::onWaitTimer, this);
+  }
   ROS_INFO("processor: %s (K0 %.6f, %zu K harmonics, calibration %s)", parameter_file_.c_str(),
            params->scale_factor.meanAt(NAN), params->scale_factor.orders().size(),
            params->calibration.method.name().c_str());
 }
 
 ProcessorRos::~ProcessorRos() {
+  wait_timer_.stop();
   channels_sub_.shutdown();
   precession_sub_.shutdown();
   input_.stop();
+}
+
+bool ProcessorRos::outputsListened() const {
+  return static_cast<int>(wave_pub_.getNumSubscribers()) >= wait_wave_ &&
+         static_cast<int>(output_pub_.getNumSubscribers()) >= wait_output_;
+}
+
+void ProcessorRos::subscribeChannels() {
+  channels_sub_ = input_.handle(nh_).subscribe("channels", queue_size_, &ProcessorRos::onChannels, this,
+                                               ros::TransportHints().tcpNoDelay());
+  // On the same thread as the channels: the two are handled in the order they arrive.
+  precession_sub_ = input_.handle(nh_).subscribe("precession/state", queue_size_, &ProcessorRos::onPrecession, this,
+                                                 ros::TransportHints().tcpNoDelay());
+  listening_ = true;
+}
+
+void ProcessorRos::onWaitTimer(const ros::WallTimerEvent&) {
+  if (listening_) return;
+  const double waited = (ros::WallTime::now() - wait_start_).toSec();
+  if (outputsListened()) {
+    wait_timer_.stop();
+    subscribeChannels();
+    ROS_INFO("processor: listening to channels after %.1f s (wave %u/%d, output %u/%d subscribers)", waited,
+             wave_pub_.getNumSubscribers(), wait_wave_, output_pub_.getNumSubscribers(), wait_output_);
+  } else if (wait_timeout_ > 0.0 && waited > wait_timeout_) {
+    wait_timer_.stop();
+    subscribeChannels();
+    ROS_WARN(
+        "processor: listening to channels after %.1f s without all expected subscribers (wave %u/%d, output %u/%d)",
+        waited, wave_pub_.getNumSubscribers(), wait_wave_, output_pub_.getNumSubscribers(), wait_output_);
+  } else if (waited >= next_wait_note_) {
+    next_wait_note_ = waited + 10.0;
+    ROS_WARN(
+        "processor: still waiting after %.0f s for subscribers (wave %u/%d, output %u/%d) before listening to "
+        "channels",
+        waited, wave_pub_.getNumSubscribers(), wait_wave_, output_pub_.getNumSubscribers(), wait_output_);
+  }
 }
 
 void ProcessorRos::publishModel(const ros::Time& since) {
@@ -365,7 +411,11 @@ void ProcessorRos::diagnoseInput(diagnostic_updater::DiagnosticStatusWrapper& st
                                    : INFINITY;
   const std::uint64_t lost = dropped_ - dropped_reported_;
   dropped_reported_ = dropped_;
-  if (!seen_input_) {
+  if (!seen_input_ && !listening_) {
+    stat.summaryf(DiagnosticStatus::WARN,
+                  "waiting for subscribers (wave %u/%d, output %u/%d) before listening to channels",
+                  wave_pub_.getNumSubscribers(), wait_wave_, output_pub_.getNumSubscribers(), wait_output_);
+  } else if (!seen_input_) {
     stat.summary(DiagnosticStatus::ERROR, "no channel amplitudes received yet");
   } else if (since > stall_timeout_) {
     stat.summaryf(DiagnosticStatus::ERROR, "input stalled: no channel amplitudes for %.2f s", since);

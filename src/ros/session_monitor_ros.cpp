@@ -62,6 +62,7 @@ SessionMonitorRos::SessionMonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 
 void SessionMonitorRos::onTruth(const GroundTruth::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  last_input_wall_ = ros::WallTime::now();
   const core::Nanoseconds t = toNanoseconds(msg->header.stamp);
   if (!truth_.empty() && t <= truth_.back().stamp) return;  // out of order: cannot be paired reliably
   const bool verify = msg->segment.rfind(prefix_, 0) == 0;
@@ -83,6 +84,7 @@ void SessionMonitorRos::onTruth(const GroundTruth::ConstPtr& msg) {
 
 void SessionMonitorRos::onOutput(const GyroOutput::ConstPtr& msg, Track* track) {
   std::lock_guard<std::mutex> lock(mutex_);
+  last_input_wall_ = ros::WallTime::now();
   if (msg->flags & (GyroOutput::FLAG_GAP | GyroOutput::FLAG_RESET)) return;
   track->pending.push_back({toNanoseconds(msg->header.stamp), msg->theta_mid, msg->alpha});
   match(track);
@@ -131,14 +133,22 @@ void SessionMonitorRos::onModel(const ModelInfo::ConstPtr& msg) {
 
 void SessionMonitorRos::onDone(const std_msgs::Bool::ConstPtr& msg) {
   if (!msg->data || finish_timer_.isValid()) return;
-  // Let in-flight outputs arrive first (under sim time the clock has stopped: wait in wall time).
-  finish_timer_ = nh_.createWallTimer(
-      ros::WallDuration(1.0),
-      [this](const ros::WallTimerEvent&) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        finish();
-      },
-      true);
+  // Let in-flight outputs arrive first, however late the pipeline runs: finish once every active
+  // track has an output for every verification truth, or once nothing came for kQuietAfterDone s
+  // (under sim time the clock has stopped: wall time). A fixed 1 s wait lost the last outputs of a
+  // processor run late on a busy host.
+  finish_timer_ = nh_.createWallTimer(ros::WallDuration(0.1), [this](const ros::WallTimerEvent&) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (finished_) return;
+    bool complete = verification_truths_ > 0;
+    for (const Track* tr : {after_.get(), before_.get()}) {
+      if (tr->passed != 0 && (tr->samples < verification_truths_ || !tr->pending.empty())) complete = false;
+    }
+    if (complete || (ros::WallTime::now() - last_input_wall_).toSec() > kQuietAfterDone) {
+      finish_timer_.stop();
+      finish();
+    }
+  });
 }
 
 void SessionMonitorRos::finish() {

@@ -1,5 +1,7 @@
 #include "hrg_gyro/ros/triad_calibrator_ros.h"
 
+#include <std_msgs/Time.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <map>
@@ -199,6 +201,7 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   }
 
   result_pub_ = pnh_.advertise<TriadCalibrationResult>("result", 1, true);
+  progress_pub_ = pnh_.advertise<std_msgs::Time>("progress", 10);
   ros::NodeHandle in = input_.handle(nh_);
   // The table last: a driver that waits for its turntable listener (driver_sim's
   // wait_for_subscribers) then finds the fixture's and the waves' subscriptions already asked for.
@@ -301,6 +304,7 @@ void TriadCalibratorRos::maybeFinish() {
 
 void TriadCalibratorRos::onWave(int axis, const WaveState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  ProgressGuard progress(this, &latest_in_[axis], msg->header.stamp);
   if (!feed_) {
     ++idle_records_;
     return;
@@ -311,6 +315,7 @@ void TriadCalibratorRos::onWave(int axis, const WaveState::ConstPtr& msg) {
 
 void TriadCalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  ProgressGuard progress(this, &latest_in_[3], msg->header.stamp);
   if (!feed_) {
     ++idle_records_;
     return;
@@ -321,6 +326,8 @@ void TriadCalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
 
 void TriadCalibratorRos::onFixture(const FixturePosition::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
+  // The fixture is logged at every change and at least every second: its next record may be 1 s on.
+  ProgressGuard progress(this, &latest_in_[4], msg->header.stamp + ros::Duration(1.0));
   if (!feed_) {
     ++idle_records_;
     return;
@@ -422,7 +429,24 @@ bool TriadCalibratorRos::finishRun(std::string* message) {
     pending_.push_back({r, written});
   }
   worker_cv_.notify_one();
+  if (written) ++pending_reloads_;  // ~progress holds until the processors and the triad run the new files
   return written;
+}
+
+void TriadCalibratorRos::publishProgress() {
+  // Up to where every stream is taken in, at most every 50 ms of stamps; held while written files
+  // are being reloaded (for driver_sim's ~pace_topic: the session waits for the slowest stream).
+  if (pending_reloads_ > 0) return;
+  ros::Time until;
+  for (const ros::Time& t : latest_in_) {
+    if (t.isZero()) return;
+    if (until.isZero() || t < until) until = t;
+  }
+  if (!last_progress_.isZero() && until >= last_progress_ && until < last_progress_ + ros::Duration(0.05)) return;
+  last_progress_ = until;
+  std_msgs::Time t;
+  t.data = until;
+  progress_pub_.publish(t);
 }
 
 void TriadCalibratorRos::resultLoop() {
@@ -454,6 +478,11 @@ void TriadCalibratorRos::resultLoop() {
       }
     }
     result_pub_.publish(p.result);
+    if (p.reload) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      --pending_reloads_;
+      publishProgress();  // the driver may be waiting for it with no data left in flight
+    }
   }
 }
 

@@ -198,7 +198,11 @@ bool TriadRos::onReload(std_srvs::Trigger::Request&, std_srvs::Trigger::Response
   ++reloads_;
   last_reload_error_.clear();
   res.success = true;
-  res.message = "loaded " + describe(triad_file_, *triad);
+  // Which samples the new file applies to: those after the last one output (the swap is between
+  // two samples); a client that compares outputs with the file needs it, however late the triad runs.
+  char since[96];
+  std::snprintf(since, sizeof since, " (in force after stamp %d.%09d)", last_stamp_.sec, last_stamp_.nsec);
+  res.message = "loaded " + describe(triad_file_, *triad) + since;
   ROS_INFO("triad: %s", res.message.c_str());
   return true;
 }

@@ -64,6 +64,8 @@ class CalibratorRos {
   void onPrecession(const PrecessionState::ConstPtr& msg);
   /// Feeds a table (or, for the field method, precession loop) record and finishes when complete.
   void addRotationRecord(const ros::Time& stamp, double angle, double rate, std::uint32_t seq);
+  /// The auto-finish check again once the waves reach the latest rotation record (the waves may lag it).
+  void checkFinishAfterWave(const ros::Time& stamp);
   /// Field method: publishes the planned commands whose time has come at the state's stamp (the
   /// plan's clock starts at the first precession state seen while the driver listens).
   void advanceFieldPlan(const core::PrecessionReport& state);
@@ -120,6 +122,17 @@ class CalibratorRos {
   InputThread input_;  // serves the four subscriptions below
   ros::Subscriber turntable_sub_, wave_sub_, channels_sub_, truth_sub_, precession_sub_;
   ros::Publisher result_pub_;
+  // ~progress (std_msgs/Time): up to which stamp both streams are taken in (publishProgress); under
+  // mutex_. A callback notes its record's stamp and publishes on the way out (ProgressGuard).
+  ros::Publisher progress_pub_;
+  ros::Time last_wave_in_, last_rotation_in_, last_progress_;
+  int pending_reloads_ = 0;  // written results whose processor reload is not done yet
+  void publishProgress();
+  struct ProgressGuard {
+    ProgressGuard(CalibratorRos* c, ros::Time* latest, const ros::Time& stamp) : calibrator(c) { *latest = stamp; }
+    ~ProgressGuard() { calibrator->publishProgress(); }
+    CalibratorRos* calibrator;
+  };
   ros::Publisher command_pub_;  // command/precession, the field method's virtual rotation
 
   // The field method's plan under way (under mutex_), and the newest wave stamp (the plan waits for
@@ -145,6 +158,10 @@ class CalibratorRos {
   ros::Time model_since_;
   std::condition_variable model_cv_;
   ros::Time skip_waves_until_;  // under mutex_
+  // The latest rotation record (turntable or precession state) that did not finish the run, and
+  // whether the waves have reached its stamp since (checkFinishAfterWave); under mutex_.
+  ros::Time last_rotation_stamp_;
+  bool waves_reached_rotation_ = true;
   std::uint64_t skipped_old_model_ = 0;
   bool stopping_ = false;
   std::thread reload_worker_;

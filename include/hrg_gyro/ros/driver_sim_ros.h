@@ -5,7 +5,9 @@
 // sample: `channels` (ChannelAmplitudes), `turntable/state` (TurntableState) and `truth`
 // (GroundTruth). With /use_sim_time it also drives /clock, `~time_scale` times faster than real
 // time (a lag beyond `~max_lag` slows the simulated clock instead of being chased, see
-// core::PlaybackSchedule); without it, stamps follow the wall clock from the start and a late
+// core::PlaybackSchedule), or, when another source drives /clock (`~publish_clock` false), follows
+// that clock: a sample goes out when /clock reaches its stamp; without it, stamps follow the wall
+// clock from the start and a late
 // thread catches up. `~done` (std_msgs/Bool, latched)
 // turns true when the scenario is over.
 //
@@ -78,6 +80,22 @@ class DriverSimRos {
   ros::Publisher fixture_pub_;
   ros::Publisher precession_pub_;  // a gyro with a precession loop only
   ros::Subscriber command_sub_;
+  // ~pace_topic (sim time only): a consumer's std_msgs/Time saying up to which stamp it has taken
+  // the data in; a sample more than ~max_lead past it waits (a calibrator fitting, or reloading the
+  // processor, holds the session instead of letting it run on). After ~pace_timeout s of wall time
+  // without a word from it, the driver goes on without it (<= 0: never).
+  std::string pace_topic_;
+  double max_lead_ = 1.0;       // s of stamps
+  double pace_timeout_ = 60.0;  // s of wall time
+  ros::Subscriber pace_sub_;
+  static constexpr core::Nanoseconds kNoPace = INT64_MIN;
+  std::atomic<core::Nanoseconds> paced_until_{kNoPace};
+  std::atomic<double> paced_wall_{0.0};
+  bool pace_given_up_ = false;              // worker thread only
+  core::Nanoseconds pace_first_ = kNoPace;  // the first sample's stamp (worker thread only)
+  /// Waits until the consumer on ~pace_topic has taken the data in up to `stamp` - ~max_lead; false
+  /// when stopping.
+  bool waitForConsumer(core::Nanoseconds stamp);
   std::mutex command_mutex_;
   struct Command {
     double rate;
@@ -97,6 +115,9 @@ class DriverSimRos {
   double clock_period_ = 0.0;
   static constexpr double kFinestAutoClockPeriod = 1e-3;  // s: "auto" publishes at most 1 kHz
   static constexpr double kMaxPrecessionRate = 10.0;      // rad/s: the scenario schedule's bound too
+  // s of wall time a /clock driven by another source may stand still before this driver, following
+  // it, goes on at its own time_scale (the source not started yet, or done)
+  static constexpr double kStillClock = 2.0;
   std::string frame_id_ = "gyro_link";
   bool use_sim_time_ = false;
   bool publish_clock_ = true;

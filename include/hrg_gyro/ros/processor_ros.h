@@ -19,6 +19,7 @@
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
 
+#include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <memory>
@@ -57,6 +58,10 @@ class ProcessorRos {
   void diagnoseWave(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseModel(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnosePrecession(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  /// ~wait_for_subscribers: the channels are subscribed once wave and output have their listeners.
+  bool outputsListened() const;
+  void subscribeChannels();
+  void onWaitTimer(const ros::WallTimerEvent& event);
   /// Publishes ~model for the model now in force; `since` is the last stamp of the previous one.
   void publishModel(const ros::Time& since);
 
@@ -73,6 +78,13 @@ class ProcessorRos {
 
   InputThread input_;  // serves channels_sub_ and precession_sub_ (one thread: in arrival order)
   ros::Subscriber channels_sub_, precession_sub_;
+  int queue_size_ = 50000;
+  int wait_wave_ = 0, wait_output_ = 0;
+  double wait_timeout_ = 0.0;  // s of wall time; <= 0: as long as it takes
+  ros::WallTime wait_start_;
+  double next_wait_note_ = 10.0;
+  ros::WallTimer wait_timer_;
+  std::atomic<bool> listening_{false};  // channels subscribed
   ros::Publisher wave_pub_, output_pub_, imu_pub_, model_pub_;
   ros::Time last_stamp_;
   ros::ServiceServer reload_srv_, capture_srv_;

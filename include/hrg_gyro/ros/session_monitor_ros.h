@@ -75,6 +75,8 @@ class SessionMonitorRos {
   bool finished_ = false;
   ros::Subscriber truth_sub_, output_sub_, before_sub_, result_sub_, done_sub_, model_sub_;
   ros::WallTimer finish_timer_;
+  ros::WallTime last_input_wall_;                 // the latest truth or output (under mutex_)
+  static constexpr double kQuietAfterDone = 5.0;  // s of wall time without input: in-flight ones are in
   ros::Publisher summary_pub_, done_pub_;
 };
 

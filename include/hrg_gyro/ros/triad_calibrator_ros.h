@@ -86,6 +86,18 @@ class TriadCalibratorRos {
   bool last_written_ = false;
   // Counted here, before the feed: messages the run could not take (no run in progress).
   std::uint64_t idle_records_ = 0;
+  // ~progress (std_msgs/Time): up to which stamp every stream (axes x, y, z, table, fixture + 1 s)
+  // is taken in; under mutex_. A callback notes its record's stamp and publishes on the way out.
+  ros::Publisher progress_pub_;
+  std::array<ros::Time, 5> latest_in_;
+  ros::Time last_progress_;
+  int pending_reloads_ = 0;  // written results whose reloads are not done yet
+  void publishProgress();
+  struct ProgressGuard {
+    ProgressGuard(TriadCalibratorRos* c, ros::Time* latest, const ros::Time& stamp) : calibrator(c) { *latest = stamp; }
+    ~ProgressGuard() { calibrator->publishProgress(); }
+    TriadCalibratorRos* calibrator;
+  };
   // The feed's counters survive its run for the diagnostics.
   std::array<core::TriadStreamCounters, core::TriadFeed::kStreamCount> last_counters_{};
 

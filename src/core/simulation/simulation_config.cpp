@@ -9,9 +9,10 @@ namespace hrg_gyro {
 namespace core {
 
 const std::vector<std::string>& nodeOnlyScenarioKeys() {
-  static const std::vector<std::string> keys = {"time_scale",         "clock_period",         "frame_id",
-                                                "publish_clock",      "wait_for_subscribers", "wait_timeout",
-                                                "shutdown_when_done", "queue_size",           "max_lag"};
+  static const std::vector<std::string> keys = {
+      "time_scale",   "clock_period",       "frame_id",   "publish_clock", "wait_for_subscribers",
+      "wait_timeout", "shutdown_when_done", "queue_size", "max_lag",       "pace_topic",
+      "max_lead",     "pace_timeout"};
   return keys;
 }
 
