@@ -118,8 +118,7 @@ class CalibrationMethod(unittest.TestCase):
             report = util.load_yaml(report_path)
             self.assertEqual(report["turntable_rejected"]["stamp_jump"], 2, report["turntable_rejected"])
             self.assertEqual(report["restarts"], 0)
-            util.wait_for(lambda: any("stamp jumps dropped" in v for v in statuses.values()), 30,
-                          "the processor's input diagnostics")
+            util.wait_for(lambda: any("stamp jumps dropped" in v for v in statuses.values()), "the processor's input diagnostics")
             processor = [v for v in statuses.values() if "stamp jumps dropped" in v][0]
             self.assertEqual(int(processor["stamp jumps dropped"]), 2)
             self.assertEqual(int(processor["resets (time went backwards)"]), 0)
@@ -206,8 +205,7 @@ class CalibrationMethod(unittest.TestCase):
             diagnostics = util.Latest("/diagnostics", DiagnosticArray, keep_all=True)
             pub = rospy.Publisher("/command/precession", PrecessionCommand, queue_size=10)
             util.wait_for(lambda: self.precession.msg is not None and self.precession.msg.commands == 2 and
-                          self.precession.msg.rate > 0.0 and pub.get_num_connections() >= 1, 120,
-                          "the first segment of the virtual rotation, the driver listening")
+                          self.precession.msg.rate > 0.0 and pub.get_num_connections() >= 1, "the first segment of the virtual rotation, the driver listening")
             self.assertEqual(self.precession.msg.source, "/calibrator")
             msg = PrecessionCommand()
             msg.rate = 0.0
@@ -222,7 +220,7 @@ class CalibrationMethod(unittest.TestCase):
             self.assertEqual([(g.name, g.passed) for g in r.gates], [("precession_command", False)])
             # Aborted at once: the stranger's command was the driver's third, and the calibrator's stop
             # (rate 0, the plan had the wave turning) its fourth and last.
-            util.wait_for(lambda: self.precession.msg.commands == 4, 30, "the calibrator's stop command")
+            util.wait_for(lambda: self.precession.msg.commands == 4, "the calibrator's stop command")
             self.assertEqual(self.precession.msg.rate, 0.0)
             self.assertEqual(self.precession.msg.source, "/calibrator")
 
@@ -232,7 +230,7 @@ class CalibrationMethod(unittest.TestCase):
                         if s.name.endswith("calibrator: calibration") and "aborted, nothing written" in s.message:
                             return s
                 return None
-            status = util.wait_for(aborted, 30, "the calibrator's diagnostic saying the run was aborted")
+            status = util.wait_for(aborted, "the calibrator's diagnostic saying the run was aborted")
             self.assertEqual(status.level, DiagnosticStatus.WARN)
             self.assertIn(me, status.message)
             with open(rospy.get_param("~parameter_file")) as f:
@@ -246,14 +244,13 @@ class CalibrationMethod(unittest.TestCase):
             outputs = util.Latest("/output", GyroOutput, keep_all=True)
             diagnostics = util.Latest("/diagnostics", DiagnosticArray, keep_all=True)
             util.wait_for(lambda: self.precession.msg is not None and self.precession.msg.commands == 2 and
-                          self.precession.msg.rate > 0.0, 120, "the first segment of the virtual rotation")
+                          self.precession.msg.rate > 0.0, "the first segment of the virtual rotation")
             pid = ServerProxy(rosgraph.Master("/calibration_method_test").lookupNode("/calibrator")).getPid("/test")[2]
             os.kill(pid, signal.SIGKILL)
-            util.wait_for(lambda: not rosnode.rosnode_ping("/calibrator", max_count=1), 20, "the calibrator to die")
+            util.wait_for(lambda: not rosnode.rosnode_ping("/calibrator", max_count=1), "the calibrator to die")
             killed = self.precession.msg.header.stamp.to_nsec()
             # 3 s of simulated time with the rate left in force, out of the processor.
-            util.wait_for(lambda: outputs.msg is not None and outputs.msg.header.stamp.to_nsec() > killed + 3000000000,
-                          60, "3 s of outputs after the kill")
+            util.wait_for(lambda: outputs.msg is not None and outputs.msg.header.stamp.to_nsec() > killed + 3000000000, "3 s of outputs after the kill")
             self.assertEqual((self.precession.msg.rate, self.precession.msg.commands), (0.2, 2), "left in force")
             after = [o for o in list(outputs.all) if o.header.stamp.to_nsec() > killed]
             self.assertGreater(len(after), 300)
@@ -269,7 +266,7 @@ class CalibrationMethod(unittest.TestCase):
                                 "0.2 rad/s in force, commanded by /calibrator" in s.message:
                             return s
                 return None
-            util.wait_for(warned, 30, "the processor's precession WARN naming /calibrator")
+            util.wait_for(warned, "the processor's precession WARN naming /calibrator")
             self.assertEqual(self.results.count, 0, "no result from a killed run")
             with open(rospy.get_param("~parameter_file")) as f:
                 self.assertEqual(f.read(), before, "the parameter file untouched")

@@ -57,12 +57,10 @@ class PrecessionSource(unittest.TestCase):
         statuses = Statuses()
         pub = rospy.Publisher("/field/command/precession", PrecessionCommand, queue_size=10)
         util.wait_for(lambda: truth.count > 0 and states.count > 200 and pub.get_num_connections() >= 1 and
-                      all(o.count > 200 for o in outputs.values()), 120,
-                      "the driver's state, both processors' outputs and the driver listening to commands")
+                      all(o.count > 200 for o in outputs.values()), "the driver's state, both processors' outputs and the driver listening to commands")
         self.assertEqual(states.msg.rate, 0.0)
         for ns in PROCESSORS:
-            util.wait_for(lambda: statuses.seen(ns, DiagnosticStatus.OK, "not turned on command"), 30,
-                          "%s: precession OK before any command" % ns)
+            util.wait_for(lambda: statuses.seen(ns, DiagnosticStatus.OK, "not turned on command"), "%s: precession OK before any command" % ns)
 
         def command(rate, since):
             """Commands `rate`; returns the stamp of the first state record (after `since`) that has it."""
@@ -70,7 +68,7 @@ class PrecessionSource(unittest.TestCase):
             msg.header.stamp = rospy.Time.now()
             msg.rate = rate
             pub.publish(msg)
-            util.wait_for(lambda: states.msg.rate == rate, 30, "precession/state at %g rad/s" % rate)
+            util.wait_for(lambda: states.msg.rate == rate, "precession/state at %g rad/s" % rate)
             return min(m.header.stamp.to_nsec() for m in list(states.all)
                        if m.rate == rate and m.header.stamp.to_nsec() > since)
 
@@ -80,18 +78,15 @@ class PrecessionSource(unittest.TestCase):
         # The WARN names the rate and this node; the rate stays on until both processors have said so.
         for ns in PROCESSORS:
             util.wait_for(lambda: statuses.seen(ns, DiagnosticStatus.WARN,
-                                                "%g rad/s in force, commanded by %s" % (RATE, me), seen_before[ns]),
-                          60, "%s: precession WARN naming %s" % (ns, me))
-        util.wait_for(lambda: states.msg.header.stamp.to_nsec() > on + 2000000000, 60, "2 s of the wave turning")
+                                                "%g rad/s in force, commanded by %s" % (RATE, me), seen_before[ns]), "%s: precession WARN naming %s" % (ns, me))
+        util.wait_for(lambda: states.msg.header.stamp.to_nsec() > on + 2000000000, "2 s of the wave turning")
         seen_on = {ns: len(statuses.reports[ns]) for ns in PROCESSORS}
         off = command(0.0, on)
         # 2 s of simulated time after the stop, out of every processor.
         end = off + 2000000000
-        util.wait_for(lambda: all(o.msg.header.stamp.to_nsec() > end for o in outputs.values()), 60,
-                      "2 s of outputs after the stop")
+        util.wait_for(lambda: all(o.msg.header.stamp.to_nsec() > end for o in outputs.values()), "2 s of outputs after the stop")
         for ns in PROCESSORS:
-            util.wait_for(lambda: statuses.seen(ns, DiagnosticStatus.OK, "not turned on command", seen_on[ns]), 60,
-                          "%s: precession OK again after the stop" % ns)
+            util.wait_for(lambda: statuses.seen(ns, DiagnosticStatus.OK, "not turned on command", seen_on[ns]), "%s: precession OK again after the stop" % ns)
 
         # The switches as the state records show them: this node's copy must hold the records just
         # before each (200 Hz, consecutive stamps), else `on` and `off` would not be the switches.

@@ -100,9 +100,8 @@ class TriadCalibrationLive(unittest.TestCase):
         # Two stray fixture records: the position in force, stamped 1000 s ahead and 100 s back.
         fixture = util.Latest("/fixture/position", FixturePosition)
         stray = rospy.Publisher("/fixture/position", FixturePosition, queue_size=2)
-        util.wait_for(lambda: fixture.msg is not None and rospy.get_rostime().to_sec() > 120.0, 300,
-                      "a fixture record past 120 s of the session")
-        util.wait_for(lambda: stray.get_num_connections() >= 2, 30, "the calibrator's subscription to the strays")
+        util.wait_for(lambda: fixture.msg is not None and rospy.get_rostime().to_sec() > 120.0, "a fixture record past 120 s of the session")
+        util.wait_for(lambda: stray.get_num_connections() >= 2, "the calibrator's subscription to the strays")
         for offset in (1000.0, -100.0):
             m = copy.deepcopy(fixture.msg)
             m.header.stamp = rospy.Time.from_sec(m.header.stamp.to_sec() + offset)

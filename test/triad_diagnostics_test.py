@@ -77,7 +77,7 @@ class TriadDiagnostics(unittest.TestCase):
         rospy.Subscriber("/diagnostics", DiagnosticArray, cls.on_diagnostics, queue_size=100)
         cls.publisher = Publisher()
         for p in cls.publisher.pubs.values():
-            util.wait_for(lambda: p.get_num_connections() > 0, 60, "the triad to subscribe to " + p.name)
+            util.wait_for(lambda: p.get_num_connections() > 0, "the triad to subscribe to " + p.name)
         cls.publisher.start()
 
     @classmethod
