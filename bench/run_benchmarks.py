@@ -3,7 +3,8 @@
 
   1. core suites (Google Benchmark, 5 repetitions, medians): demodulation, wave state, compensation
      with 0/4/8 harmonics and K(theta, f), the whole per-sample processor, fits, simulator RTF,
-     the resonator with its loops closed (ns per output sample, RTF);
+     the resonator with its loops closed (ns per output sample, RTF), north-finding (an alignment of a 10 min
+     window of 200 Hz triad samples, static and indexed: bench/alignment_benchmarks.cpp);
   2. calibration: 24 h of 1 kHz streams through the dual-rate session (time, peak RSS);
   3. offline: `hrg_bag process` (no output, --csv, --out) on bags of 1 M and 5 M samples beside its floor,
      hrg_gyro_bag_read_floor reading the same bag and nothing else (whole processes, wall clock, ratio);

@@ -16,8 +16,8 @@
 
 namespace {
 
-const std::vector<std::string> kFolders = {"common",     "model",       "resonator",  "signal",    "estimation",
-                                           "processing", "calibration", "simulation", "evaluation"};
+const std::vector<std::string> kFolders = {"common",     "model",     "resonator",   "signal",     "estimation",
+                                           "processing", "alignment", "calibration", "simulation", "evaluation"};
 
 std::vector<std::string> entries(const std::string& dir, bool directories) {
   std::vector<std::string> out;

@@ -1,0 +1,93 @@
+// North-finding: an alignment of a 10 min window at 200 Hz (120,000 triad samples, as many
+// accelerometer records; the indexed window also 100 Hz indexer records), from the first record fed to
+// the result with its error budget. Part of hrg_gyro_core_bench (`make bench`).
+#include <benchmark/benchmark.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <vector>
+
+#include "hrg_gyro/core/alignment/gyrocompass.h"
+#include "hrg_gyro/core/alignment/local_level.h"
+#include "hrg_gyro/core/simulation/gaussian_noise.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+constexpr double kRate = 200.0, kSeconds = 600.0, kLatitude = 0.9;
+
+struct Window {
+  std::vector<TriadBodySample> gyro;
+  std::vector<AccelerometerRecord> accelerometer;
+  std::vector<IndexerRecord> indexer;
+};
+
+// A mount at yaw 0.3 rad; indexed: the body at 0 for the first half, then turned to pi in 2 s.
+Window makeWindow(bool indexed) {
+  Window w;
+  GaussianNoise noise(1);
+  const Eigen::Matrix3d mount = orientationFromEuler(EulerAngles{0.002, -0.001, 0.3}).toRotationMatrix();
+  const Eigen::Vector3d earth = mount.transpose() * earthRateEnu(kLatitude);
+  const Eigen::Vector3d gravity = mount.transpose() * Eigen::Vector3d(0, 0, kStandardGravity);
+  const double h = 1.0 / kRate, white = 4.9e-6 / 0.56;
+  const long n = static_cast<long>(kSeconds * kRate);
+  Eigen::Vector3d angle = Eigen::Vector3d::Zero(), previous = Eigen::Vector3d::Zero();
+  auto psiAt = [&](double t) {
+    if (!indexed || t < 0.5 * kSeconds) return 0.0;
+    return std::min(1.0, (t - 0.5 * kSeconds) / 2.0) * kPi;
+  };
+  for (long k = 1; k <= n + 1; ++k) {
+    const double t = k * h, psi0 = psiAt(t - h), psi1 = psiAt(t);
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.5 * (psi0 + psi1), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    angle += turn.transpose() * earth * h + Eigen::Vector3d::UnitZ() * (psi1 - psi0);
+    const Eigen::Vector3d measured = angle + white * Eigen::Vector3d(noise.next(), noise.next(), noise.next());
+    TriadBodySample x;
+    x.stamp = toNanoseconds(10.0 + t);
+    x.dt = h;
+    x.delta_angle = measured - previous;
+    x.angular_velocity = x.delta_angle / h;
+    previous = measured;
+    w.gyro.push_back(x);
+    AccelerometerRecord a;
+    a.stamp = x.stamp;
+    a.specific_force = turn.transpose() * gravity + 2e-3 * Eigen::Vector3d(noise.next(), noise.next(), noise.next());
+    w.accelerometer.push_back(a);
+    if (indexed && k % 2 == 0) w.indexer.push_back(IndexerRecord{x.stamp, psi1, (psi1 - psi0) / h});
+  }
+  return w;
+}
+
+void BM_Alignment10MinuteWindow(benchmark::State& state) {
+  const bool indexed = state.range(0) != 0;
+  static const Window windows[2] = {makeWindow(false), makeWindow(true)};
+  const Window& w = windows[indexed];
+  AlignmentSettings settings;
+  settings.mode = indexed ? AlignmentMode::kIndexed : AlignmentMode::kStatic;
+  settings.latitude = kLatitude;
+  settings.duration = kSeconds;
+  settings.noise.residual_bias = 1e-8;
+  AlignmentResult result;
+  for (auto _ : state) {
+    Gyrocompass g(settings);
+    for (const IndexerRecord& r : w.indexer) g.addIndexer(r);
+    for (std::size_t k = 0; k < w.gyro.size(); ++k) {
+      g.addTriad(w.gyro[k]);
+      g.addAccelerometer(w.accelerometer[k]);
+    }
+    result = g.finish();
+    benchmark::DoNotOptimize(result.heading);
+  }
+  if (!result.accepted) state.SkipWithError(result.summary().c_str());
+  state.SetItemsProcessed(static_cast<std::int64_t>(w.gyro.size()) * state.iterations());
+  char label[160];
+  std::snprintf(label, sizeof label, "%s, %zu triad samples (10 min at 200 Hz): heading %.4f +- %.4f deg",
+                indexed ? "indexed, two positions" : "static triad", w.gyro.size() - 1, result.heading,
+                result.heading_sigma);
+  state.SetLabel(label);
+}
+BENCHMARK(BM_Alignment10MinuteWindow)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro

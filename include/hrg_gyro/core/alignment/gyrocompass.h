@@ -1,0 +1,151 @@
+// North-finding from the Earth's rate (gyrocompassing): the one object the gyrocompass node and the
+// offline tool feed with the records of a window, each stream in stamp order, and read the result
+// from. Same records, same result, bit for bit.
+//
+// Streams, by mode (alignment_settings.h says what each mode resolves):
+//   static   addTriad (the triad combiner's body samples), a gravity reference;
+//   indexed  addTriad, or addAxis for one gyro (single_gyro), and addIndexer (the indexer's or rate
+//            table's state: stamp, angle, rate), a gravity reference;
+//   sweep    addSweepAxis per axis (each axis processor's outputs, PRECESSING flags and all) and
+//            addPrecession per axis (its driver's precession state: the commanded rate and angle),
+//            the triad's file for M and the body bias, a gravity reference;
+//   gravity  addAccelerometer (an IMU on the same mount, its mounting a setting), or a declared level.
+//
+// The window is `duration` s of gyro stamps from the first sample's start; complete() says when
+// it is full. finish() fits, levels, finds the heading and its error budget, and applies the gates:
+//   latitude    above max_latitude (checked at once: the object starts refused);
+//   motion      within a segment, a block's mean rate departs from another's by more than
+//               2 max_motion (as the turn-on bias capture judges a still gyro; judged as the samples
+//               come in the static mode, so a moving base ends the alignment at once), or the wave
+//               was turned on command outside the sweep mode;
+//   stillness   the fit's residuals scatter beyond max_scatter times the noise model's prediction;
+//   level       no gravity reference, or |f| not g;
+//   design      the data cannot resolve the heading: one gyro at two positions (one horizontal
+//               component), positions that do not differ, a sweep that does not turn both ways;
+//   earth_rate  the horizontal rate measured is not the Earth's (a gross bias, a wrong latitude);
+//   attitude    the body's x axis too close to vertical for a heading.
+// Each fit is on the integrated angles (integrated_angle_fit.h), in segments: a gap or reset, an
+// indexer position, a commanded rate each start a new one. In the indexed mode a channel with
+// sensitive direction d (platform frame) at indexer angle psi senses
+//     b_c + w_x (d_x cos psi - d_y sin psi) + w_y (d_x sin psi + d_y cos psi) + d_z (v + psi')
+// (w the Earth's rate in the indexer's zero frame, v its vertical part); the known table rate psi' is
+// removed, v goes into the channel's bias b_c, and (w_x, w_y, v) is levelled. In the sweep mode
+// each axis's output is fitted as omega_i t + g_i psi_cmd(t) + sum_k (s_k sin k psi_cmd + c_k cos k
+// psi_cmd) (the commanded angle psi_cmd, executed with the gain G_v / K0 = g_i and its harmonics),
+// within segments of one commanded rate, settle s after each change left out, and the body rate is
+// M omega - bias. The vehicle's own travel over the Earth is out of scope. No ROS.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hrg_gyro/core/alignment/alignment_result.h"
+#include "hrg_gyro/core/alignment/alignment_settings.h"
+#include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/triad_parameters.h"
+#include "hrg_gyro/core/processing/precession_watch.h"
+#include "hrg_gyro/core/processing/triad_combiner.h"
+
+namespace hrg_gyro {
+namespace core {
+
+/// The indexer's (or rate table's) state, as TurntableState carries it.
+struct IndexerRecord {
+  Nanoseconds stamp = 0;
+  double angle = 0.0;  ///< rad, counter-clockwise seen from above (about the platform's z)
+  double rate = NAN;   ///< rad/s; NaN: taken from the angles
+};
+
+/// One accelerometer sample: the specific force in the accelerometer's frame (sensor_msgs/Imu
+/// linear_acceleration, REP-145: +g up at rest), m/s^2.
+struct AccelerometerRecord {
+  Nanoseconds stamp = 0;
+  Eigen::Vector3d specific_force = Eigen::Vector3d::Zero();
+};
+
+struct AlignmentProgress {
+  double seconds = 0.0;   ///< of gyro stamps in the window so far
+  double duration = 0.0;  ///< the window's
+  bool complete = false;  ///< full, or refused
+  bool refused = false;   ///< refused before the end (latitude, motion, a commanded wave, abort)
+  std::string reason;
+  std::uint64_t samples = 0;  ///< gyro samples taken (per channel)
+  std::uint64_t gaps = 0;     ///< gaps and resets in the gyro input
+  std::uint64_t dropped = 0;  ///< records dropped: out of order, duplicate, not finite
+  std::uint64_t indexer = 0, accelerometer = 0, precession = 0;  ///< records taken
+};
+
+class Gyrocompass {
+ public:
+  /// Throws ConfigError (naming the key) for bad settings. `triad`: the triad's file, used by the
+  /// sweep mode (M and the body bias applied to the axes' outputs).
+  explicit Gyrocompass(const AlignmentSettings& settings, const TriadParameters& triad = TriadParameters());
+
+  void addTriad(const TriadBodySample& sample);
+  void addAxis(const AxisOutput& output);
+  void addSweepAxis(std::size_t axis, const AxisOutput& output);
+  void addPrecession(std::size_t axis, const PrecessionStateRecord& record);
+  void addIndexer(const IndexerRecord& record);
+  void addAccelerometer(const AccelerometerRecord& record);
+
+  /// The window is full (a gyro stamp reached its end on every stream), or the alignment was refused.
+  bool complete() const;
+  /// Ends it with a reason (a service call, shutdown, the input stopped).
+  void abort(const std::string& reason);
+  AlignmentProgress progress() const;
+  /// Solves with what the window holds (complete or not) and applies the gates.
+  AlignmentResult finish() const;
+
+  const AlignmentSettings& settings() const { return settings_; }
+  /// The window's start and end, gyro stamps (0 before the first sample).
+  Nanoseconds windowStart() const { return start_; }
+  Nanoseconds windowEnd() const { return end_; }
+
+ private:
+  // One gyro stream: a triad's three body axes, one gyro, or one axis of a sweep.
+  struct Stream {
+    std::size_t channels = 3;
+    std::vector<Nanoseconds> stamp;
+    std::vector<double> dt;
+    std::vector<double> increment;     // `channels` per sample
+    std::vector<std::uint8_t> broken;  // 1: the sample does not continue the previous one
+    Nanoseconds last = 0;
+    bool pending_break = false;
+    bool full = false;
+  };
+  // Running block means of one stream within a segment (the stillness judged as data come).
+  struct BlockMotion {
+    std::size_t channels = 3;
+    double block_dt = 0.0;
+    std::array<double, 3> block_sum{{0.0, 0.0, 0.0}}, low{{0.0, 0.0, 0.0}}, high{{0.0, 0.0, 0.0}};
+    bool has_block = false;
+    double worst = 0.0;  // largest half-spread of block rates so far, rad/s
+    void restart();
+    void add(double dt, const double* increment, double block);
+  };
+
+  bool admit(Stream* stream, Nanoseconds stamp, double dt, const double* increment, std::size_t channels, bool gap,
+             bool precessing);
+  void refuse(const std::string& gate, const std::string& reason);
+
+  AlignmentSettings settings_;
+  TriadParameters triad_;
+  std::array<Stream, 3> streams_;  // [0]: triad or single gyro; sweep: one per axis
+  std::size_t stream_count_ = 1;
+  Nanoseconds start_ = 0, end_ = 0;
+  bool started_ = false;
+  BlockMotion live_motion_;  // the static mode's, as samples come
+  std::vector<IndexerRecord> indexer_;
+  std::vector<AccelerometerRecord> accelerometer_;
+  std::array<std::vector<PrecessionStateRecord>, 3> precession_;
+  std::string refused_gate_, refused_reason_;
+  std::uint64_t gaps_ = 0, dropped_ = 0;
+
+  friend class GyrocompassSolver;
+};
+
+}  // namespace core
+}  // namespace hrg_gyro

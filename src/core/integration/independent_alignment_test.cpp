@@ -1,0 +1,141 @@
+// The gyrocompass on windows from an independent generator: test/independent_alignment.py (numpy, its own
+// frames, rotations and integration, none of the package's code) writes a static triad window and a
+// two-position indexed window as CSV files with the truth; each is read back here and aligned, and the
+// heading must be the truth's within the reported sigma's bounds (4 sigma), the sigma as small as the
+// noise and the residual bias allow.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "hrg_gyro/core/alignment/gyrocompass.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+// The rows of a CSV file of numbers after its header line.
+std::vector<std::vector<double>> readCsv(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  if (!std::getline(in, line)) return rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) row.push_back(std::strtod(cell.c_str(), nullptr));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+Nanoseconds stampOf(double ns) { return static_cast<Nanoseconds>(std::llround(ns)); }
+
+struct Window {
+  std::string dir;
+  std::map<std::string, double> truth;
+};
+
+Window generate(int seed) {
+  char pattern[] = "/tmp/hrg_independent_alignment_XXXXXX";
+  Window w;
+  w.dir = mkdtemp(pattern);
+  const std::string command = "/usr/bin/python3 " + std::string(HRG_GYRO_SOURCE_DIR) +
+                              "/test/independent_alignment.py --out " + w.dir + " --seed " + std::to_string(seed);
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  for (const auto& row : [&] {
+         std::ifstream in(w.dir + "/truth.csv");
+         std::vector<std::pair<std::string, double>> kv;
+         std::string line;
+         std::getline(in, line);
+         while (std::getline(in, line)) {
+           const std::size_t comma = line.find(',');
+           kv.emplace_back(line.substr(0, comma), std::strtod(line.c_str() + comma + 1, nullptr));
+         }
+         return kv;
+       }()) {
+    w.truth[row.first] = row.second;
+  }
+  return w;
+}
+
+void removeWindow(const Window& w) {
+  for (const char* f : {"static_gyro.csv", "static_accel.csv", "indexed_gyro.csv", "indexed_accel.csv",
+                        "indexed_indexer.csv", "truth.csv"}) {
+    std::remove((w.dir + "/" + f).c_str());
+  }
+  rmdir(w.dir.c_str());
+}
+
+AlignmentResult align(const Window& w, const std::string& prefix, AlignmentMode mode) {
+  AlignmentSettings s;
+  s.mode = mode;
+  s.latitude = w.truth.at("latitude");
+  s.duration = w.truth.at(prefix + "_seconds");
+  s.noise.residual_bias = 1e-8;
+  s.level.accelerometer_bias_sigma = w.truth.at("accelerometer_bias_sigma");
+  Gyrocompass g(s);
+  const auto gyro = readCsv(w.dir + "/" + prefix + "_gyro.csv");
+  const auto accel = readCsv(w.dir + "/" + prefix + "_accel.csv");
+  EXPECT_GT(gyro.size(), 1000u);
+  for (const auto& r : readCsv(w.dir + "/" + prefix + "_indexer.csv")) {
+    g.addIndexer(IndexerRecord{stampOf(r.at(0)), r.at(1), r.at(2)});
+  }
+  for (std::size_t k = 0; k < gyro.size(); ++k) {
+    TriadBodySample x;
+    x.stamp = stampOf(gyro[k].at(0));
+    x.dt = gyro[k].at(1);
+    x.delta_angle = Eigen::Vector3d(gyro[k].at(2), gyro[k].at(3), gyro[k].at(4));
+    g.addTriad(x);
+    if (k < accel.size()) {
+      AccelerometerRecord a;
+      a.stamp = stampOf(accel[k].at(0));
+      a.specific_force = Eigen::Vector3d(accel[k].at(1), accel[k].at(2), accel[k].at(3));
+      g.addAccelerometer(a);
+    }
+  }
+  EXPECT_TRUE(g.complete());
+  return g.finish();
+}
+
+TEST(IndependentAlignment, TheGyrocompassFindsTheIndependentGeneratorsHeading) {
+  double worst_z = 0.0;
+  for (int seed = 1; seed <= 3; ++seed) {
+    const Window w = generate(seed);
+    for (const std::string prefix : {"static", "indexed"}) {
+      const AlignmentMode mode = prefix == "static" ? AlignmentMode::kStatic : AlignmentMode::kIndexed;
+      const AlignmentResult r = align(w, prefix, mode);
+      ASSERT_TRUE(r.accepted) << prefix << ": " << r.summary();
+      const double truth = w.truth.at(prefix + "_heading_deg");
+      double error = r.heading - truth;  // degrees, wrapped to (-180, 180]
+      error -= 360.0 * std::round(error / 360.0);
+      const double error_rad = error * kPi / 180.0, sigma = r.budget.total;
+      worst_z = std::max(worst_z, std::abs(error_rad) / sigma);
+      std::printf(
+          "[ measured ] independent generator, seed %d, %s: heading %.4f deg (truth %.4f), error %+.4f mrad, "
+          "sigma %.4f mrad; roll %+.3f mrad, pitch %+.3f mrad off\n",
+          seed, prefix.c_str(), r.heading, truth, 1e3 * error_rad, 1e3 * sigma,
+          1e3 * (r.attitude.roll - w.truth.at(prefix + "_roll")),
+          1e3 * (r.attitude.pitch - w.truth.at(prefix + "_pitch")));
+      EXPECT_LT(std::abs(error_rad), 4.0 * sigma) << prefix;
+      EXPECT_NEAR(r.attitude.roll, w.truth.at(prefix + "_roll"), 1e-4) << prefix;
+      EXPECT_NEAR(r.attitude.pitch, w.truth.at(prefix + "_pitch"), 1e-4) << prefix;
+      // The static sigma is the residual bias's floor, the indexed one the noise's.
+      EXPECT_LT(sigma, prefix == "static" ? 0.5e-3 : 0.1e-3) << prefix;
+    }
+    removeWindow(w);
+  }
+  std::printf("[ measured ] independent generator: worst |error| / sigma %.2f\n", worst_z);
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro
