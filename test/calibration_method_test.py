@@ -52,7 +52,8 @@ def clean_offline_report(scenario, prior, method):
     bag, report = os.path.join(work, "clean.bag"), os.path.join(work, "clean.report.yaml")
     subprocess.run([hrg_bag, "simulate", "--scenario", scenario, "--out", bag], check=True,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=600)
-    subprocess.run([hrg_bag, "calibrate", bag, "--method", method, "--params", prior, "--report", report],
+    subprocess.run([hrg_bag, "calibrate", bag, "--method", method, "--params", prior, "--report", report, "--out",
+                    os.path.join(work, "clean.yaml")],
                    check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=600)
     return util.load_yaml(report)
 
