@@ -48,6 +48,7 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
       updater_(nh, params_.checkDiagnosticPeriod(), pnh.getNamespace()) {
   base_settings_ = core::CalibrationSettings::parse(core::YamlField(privateParameters(pnh_), ""), nodeOnlyKeys());
   params_.claim(core::CalibrationSettings::keyPaths());
+  params_.claim(core::CalibrationSettings::formerKeyPaths(), true);  // read when set, never a default
   // The triad mode's keys (TriadCalibratorRos reads them): shared template, not used by one axis.
   std::vector<std::string> triad_keys{"triad_file", "reload_services", "stream_hold"};
   for (const std::string& k : core::TriadCalibrationSettings::keys()) triad_keys.push_back("triad/" + k);

@@ -76,6 +76,7 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   }
   if (root.has("triad")) triad_settings_ = core::TriadCalibrationSettings::parse(root["triad"]);
   params_.claim(core::CalibrationSettings::keyPaths());
+  params_.claim(core::CalibrationSettings::formerKeyPaths(), true);  // read when set, never a default
   std::vector<std::string> triad_keys;
   for (const std::string& k : core::TriadCalibrationSettings::keys()) triad_keys.push_back("triad/" + k);
   params_.claim(triad_keys);

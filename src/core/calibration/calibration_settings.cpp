@@ -39,9 +39,11 @@ const std::vector<std::string> kFieldKeys = {"gain_orders",    "rate",         "
                                              "resonator",      "min_turns",    "max_excess_scatter",
                                              "max_gain_error", "max_drift_std"};
 const std::vector<std::string> kScalarKeys = {
-    "method",           "scale_factor_orders", "drift_orders",     "bins",           "window",
-    "window_span",      "group_tolerance",     "auto_finish_idle", "backward_reset", "backward_persist",
-    "bias_trend_order", "forward_jump",        "jump_persist"};
+    "method",         "scale_factor_orders", "drift_orders",    "bins",
+    "window",         "window_span",         "group_tolerance", "auto_finish_idle",
+    "backward_reset", "bias_trend_order",    "forward_jump",    "jump_persist"};
+// Former names parse() still reads, left out of keyPaths(): the template gives the current name only.
+const std::vector<std::string> kFormerKeys = {"backward_persist"};
 
 double positive(const YamlField& parent, const char* key, double fallback) {
   const double v = parent.getDouble(key, fallback);
@@ -112,6 +114,8 @@ std::vector<std::string> CalibrationSettings::keyPaths() {
   return keys;
 }
 
+std::vector<std::string> CalibrationSettings::formerKeyPaths() { return kFormerKeys; }
+
 StampRule CalibrationSettings::stampRule() const {
   StampRule r;
   r.backward_reset = backward_reset;
@@ -124,6 +128,7 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   CalibrationSettings s;
   root.requireMap();
   std::vector<std::string> allowed = kScalarKeys;
+  allowed.insert(allowed.end(), kFormerKeys.begin(), kFormerKeys.end());
   allowed.insert(allowed.end(), {"plateau", "gates", "thermal", "table_clock", "field"});
   allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
   root.rejectUnknownKeys(allowed);

@@ -160,6 +160,10 @@ TEST(CalibrationSettingsTest, KeyPathsListEveryKeyOnce) {
                         "field/directions", "field/gain_orders", "field/resonator"}) {
     EXPECT_EQ(std::count(keys.begin(), keys.end(), k), 1) << k;
   }
+  // A former name is read but not listed: the template, which must hold every listed key, gives the new one.
+  EXPECT_EQ(std::count(keys.begin(), keys.end(), "backward_persist"), 0);
+  const std::vector<std::string> former = CalibrationSettings::formerKeyPaths();
+  EXPECT_EQ(std::count(former.begin(), former.end(), "backward_persist"), 1);
 }
 
 // Each range check says the range it applies: the bounds of the message are accepted, a step beyond

@@ -100,4 +100,43 @@ TEST_F(CoreLayoutTest, UnitTestsAreNamedAfterTheirModule) {
   }
 }
 
+// A module is a header or a library source (tests excluded) by its name without extension, in the folder
+// or in a sub-folder of it.
+std::set<std::string> modulesIn(const std::string& dir) {
+  std::set<std::string> out;
+  for (const std::string& f : entries(dir, false)) {
+    if (endsWith(f, "_test.cpp") || !(endsWith(f, ".cpp") || endsWith(f, ".h"))) continue;
+    out.insert(f.substr(0, f.rfind('.')));
+  }
+  for (const std::string& d : entries(dir, true)) {
+    for (const std::string& m : modulesIn(dir + "/" + d)) out.insert(m);
+  }
+  return out;
+}
+
+bool names(const std::string& text, const std::string& module) {
+  return std::regex_search(text, std::regex("(^|[^a-z0-9_])" + module + "([^a-z0-9_]|$)"));
+}
+
+// The maps are true: a newcomer who reads a folder's README, or docs/layout.md, learns of every file in it.
+TEST_F(CoreLayoutTest, EveryModuleIsNamedInItsFoldersReadmeAndInTheLayout) {
+  const std::string layout = read(root_ + "/docs/layout.md");
+  ASSERT_FALSE(layout.empty()) << "docs/layout.md";
+  int checked = 0;
+  for (const std::string& folder : kFolders) {
+    std::set<std::string> modules = modulesIn(include_ + "/" + folder);
+    for (const std::string& m : modulesIn(src_ + "/" + folder)) modules.insert(m);
+    std::string readme = read(src_ + "/" + folder + "/README.md");
+    for (const std::string& d : entries(src_ + "/" + folder, true))
+      readme += read(src_ + "/" + folder + "/" + d + "/README.md");
+    for (const std::string& m : modules) {
+      EXPECT_TRUE(names(readme, m)) << m << " (core/" << folder << ") is not named in src/core/" << folder
+                                    << "/README.md";
+      EXPECT_TRUE(names(layout, m)) << m << " (core/" << folder << ") is not named in docs/layout.md";
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 60);
+}
+
 }  // namespace

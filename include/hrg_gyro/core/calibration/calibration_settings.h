@@ -135,6 +135,8 @@ struct CalibrationSettings {
   static CalibrationSettings parse(const YamlField& root, const std::vector<std::string>& extra_keys = {});
   /// Every key parse() reads, nested ones as "section/key" (the calibrator's parameter template lists them all).
   static std::vector<std::string> keyPaths();
+  /// Former names of keys that parse() still reads (backward_persist), not in keyPaths().
+  static std::vector<std::string> formerKeyPaths();
 };
 
 }  // namespace core
