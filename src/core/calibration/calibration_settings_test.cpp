@@ -180,7 +180,7 @@ TEST(CalibrationSettingsTest, RangeChecksMatchTheirMessages) {
   EXPECT_EQ(parse("bins: 8").bins, 8);
   EXPECT_EQ(parse("bins: 4096").bins, 4096);
   EXPECT_EQ(refusedKey("bins: 4097"), "bins");
-  EXPECT_EQ(parse("backward_persist: 1000").backward_persist, 1000);
+  EXPECT_EQ(parse("backward_persist: 7").jump_persist, 7);  // its former name
   EXPECT_EQ(refusedKey("backward_persist: 1001"), "backward_persist");
   EXPECT_DOUBLE_EQ(parse("plateau: {smoothing_span: 20}").plateau.smoothing_span, 20.0);
   EXPECT_EQ(refusedKey("plateau: {smoothing_span: 20.5}"), "plateau.smoothing_span");
