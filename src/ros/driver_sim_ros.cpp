@@ -156,9 +156,9 @@ void DriverSimRos::onPrecessionCommand(const ros::MessageEvent<PrecessionCommand
     }
     return;
   }
-  if (!std::isfinite(msg->rate) || std::abs(msg->rate) > kMaxPrecessionRate) {
+  if (!std::isfinite(msg->rate) || std::abs(msg->rate) > core::kMaxPrecessionRate) {
     ROS_WARN("driver_sim: precession command %g rad/s ignored: not a finite rate within +-%g rad/s", msg->rate,
-             kMaxPrecessionRate);
+             core::kMaxPrecessionRate);
     return;
   }
   std::lock_guard<std::mutex> lock(command_mutex_);

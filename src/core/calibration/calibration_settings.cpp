@@ -222,8 +222,10 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
     FieldSettings& fs = s.field;
     if (f.has("gain_orders")) fs.gain_orders = parseEvenOrders(f["gain_orders"]);
     fs.rate = f.getDouble("rate", fs.rate);
-    if (!(fs.rate >= FieldSettings::kMinRate && fs.rate <= FieldSettings::kMaxRate))
-      f["rate"].fail("must be in [0.01, 10] rad/s (electrical)");
+    if (!(fs.rate >= FieldSettings::kMinRate && fs.rate <= kMaxPrecessionRate)) {
+      f["rate"].fail("must be in [" + formatShort(FieldSettings::kMinRate) + ", " + formatShort(kMaxPrecessionRate) +
+                     "] rad/s (electrical)");
+    }
     fs.turns = f.getDouble("turns", fs.turns);
     if (!(fs.turns > 0.0 && fs.turns <= FieldSettings::kMaxTurns))
       f["turns"].fail("must be in (0, 100] full turns per segment");

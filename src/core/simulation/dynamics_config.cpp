@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "hrg_gyro/core/calibration/calibration_outcome.h"
+
 namespace hrg_gyro {
 namespace core {
 namespace {
@@ -95,7 +97,9 @@ DynamicsConfig parseDynamicsSection(const YamlField& d, double frequency, double
       if (!(p.time >= 0.0)) e["time"].fail("must be >= 0 (s from the scenario start)");
       if (!c.commands.empty() && !(p.time > c.commands.back().time))
         e["time"].fail("must increase from command to command");
-      if (!(std::abs(p.rate) <= 10.0)) e["rate"].fail("must be within +-10 rad/s (electrical)");
+      if (!(std::abs(p.rate) <= kMaxPrecessionRate)) {
+        e["rate"].fail("must be within +-" + formatShort(kMaxPrecessionRate) + " rad/s (electrical)");
+      }
       c.commands.push_back(p);
     }
   }

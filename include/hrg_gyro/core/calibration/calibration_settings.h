@@ -77,7 +77,7 @@ struct FieldResonator {
 /// (fieldCommandPlan); the rest are the estimator's orders and the method's own gates.
 struct FieldSettings {
   std::vector<int> gain_orders{2, 4};  ///< harmonic orders of the virtual rate's gain G_v(theta)
-  /// rad/s (electrical), |commanded virtual rate|, in [kMinRate, kMaxRate]. Faster, the loops' lag
+  /// rad/s (electrical), |commanded virtual rate|, in [kMinRate, kMaxPrecessionRate]. Faster, the loops' lag
   /// adds more drift (as the rate squared and faster): see `resonator` and the loop_lag gate.
   double rate = 0.2;
   double turns = 2.0;                         ///< full turns of theta (2 pi) per segment, at most kMaxTurns
@@ -99,7 +99,7 @@ struct FieldSettings {
 
   /// Bounds of the plan's keys (each refused by name beyond them); the whole plan is bounded by
   /// kMaxFieldPlanDuration (field_command_plan.h).
-  static constexpr double kMinRate = 0.01, kMaxRate = 10.0;  ///< rad/s
+  static constexpr double kMinRate = 0.01;  ///< rad/s (the largest: kMaxPrecessionRate, control_loops.h)
   static constexpr double kMaxTurns = 100.0;
   static constexpr double kMaxRest = 600.0;  ///< s
   static constexpr std::size_t kMaxDirections = 16;
