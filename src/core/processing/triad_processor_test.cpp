@@ -82,7 +82,7 @@ TEST(TriadProcessorTest, AnOutputWaitsForItsAxisPrecessionStateAndIsFlaggedWhenT
   // The commanded rate of axis 1's loop at each sample's end: turning from sample 10 to 20.
   auto rate = [](int k) { return k >= 10 && k <= 20 ? 0.5 : 0.0; };
   double angle = 0.0;
-  ASSERT_TRUE(triad.addPrecessionState(1, {kStart, 0.0, 0.0}));
+  ASSERT_TRUE(triad.addPrecessionState(1, {kStart - kMs, 0.0, 0.0}));  // the loop idle before the first sample
   std::vector<TriadAxisOutput> outputs;
   std::vector<TriadBodySample> samples;
   ProcessorResult r;
