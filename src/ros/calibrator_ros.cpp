@@ -8,7 +8,7 @@
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/ModelInfo.h"
 #include "hrg_gyro/PrecessionCommand.h"
-#include "hrg_gyro/core/calibration/triad_calibration.h"
+#include "hrg_gyro/core/calibration/triad/triad_calibration.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/output_directory.h"
 #include "hrg_gyro/core/model/parameter_file.h"

@@ -6,7 +6,7 @@
 
 #include "hrg_gyro/TriadOutput.h"
 #include "hrg_gyro/core/common/yaml_field.h"
-#include "hrg_gyro/core/model/triad_parameters.h"
+#include "hrg_gyro/core/model/triad_file.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/diagnostics_timer.h"
 
@@ -44,7 +44,7 @@ std::string describe(const std::string& path, const core::TriadParameters& t) {
   std::snprintf(buf, sizeof buf,
                 "%s: frame %s, axes %s %s %s, largest |M - I| %.3g, bias [%.3g %.3g %.3g] rad/s, calibration %s %s",
                 path.c_str(), t.frame_id.c_str(), t.axes[0].c_str(), t.axes[1].c_str(), t.axes[2].c_str(),
-                (t.axis_to_body - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), t.bias(0), t.bias(1), t.bias(2),
+                core::largestMisalignment(t.axis_to_body), t.bias(0), t.bias(1), t.bias(2),
                 t.calibration.method.name().c_str(), t.calibration.time.c_str());
   return buf;
 }

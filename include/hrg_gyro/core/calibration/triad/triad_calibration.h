@@ -2,23 +2,21 @@
 // fixture that the operator turns through positions (which body axis points along the table axis, up
 // or down, and tilted ones), each with its table profile, and the bench logs the fixture's position.
 //
-// Three stages, all from one session:
+// Three stages, all from one session, each in a file of its own:
 //  1. Each axis's K(theta) and D(theta): today's dual-rate method, fed with the axis's wave angle and
 //     the table while the axis points along the table axis (up, or down with the table angle's sign
-//     turned and the Earth's vertical rate with it), one single-axis CalibrationSession per axis.
+//     turned and the Earth's vertical rate with it), one single-axis CalibrationSession per axis
+//     (here: fitAxes).
 //  2. The axes' directions A in the body frame: in every fixture position, each axis's compensated
-//     increments (stage 1's K and D applied to its wave angle) against the table angle, over window
-//     increments on the position's moving plateaus, give its response c_i,p = A_i . u_p to the table's
-//     rate (u_p: the table axis in the body frame, from the position's logged orientation); the fit
-//     also takes a constant rate (the axis's residual bias) and the Earth's horizontal rate, which turns
-//     with the table as a sinusoid of the table angle. A_i is then the least-squares solution over the
-//     positions: at least three independent table-axis directions are needed (refused otherwise, the
-//     missing body axes named). M = A^-1.
+//     increments (stage 1's K and D applied to its wave angle: triad_position_samples.h) against the
+//     table angle give its response c_i,p = A_i . u_p to the table's rate (u_p: the table axis in the
+//     body frame, from the position's logged orientation); A_i is then the least-squares solution
+//     over the positions: at least three independent table-axis directions are needed (refused
+//     otherwise, the missing body axes named). M = A^-1 (triad_axis_directions.h).
 //  3. The body bias: in every rest of a locked position, the axes' mean compensated rates through M
 //     against the Earth's 3-D rate in the body frame (latitude from the axes' parameter files, the
-//     table's azimuth from the settings, the table angle at rest from the log). Its standard error
-//     is the rests' noise (or their scatter, if larger) plus stage 1's D(theta) uncertainty at the
-//     angles where the waves rested: that part is common to the rests and does not shrink with them.
+//     table's azimuth from the settings, the table angle at rest from the log), with its standard
+//     error (triad_body_bias.h).
 //
 // A fixture position off by a small rotation makes u_p, and so the responses of that position, off by
 // it: the error enters A as the least-squares image of the positions' errors (docs/triad.md).
@@ -39,24 +37,12 @@
 #include <vector>
 
 #include "hrg_gyro/core/calibration/calibration_session.h"
-#include "hrg_gyro/core/calibration/triad_outcome.h"
+#include "hrg_gyro/core/calibration/triad/triad_calibration_settings.h"
+#include "hrg_gyro/core/calibration/triad/triad_outcome.h"
+#include "hrg_gyro/core/calibration/triad/triad_position_samples.h"
 
 namespace hrg_gyro {
 namespace core {
-
-struct TriadCalibrationSettings {
-  double azimuth = 0.0;                             ///< rad: the table's zero mark from North towards East
-  double window = 1.0;                              ///< s: window of the cross-axis response fit
-  double store_rate = 20.0;                         ///< Hz: wave and table block means kept for stages 2 and 3
-  double vertical_tolerance = 0.02;                 ///< an axis is along the table axis when |u . e_i| >= 1 - this
-  double min_rest = 20.0;                           ///< s of settled rest for a bias estimate
-  double min_position_time = 60.0;                  ///< s of moving plateaus for a position's responses
-  double max_misalignment = kMaxTriadMisalignment;  ///< largest |A - I| accepted
-
-  /// Parses the `triad` section of the calibrator settings. Throws ConfigError naming the key.
-  static TriadCalibrationSettings parse(const YamlField& section);
-  static std::vector<std::string> keys();
-};
 
 /// The input streams of a triad calibration, in the order records of equal stamps are taken.
 enum TriadStream : int { kFixtureStream = 0, kTableStream = 1, kAxisStream0 = 2, kTriadStreamCount = 5 };
@@ -68,6 +54,9 @@ struct TriadStreamRejects {
   std::uint64_t out_of_order = 0;  ///< a duplicate, or behind the last good stamp by at most backward_reset
   std::uint64_t stamp_jump = 0;    ///< further back or ahead: a glitch (or the first records of a real jump)
   std::uint64_t total() const { return bad_stamp + bad_value + out_of_order + stamp_jump; }
+  /// Whether a record of this stamp verdict (common/stamp_timeline.h) goes on: kNext, kResumedAhead
+  /// and kNewTimeline do; any other is dropped, and counted here.
+  bool admits(StampVerdict verdict);
 };
 
 /// The fixture's position as the bench logs it (hrg_gyro/FixturePosition).
@@ -116,10 +105,12 @@ class TriadCalibration {
   void restart();
   /// The notes on dropped records and restarts.
   void noteRejects(TriadOutcome* o) const;
-  struct StoredSample {
-    Nanoseconds stamp;
-    double value;  // the wave angle, or the table angle
-  };
+  /// Why a refusal for want of positions may lie in the fixture records dropped ("" when none was).
+  std::string fixtureDrops() const;
+  /// Stage 1: each axis's outcome and gate into *o; the axes' parameters, calibrated where accepted.
+  std::array<GyroParameters, 3> fitAxes(TriadOutcome* o) const;
+  /// The locked positions with their samples, for stages 2 and 3.
+  std::vector<TriadLockedPosition> lockedPositions(const std::array<GyroParameters, 3>& params) const;
   /// Samples averaged over blocks of 1 / store_rate s (not picked): the stored series keeps the noise
   /// reduction of every sample. A block ends at its length, at a gap or at a stamp that goes back.
   struct BlockMean {
@@ -128,17 +119,12 @@ class TriadCalibration {
     int count = 0;
   };
   /// Adds a sample to `block`; a completed block's mean goes to `out` (and its mean rate to `rates`).
-  void addToBlock(BlockMean* block, Nanoseconds stamp, double value, double rate, std::vector<StoredSample>* out,
+  void addToBlock(BlockMean* block, Nanoseconds stamp, double value, double rate, StampedSeries* out,
                   std::vector<double>* rates) const;
-  struct Interval {  // a locked fixture position
-    Nanoseconds from = 0, to = 0;
-    FixtureRecord fixture;
-  };
   /// The fixture record in force at `stamp` (nullptr: none yet).
   const FixtureRecord* fixtureAt(Nanoseconds stamp) const;
   /// +1 or -1 when axis `axis` points up or down the table axis in `fixture`, 0 otherwise.
   int verticalSign(const FixtureRecord& fixture, int axis) const;
-  std::vector<Interval> lockedIntervals() const;
 
   CalibrationSettings axis_settings_;
   TriadCalibrationSettings settings_;
@@ -146,9 +132,9 @@ class TriadCalibration {
   TriadParameters prior_triad_;
   std::array<std::unique_ptr<CalibrationSession>, 3> sessions_;
   std::vector<FixtureRecord> fixtures_;  // every change of the fixture's state, in order
-  std::array<std::vector<StoredSample>, 3> waves_;
-  std::vector<StoredSample> table_;  // the table angle, thinned
-  std::vector<double> table_rates_;  // the reported rate of each stored table sample
+  std::array<StampedSeries, 3> waves_;   // each axis's wave angle, thinned
+  StampedSeries table_;                  // the table angle, thinned
+  std::vector<double> table_rates_;      // the reported rate of each stored table sample
   std::array<BlockMean, 3> wave_blocks_;
   BlockMean table_block_;
   double table_unwrapped_ = NAN;  // the last table angle, unwrapped

@@ -1,10 +1,11 @@
-#include "hrg_gyro/core/calibration/triad_result_files.h"
+#include "hrg_gyro/core/calibration/triad/triad_result_files.h"
 
 #include <stdexcept>
 
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/model/triad_file.h"
 
 namespace hrg_gyro {
 namespace core {

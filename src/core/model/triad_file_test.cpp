@@ -1,4 +1,7 @@
-#include "hrg_gyro/core/model/triad_parameters.h"
+// The triad file: the equation and every key emitted and read back exactly, the nominal triad from
+// the minimal file, every bad key named (axis names that are no ROS name component among them), and
+// the atomic save that refuses an invalid triad and keeps the previous file.
+#include "hrg_gyro/core/model/triad_file.h"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -39,7 +42,7 @@ std::string refusedKey(const std::string& yaml) {
 const char* kValid =
     "frame_id: imu_link\naxes: [x, y, z]\naxis_to_body: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\nbias: [0, 0, 0]\n";
 
-TEST(TriadParametersTest, EmitsTheEquationAndReadsBackExactly) {
+TEST(TriadFileTest, EmitsTheEquationAndReadsBackExactly) {
   const TriadParameters t = sample();
   const std::string text = emitTriadParameters(t);
   EXPECT_NE(text.find("omega_body = M omega_axis - bias"), std::string::npos) << text;
@@ -49,14 +52,14 @@ TEST(TriadParametersTest, EmitsTheEquationAndReadsBackExactly) {
   EXPECT_LT((t.axis_to_body * t.bodyToAxis() - Eigen::Matrix3d::Identity()).norm(), 1e-15);
 }
 
-TEST(TriadParametersTest, TheMinimalFileIsTheNominalTriad) {
+TEST(TriadFileTest, TheMinimalFileIsTheNominalTriad) {
   const TriadParameters t = parseTriadParameters(YAML::Load(kValid));
   EXPECT_EQ(t.axis_to_body, Eigen::Matrix3d::Identity());
   EXPECT_EQ(t.bias, Eigen::Vector3d::Zero());
   EXPECT_TRUE(t.calibration.method.isNone());
 }
 
-TEST(TriadParametersTest, EveryBadKeyIsNamed) {
+TEST(TriadFileTest, EveryBadKeyIsNamed) {
   const std::string v = kValid;
   auto with = [&](const std::string& key, const std::string& value) {
     YAML::Node n = YAML::Load(v);
@@ -82,7 +85,7 @@ TEST(TriadParametersTest, EveryBadKeyIsNamed) {
 
 // The triad node subscribes `<axis>/output` and a launch puts each axis's processor in the namespace
 // `<axis>`: a name that is no ROS name component would kill the node when it makes the topic.
-TEST(TriadParametersTest, AxisNamesAreRosNameComponents) {
+TEST(TriadFileTest, AxisNamesAreRosNameComponents) {
   auto axes = [](const std::string& second) {
     YAML::Node n = YAML::Load(kValid);
     n["axes"][1] = second;
@@ -122,9 +125,9 @@ TEST(TriadParametersTest, AxisNamesAreRosNameComponents) {
   EXPECT_EQ(parseTriadParameters(YAML::Load(axes("X"))).axes[1], "X");
 }
 
-TEST(TriadParametersTest, SavedAtomicallyAndLoadedBack) {
+TEST(TriadFileTest, SavedAtomicallyAndLoadedBack) {
   const std::string dir = ::testing::TempDir();
-  const std::string path = dir + "/triad_parameters_test.yaml";
+  const std::string path = dir + "/triad_file_test.yaml";
   std::remove(path.c_str());
   std::remove((path + ".bak").c_str());
   const TriadParameters t = sample();

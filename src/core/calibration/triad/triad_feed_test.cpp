@@ -6,7 +6,7 @@
 // record stamped far ahead, far back, slightly back, zero, a duplicate, a bad value) on every stream,
 // live and straight into the calibration, costs those records only; a stream that goes back for good
 // restarts the run; the auto-finish rule.
-#include "hrg_gyro/core/calibration/triad_feed.h"
+#include "hrg_gyro/core/calibration/triad/triad_feed.h"
 
 #include <gtest/gtest.h>
 
@@ -36,14 +36,9 @@ struct Event {
 };
 
 AngleLevelTriad triad() {
-  AngleLevelTriad g;
-  g.k[0] = HarmonicModel({2, 4}, -0.56, {-6e-4, 2e-3}, {4e-4, 0.0});
-  g.k[1] = HarmonicModel({2, 4}, -0.561, {5e-4, -1.5e-3}, {-3e-4, 2e-4});
-  g.k[2] = HarmonicModel({2, 4}, -0.559, {-4e-4, 1e-3}, {2e-4, -1e-4});
-  g.d[0] = HarmonicModel({2}, 1e-5, {2e-5}, {-1e-5});
-  g.body_to_axis << 1.0, 1.2e-4, -8e-5, -6e-5, 1.0, 2.1e-4, 1.5e-4, -9e-5, 1.0;
-  g.noise = 1.1e-5;
-  g.rate_hz = 200.0;  // enough for the fits, and a session of 1.5 M records
+  AngleLevelTriad g = testing::misalignedTriad();
+  g.d[1] = g.d[2] = HarmonicModel(0.0);  // one axis's D(theta) harmonics are enough here
+  g.rate_hz = 200.0;                     // enough for the fits, and a session of 1.5 M records
   return g;
 }
 
@@ -65,27 +60,21 @@ const std::vector<Event>& session() {
   return events;
 }
 
-std::array<GyroParameters, 3> priors() {
-  std::array<GyroParameters, 3> p;
-  for (auto& one : p) one.earth_rate.latitude = triad().latitude;
-  return p;
-}
-
-CalibrationSettings axisSettings() {
-  CalibrationSettings s;
-  s.scale_factor_orders = {2, 4};
-  s.drift_orders = {2};
+/// The calibration's settings and priors for triad().
+const testing::AngleLevelTriadSettings& calibrationSettings() {
+  static const testing::AngleLevelTriadSettings s = testing::settingsFor(triad());
   return s;
 }
 
-TriadCalibrationSettings triadSettings() {
-  TriadCalibrationSettings s;
-  s.azimuth = triad().azimuth;
-  return s;
+TriadFeed makeFeed(const TriadFeedSettings& feed = TriadFeedSettings()) {
+  const testing::AngleLevelTriadSettings& s = calibrationSettings();
+  return TriadFeed(s.axis, s.triad, s.priors, TriadParameters(), feed);
 }
 
-TriadFeed makeFeed(const TriadFeedSettings& settings = TriadFeedSettings()) {
-  return TriadFeed(axisSettings(), triadSettings(), priors(), TriadParameters(), settings);
+/// The calibration the feed feeds, fed here directly (the records in stamp order).
+TriadCalibration makeCalibration() {
+  const testing::AngleLevelTriadSettings& s = calibrationSettings();
+  return TriadCalibration(s.axis, s.triad, s.priors, TriadParameters());
 }
 
 void deliver(TriadFeed* feed, const Event& e) {
@@ -119,7 +108,7 @@ std::vector<Event> arrival(const std::vector<Event>& events, const std::array<do
 
 TEST(TriadFeedTest, LateStreamsGiveTheCalibrationExactlyWhatTheStampOrderGives) {
   // The reference: the records straight into the calibration in stamp order, as hrg_bag does.
-  TriadCalibration direct(axisSettings(), triadSettings(), priors(), TriadParameters());
+  TriadCalibration direct = makeCalibration();
   for (const Event& e : session()) {
     if (e.stream == TriadFeed::kFixture) direct.addFixture(e.fixture);
     if (e.stream == TriadFeed::kTable) direct.addTurntable(e.stamp, e.a, e.b, e.sequence);
@@ -361,7 +350,7 @@ TEST(TriadFeedTest, OneGlitchedRecordOnAnyStreamCostsThatRecordOnly) {
   expectSameWithinSigmas(reference, live, 0.05);
 
   // Offline: the records in stamp order straight into the calibration, as hrg_bag calibrate reads a bag.
-  TriadCalibration direct(axisSettings(), triadSettings(), priors(), TriadParameters());
+  TriadCalibration direct = makeCalibration();
   for (const Event& e : events) {
     if (e.stream == TriadFeed::kFixture) direct.addFixture(e.fixture);
     if (e.stream == TriadFeed::kTable) direct.addTurntable(e.stamp, e.a, e.b, e.sequence);

@@ -33,21 +33,18 @@
 #include <memory>
 #include <string>
 
-#include "hrg_gyro/core/calibration/triad_calibration.h"
+#include "hrg_gyro/core/calibration/triad/triad_calibration.h"
 
 namespace hrg_gyro {
 namespace core {
 
-/// What one input stream has delivered.
-struct TriadStreamCounters {
-  std::uint64_t received = 0;      ///< records offered
-  std::uint64_t fed = 0;           ///< handed to the calibration
-  std::uint64_t bad_stamp = 0;     ///< dropped: zero stamp
-  std::uint64_t bad_value = 0;     ///< dropped: a non-finite wave angle, or a fixture orientation that is no rotation
-  std::uint64_t out_of_order = 0;  ///< dropped: a duplicate, or slightly older than the stream's previous record
-  std::uint64_t stamp_jump = 0;    ///< dropped: the stamp jumped back or ahead (a glitch until it persists)
-  std::uint64_t late = 0;          ///< fed after later-stamped records of other streams (it lagged beyond the hold)
-  Nanoseconds last_stamp = 0;      ///< newest stamp received (0: none yet)
+/// What one input stream has delivered; the records dropped by reason (TriadStreamRejects: a zero
+/// stamp, a bad value, out of order, a stamp jump) were not queued.
+struct TriadStreamCounters : TriadStreamRejects {
+  std::uint64_t received = 0;  ///< records offered
+  std::uint64_t fed = 0;       ///< handed to the calibration
+  std::uint64_t late = 0;      ///< fed after later-stamped records of other streams (it lagged beyond the hold)
+  Nanoseconds last_stamp = 0;  ///< newest stamp received (0: none yet)
 };
 
 struct TriadFeedSettings {

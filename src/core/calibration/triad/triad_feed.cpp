@@ -1,4 +1,4 @@
-#include "hrg_gyro/core/calibration/triad_feed.h"
+#include "hrg_gyro/core/calibration/triad/triad_feed.h"
 
 #include <algorithm>
 #include <cmath>
@@ -62,29 +62,16 @@ bool TriadFeed::admit(int stream, Nanoseconds stamp) {
   for (int s = 0; s < kStreamCount; ++s) {
     if (s != stream) others = std::max(others, counters_[s].last_stamp);
   }
-  switch (timelines_[stream].check(stamp, others)) {
-    case StampVerdict::kNext:
-    case StampVerdict::kResumedAhead:
-      break;
-    case StampVerdict::kNewTimeline:
-      restart();  // this record is the first of the new timeline; the others are about to follow
-      for (int s = 0; s < kStreamCount; ++s) {
-        if (s != stream) timelines_[s].expectJumpBack(kFollowGiveUp);
-      }
-      c.last_stamp = stamp;
-      newest_ = stamp;
-      return true;
-    case StampVerdict::kNonPositive:
-      ++c.bad_stamp;
-      return false;
-    case StampVerdict::kDuplicate:
-    case StampVerdict::kBehind:
-      ++c.out_of_order;
-      return false;
-    case StampVerdict::kJumpedBack:
-    case StampVerdict::kJumpedAhead:
-      ++c.stamp_jump;
-      return false;
+  const StampVerdict verdict = timelines_[stream].check(stamp, others);
+  if (!c.admits(verdict)) return false;
+  if (verdict == StampVerdict::kNewTimeline) {
+    restart();  // this record is the first of the new timeline; the others are about to follow
+    for (int s = 0; s < kStreamCount; ++s) {
+      if (s != stream) timelines_[s].expectJumpBack(kFollowGiveUp);
+    }
+    c.last_stamp = stamp;
+    newest_ = stamp;
+    return true;
   }
   if (stamp < fed_until_) ++c.late;  // fed next, behind later stamps of the other streams
   c.last_stamp = stamp;

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "hrg_gyro/core/calibration/triad_outcome.h"
+#include "hrg_gyro/core/calibration/triad/triad_outcome.h"
 
 namespace hrg_gyro {
 namespace core {

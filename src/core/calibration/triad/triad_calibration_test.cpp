@@ -2,7 +2,7 @@
 // angle_level_triad.h, written apart from the signal-level simulator): each axis's K(theta), the
 // axes' directions A (and M), the body bias; with fixture errors, the error they explain; and the
 // refusal of a session with too few positions.
-#include "hrg_gyro/core/calibration/triad_calibration.h"
+#include "hrg_gyro/core/calibration/triad/triad_calibration.h"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -11,6 +11,7 @@
 
 #include "core/testing/angle_level_session.h"
 #include "core/testing/angle_level_triad.h"
+#include "hrg_gyro/core/model/triad_file.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -18,39 +19,6 @@ namespace {
 
 using testing::AngleLevelTriad;
 using testing::TriadPosition;
-
-AngleLevelTriad triad() {
-  AngleLevelTriad g;
-  g.k[0] = HarmonicModel({2, 4}, -0.56, {-6e-4, 2e-3}, {4e-4, 0.0});
-  g.k[1] = HarmonicModel({2, 4}, -0.561, {5e-4, -1.5e-3}, {-3e-4, 2e-4});
-  g.k[2] = HarmonicModel({2, 4}, -0.559, {-4e-4, 1e-3}, {2e-4, -1e-4});
-  g.d[0] = HarmonicModel({2}, 1e-5, {2e-5}, {-1e-5});
-  g.d[1] = HarmonicModel({2}, -2e-5, {1e-5}, {1.5e-5});
-  g.d[2] = HarmonicModel({2}, 5e-6, {-2e-5}, {5e-6});
-  // Misalignments of tens to hundreds of microradians (rows: each axis's direction in the body frame).
-  g.body_to_axis << 1.0, 1.2e-4, -8e-5, -6e-5, 1.0, 2.1e-4, 1.5e-4, -9e-5, 1.0;
-  g.noise = 1.1e-5;
-  return g;
-}
-
-std::array<GyroParameters, 3> priors(const AngleLevelTriad& g) {
-  std::array<GyroParameters, 3> p;
-  for (auto& one : p) one.earth_rate.latitude = g.latitude;
-  return p;
-}
-
-CalibrationSettings axisSettings() {
-  CalibrationSettings s;
-  s.scale_factor_orders = {2, 4};
-  s.drift_orders = {2};
-  return s;
-}
-
-TriadCalibrationSettings triadSettings(const AngleLevelTriad& g) {
-  TriadCalibrationSettings s;
-  s.azimuth = g.azimuth;
-  return s;
-}
 
 double worstAngleMicroradians(const Eigen::Matrix3d& estimated, const Eigen::Matrix3d& truth) {
   double worst = 0.0;
@@ -61,9 +29,9 @@ double worstAngleMicroradians(const Eigen::Matrix3d& estimated, const Eigen::Mat
 }
 
 TEST(TriadCalibrationTest, TheAxesDirectionsEachAxisKAndTheBiasAgainstTheExactTriad) {
-  const AngleLevelTriad g = triad();
+  const AngleLevelTriad g = testing::misalignedTriad();
   const std::vector<TriadPosition> positions = testing::sixPositions(0.4, 40.0, 2, 30.0);
-  const TriadOutcome o = testing::calibrateAngleLevelTriad(g, positions, axisSettings(), triadSettings(g), priors(g));
+  const TriadOutcome o = testing::calibrateAngleLevelTriad(g, positions, testing::settingsFor(g));
   ASSERT_TRUE(o.accepted) << o.reason;
   const double worst = worstAngleMicroradians(o.body_to_axis, g.body_to_axis);
   std::printf("triad, perfect fixture: worst misalignment error %.3f urad; A - truth (urad):\n", worst);
@@ -109,12 +77,12 @@ TEST(TriadCalibrationTest, TheAxesDirectionsEachAxisKAndTheBiasAgainstTheExactTr
 }
 
 TEST(TriadCalibrationTest, AFixtureOffByMicroradiansGivesTheErrorItExplains) {
-  AngleLevelTriad g = triad();
+  AngleLevelTriad g = testing::misalignedTriad();
   std::vector<TriadPosition> positions = testing::sixPositions(0.4, 40.0, 2, 30.0);
   const double e = 30e-6;
   const Eigen::Vector3d errors[] = {{e, 0, 0}, {0, -e, 0}, {0, e, e}, {-e, 0, e}, {e, e, 0}, {0, 0, -e}};
   for (std::size_t p = 0; p < positions.size(); ++p) positions[p].error = errors[p];
-  const TriadOutcome o = testing::calibrateAngleLevelTriad(g, positions, axisSettings(), triadSettings(g), priors(g));
+  const TriadOutcome o = testing::calibrateAngleLevelTriad(g, positions, testing::settingsFor(g));
   ASSERT_TRUE(o.accepted) << o.reason;
   // What the errors predict: each position's true table axis u_true, fitted on the plan's u.
   Eigen::Matrix3d predicted;
@@ -141,10 +109,10 @@ TEST(TriadCalibrationTest, AFixtureOffByMicroradiansGivesTheErrorItExplains) {
 }
 
 TEST(TriadCalibrationTest, TooFewPositionsAreRefusedWithTheMissingOnesNamed) {
-  const AngleLevelTriad g = triad();
+  const AngleLevelTriad g = testing::misalignedTriad();
   std::vector<TriadPosition> positions = testing::sixPositions(0.4, 40.0, 2, 30.0);
   positions.resize(4);  // +z, -z, +x, -x: y never along the table axis
-  const TriadOutcome o = testing::calibrateAngleLevelTriad(g, positions, axisSettings(), triadSettings(g), priors(g));
+  const TriadOutcome o = testing::calibrateAngleLevelTriad(g, positions, testing::settingsFor(g));
   EXPECT_FALSE(o.accepted);
   std::printf("four positions: %s\n", o.reason.c_str());
   EXPECT_NE(o.reason.find("axis y"), std::string::npos) << o.reason;

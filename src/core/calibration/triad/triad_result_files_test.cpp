@@ -1,4 +1,4 @@
-#include "hrg_gyro/core/calibration/triad_result_files.h"
+#include "hrg_gyro/core/calibration/triad/triad_result_files.h"
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
@@ -13,6 +13,7 @@
 
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/model/triad_file.h"
 
 namespace hrg_gyro {
 namespace core {

@@ -1,8 +1,9 @@
-#include "hrg_gyro/core/calibration/triad_outcome.h"
+#include "hrg_gyro/core/calibration/triad/triad_outcome.h"
 
 #include <yaml-cpp/yaml.h>
 
 #include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/model/triad_file.h"
 
 namespace hrg_gyro {
 namespace core {
