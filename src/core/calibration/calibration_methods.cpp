@@ -112,9 +112,10 @@ double DualRateMethod::windowFor(double table_rate) const {
 
 void DualRateMethod::addSample(const PlateauSample& s) {
   // A non-finite angle would poison every sum of the regression: such a sample is not data.
-  if (s.plateau.is_static || !std::isfinite(s.theta) || !std::isfinite(s.table_angle) || !std::isfinite(s.table_rate))
+  if (s.plateau.is_static || !std::isfinite(s.theta) || !std::isfinite(s.rotation_angle) ||
+      !std::isfinite(s.rotation_rate))
     return;
-  groups_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.table_rate);
+  groups_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.rotation_rate);
   ++samples_;
   const bool gap = in_chain_ && toSeconds(s.stamp - last_stamp_) > settings_.plateau.max_gap;
   if (!in_chain_ || s.plateau.id != chain_plateau_ || gap || s.stamp <= last_stamp_) {
@@ -125,13 +126,13 @@ void DualRateMethod::addSample(const PlateauSample& s) {
     unwrap_ = 0.0;
     rate_integral_ = 0.0;
   } else {
-    rate_integral_ += 0.5 * (s.table_rate + last_table_rate_) * toSeconds(s.stamp - last_stamp_);
+    rate_integral_ += 0.5 * (s.rotation_rate + last_table_rate_) * toSeconds(s.stamp - last_stamp_);
     // A controller may log its angle modulo 2 pi: unwrap it.
-    const double step = s.table_angle + unwrap_ - last_table_angle_;
+    const double step = s.rotation_angle + unwrap_ - last_table_angle_;
     if (step > kPi) unwrap_ -= 2.0 * kPi;
     if (step < -kPi) unwrap_ += 2.0 * kPi;
   }
-  const double angle = s.table_angle + unwrap_;
+  const double angle = s.rotation_angle + unwrap_;
   regression_.setAngleSmoothError(s.angle_smooth_error);
   // The logged rate's integral too, where the angle is logged: the regression weighs the two by
   // their noise (without an angle, the angle is that integral already).
@@ -139,7 +140,7 @@ void DualRateMethod::addSample(const PlateauSample& s) {
   angle_logged_ = s.angle_logged;
   last_stamp_ = s.stamp;
   last_table_angle_ = angle;
-  last_table_rate_ = s.table_rate;
+  last_table_rate_ = s.rotation_rate;
 }
 
 bool DualRateMethod::complete() const { return progress().fraction >= 1.0; }
@@ -286,10 +287,10 @@ void ConstantRateMethod::addSample(const PlateauSample& s) {
       closeDwell();
       dwell_plateau_ = s.plateau.id;
     }
-    dwell_.add(s.stamp, s.theta, s.table_angle);
+    dwell_.add(s.stamp, s.theta, s.rotation_angle);
     return;
   }
-  groups_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.table_rate);
+  groups_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.rotation_rate);
 }
 
 double ConstantRateMethod::dwellTime() const { return rest_time_ + dwell_.duration(); }
@@ -443,7 +444,7 @@ void StepMethod::addSample(const PlateauSample& s) {
     current_plateau_ = s.plateau.id;
     current_.setRestSince(s.plateau.start);
   }
-  current_.add(s.stamp, s.theta, s.table_angle);
+  current_.add(s.stamp, s.theta, s.rotation_angle);
 }
 
 double StepMethod::coverage() const {

@@ -69,7 +69,7 @@ TEST(DualRateTest, NonFiniteWaveAnglesAreSkipped) {
   long i = 0;
   testing::runAngleLevel(g, dualRateProfile(0.05, -0.05, 120.0),
                          [&](Nanoseconds t, double angle, double rate, double theta) {
-                           session.addTurntable(t, angle, rate);
+                           session.addRotationRecord(t, angle, rate);
                            session.addWave(t, ++i % 997 == 0 ? NAN : theta, NAN);
                          });
   const CalibrationOutcome o = session.finish();
@@ -237,11 +237,12 @@ TEST(CalibrationSessionTest, SynchronisesStreamsArrivingOutOfStep) {
     session.addWave(t, theta, NAN);
     delayed.emplace_back(t, angle, rate);
     if (delayed.size() > 300) {
-      session.addTurntable(std::get<0>(delayed.front()), std::get<1>(delayed.front()), std::get<2>(delayed.front()));
+      session.addRotationRecord(std::get<0>(delayed.front()), std::get<1>(delayed.front()),
+                                std::get<2>(delayed.front()));
       delayed.pop_front();
     }
   });
-  for (const auto& d : delayed) session.addTurntable(std::get<0>(d), std::get<1>(d), std::get<2>(d));
+  for (const auto& d : delayed) session.addRotationRecord(std::get<0>(d), std::get<1>(d), std::get<2>(d));
   const CalibrationOutcome late = session.finish();
   ASSERT_TRUE(late.accepted) << late.reason;
   EXPECT_EQ(late.samples, direct.samples);
@@ -255,7 +256,7 @@ TEST(CalibrationSessionTest, AutoFinishWaitsForRestAfterCompleteData) {
   CalibrationSession session(s, priorFor(g));
   double finished_at = -1.0;
   testing::runAngleLevel(g, dualRateProfile(0.05, -0.05, 120.0), [&](Nanoseconds t, double a, double r, double th) {
-    session.addTurntable(t, a, r);
+    session.addRotationRecord(t, a, r);
     session.addWave(t, th, NAN);
     if (finished_at < 0 && session.shouldFinish()) finished_at = toSeconds(t);
   });

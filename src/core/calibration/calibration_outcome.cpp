@@ -137,19 +137,20 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
     out << YAML::EndMap;
   }
   out << YAML::Key << "quadrature_ratio" << YAML::Value << formatDouble(o.quadrature_ratio);
-  // The records of the table's stream (a field run's: the precession loop's states), the glitched ones
-  // dropped before the plateau detector, and bag-loop restarts.
-  out << YAML::Key << "turntable_records" << YAML::Value << o.turntable_records;
+  // The records of the rotation's stream (the table's; a field run's: the precession loop's states),
+  // the glitched ones dropped before the plateau detector, and bag-loop restarts. The keys keep the
+  // table's names.
+  out << YAML::Key << "turntable_records" << YAML::Value << o.rotation_records;
   if (traitsOf(o.method).virtual_rotation) {
     out << YAML::Comment("precession states (the field method's stream), and their glitches below");
   }
   out << YAML::Key << "turntable_rejected" << YAML::Value << YAML::Flow << YAML::BeginMap;
-  out << YAML::Key << "bad_rate" << YAML::Value << o.turntable_rejected.bad_rate;
-  out << YAML::Key << "bad_angle" << YAML::Value << o.turntable_rejected.bad_angle;
-  out << YAML::Key << "bad_stamp" << YAML::Value << o.turntable_rejected.bad_stamp;
-  out << YAML::Key << "duplicate" << YAML::Value << o.turntable_rejected.duplicate;
-  out << YAML::Key << "out_of_order" << YAML::Value << o.turntable_rejected.out_of_order;
-  out << YAML::Key << "stamp_jump" << YAML::Value << o.turntable_rejected.stamp_jump;
+  out << YAML::Key << "bad_rate" << YAML::Value << o.rotation_rejected.bad_rate;
+  out << YAML::Key << "bad_angle" << YAML::Value << o.rotation_rejected.bad_angle;
+  out << YAML::Key << "bad_stamp" << YAML::Value << o.rotation_rejected.bad_stamp;
+  out << YAML::Key << "duplicate" << YAML::Value << o.rotation_rejected.duplicate;
+  out << YAML::Key << "out_of_order" << YAML::Value << o.rotation_rejected.out_of_order;
+  out << YAML::Key << "stamp_jump" << YAML::Value << o.rotation_rejected.stamp_jump;
   out << YAML::EndMap;
   out << YAML::Key << "restarts" << YAML::Value << o.restarts;
   if (o.table_clock.measured) {

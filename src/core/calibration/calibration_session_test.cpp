@@ -83,36 +83,36 @@ CalibrationOutcome run(const TurntableProfile& profile, CalibrationMethodKind me
       ++injected->count[kind];
       switch (kind) {
         case kNanRate:
-          session.addTurntable(t, angle, NAN);
+          session.addRotationRecord(t, angle, NAN);
           break;
         case kAbsurdRate:
-          session.addTurntable(t, angle, 1e6);
+          session.addRotationRecord(t, angle, 1e6);
           break;
         case kInfAngle:
-          session.addTurntable(t, INFINITY, rate);
+          session.addRotationRecord(t, INFINITY, rate);
           break;
         case kZeroStamp:
-          session.addTurntable(0, angle, rate);
+          session.addRotationRecord(0, angle, rate);
           break;
         case kDuplicate:
-          session.addTurntable(previous, angle, rate);
+          session.addRotationRecord(previous, angle, rate);
           break;
         case kSlightlyBack:
-          session.addTurntable(previous - toNanoseconds(0.0005), angle, rate);
+          session.addRotationRecord(previous - toNanoseconds(0.0005), angle, rate);
           break;
         case kFarAhead:
-          session.addTurntable(t + toNanoseconds(100.0), angle, rate);
+          session.addRotationRecord(t + toNanoseconds(100.0), angle, rate);
           break;
         default:
           if (t <= toNanoseconds(100.0)) {  // not a stamp at all this early: a zero-stamp glitch
             --injected->count[kFarBack];
             ++injected->count[kZeroStamp];
           }
-          session.addTurntable(t - toNanoseconds(100.0), angle, rate);
+          session.addRotationRecord(t - toNanoseconds(100.0), angle, rate);
           break;
       }
     } else {
-      session.addTurntable(t, angle, rate);
+      session.addRotationRecord(t, angle, rate);
       previous = t;
     }
     if (one_in > 0 && pick(random) == 0) {
@@ -150,12 +150,12 @@ void expectSameWithin(const CalibrationOutcome& a, const CalibrationOutcome& b, 
 }
 
 void expectCounted(const CalibrationOutcome& o, const Injected& in) {
-  EXPECT_EQ(o.turntable_rejected.bad_rate, in.count[kNanRate] + in.count[kAbsurdRate]);
-  EXPECT_EQ(o.turntable_rejected.bad_angle, in.count[kInfAngle]);
-  EXPECT_EQ(o.turntable_rejected.bad_stamp, in.count[kZeroStamp]);
-  EXPECT_EQ(o.turntable_rejected.duplicate, in.count[kDuplicate]);
-  EXPECT_EQ(o.turntable_rejected.out_of_order, in.count[kSlightlyBack]);
-  EXPECT_EQ(o.turntable_rejected.stamp_jump, in.count[kFarAhead] + in.count[kFarBack]);
+  EXPECT_EQ(o.rotation_rejected.bad_rate, in.count[kNanRate] + in.count[kAbsurdRate]);
+  EXPECT_EQ(o.rotation_rejected.bad_angle, in.count[kInfAngle]);
+  EXPECT_EQ(o.rotation_rejected.bad_stamp, in.count[kZeroStamp]);
+  EXPECT_EQ(o.rotation_rejected.duplicate, in.count[kDuplicate]);
+  EXPECT_EQ(o.rotation_rejected.out_of_order, in.count[kSlightlyBack]);
+  EXPECT_EQ(o.rotation_rejected.stamp_jump, in.count[kFarAhead] + in.count[kFarBack]);
   EXPECT_EQ(o.restarts, 0u);
 }
 
@@ -171,7 +171,7 @@ TEST(CalibrationSessionTest, DualRateIgnoresOneGlitchedTurntableRecordInAThousan
   expectCounted(glitched, glitches);
   EXPECT_EQ(glitched.plateaus.size(), clean.plateaus.size());
   expectSameWithin(clean, glitched, 1.0);
-  EXPECT_EQ(clean.turntable_rejected.total(), 0u);
+  EXPECT_EQ(clean.rotation_rejected.total(), 0u);
 }
 
 TEST(CalibrationSessionTest, ConstantRateIgnoresOneGlitchedTurntableRecordInAThousand) {
@@ -183,7 +183,7 @@ TEST(CalibrationSessionTest, ConstantRateIgnoresOneGlitchedTurntableRecordInATho
   expectSameWithin(clean, glitched, 1.0);
   // The report carries the counts.
   const std::string report = emitCalibrationReport(glitched);
-  EXPECT_NE(report.find("turntable_rejected: {bad_rate: " + std::to_string(glitched.turntable_rejected.bad_rate)),
+  EXPECT_NE(report.find("turntable_rejected: {bad_rate: " + std::to_string(glitched.rotation_rejected.bad_rate)),
             std::string::npos)
       << report.substr(0, 2000);
 }
@@ -192,16 +192,16 @@ TEST(CalibrationSessionTest, ZeroStampsAndLoneBackwardStampsDoNotRestartTheRun) 
   CalibrationSession session(settings(CalibrationMethodKind::kDualRate), prior());
   for (int i = 1; i <= 3000; ++i) {
     const Nanoseconds t = toNanoseconds(200.0 + i * 1e-3);
-    session.addTurntable(t, 0.0, 0.0);
+    session.addRotationRecord(t, 0.0, 0.0);
     if (i == 1000) {
-      for (int z = 0; z < 20; ++z) session.addTurntable(0, 0.0, 0.0);  // a burst of zero stamps
+      for (int z = 0; z < 20; ++z) session.addRotationRecord(0, 0.0, 0.0);  // a burst of zero stamps
     }
-    if (i == 2000) session.addTurntable(t - toNanoseconds(100.0), 0.0, 0.0);  // one stamp far back
+    if (i == 2000) session.addRotationRecord(t - toNanoseconds(100.0), 0.0, 0.0);  // one stamp far back
   }
   EXPECT_EQ(session.counters().restarts, 0u);
   EXPECT_EQ(session.counters().rejected.bad_stamp, 20u);
   EXPECT_EQ(session.counters().rejected.stamp_jump, 1u);
-  EXPECT_EQ(session.counters().turntable, 3021u);
+  EXPECT_EQ(session.counters().rotation_records, 3021u);
 }
 
 TEST(CalibrationSessionTest, APersistingBackwardTimelineRestartsTheRun) {
@@ -214,12 +214,12 @@ TEST(CalibrationSessionTest, APersistingBackwardTimelineRestartsTheRun) {
   CalibrationSession session(s, prior());
   testing::runAngleLevel(g, p, [&](Nanoseconds t, double angle, double rate, double theta) {
     if (toSeconds(t) > 100.0) return;
-    session.addTurntable(t, angle, rate);
+    session.addRotationRecord(t, angle, rate);
     session.addWave(t, theta, NAN);
   });
   EXPECT_EQ(session.counters().restarts, 0u);
   testing::runAngleLevel(g, p, [&](Nanoseconds t, double angle, double rate, double theta) {
-    session.addTurntable(t, angle, rate);
+    session.addRotationRecord(t, angle, rate);
     session.addWave(t, theta, NAN);
   });
   EXPECT_EQ(session.counters().restarts, 1u);
@@ -234,10 +234,10 @@ TEST(CalibrationSessionTest, JumpPersistOfOneRestartsOnAnyLongJump) {
   CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
   s.jump_persist = 1;
   CalibrationSession session(s, prior());
-  session.addTurntable(toNanoseconds(10.0), 0.0, 0.0);
-  session.addTurntable(toNanoseconds(9.8), 0.0, 0.0);  // within backward_reset: a glitch
+  session.addRotationRecord(toNanoseconds(10.0), 0.0, 0.0);
+  session.addRotationRecord(toNanoseconds(9.8), 0.0, 0.0);  // within backward_reset: a glitch
   EXPECT_EQ(session.counters().restarts, 0u);
-  EXPECT_TRUE(session.addTurntable(toNanoseconds(2.0), 0.0, 0.0));
+  EXPECT_TRUE(session.addRotationRecord(toNanoseconds(2.0), 0.0, 0.0));
   EXPECT_EQ(session.counters().restarts, 1u);
 }
 
@@ -267,7 +267,7 @@ CalibrationOutcome runLogged(const AngleLevelGyro& g, const TurntableProfile& p,
       const double reported =
           log.differenced_rate ? (std::isnan(previous) ? 0.0 : (logged - previous) * log.log_hz) : rate;
       previous = logged;
-      session.addTurntable(t, log.log_angle ? logged : NAN, reported + log.rate_noise * normal(random));
+      session.addRotationRecord(t, log.log_angle ? logged : NAN, reported + log.rate_noise * normal(random));
     }
     if (feed_wave) session.addWave(t + toNanoseconds(wave_offset), theta, NAN);
   });
@@ -378,12 +378,12 @@ TEST(CalibrationSessionTest, RefusalNamesAMissingOrUnsynchronizedWave) {
 
 TEST(CalibrationSessionTest, ANanAngleIsRateOnlyFromTheStartAndAGlitchAfterALoggedAngle) {
   CalibrationSession rate_only(settings(CalibrationMethodKind::kDualRate), prior());
-  for (int i = 1; i <= 100; ++i) EXPECT_TRUE(rate_only.addTurntable(toNanoseconds(i * 0.01), NAN, 0.05));
+  for (int i = 1; i <= 100; ++i) EXPECT_TRUE(rate_only.addRotationRecord(toNanoseconds(i * 0.01), NAN, 0.05));
   EXPECT_EQ(rate_only.counters().rejected.total(), 0u);
   CalibrationSession logged(settings(CalibrationMethodKind::kDualRate), prior());
   for (int i = 1; i <= 100; ++i) {
     const double t = i * 0.01;
-    EXPECT_EQ(logged.addTurntable(toNanoseconds(t), i == 50 ? NAN : 0.05 * t, 0.05), i != 50) << i;
+    EXPECT_EQ(logged.addRotationRecord(toNanoseconds(t), i == 50 ? NAN : 0.05 * t, 0.05), i != 50) << i;
   }
   EXPECT_EQ(logged.counters().rejected.bad_angle, 1u);
   EXPECT_EQ(logged.counters().rejected.total(), 1u);
@@ -456,15 +456,15 @@ TEST(CalibrationSessionTest, AFieldRunCallsItsStreamThePrecessionState) {
     CalibrationSession session(settings(method), prior());
     long i = 0;
     testing::runAngleLevel(noisyReferenceGyro(), p, [&](Nanoseconds t, double angle, double rate, double theta) {
-      session.addTurntable(t, angle, ++i % 100 == 0 ? NAN : rate);
+      session.addRotationRecord(t, angle, ++i % 100 == 0 ? NAN : rate);
       session.addWave(t, theta, NAN);
     });
     const CalibrationOutcome glitched = session.finish();
     const std::string dropped =
         note(glitched, field ? " glitched precession states dropped (" : " glitched turntable records dropped (");
     EXPECT_NE(dropped, "") << nameOf(method);
-    EXPECT_EQ(numberAfter(dropped, ""), static_cast<double>(glitched.turntable_rejected.total()));
-    EXPECT_GT(glitched.turntable_rejected.bad_rate, 0u);
+    EXPECT_EQ(numberAfter(dropped, ""), static_cast<double>(glitched.rotation_rejected.total()));
+    EXPECT_GT(glitched.rotation_rejected.bad_rate, 0u);
     if (field) {
       EXPECT_FALSE(mentions(glitched, "turntable")) << glitched.reason;
     }

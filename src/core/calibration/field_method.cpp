@@ -46,9 +46,10 @@ double FieldMethod::windowFor(double rate) const {
 
 void FieldMethod::addSample(const PlateauSample& s) {
   // At rest (w_v = 0) the wave hardly moves: nothing to separate.
-  if (s.plateau.is_static || !std::isfinite(s.theta) || !std::isfinite(s.table_angle) || !std::isfinite(s.table_rate))
+  if (s.plateau.is_static || !std::isfinite(s.theta) || !std::isfinite(s.rotation_angle) ||
+      !std::isfinite(s.rotation_rate))
     return;
-  groups_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.table_rate);
+  groups_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.rotation_rate);
   ++samples_;
   if (std::isfinite(s.frequency)) {
     frequency_sum_ += s.frequency;
@@ -62,7 +63,7 @@ void FieldMethod::addSample(const PlateauSample& s) {
     chain_plateau_ = s.plateau.id;
   }
   // psi is the driver's own integral of the command: exact, and continuous (never wrapped).
-  regression_.add(s.stamp, s.theta, s.table_angle);
+  regression_.add(s.stamp, s.theta, s.rotation_angle);
   last_stamp_ = s.stamp;
 }
 

@@ -37,7 +37,7 @@ void ThermalMethod::addSample(const PlateauSample& s) {
     ++out_of_range_;
     return;
   }
-  if (!rates_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.table_rate, s.frequency)) {
+  if (!rates_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.rotation_rate, s.frequency)) {
     ++slice_limit_;
     return;
   }

@@ -26,10 +26,10 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
     }
     // What the table controller logged, not the truth; or what the precession loop executed.
     if (virtual_rotation) {
-      if (sim.hasPrecessionLoop()) session.addTurntable(s.stamp, s.precession.angle, s.precession.rate, s.index);
+      if (sim.hasPrecessionLoop()) session.addRotationRecord(s.stamp, s.precession.angle, s.precession.rate, s.index);
     } else {
       for (const TurntableLogRecord& record : s.turntable)
-        session.addTurntable(record.stamp, record.angle, record.rate, record.index);
+        session.addRotationRecord(record.stamp, record.angle, record.rate, record.index);
     }
     if (!s.channels_delivered) continue;
     const ProcessorResult r = proc.process({s.stamp + s.channels_stamp_offset, s.z, s.frequency, s.temperature});
