@@ -8,46 +8,31 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "core/testing/angle_level_session.h"
+#include "core/testing/method_test_settings.h"
 
 namespace hrg_gyro {
 namespace core {
 namespace {
 
 using testing::AngleLevelGyro;
+using testing::calibrateAngleLevel;
+using testing::constantRateProfile;
+using testing::dualRateProfile;
+using testing::methodSettings;
+using testing::referenceGyro;
+using testing::referencePrior;
 
 AngleLevelGyro noisyReferenceGyro() {
   AngleLevelGyro g = testing::referenceGyro();
   g.noise = 1e-6;
   return g;
-}
-
-GyroParameters prior() {
-  GyroParameters p;
-  p.earth_rate.latitude = 0.9;
-  return p;
-}
-
-CalibrationSettings settings(CalibrationMethodKind method) {
-  CalibrationSettings s;
-  s.method = method;
-  s.scale_factor_orders = {2, 4};
-  s.drift_orders = {2};
-  return s;
-}
-
-TurntableProfile constantRateProfile() {
-  TurntableProfile p;
-  p.append(30.0, 0.0, 0.0, "rest");
-  p.append(0.1, 0.0, 0.5, "ramp");
-  p.append(250.0, 0.05, 0.0, "turn");
-  p.append(0.1, 0.05, -0.5, "ramp");
-  p.append(25.0, 0.0, 0.0, "rest");
-  return p;
 }
 
 enum Glitch {
@@ -72,7 +57,7 @@ struct Injected {
 // 100 s back.
 CalibrationOutcome run(const TurntableProfile& profile, CalibrationMethodKind method, int one_in, Injected* injected,
                        SessionCounters* counters = nullptr) {
-  CalibrationSession session(settings(method), prior());
+  CalibrationSession session(methodSettings(method), referencePrior());
   std::mt19937_64 random(42);
   std::uniform_int_distribution<int> pick(0, one_in - 1);
   int next_kind = 0;
@@ -189,7 +174,7 @@ TEST(CalibrationSessionTest, ConstantRateIgnoresOneGlitchedTurntableRecordInATho
 }
 
 TEST(CalibrationSessionTest, ZeroStampsAndLoneBackwardStampsDoNotRestartTheRun) {
-  CalibrationSession session(settings(CalibrationMethodKind::kDualRate), prior());
+  CalibrationSession session(methodSettings(CalibrationMethodKind::kDualRate), referencePrior());
   for (int i = 1; i <= 3000; ++i) {
     const Nanoseconds t = toNanoseconds(200.0 + i * 1e-3);
     session.addRotationRecord(t, 0.0, 0.0);
@@ -209,9 +194,9 @@ TEST(CalibrationSessionTest, APersistingBackwardTimelineRestartsTheRun) {
   // run restarts once and ends as the single pass does.
   const AngleLevelGyro g = noisyReferenceGyro();
   const TurntableProfile p = testing::dualRateProfile(0.05, -0.05, 120.0);
-  const CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
-  const CalibrationOutcome single = testing::calibrateAngleLevel(g, p, s, prior());
-  CalibrationSession session(s, prior());
+  const CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
+  const CalibrationOutcome single = testing::calibrateAngleLevel(g, p, s, referencePrior());
+  CalibrationSession session(s, referencePrior());
   testing::runAngleLevel(g, p, [&](Nanoseconds t, double angle, double rate, double theta) {
     if (toSeconds(t) > 100.0) return;
     session.addRotationRecord(t, angle, rate);
@@ -231,9 +216,9 @@ TEST(CalibrationSessionTest, APersistingBackwardTimelineRestartsTheRun) {
 }
 
 TEST(CalibrationSessionTest, JumpPersistOfOneRestartsOnAnyLongJump) {
-  CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
   s.jump_persist = 1;
-  CalibrationSession session(s, prior());
+  CalibrationSession session(s, referencePrior());
   session.addRotationRecord(toNanoseconds(10.0), 0.0, 0.0);
   session.addRotationRecord(toNanoseconds(9.8), 0.0, 0.0);  // within backward_reset: a glitch
   EXPECT_EQ(session.counters().restarts, 0u);
@@ -255,7 +240,7 @@ struct TableLog {
 CalibrationOutcome runLogged(const AngleLevelGyro& g, const TurntableProfile& p, const CalibrationSettings& s,
                              const TableLog& log, SessionCounters* counters = nullptr, bool feed_wave = true,
                              double wave_offset = 0.0) {
-  CalibrationSession session(s, prior());
+  CalibrationSession session(s, referencePrior());
   std::mt19937_64 random(11);
   std::normal_distribution<double> normal;
   const long every = std::lround(g.rate_hz / log.log_hz);
@@ -286,7 +271,7 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 TEST(CalibrationSessionTest, EncoderNoiseWithTheRateDifferencedKeepsThePlateaus) {
   // 2 urad of encoder noise at 100 Hz with the rate differenced: 0.57 % of rate scatter at 0.05 rad/s.
   const TurntableProfile p = testing::dualRateProfile(0.05, -0.05, 120.0);
-  CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
   s.gates.max_rate_noise = 0.02;  // that gate judges the raw reported rate; not what is tested here
   SessionCounters clean_counters, angle_counters, rate_counters;
   const CalibrationOutcome clean = runLogged(noisyReferenceGyro(), p, s, TableLog(), &clean_counters);
@@ -312,7 +297,7 @@ TEST(CalibrationSessionTest, EncoderNoiseWithTheRateDifferencedKeepsThePlateaus)
 TEST(CalibrationSessionTest, RefusalNamesTheRateScatterThatHidesThePlateaus) {
   // The same stream, rate only, judged record by record (no smoothing): refused, and the reason
   // names the scatter, measured, and what to do.
-  CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
   s.plateau.smoothing_span = 0.0;
   TableLog noisy;
   noisy.encoder_noise = 2e-6;
@@ -338,7 +323,7 @@ TEST(CalibrationSessionTest, RefusalNamesTheScatterLeftAfterSmoothingARateOnlySt
   noisy.log_angle = false;
   noisy.rate_noise = 3e-3;
   const CalibrationOutcome o = runLogged(noisyReferenceGyro(), testing::dualRateProfile(0.05, -0.05, 120.0),
-                                         settings(CalibrationMethodKind::kDualRate), noisy);
+                                         methodSettings(CalibrationMethodKind::kDualRate), noisy);
   ASSERT_FALSE(o.accepted);
   std::printf("[ measured ] %s\n", o.reason.c_str());
   EXPECT_TRUE(contains(o.reason, "plateaus: reported rate scatter ")) << o.reason;
@@ -349,7 +334,7 @@ TEST(CalibrationSessionTest, RefusalNamesTheScatterLeftAfterSmoothingARateOnlySt
 }
 
 TEST(CalibrationSessionTest, RefusalNamesPlateausShorterThanTheSettleTime) {
-  CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
   const CalibrationOutcome o =
       runLogged(noisyReferenceGyro(), testing::dualRateProfile(0.05, -0.05, 1.5, 20), s, TableLog());
   ASSERT_FALSE(o.accepted);
@@ -365,7 +350,7 @@ TEST(CalibrationSessionTest, RefusalNamesPlateausShorterThanTheSettleTime) {
 
 TEST(CalibrationSessionTest, RefusalNamesAMissingOrUnsynchronizedWave) {
   const TurntableProfile p = testing::dualRateProfile(0.05, -0.05, 30.0);
-  const CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
+  const CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
   const CalibrationOutcome no_wave = runLogged(noisyReferenceGyro(), p, s, TableLog(), nullptr, false);
   ASSERT_FALSE(no_wave.accepted);
   EXPECT_TRUE(contains(no_wave.reason, "plateaus: turntable records arrived without the wave (")) << no_wave.reason;
@@ -377,10 +362,10 @@ TEST(CalibrationSessionTest, RefusalNamesAMissingOrUnsynchronizedWave) {
 }
 
 TEST(CalibrationSessionTest, ANanAngleIsRateOnlyFromTheStartAndAGlitchAfterALoggedAngle) {
-  CalibrationSession rate_only(settings(CalibrationMethodKind::kDualRate), prior());
+  CalibrationSession rate_only(methodSettings(CalibrationMethodKind::kDualRate), referencePrior());
   for (int i = 1; i <= 100; ++i) EXPECT_TRUE(rate_only.addRotationRecord(toNanoseconds(i * 0.01), NAN, 0.05));
   EXPECT_EQ(rate_only.counters().rejected.total(), 0u);
-  CalibrationSession logged(settings(CalibrationMethodKind::kDualRate), prior());
+  CalibrationSession logged(methodSettings(CalibrationMethodKind::kDualRate), referencePrior());
   for (int i = 1; i <= 100; ++i) {
     const double t = i * 0.01;
     EXPECT_EQ(logged.addRotationRecord(toNanoseconds(t), i == 50 ? NAN : 0.05 * t, 0.05), i != 50) << i;
@@ -402,7 +387,7 @@ TEST(CalibrationSessionTest, StepMethodOnARateOnlyStreamUsesTheRateIntegral) {
     p.append(0.349, 0.1745, -0.5, "ramp");
     p.append(15.0, 0.0, 0.0, "rest");
   }
-  CalibrationSettings s = settings(CalibrationMethodKind::kStep);
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kStep);
   s.bins = 64;
   const CalibrationOutcome with_angle = runLogged(g, p, s, TableLog());
   TableLog rate_only;
@@ -435,7 +420,7 @@ TEST(CalibrationSessionTest, AFieldRunCallsItsStreamThePrecessionState) {
     const bool field = method == CalibrationMethodKind::kField;
     // The wave 1000 s after the stream: no sample has the stream around it.
     const CalibrationOutcome late =
-        runLogged(noisyReferenceGyro(), p, settings(method), TableLog(), nullptr, true, 1000.0);
+        runLogged(noisyReferenceGyro(), p, methodSettings(method), TableLog(), nullptr, true, 1000.0);
     ASSERT_FALSE(late.accepted);
     std::printf("[ measured ] %s: %s\n", nameOf(method).c_str(), late.reason.c_str());
     EXPECT_NE(note(late, field ? " wave samples had no precession state around them and were not used"
@@ -453,7 +438,7 @@ TEST(CalibrationSessionTest, AFieldRunCallsItsStreamThePrecessionState) {
     EXPECT_EQ(contains(line, "# precession states (the field method's stream)"), field) << line;
 
     // One record in a hundred has a NaN rate: dropped and counted under the stream's name.
-    CalibrationSession session(settings(method), prior());
+    CalibrationSession session(methodSettings(method), referencePrior());
     long i = 0;
     testing::runAngleLevel(noisyReferenceGyro(), p, [&](Nanoseconds t, double angle, double rate, double theta) {
       session.addRotationRecord(t, angle, ++i % 100 == 0 ? NAN : rate);
@@ -469,6 +454,56 @@ TEST(CalibrationSessionTest, AFieldRunCallsItsStreamThePrecessionState) {
       EXPECT_FALSE(mentions(glitched, "turntable")) << glitched.reason;
     }
   }
+}
+
+TEST(CalibrationSessionTest, NoTurntableDataMeansNoCalibration) {
+  CalibrationSession session(methodSettings(CalibrationMethodKind::kDualRate), GyroParameters());
+  // Samples wait up to 60 s for a turntable state, then are dropped (bounded memory).
+  for (int i = 0; i < 100000; ++i) session.addWave(toNanoseconds(1.0 + i * 1e-3), 0.2 - 0.028 * i * 1e-3, NAN);
+  EXPECT_EQ(session.counters().used, 0u);
+  EXPECT_GT(session.counters().unsynchronized, 39000u);
+  const CalibrationOutcome o = session.finish();
+  EXPECT_FALSE(o.accepted);
+}
+
+TEST(CalibrationSessionTest, SynchronisesStreamsArrivingOutOfStep) {
+  // The same session with the turntable stream delayed by 300 ms gives the same result.
+  const AngleLevelGyro g = referenceGyro();
+  const TurntableProfile p = dualRateProfile(0.05, -0.05, 120.0);
+  const CalibrationOutcome direct =
+      calibrateAngleLevel(g, p, methodSettings(CalibrationMethodKind::kDualRate), referencePrior());
+  CalibrationSession session(methodSettings(CalibrationMethodKind::kDualRate), referencePrior());
+  std::deque<std::tuple<Nanoseconds, double, double>> delayed;
+  testing::runAngleLevel(g, p, [&](Nanoseconds t, double angle, double rate, double theta) {
+    session.addWave(t, theta, NAN);
+    delayed.emplace_back(t, angle, rate);
+    if (delayed.size() > 300) {
+      session.addRotationRecord(std::get<0>(delayed.front()), std::get<1>(delayed.front()),
+                                std::get<2>(delayed.front()));
+      delayed.pop_front();
+    }
+  });
+  for (const auto& d : delayed) session.addRotationRecord(std::get<0>(d), std::get<1>(d), std::get<2>(d));
+  const CalibrationOutcome late = session.finish();
+  ASSERT_TRUE(late.accepted) << late.reason;
+  EXPECT_EQ(late.samples, direct.samples);
+  EXPECT_DOUBLE_EQ(late.scale_factor[0].cos[1], direct.scale_factor[0].cos[1]);
+}
+
+TEST(CalibrationSessionTest, AutoFinishWaitsForRestAfterCompleteData) {
+  const AngleLevelGyro g = referenceGyro();
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
+  s.auto_finish_idle = 10.0;
+  CalibrationSession session(s, referencePrior());
+  double finished_at = -1.0;
+  testing::runAngleLevel(g, dualRateProfile(0.05, -0.05, 120.0), [&](Nanoseconds t, double a, double r, double th) {
+    session.addRotationRecord(t, a, r);
+    session.addWave(t, th, NAN);
+    if (finished_at < 0 && session.shouldFinish()) finished_at = toSeconds(t);
+  });
+  // Plateaus end at ~5 + 0.1 + 120 + 0.2 + 120 + 0.1 = 245.4 s (+ the 1 s stamp offset); then 10 s of rest,
+  // found up to half a smoothing span after the table stopped and judged half a span later.
+  EXPECT_NEAR(finished_at, 1.0 + 245.4 + 10.0 + s.plateau.smoothing_span, 0.5);
 }
 
 }  // namespace

@@ -5,44 +5,18 @@
 #include <sstream>
 
 #include "hrg_gyro/core/calibration/field_command_plan.h"
+#include "hrg_gyro/core/calibration/outcome_from_fits.h"
 #include "hrg_gyro/core/common/units.h"
 
 namespace hrg_gyro {
 namespace core {
-namespace {
-
-double largestStd(const HarmonicFitResult& f) {
-  double m = f.mean_std;
-  for (std::size_t j = 0; j < f.orders.size(); ++j) m = std::max({m, f.cos_std[j], f.sin_std[j]});
-  return m;
-}
-
-GroupSummary summarize(const RateGroup& g, double min_bin_time) {
-  GroupSummary s;
-  s.rate = g.meanRate();
-  s.rate_std = g.rateStd();
-  s.duration = g.rates().totalTime();
-  s.samples = g.rates().samples();
-  s.coverage = g.rates().coverage(min_bin_time);
-  s.turns = g.rates().thetaSwept() / kPi;
-  return s;
-}
-
-}  // namespace
-
 FieldMethod::FieldMethod(const CalibrationSettings& s)
     : settings_(s),
       // The wave turns at about the commanded rate: one radian of theta per radian of psi.
       groups_(s.bins, s.window, s.window_span, 1.0, maxFittedOrder(s.field.gain_orders, s.drift_orders),
               s.group_tolerance, s.plateau.max_gap),
-      regression_(s.field.gain_orders, s.drift_orders, s.bins, s.bias_trend_order) {}
-
-double FieldMethod::windowFor(double rate) const {
-  const int top = maxFittedOrder(settings_.field.gain_orders, settings_.drift_orders);
-  const double span = std::min(settings_.window_span, 1.0 / top);
-  const double sweep = std::abs(rate);
-  return sweep > 0.0 ? std::min(settings_.window, span / sweep) : settings_.window;
-}
+      regression_(s.field.gain_orders, s.drift_orders, s.bins, s.bias_trend_order),
+      chains_(s, maxFittedOrder(s.field.gain_orders, s.drift_orders), 1.0) {}
 
 void FieldMethod::addSample(const PlateauSample& s) {
   // At rest (w_v = 0) the wave hardly moves: nothing to separate.
@@ -55,16 +29,9 @@ void FieldMethod::addSample(const PlateauSample& s) {
     frequency_sum_ += s.frequency;
     ++frequency_count_;
   }
-  const bool gap = in_chain_ && toSeconds(s.stamp - last_stamp_) > settings_.plateau.max_gap;
-  if (!in_chain_ || s.plateau.id != chain_plateau_ || gap || s.stamp <= last_stamp_) {
-    const int group = regressionGroupOf(&group_rates_, s.plateau.rate, settings_.group_tolerance);
-    regression_.startChain(group, windowFor(s.plateau.rate));
-    in_chain_ = true;
-    chain_plateau_ = s.plateau.id;
-  }
+  chains_.follow(s, &regression_);
   // psi is the driver's own integral of the command: exact, and continuous (never wrapped).
   regression_.add(s.stamp, s.theta, s.rotation_angle);
-  last_stamp_ = s.stamp;
 }
 
 void FieldMethod::directionGroups(int* positive, int* negative) const {
@@ -122,7 +89,7 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
   }
   for (std::size_t i : groups_.byDuration()) {
     const RateGroup& g = groups_.groups()[i];
-    o.plateaus.push_back(summarize(g, minBinTime(g.meanRate())));
+    o.plateaus.push_back(summarizeGroup(g, minBinTime(g.meanRate())));
   }
   o.samples = samples_;
   o.gate("samples", samples_ >= q.min_samples, static_cast<double>(samples_), static_cast<double>(q.min_samples),
@@ -221,7 +188,7 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
   o.gate("virtual_rate_gain", gain_error <= fs.max_gain_error, gain_error, fs.max_gain_error,
          "the precession loop realised " + formatShort(e.k.mean, 8) + " of the commanded rate (+- " +
              formatShort(e.k.mean_std, 2) + ")");
-  const double worst = largestStd(d);
+  const double worst = largestTermStd(d);
   o.gate("drift_std", worst <= fs.max_drift_std, worst, fs.max_drift_std,
          "largest standard error of a D term " + formatShort(worst, 3) + " rad/s");
   // The loops trail the precessed wave; what they leave that keeps its sign in both directions is
