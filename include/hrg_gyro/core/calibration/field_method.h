@@ -45,6 +45,17 @@ class FieldMethod : public CalibrationMethod {
   double minBinTime(double rate) const { return chains_.minBinTime(rate); }
   /// The longest-running group of each sign of the commanded rate (-1: none).
   void directionGroups(int* positive, int* negative) const;
+  // The phases of finish(), in its order.
+  /// The two directions' rates, turns and times, and their coverage and turns gates; returns the
+  /// swept time a bin needs in both.
+  double gateDirections(const RateGroup& positive, const RateGroup& negative, CalibrationOutcome* o) const;
+  /// The fit into the report, and D: the still gyro's rate less K(theta) Omega_s.
+  HarmonicFitResult driftFromFit(const IncrementFit& e, const GyroParameters& prior, CalibrationOutcome* o) const;
+  /// The gates on the fit: condition, stillness, the realised gain, D's errors, the loops' lag, the trend.
+  void gateFit(const IncrementFit& e, const HarmonicFitResult& d, CalibrationOutcome* o) const;
+  /// The notes on what was kept, what D rests on, and the fit.
+  void noteResult(const IncrementFit& e, const GyroParameters& prior, CalibrationOutcome* o) const;
+
   CalibrationSettings settings_;
   RateGroups groups_;
   IncrementRegression regression_;
