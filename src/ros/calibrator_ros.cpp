@@ -475,7 +475,7 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
   if (session()) {
     const core::CalibrationProgress p = session()->progress();
     const core::SessionCounters& c = session()->counters();
-    if (c.turntable == 0 && c.wave > 100) {
+    if (c.rotation_records == 0 && c.wave > 100) {
       stat.summary(DiagnosticStatus::WARN, fieldRun() ? "wave samples but no precession state: check "
                                                         "precession/state (a driver whose gyro has the loop)"
                                                       : "wave samples but no turntable state: check turntable/state");
@@ -489,7 +489,7 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
     stat.add("progress", p.fraction);
     // The table's stream: a field run's is the precession loop's state.
     const std::string stream = fieldRun() ? "precession" : "turntable";
-    stat.add(stream + " states", c.turntable);
+    stat.add(stream + " states", c.rotation_records);
     stat.add("wave samples", c.wave);
     stat.add("used", c.used);
     stat.add("not on a settled plateau", c.unsettled);

@@ -101,7 +101,7 @@ FeedStep CalibrationFeed::addPrecessionState(Nanoseconds stamp, double angle, do
 FeedStep CalibrationFeed::addRotation(Nanoseconds stamp, double angle, double rate, std::uint64_t sequence) {
   FeedStep step;
   const std::uint64_t restarts = session_->counters().restarts;
-  session_->addTurntable(stamp, angle, rate, sequence);
+  session_->addRotationRecord(stamp, angle, rate, sequence);
   noteRestart(restarts, &step);
   if (!watch_finish_) return step;
   if (session_->shouldFinish()) {

@@ -60,7 +60,7 @@ TEST(CalibrationFeedTest, TheRotationStreamIsTheMethodsOwn) {
       feed.addPrecessionState(i * 10 * kMs, 0.0, 0.0, i);
     }
     // Two table states for each precession state: the count says which stream the session saw.
-    EXPECT_EQ(session.counters().turntable_total, method == CalibrationMethodKind::kField ? 10u : 20u);
+    EXPECT_EQ(session.counters().rotation_records_total, method == CalibrationMethodKind::kField ? 10u : 20u);
   }
 }
 
@@ -203,7 +203,7 @@ TEST(CalibrationFeedTest, AWatchedRunMayFinishWhenTheWavesReachTheTablesLastStat
                              in_transit.emplace_back(t, theta);
                              if (in_transit.size() > 50000) wave();
                            });
-    ASSERT_GT(session.counters().turntable_total, 0u);
+    ASSERT_GT(session.counters().rotation_records_total, 0u);
     EXPECT_FALSE(session.complete()) << "the waves in transit complete the data";
     while (!in_transit.empty()) wave();
     ASSERT_GT(complete_at, 0);

@@ -138,7 +138,7 @@ TEST(RealSessionImperfectionsTest, GlitchedTableRecords) {
   c.turntable_log.glitches.per_record = {1e-3, 1e-3, 1e-3, 1e-3, 1e-3};
   const Measured m = calibrate("1e-3 glitched records per kind", c);
   expectWithinOnePpm(m);
-  const TurntableRejects& r = m.run.session.rejected;
+  const RotationRecordRejects& r = m.run.session.rejected;
   EXPECT_GT(r.bad_rate + r.bad_angle + r.bad_stamp + r.out_of_order, 0u);
   EXPECT_EQ(m.run.session.restarts, 0u);
 }

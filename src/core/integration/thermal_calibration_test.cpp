@@ -125,7 +125,7 @@ TEST(Thermal, AFrequencyIndependentModelLeavesPpmThatTheSplineRemoves) {
   CalibrationSession thermal_session(thermalSettings(), prior()), dual_session(dual, prior());
   testing::runAngleLevel(g, kRampProfile, [&](Nanoseconds t, double angle, double rate, double theta, double f) {
     for (CalibrationSession* s : {&thermal_session, &dual_session}) {
-      s->addTurntable(t, angle, rate);
+      s->addRotationRecord(t, angle, rate);
       s->addWave(t, theta, f);
     }
   });
@@ -239,7 +239,7 @@ TEST(Thermal, ProgressAndCompletionFollowTheNodeIntervals) {
   CalibrationSession session(s, prior());
   double complete_at = -1.0;
   testing::runAngleLevel(g, kRampProfile, [&](Nanoseconds t, double angle, double rate, double theta, double f) {
-    session.addTurntable(t, angle, rate);
+    session.addRotationRecord(t, angle, rate);
     session.addWave(t, theta, f);
     if (complete_at < 0.0 && session.complete()) complete_at = toSeconds(t);
   });

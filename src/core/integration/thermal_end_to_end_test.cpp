@@ -51,7 +51,7 @@ TEST(ThermalEndToEnd, RampCalibrationBringsTheResidualBelowOnePpmAcrossTheRange)
   while (sim.next(&s)) {
     const ProcessorResult r = processor.process({s.stamp, s.z, s.frequency, s.temperature});
     for (CalibrationSession* session : {&thermal_session, &dual_session}) {
-      session->addTurntable(s.stamp, s.truth.table_angle, s.truth.table_rate);
+      session->addRotationRecord(s.stamp, s.truth.table_angle, s.truth.table_rate);
       if (r.has_wave) session->addWave(s.stamp, r.wave.theta, s.frequency);
     }
   }

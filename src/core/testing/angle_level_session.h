@@ -197,7 +197,7 @@ inline CalibrationOutcome calibrateTableSession(const AngleLevelGyro& g, const T
                                                 const GyroParameters& prior) {
   CalibrationSession session(settings, prior);
   runTableSession(
-      g, table, profile, [&](const TableRecord& r) { session.addTurntable(r.stamp, r.angle, r.rate, r.seq); },
+      g, table, profile, [&](const TableRecord& r) { session.addRotationRecord(r.stamp, r.angle, r.rate, r.seq); },
       [&](Nanoseconds t, double theta, double frequency) { session.addWave(t, theta, frequency); });
   return session.finish();
 }
@@ -234,7 +234,7 @@ inline CalibrationOutcome calibrateAngleLevel(const AngleLevelGyro& g, const Tur
                                               SessionCounters* counters = nullptr) {
   CalibrationSession session(settings, prior);
   runAngleLevel(g, profile, [&](Nanoseconds t, double angle, double rate, double theta, double frequency) {
-    session.addTurntable(t, angle, rate);
+    session.addRotationRecord(t, angle, rate);
     session.addWave(t, theta, frequency);
   });
   if (counters) *counters = session.counters();

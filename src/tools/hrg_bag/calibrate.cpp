@@ -156,11 +156,11 @@ void printOutcome(const core::CalibrationOutcome& outcome) {
     std::cout << "  " << (g.passed ? "pass" : "FAIL") << "  " << g.name << ": " << g.message << "\n";
   }
   for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
-  const core::TurntableRejects& r = outcome.turntable_rejected;
+  const core::RotationRecordRejects& r = outcome.rotation_rejected;
   // A field run's table stream is the precession loop's state.
   std::cout << "calibrate: "
             << (core::traitsOf(outcome.method).virtual_rotation ? "precession states " : "turntable records ")
-            << outcome.turntable_records << ", dropped " << r.total() << " (bad rate " << r.bad_rate << ", bad angle "
+            << outcome.rotation_records << ", dropped " << r.total() << " (bad rate " << r.bad_rate << ", bad angle "
             << r.bad_angle << ", zero stamp " << r.bad_stamp << ", duplicate " << r.duplicate << ", out of order "
             << r.out_of_order << ", stamp jump " << r.stamp_jump << "), restarts " << outcome.restarts << "\n";
   for (const core::DefectDiagnosis& d : outcome.diagnosis) {
