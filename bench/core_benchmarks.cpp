@@ -343,7 +343,7 @@ BENCHMARK(BM_SimulatorRealTimeFactor)->Arg(5)->Arg(25)->Unit(benchmark::kMillise
 // One step is one output sample of `periods` carrier periods: 5 is the simulator's 1 kHz output, 25
 // its 200 Hz. Counter rtf: simulated seconds per wall second.
 void BM_ResonatorStep(benchmark::State& state) {
-  ResonatorParameters shell;
+  ShellParameters shell;
   shell.frequency = 5000.0;
   shell.damping_time = 600.0;
   shell.damping_anisotropy = 4e-5;

@@ -34,6 +34,9 @@ struct BiasDriftConfig {
   double trendAt(double t) const { return rate * t; }
 };
 
+/// A scenario's `resonator` section: the simulated gyro's carrier and sampling, the wave it holds and
+/// its given K(theta) and D(theta). Not the shell's physics (resonator/shell_parameters.h, the
+/// `dynamics.shell` section), which the averaged dynamics use instead of the given K and D.
 struct ResonatorConfig {
   double frequency = 5000.0;          ///< Hz
   int samples_per_period = 32;        ///< N >= 8
