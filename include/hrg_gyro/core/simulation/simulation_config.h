@@ -105,6 +105,12 @@ PickoffDefects parsePickoffSection(const YamlField& pickoff, double amplitude);
 TableRippleConfig parseRippleSection(const YamlField& ripple);
 DeliveryConfig parseChannelDeliverySection(const YamlField& channels);
 
+/// A scenario's top level, as the single gyro's and the triad's are read: a map of `keys` and
+/// `extra_keys` only (any other refused), its `seed` (>= 0, default 1) and `start_time` (> 0 s,
+/// default `*start_time`). Throws ConfigError naming the key.
+void parseScenarioTopLevel(const YamlField& root, std::vector<std::string> keys,
+                           const std::vector<std::string>& extra_keys, std::uint64_t* seed, double* start_time);
+
 /// A scenario file's YAML document: only a regular file of at most kMaxScenarioFileBytes (a FIFO, a
 /// device or a directory is refused at once), a syntax error reported with its line. Throws ConfigError.
 YAML::Node loadScenarioDocument(const std::string& path);
