@@ -225,22 +225,35 @@ void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_t
       ->check(tools::notEmpty());
 }
 
-GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable,
-                      TopicNeed precession) {
+std::map<std::string, std::string> topicTypes(const rosbag::Bag& bag) {
   rosbag::View all(bag);
   std::map<std::string, std::string> types;
   for (const rosbag::ConnectionInfo* c : all.getConnections()) types[c->topic] = c->datatype;
+  return types;
+}
+
+std::string checkGivenTopic(const std::map<std::string, std::string>& types, const std::string& topic,
+                            const std::string& option, const std::string& type) {
+  const auto it = types.find(topic);
+  if (it == types.end()) throw UsageError("topic " + topic + " (--" + option + ") is not in the bag");
+  if (it->second != type) throw UsageError("topic " + topic + " has type " + it->second + ", expected " + type);
+  return topic;
+}
+
+std::vector<std::string> topicsOfType(const std::map<std::string, std::string>& types, const std::string& type) {
+  std::vector<std::string> found;
+  for (const auto& kv : types) {
+    if (kv.second == type) found.push_back(kv.first);
+  }
+  return found;
+}
+
+GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable,
+                      TopicNeed precession) {
+  const std::map<std::string, std::string> types = topicTypes(bag);
   auto pick = [&](const std::string& topic, const std::string& option, const std::string& type, bool required) {
-    if (!topic.empty()) {
-      const auto it = types.find(topic);
-      if (it == types.end()) throw UsageError("topic " + topic + " (--" + option + ") is not in the bag");
-      if (it->second != type) throw UsageError("topic " + topic + " has type " + it->second + ", expected " + type);
-      return topic;
-    }
-    std::vector<std::string> found;
-    for (const auto& kv : types) {
-      if (kv.second == type) found.push_back(kv.first);
-    }
+    if (!topic.empty()) return checkGivenTopic(types, topic, option, type);
+    const std::vector<std::string> found = topicsOfType(types, type);
     if (found.size() > 1) {
       throw UsageError("several " + type + " topics in the bag; choose one with --" + option);
     }
@@ -421,7 +434,7 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
   PrecessionStateReader state_reader;
   std::size_t filling = 0;
   std::uint64_t n = 0, read = 0;  // channel messages; every message of the view
-  try {
+  readingSamples(n, [&] {
     for (const rosbag::MessageInstance& m : view) {
       ++read;
       ReplayBlock& block = blocks[filling];
@@ -446,12 +459,7 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
     }
     if (blocks[filling].count > 0 || blocks[filling].state_count > 0) submit(&blocks[filling]);
     worker.finish();  // rethrows what the processing or the sink threw
-  } catch (const rosbag::BagException& e) {
-    throw UsageError(std::string("bag read error after ") + std::to_string(n) + " samples (truncated?): " + e.what());
-  } catch (const ros::serialization::StreamOverrunException& e) {
-    throw UsageError(std::string("bag read error after ") + std::to_string(n) +
-                     " samples: a message shorter than its type (corrupt?): " + e.what());
-  }
+  });
   progress.finish(n);
   return n;
 }

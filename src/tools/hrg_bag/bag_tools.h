@@ -3,7 +3,9 @@
 // same core::GyroProcessor the processor node runs.
 #pragma once
 
+#include <ros/serialization.h>
 #include <rosbag/bag.h>
+#include <rosbag/exceptions.h>
 #include <rosbag/view.h>
 
 #include <CLI/CLI.hpp>
@@ -11,6 +13,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -72,6 +75,15 @@ CLI::Validator topicName();
 void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_truth);
 /// Whether a subcommand looks for a topic: not at all, when the bag has one, or as a requirement.
 enum class TopicNeed { kNo, kIfPresent, kRequired };
+/// Every topic of the bag with its message type.
+std::map<std::string, std::string> topicTypes(const rosbag::Bag& bag);
+/// A topic given on the command line (option --`option`) checked against the bag's `types`: there and
+/// of `type`, else a UsageError that says which. Returns `topic`.
+std::string checkGivenTopic(const std::map<std::string, std::string>& types, const std::string& topic,
+                            const std::string& option, const std::string& type);
+/// The bag's topics of `type`, in name order.
+std::vector<std::string> topicsOfType(const std::map<std::string, std::string>& types, const std::string& type);
+
 /// Explicit topics win; otherwise the single topic of the right type is taken. Throws UsageError
 /// when a required topic is missing, ambiguous or of the wrong type. The precession state is looked
 /// for only when asked (empty when not found and not required).
@@ -182,6 +194,37 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
                              const std::function<void(const ChannelAmplitudes&, const core::ProcessorResult&)>& sink,
                              const std::string& progress_label, const std::string& precession_topic = std::string(),
                              const std::function<void(const PrecessionState&)>& state_sink = {});
+
+/// Runs `read`, a loop over a bag's messages that has read `samples` samples so far: a bag that
+/// cannot be read to its end becomes a UsageError saying after how many samples and why (truncated,
+/// or a message shorter than its type).
+template <class Read>
+void readingSamples(const std::uint64_t& samples, const Read& read) {
+  try {
+    read();
+  } catch (const rosbag::BagException& e) {
+    throw UsageError(std::string("bag read error after ") + std::to_string(samples) +
+                     " samples (truncated?): " + e.what());
+  } catch (const ros::serialization::StreamOverrunException& e) {
+    throw UsageError(std::string("bag read error after ") + std::to_string(samples) +
+                     " samples: a message shorter than its type (corrupt?): " + e.what());
+  }
+}
+
+/// Hands every message of `view` to `handle(message)` in order, counting them in `*count` with the
+/// progress on stderr; a bag that cannot be read to its end (truncated, corrupt) is a UsageError.
+template <class Handle>
+void readMessages(rosbag::View& view, Progress& progress, std::uint64_t* count, const Handle& handle) {
+  try {
+    for (const rosbag::MessageInstance& m : view) {
+      ++*count;
+      progress.update(*count, *count);
+      handle(m);
+    }
+  } catch (const rosbag::BagException& e) {
+    throw UsageError(std::string("bag read error (truncated?): ") + e.what());
+  }
+}
 
 /// The package's Python script `name`: installed beside hrg_bag (lib/hrg_gyro, devel and install
 /// space alike); a source checkout without that copy falls back to the package's scripts/.
