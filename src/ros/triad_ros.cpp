@@ -188,15 +188,10 @@ bool TriadRos::onReload(std_srvs::Trigger::Request&, std_srvs::Trigger::Response
     }
   }
   if (!error.empty()) {
-    ++failed_reloads_;
-    last_reload_error_ = error;
-    res.success = false;
-    res.message = "kept the previous triad: " + error;
-    ROS_ERROR("triad: reload refused: %s", error.c_str());
+    reload_.refuse(error, &res);
     return true;
   }
-  ++reloads_;
-  last_reload_error_.clear();
+  reload_.loaded();
   res.success = true;
   // Which samples the new file applies to: those after the last one output (the swap is between
   // two samples); a client that compares outputs with the file needs it, however late the triad runs.
@@ -370,8 +365,8 @@ void TriadRos::diagnoseTriad(diagnostic_updater::DiagnosticStatusWrapper& stat) 
 void TriadRos::diagnoseFile(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   std::lock_guard<std::mutex> lock(mutex_);
   const core::TriadParameters& t = combiner_->parameters();
-  if (!last_reload_error_.empty()) {
-    stat.summary(DiagnosticStatus::WARN, "last reload refused, previous triad kept: " + last_reload_error_);
+  if (reload_.lastRefused()) {
+    stat.summary(DiagnosticStatus::WARN, reload_.refusalSummary());
   } else if (t.calibration.method.isNone()) {
     // A nominal triad takes the axes as the body axes: their misalignment (mrad) goes uncorrected.
     stat.summary(DiagnosticStatus::WARN, "nominal triad (calibration method: none): misalignment not corrected");
@@ -391,8 +386,7 @@ void TriadRos::diagnoseFile(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   stat.add("bias (rad/s)", bias);
   stat.add("calibration method", t.calibration.method.name());
   stat.add("calibration time", t.calibration.time);
-  stat.add("reloads", reloads_);
-  stat.add("refused reloads", failed_reloads_);
+  reload_.addCounts(stat);
 }
 
 }  // namespace hrg_gyro

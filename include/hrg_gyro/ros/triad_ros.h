@@ -30,6 +30,7 @@
 #include "hrg_gyro/core/processing/triad_combiner.h"
 #include "hrg_gyro/ros/input_thread.h"
 #include "hrg_gyro/ros/parameter_reader.h"
+#include "hrg_gyro/ros/reload_record.h"
 
 namespace hrg_gyro {
 
@@ -92,8 +93,7 @@ class TriadRos {
   core::TriadCounters reported_;                     // the combiner's counters at the last triad report
   std::array<std::uint64_t, 3> reported_outputs_{};  // each axis's outputs received then
   ros::WallTime reported_wall_;                      // and when
-  std::uint64_t reloads_ = 0, failed_reloads_ = 0;
-  std::string last_reload_error_;
+  ReloadRecord reload_{"triad", "triad"};
   ros::Time last_stamp_;
 };
 
