@@ -267,8 +267,8 @@ void DriverSimRos::publishSingle(const core::SimulationSample& s, const ros::Tim
   }
   if (has_precession_loop_) {
     updatePrecessionSource(s, handed_source_, &precession_source_);
-    precession_pub_.publish(
-        boost::make_shared<PrecessionState>(toPrecessionStateMessage(s, trueHeader(channels->header, stamp), precession_source_)));
+    precession_pub_.publish(boost::make_shared<PrecessionState>(
+        toPrecessionStateMessage(s, trueHeader(channels->header, stamp), precession_source_)));
   }
 }
 

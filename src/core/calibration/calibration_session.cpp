@@ -410,7 +410,8 @@ CalibrationOutcome CalibrationSession::finish() const {
                       (traits.virtual_rotation ? "precession states" : "turntable records") + " dropped (" +
                       std::to_string(r.bad_rate) + " bad rate, " + std::to_string(r.bad_angle) + " bad angle, " +
                       std::to_string(r.bad_stamp) + " zero stamp, " + std::to_string(r.duplicate) + " duplicate, " +
-                      std::to_string(r.out_of_order) + " out of order, " + std::to_string(r.stamp_jump) + " stamp jump)");
+                      std::to_string(r.out_of_order) + " out of order, " + std::to_string(r.stamp_jump) +
+                      " stamp jump)");
   }
   if (counters_.wave_jumps > 0) {
     o.notes.push_back(std::to_string(counters_.wave_jumps) +

@@ -252,7 +252,8 @@ TEST(TriadFeedTest, BadRecordsAreDroppedAndCounted) {
 // 2). A stamp glitch is an extra record sent beside the good one of its instant (a stray, a buffered
 // message); a value glitch replaces it.
 std::vector<Event> glitched(const std::vector<Event>& events, const std::array<int, TriadFeed::kStreamCount>& one_in,
-                            std::size_t* injected, std::array<std::size_t, TriadFeed::kStreamCount>* per_stream = nullptr) {
+                            std::size_t* injected,
+                            std::array<std::size_t, TriadFeed::kStreamCount>* per_stream = nullptr) {
   std::vector<Event> out;
   out.reserve(events.size() + events.size() / 100);
   std::array<Nanoseconds, TriadFeed::kStreamCount> previous{};
@@ -345,11 +346,12 @@ TEST(TriadFeedTest, OneGlitchedRecordOnAnyStreamCostsThatRecordOnly) {
     const TriadStreamCounters& c = feed.counters(s);
     dropped += c.bad_stamp + c.bad_value + c.out_of_order + c.stamp_jump;
     EXPECT_GT(c.stamp_jump, 0u) << s;
-    std::printf("[ measured ] stream %d: %llu received, dropped: %llu zero stamp, %llu bad value, %llu out of order, %llu "
-                "stamp jump\n",
-                s, static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.bad_stamp),
-                static_cast<unsigned long long>(c.bad_value), static_cast<unsigned long long>(c.out_of_order),
-                static_cast<unsigned long long>(c.stamp_jump));
+    std::printf(
+        "[ measured ] stream %d: %llu received, dropped: %llu zero stamp, %llu bad value, %llu out of order, %llu "
+        "stamp jump\n",
+        s, static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.bad_stamp),
+        static_cast<unsigned long long>(c.bad_value), static_cast<unsigned long long>(c.out_of_order),
+        static_cast<unsigned long long>(c.stamp_jump));
   }
   // The table's NaN rates are the axis sessions' to count (they are values, not stamps).
   std::size_t nan_rates = 0;
