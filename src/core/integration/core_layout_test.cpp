@@ -172,4 +172,17 @@ TEST_F(CoreLayoutTest, EveryModuleIsNamedInItsFoldersReadmeAndInTheLayout) {
   EXPECT_GT(checked, 60);
 }
 
+// Beyond the core: the ROS layer, the offline tools and the core's test helpers are in docs/layout.md too.
+TEST_F(CoreLayoutTest, EveryWrapperToolAndTestHelperIsNamedInTheLayout) {
+  const std::string layout = read(root_ + "/docs/layout.md");
+  int checked = 0;
+  for (const std::string dir : {"/include/hrg_gyro/ros", "/src/ros", "/src/tools", "/src/core/testing"}) {
+    for (const std::string& m : modulesIn(root_ + dir)) {
+      EXPECT_TRUE(names(layout, m)) << m << " (" << dir.substr(1) << ") is not named in docs/layout.md";
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 40);
+}
+
 }  // namespace

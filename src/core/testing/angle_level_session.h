@@ -52,6 +52,26 @@ inline AngleLevelGyro referenceGyro() {
   return g;
 }
 
+/// White wave-angle noise per sample of the calibration tests' gyro at 1 kHz, rad.
+constexpr double kNominalNoise = 1.1e-5;
+
+/// referenceGyro() with K harmonics up to order 8 and the nominal wave noise: the gyro of the
+/// table-session tests.
+inline AngleLevelGyro nominalGyro(std::uint64_t seed) {
+  AngleLevelGyro g = referenceGyro();
+  g.k = HarmonicModel({2, 4, 6, 8}, -0.56, {-6e-4, 2e-3, 1e-4, -5e-5}, {4e-4, 0.0, -1e-4, 0.0});
+  g.noise = kNominalNoise;
+  g.seed = seed;
+  return g;
+}
+
+/// The prior of the calibration tests: the nominal parameters at the reference gyro's latitude.
+inline GyroParameters referencePrior() {
+  GyroParameters p;
+  p.earth_rate.latitude = 0.9;
+  return p;
+}
+
 /// Calls sink(stamp, table_angle, table_rate_reported, theta_measured, frequency) for every sample.
 inline void runAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profile,
                           const std::function<void(Nanoseconds, double, double, double, double)>& sink) {

@@ -1,8 +1,10 @@
 // Test support: what the calibration methods' and the session's unit tests share -- the chosen
 // method with K fitted to orders 2 and 4 and D to order 2, a prior whose Earth rate is taken at
-// latitude 0.9 rad (the angle-level reference gyro's), and a constant-rate table profile.
+// latitude 0.9 rad (the angle-level reference gyro's: referencePrior, angle_level_session.h), and a
+// constant-rate table profile.
 #pragma once
 
+#include "core/testing/angle_level_session.h"
 #include "hrg_gyro/core/calibration/calibration_settings.h"
 #include "hrg_gyro/core/model/gyro_parameters.h"
 #include "hrg_gyro/core/simulation/turntable_profile.h"
@@ -17,12 +19,6 @@ inline CalibrationSettings methodSettings(CalibrationMethodKind method) {
   s.scale_factor_orders = {2, 4};
   s.drift_orders = {2};
   return s;
-}
-
-inline GyroParameters referencePrior() {
-  GyroParameters p;
-  p.earth_rate.latitude = 0.9;
-  return p;
 }
 
 /// A constant-rate session: a rest, 250 s at 0.05 rad/s, a rest.

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "hrg_gyro/core/estimation/binned_rate_fit.h"
 #include "hrg_gyro/core/estimation/defect_diagnosis.h"
-#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/estimation/increment_regression.h"
 #include "hrg_gyro/core/estimation/table_clock_offset.h"

@@ -15,7 +15,7 @@
 #include "hrg_gyro/core/model/frequency_interpolator.h"
 #include "hrg_gyro/core/resonator/control_loops.h"
 #include "hrg_gyro/core/resonator/drive_chain.h"
-#include "hrg_gyro/core/resonator/resonator_parameters.h"
+#include "hrg_gyro/core/resonator/shell_parameters.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -67,7 +67,7 @@ struct TableClockSettings {
 /// precessed wave (precessionLagDrift in resonator/first_order_model.h): from the gyro's maker, or
 /// a simulated gyro's scenario (its dynamics section's shell, loops and drive).
 struct FieldResonator {
-  ResonatorParameters shell;
+  ShellParameters shell;
   LoopSettings loops;
   DriveChainErrors drive;
 };

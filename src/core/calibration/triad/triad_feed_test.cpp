@@ -388,10 +388,16 @@ TEST(TriadFeedTest, AStreamThatGoesBackForGoodRestartsTheRun) {
   EXPECT_GT(feed.duration(), toSeconds(all[part - 1].stamp - all[0].stamp) - 2.0);
 }
 
+/// Records held 0.5 s for stamp order; the run finishes by itself after `idle` s with the fixture released.
+TriadFeedSettings autoFinishing(double idle) {
+  TriadFeedSettings s;
+  s.hold = 0.5;
+  s.auto_finish_idle = idle;
+  return s;
+}
+
 TEST(TriadFeedTest, AutoFinishOnceEveryAxisWasAlongTheTableAndTheFixtureStaysReleased) {
-  TriadFeedSettings settings;
-  settings.hold = 0.5;
-  settings.auto_finish_idle = 10.0;
+  const TriadFeedSettings settings = autoFinishing(10.0);
   TriadFeed feed = makeFeed(settings);
   const std::vector<Event>& all = session();
   for (const Event& e : all) {
@@ -424,16 +430,10 @@ TEST(TriadFeedTest, AutoFinishOnceEveryAxisWasAlongTheTableAndTheFixtureStaysRel
 }
 
 TEST(TriadFeedTest, NoAutoFinishWhileAnAxisWasNeverAlongTheTable) {
-  TriadFeedSettings settings;
-  settings.hold = 0.5;
-  settings.auto_finish_idle = 1.0;
-  TriadFeed feed = makeFeed(settings);
+  TriadFeed feed = makeFeed(autoFinishing(1.0));
   // Only +z and -z: x and y never along the table axis, although the fixture is released between.
-  const std::vector<Event>& all = session();
-  for (std::size_t k = 0; k < all.size() / 3; ++k) {
-    deliver(&feed, all[k]);
-    ASSERT_FALSE(feed.shouldFinish());
-  }
+  const std::size_t part = session().size() / 3;
+  for (std::size_t k = 0; k < part; ++k) ASSERT_FALSE((deliver(&feed, session()[k]), feed.shouldFinish())) << k;
   EXPECT_GE(feed.lockedPositions(), 2u);
   EXPECT_FALSE(feed.axesAlongTable()[0]);
 }

@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/testing/output_directory_test_base.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/model/triad_file.h"
@@ -38,25 +39,13 @@ TriadOutcome acceptedOutcome() {
   return o;
 }
 
-class TriadResultFilesTest : public ::testing::Test {
+class TriadResultFilesTest : public OutputDirectoryTestBase {
  protected:
   void SetUp() override {
-    char tmpl[] = "/tmp/hrg_triad_result_files_test_XXXXXX";
-    ASSERT_NE(::mkdtemp(tmpl), nullptr);
-    dir_ = tmpl;
+    OutputDirectoryTestBase::SetUp();
     paths_.triad = dir_ + "/triad.yaml";
     for (int i = 0; i < 3; ++i) paths_.axes[i] = dir_ + "/" + std::string(1, "xyz"[i]) + ".yaml";
   }
-  void TearDown() override {
-    fault_injection::setOutputFileFault({});
-    fs::remove_all(dir_);
-  }
-  std::set<std::string> listing() const {
-    std::set<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir_)) names.insert(e.path().filename().string());
-    return names;
-  }
-  std::string dir_;
   TriadResultPaths paths_;
 };
 
@@ -162,14 +151,7 @@ class TriadResultSetTest : public TriadResultFilesTest {
 // A full disk, a failed sync or a failed backup link at any member, the first, a middle one or the
 // last: nothing is renamed before every member is complete, so the old set stays whole.
 TEST_F(TriadResultSetTest, AFailureBeforeTheRenamesLeavesTheOldSetWhole) {
-  struct Case {
-    OutputFileStep step;
-    int error;
-    const char* message;
-  };
-  for (const Case& c :
-       {Case{OutputFileStep::kWrite, ENOSPC, "No space left on device"},
-        Case{OutputFileStep::kSync, EIO, "Input/output error"}, Case{OutputFileStep::kBackup, EDQUOT, "quota"}}) {
+  for (const OutputFileFault& c : faultsBeforeTheRename()) {
     for (const std::string& failing : {paths_.axes[0], paths_.axes[1], paths_.triad}) {
       expectOldSetWhole([&](OutputFileStep step,
                             const std::string& target) { return step == c.step && target == failing ? c.error : 0; },

@@ -1,5 +1,7 @@
-// The dual-rate method (method 3 of docs/math.md, 'Calibration methods'): drift cancels between two
-// plateau groups.
+// Harmonic fits of theta-binned rates (ThetaBinnedRates): one plateau group's rate r(theta), and
+// K(theta) and D(theta) from two groups by their difference, the estimate the verification makes of
+// a processor's output against the truth (the dual-rate calibration itself fits window increments
+// exactly: increment_regression.h).
 //
 // Each group g at effective rate R_g (table rate + Earth rate for calibration) measures, per wave
 // angle bin, r_g(theta) = K(theta) R_g + D(theta). Per bin (pairing by theta, not by time):
@@ -10,15 +12,16 @@
 // same-sign rates.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/estimation/theta_binned_rates.h"
-#include "hrg_gyro/core/model/harmonic_model.h"
 
 namespace hrg_gyro {
 namespace core {
 
+/// K and D at one wave-angle bin: the binned curves the reports draw against the fitted models.
 struct BinnedCurvePoint {
   double theta = 0.0;   ///< bin centre, rad
   double k = 0.0;       ///< (r1 - r2) / (R1 - R2), smoothed by the bin and window
@@ -26,7 +29,8 @@ struct BinnedCurvePoint {
   double weight = 0.0;  ///< s of data (smaller of the two groups)
 };
 
-struct DualRateEstimate {
+/// K(theta) and D(theta) from two groups' binned rates.
+struct BinnedTwoRateFit {
   bool ok = false;
   std::string reason;
   HarmonicFitResult k;  ///< K(theta) with standard errors (residual of the binned K about the fit)
@@ -37,19 +41,13 @@ struct DualRateEstimate {
 };
 
 /// min_bin_time: bins with less data in either group are left out.
-DualRateEstimate estimateDualRate(const ThetaBinnedRates& group1, double rate1, const ThetaBinnedRates& group2,
-                                  double rate2, const std::vector<int>& k_orders, const std::vector<int>& d_orders,
-                                  double min_bin_time, double max_condition = 1e6);
+BinnedTwoRateFit fitBinnedTwoRates(const ThetaBinnedRates& group1, double rate1, const ThetaBinnedRates& group2,
+                                   double rate2, const std::vector<int>& k_orders, const std::vector<int>& d_orders,
+                                   double min_bin_time, double max_condition = 1e6);
 
-/// Fits one group's binned rates (used by the dual-rate and constant-rate methods).
+/// Fits one group's binned rates (the constant-rate method's K, each group of fitBinnedTwoRates).
 HarmonicFitResult fitBinnedRates(const ThetaBinnedRates& group, const std::vector<int>& orders, double min_bin_time,
                                  double max_condition = 1e6);
-
-/// The frequency-independent model of a fit (only the given orders, in that order).
-HarmonicModel toModel(const HarmonicFitResult& fit);
-
-/// Union of two order sets, sorted.
-std::vector<int> mergeOrders(const std::vector<int>& a, const std::vector<int>& b);
 
 }  // namespace core
 }  // namespace hrg_gyro

@@ -1,4 +1,4 @@
-#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
+#include "hrg_gyro/core/estimation/binned_rate_fit.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,14 +7,6 @@
 
 namespace hrg_gyro {
 namespace core {
-
-std::vector<int> mergeOrders(const std::vector<int>& a, const std::vector<int>& b) {
-  std::vector<int> out(a);
-  out.insert(out.end(), b.begin(), b.end());
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
 
 HarmonicFitResult fitBinnedRates(const ThetaBinnedRates& group, const std::vector<int>& orders, double min_bin_time,
                                  double max_condition) {
@@ -37,12 +29,10 @@ HarmonicFitResult fitBinnedRates(const ThetaBinnedRates& group, const std::vecto
   return fitHarmonics(points, orders, window, max_condition, &covariance);
 }
 
-HarmonicModel toModel(const HarmonicFitResult& fit) { return HarmonicModel(fit.orders, fit.mean, fit.cos, fit.sin); }
-
-DualRateEstimate estimateDualRate(const ThetaBinnedRates& g1, double r1, const ThetaBinnedRates& g2, double r2,
-                                  const std::vector<int>& k_orders, const std::vector<int>& d_orders,
-                                  double min_bin_time, double max_condition) {
-  DualRateEstimate e;
+BinnedTwoRateFit fitBinnedTwoRates(const ThetaBinnedRates& g1, double r1, const ThetaBinnedRates& g2, double r2,
+                                   const std::vector<int>& k_orders, const std::vector<int>& d_orders,
+                                   double min_bin_time, double max_condition) {
+  BinnedTwoRateFit e;
   if (!(std::abs(r1 - r2) > 0.0)) {
     e.reason = "the two plateau rates are equal";
     return e;

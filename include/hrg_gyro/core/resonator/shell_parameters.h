@@ -5,12 +5,15 @@
 // Axes are given as **electrical** angles, like the wave angle theta: a mode whose antinode sits at
 // case angle phi has electrical angle 2 phi. The two modes of the pair along one defect's axes are
 // then pi/2 apart electrically (45 degrees on the shell). Rates are rad/s, times s.
+//
+// Not the simulation's `resonator` section (ResonatorConfig, simulation_config.h: the simulated gyro's
+// sampling, wave and given K and D); a scenario gives these in its `dynamics.shell` section.
 #pragma once
 
 namespace hrg_gyro {
 namespace core {
 
-struct ResonatorParameters {
+struct ShellParameters {
   double frequency = 5000.0;  ///< f0, Hz: the mean resonance of the pair (w0 = 2 pi f0)
   /// k, the Bryan factor: relative to the case the wave turns by -k times the body angle on the
   /// shell, so the package's scale factor is K0 = -2 k in electrical angle.

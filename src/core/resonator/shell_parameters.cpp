@@ -1,4 +1,4 @@
-#include "hrg_gyro/core/resonator/resonator_parameters.h"
+#include "hrg_gyro/core/resonator/shell_parameters.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -9,9 +9,9 @@
 namespace hrg_gyro {
 namespace core {
 
-double ResonatorParameters::angularFrequency() const { return kTwoPi * frequency; }
+double ShellParameters::angularFrequency() const { return kTwoPi * frequency; }
 
-void ResonatorParameters::validate() const {
+void ShellParameters::validate() const {
   const auto require = [](bool ok, const char* field, const std::string& what) {
     if (!ok) throw std::invalid_argument(std::string("resonator ") + field + ": " + what);
   };

@@ -1,4 +1,4 @@
-#include "hrg_gyro/core/processing/rate_variance_pairing.h"
+#include "hrg_gyro/core/processing/triad_variance_pairing.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -8,12 +8,12 @@
 namespace hrg_gyro {
 namespace core {
 
-RateVariancePairing::RateVariancePairing(std::size_t max_held)
+TriadVariancePairing::TriadVariancePairing(std::size_t max_held)
     : max_held_(max_held), outputs_(max_held + 1), variances_(max_held + 1) {
   if (max_held < 1) throw std::invalid_argument("rate variance pairing: max_held must be at least 1");
 }
 
-void RateVariancePairing::release(AxisOutput output, double variance, std::vector<AxisOutput>* ready) {
+void TriadVariancePairing::release(AxisOutput output, double variance, std::vector<AxisOutput>* ready) {
   output.rate_variance = variance;
   if (std::isnan(variance)) {
     ++counters_.without_variance;
@@ -23,7 +23,7 @@ void RateVariancePairing::release(AxisOutput output, double variance, std::vecto
   ready->push_back(output);
 }
 
-void RateVariancePairing::addOutput(const AxisOutput& output, std::vector<AxisOutput>* ready) {
+void TriadVariancePairing::addOutput(const AxisOutput& output, std::vector<AxisOutput>* ready) {
   if (has_output_ && output.stamp < last_output_) {
     // A loop: what waits from before it will find no variance any more.
     while (!outputs_.empty()) {
@@ -42,7 +42,7 @@ void RateVariancePairing::addOutput(const AxisOutput& output, std::vector<AxisOu
   }
 }
 
-void RateVariancePairing::addVariance(Nanoseconds stamp, double variance, std::vector<AxisOutput>* ready) {
+void TriadVariancePairing::addVariance(Nanoseconds stamp, double variance, std::vector<AxisOutput>* ready) {
   if (has_variance_ && stamp < last_variance_) {
     counters_.unmatched_variances += variances_.size();
     variances_.clear();
@@ -57,7 +57,7 @@ void RateVariancePairing::addVariance(Nanoseconds stamp, double variance, std::v
   }
 }
 
-void RateVariancePairing::drain(std::vector<AxisOutput>* ready) {
+void TriadVariancePairing::drain(std::vector<AxisOutput>* ready) {
   while (!outputs_.empty()) {
     const AxisOutput& o = outputs_.front();
     if (o.flags & (kFlagGap | kFlagReset)) {  // the processor publishes no Imu for these

@@ -1,7 +1,7 @@
-// An axis's outputs and the rate variances its processor reports for them arrive on two topics
-// (GyroOutput on `output`; the variance in the Imu on `imu/data_raw`, angular_velocity_covariance[8]),
-// each in order but in no fixed order between the two. This pairs them by stamp, so that every
-// output goes on to the triad combiner with the variance of its own stamp, in the axis's order:
+// For the triad (its node only): an axis's outputs and the rate variances its processor reports for them arrive on two
+// topics (GyroOutput on `output`; the variance in the Imu on `imu/data_raw`, angular_velocity_covariance[8]), each in
+// order but in no fixed order between the two. This pairs them by stamp, so that every output goes on to the triad
+// combiner with the variance of its own stamp, in the axis's order:
 //   - an output the processor publishes no Imu for (a gap or reset flag) goes on at once, without;
 //   - an output waits for the Imu of its stamp; an Imu of a later stamp means its own was lost, and
 //     it goes on without (the combiner keeps the axis's last variance);
@@ -24,15 +24,15 @@
 namespace hrg_gyro {
 namespace core {
 
-struct RateVariancePairingCounters {
+struct TriadVariancePairingCounters {
   std::uint64_t paired = 0;               ///< outputs that went on with the variance of their stamp
   std::uint64_t without_variance = 0;     ///< outputs that went on without one (none due, lost, or waited too long)
   std::uint64_t unmatched_variances = 0;  ///< variances dropped: their output never came
 };
 
-class RateVariancePairing {
+class TriadVariancePairing {
  public:
-  explicit RateVariancePairing(std::size_t max_held = 1000);
+  explicit TriadVariancePairing(std::size_t max_held = 1000);
 
   /// An output of the axis (its rate_variance is ignored). Outputs ready to go on, in order, with
   /// their rate_variance set (NaN: none), are appended to *ready.
@@ -42,7 +42,7 @@ class RateVariancePairing {
 
   std::size_t heldOutputs() const { return outputs_.size(); }
   std::size_t heldVariances() const { return variances_.size(); }
-  const RateVariancePairingCounters& counters() const { return counters_; }
+  const TriadVariancePairingCounters& counters() const { return counters_; }
 
  private:
   struct Variance {
@@ -57,7 +57,7 @@ class RateVariancePairing {
   RingBuffer<Variance> variances_;
   bool has_output_ = false, has_variance_ = false;
   Nanoseconds last_output_ = 0, last_variance_ = 0;
-  RateVariancePairingCounters counters_;
+  TriadVariancePairingCounters counters_;
 };
 
 }  // namespace core
