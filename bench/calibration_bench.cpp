@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
     angle += table * dt;
     theta += (k(theta) * (table + earth) + d(theta)) * dt;
     const Nanoseconds stamp = toNanoseconds(1.0 + t);
-    session.addTurntable(stamp, angle, table);
+    session.addRotationRecord(stamp, angle, table);
     session.addWave(stamp, theta + 1e-6 * noise.next(), 5000.0);
     if ((i + 1) % (samples / 8) == 0) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -15,8 +15,8 @@
 #include "hrg_gyro/core/model/wave_parameters.h"
 #include "hrg_gyro/core/processing/compensator.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
-#include "hrg_gyro/core/processing/rate_variance_pairing.h"
 #include "hrg_gyro/core/processing/triad_combiner.h"
+#include "hrg_gyro/core/processing/triad_variance_pairing.h"
 #include "hrg_gyro/core/resonator/resonator_dynamics.h"
 #include "hrg_gyro/core/signal/synchronous_demodulator.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
@@ -236,7 +236,7 @@ BENCHMARK(BM_TriadStep);
 // The triad node's path: each output first paired with its variance from the axis's Imu topic.
 void BM_TriadStepPaired(benchmark::State& state) {
   TriadCombiner combiner(TriadCombinerSettings(), benchTriad());
-  std::array<RateVariancePairing, 3> pairings;
+  std::array<TriadVariancePairing, 3> pairings;
   std::vector<std::array<AxisOutput, 3>> stream = triadStream();
   const Nanoseconds period = static_cast<Nanoseconds>(stream.size()) * 100000;
   std::vector<TriadBodySample> out;
@@ -343,7 +343,7 @@ BENCHMARK(BM_SimulatorRealTimeFactor)->Arg(5)->Arg(25)->Unit(benchmark::kMillise
 // One step is one output sample of `periods` carrier periods: 5 is the simulator's 1 kHz output, 25
 // its 200 Hz. Counter rtf: simulated seconds per wall second.
 void BM_ResonatorStep(benchmark::State& state) {
-  ResonatorParameters shell;
+  ShellParameters shell;
   shell.frequency = 5000.0;
   shell.damping_time = 600.0;
   shell.damping_anisotropy = 4e-5;

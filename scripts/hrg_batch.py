@@ -44,9 +44,11 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-import hrg_report  # noqa: E402  (beside this script, source and install space alike)
+import hrg_report  # noqa: E402  (beside this script, source and install space alike: its page templates)
 import hrg_output_file  # noqa: E402
-from hrg_report import one_line  # noqa: E402
+from hrg_models import one_line  # noqa: E402
+from hrg_report_figures import hrg_bag_executable  # noqa: E402
+from hrg_report_validation import ReportError, load_spec  # noqa: E402
 
 INDEX = "index.html"
 # Per-bag folder names that would be the index, OUT_DIR itself or its parent.
@@ -277,9 +279,9 @@ def run(args):
         setattr(args, option, os.path.abspath(path))
     try:
         if args.spec:
-            hrg_report.load_spec(args.spec)  # a bad specification is refused once, before any work
-        hrg_bag = hrg_report.hrg_bag_executable()
-    except hrg_report.ReportError as e:
+            load_spec(args.spec)  # a bad specification is refused once, before any work
+        hrg_bag = hrg_bag_executable()
+    except ReportError as e:
         return usage_error(e)
     bag_names = sorted(n[:-len(".bag")] for n in names if n.endswith(".bag"))
     if not bag_names:

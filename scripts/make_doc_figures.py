@@ -33,6 +33,7 @@ import yaml  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import plot_calibration  # noqa: E402  (the report plots: one reader of each tool output)
+from hrg_models import YamlFileError, model, read_yaml  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DPI = 100
@@ -46,8 +47,10 @@ def fail(message):
 def load_yaml(path, what):
     if not os.path.isfile(path):
         fail("%s not found: %s (run `make run` first)" % (what, path))
-    with open(path) as f:
-        return yaml.safe_load(f)
+    try:
+        return read_yaml(path, what)
+    except YamlFileError as e:
+        fail(str(e))
 
 
 def find_report(run_output):
@@ -55,13 +58,6 @@ def find_report(run_output):
     if not candidates:
         fail("no calibration report params*.report.yaml in %s (run `make run` first)" % run_output)
     return max(candidates, key=os.path.getmtime)
-
-
-def model(estimate, theta):
-    value = estimate["mean"]
-    for k, a, b in zip(estimate["orders"], estimate["cos"], estimate["sin"]):
-        value += a * math.cos(k * theta) + b * math.sin(k * theta)
-    return value
 
 
 def peak_deviation(values):
@@ -203,8 +199,7 @@ def figure_before_after(report, injected, summary, path):
 
 def rest_scenario(seconds, directory):
     """The make-run gyro (config/scenarios/demo.yaml) on a table at rest for `seconds`."""
-    with open(os.path.join(ROOT, "config", "scenarios", "demo.yaml")) as f:
-        scenario = yaml.safe_load(f)
+    scenario = load_yaml(os.path.join(ROOT, "config", "scenarios", "demo.yaml"), "scenario")
     scenario["turntable"]["profile"] = [{"type": "dwell", "duration": float(seconds), "label": "rest"}]
     path = os.path.join(directory, "rest.yaml")
     with open(path, "w") as f:

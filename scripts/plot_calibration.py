@@ -12,80 +12,24 @@
 
 The report is the YAML the calibrator and `hrg_bag calibrate --report` write."""
 import math
+import os
 import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-import yaml  # noqa: E402
 
-
-def model(estimate, theta):
-    value = estimate["mean"]
-    for k, a, b in zip(estimate["orders"], estimate["cos"], estimate["sin"]):
-        value += a * math.cos(k * theta) + b * math.sin(k * theta)
-    return value
-
-
-def spline_weights(nodes, f, natural):
-    """Weights w_j with value(f) = sum_j w_j y_j: natural cubic spline or piecewise linear, end values
-    held outside the nodes (as FrequencyInterpolator does)."""
-    n = len(nodes)
-    w = [0.0] * n
-    if f <= nodes[0] or f >= nodes[-1]:
-        w[0 if f <= nodes[0] else n - 1] = 1.0
-        return w
-    i = max(j for j in range(n - 1) if nodes[j] <= f)
-    h = nodes[i + 1] - nodes[i]
-    t = (f - nodes[i]) / h
-    w[i], w[i + 1] = 1.0 - t, t
-    if not natural or n < 3:
-        return w
-    # Second derivatives m = C y with m_0 = m_{n-1} = 0 from the interior equations T m = D y.
-    m = n - 2
-    T = [[0.0] * m for _ in range(m)]
-    D = [[0.0] * n for _ in range(m)]
-    for r in range(m):
-        h0, h1 = nodes[r + 1] - nodes[r], nodes[r + 2] - nodes[r + 1]
-        if r > 0:
-            T[r][r - 1] = h0
-        T[r][r] = 2.0 * (h0 + h1)
-        if r < m - 1:
-            T[r][r + 1] = h1
-        D[r][r], D[r][r + 1], D[r][r + 2] = 6.0 / h0, -6.0 / h0 - 6.0 / h1, 6.0 / h1
-    # Solve T C = D by Gaussian elimination (T is small and diagonally dominant).
-    for c in range(m):
-        for r in range(c + 1, m):
-            factor = T[r][c] / T[c][c]
-            T[r] = [a - factor * b for a, b in zip(T[r], T[c])]
-            D[r] = [a - factor * b for a, b in zip(D[r], D[c])]
-    C = [[0.0] * n for _ in range(m)]
-    for r in reversed(range(m)):
-        row = D[r][:]
-        for c in range(r + 1, m):
-            row = [a - T[r][c] * b for a, b in zip(row, C[c])]
-        C[r] = [a / T[r][r] for a in row]
-    curvature = [[0.0] * n] + C + [[0.0] * n]
-    ci = h * h / 6.0 * ((1.0 - t) ** 3 - (1.0 - t))
-    cj = h * h / 6.0 * (t ** 3 - t)
-    return [w[k] + ci * curvature[i][k] + cj * curvature[i + 1][k] for k in range(n)]
-
-
-def at_frequency(fits, nodes, f, natural):
-    """The fitted coefficients of a frequency-dependent result interpolated at f."""
-    w = spline_weights(nodes, f, natural)
-    out = dict(fits[0])
-    for key in ("mean",):
-        out[key] = sum(wj * fit[key] for wj, fit in zip(w, fits))
-    for key in ("cos", "sin"):
-        out[key] = [sum(wj * fit[key][q] for wj, fit in zip(w, fits)) for q in range(len(fits[0][key]))]
-    return out
+# The module beside this script (its own folder first, as hrg_report.py does).
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from hrg_models import YamlFileError, at_frequency, model, parse_yaml, read_yaml  # noqa: E402
 
 
 def plot_calibration(report_path, out_path):
-    with open(report_path) as f:
-        r = yaml.safe_load(f)
+    try:
+        r = read_yaml(report_path, "calibration report")
+    except YamlFileError as e:
+        raise SystemExit(str(e))
     binned = r.get("binned") or {}
     theta = binned.get("theta") or []
     if not r.get("scale_factor"):
@@ -95,7 +39,7 @@ def plot_calibration(report_path, out_path):
     nodes = r.get("frequency_nodes") or []
     node_models, where = [], ""
     if len(nodes) > 1 and len(r["scale_factor"]) == len(nodes):
-        written = yaml.safe_load(r["parameters"]) if r.get("accepted") else None
+        written = parse_yaml(r["parameters"]) if r.get("accepted") else None
         natural = not written or written["scale_factor"].get("interpolation") != "piecewise_linear"
         f_mid = 0.5 * (nodes[0] + nodes[-1])
         node_models = list(zip(nodes, r["scale_factor"]))

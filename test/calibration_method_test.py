@@ -17,10 +17,12 @@ import tempfile
 import unittest
 from xmlrpc.client import ServerProxy
 
+import rosbag
 import rosgraph
 import rosnode
 import rospy
 import rostest
+import yaml
 from diagnostic_msgs.msg import DiagnosticArray
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
@@ -44,15 +46,38 @@ FIELD_D0 = 9.9733e-06
 FIELD_GAIN = 1.0035038
 
 
-def clean_offline_report(scenario, prior, method):
-    """The same scenario, without glitches, simulated and calibrated by hrg_bag: its report."""
+# The keys of config/calibrator.yaml that hrg_bag calibrate --config reads (the others are the node's).
+CALIBRATION_KEYS = ("scale_factor_orders", "drift_orders", "bins", "window", "window_span", "group_tolerance",
+                    "auto_finish_idle", "backward_reset", "forward_jump", "jump_persist", "bias_trend_order", "plateau",
+                    "gates", "thermal", "table_clock", "field")
+
+
+def clean_offline_report(scenario, prior, method, turntable_records):
+    """The same scenario, without glitches, simulated and calibrated by hrg_bag on the part of the
+    session the live calibrator saw (it finishes by itself at rest, before the scenario's end: its
+    first `turntable_records` table records and the channels up to the last of them): its report."""
     hrg_bag = subprocess.check_output(["catkin_find", "--first-only", "--libexec", "hrg_gyro", "hrg_bag"],
                                       universal_newlines=True).strip()
     work = tempfile.mkdtemp(prefix="hrg_clean_")
-    bag, report = os.path.join(work, "clean.bag"), os.path.join(work, "clean.report.yaml")
-    subprocess.run([hrg_bag, "simulate", "--scenario", scenario, "--out", bag], check=True,
+    full, bag = os.path.join(work, "full.bag"), os.path.join(work, "clean.bag")
+    report = os.path.join(work, "clean.report.yaml")
+    subprocess.run([hrg_bag, "simulate", "--scenario", scenario, "--out", full], check=True,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=600)
-    subprocess.run([hrg_bag, "calibrate", bag, "--method", method, "--params", prior, "--report", report],
+    with rosbag.Bag(full) as b:
+        stamps = [m.header.stamp for _, m, _ in b.read_messages(topics=["/turntable/state"])]
+        end = stamps[turntable_records - 1]
+        with rosbag.Bag(bag, "w") as out:
+            for topic, m, t in b.read_messages():
+                if t <= end:
+                    out.write(topic, m, t)
+    # The calibrator's settings as the live calibrator has them (its node-only keys left out).
+    settings = {k: v for k, v in util.load_yaml(os.path.join(os.path.dirname(prior), "calibrator.yaml")).items()
+                if k in CALIBRATION_KEYS}
+    config = os.path.join(work, "settings.yaml")
+    with open(config, "w") as f:
+        yaml.safe_dump(settings, f)
+    subprocess.run([hrg_bag, "calibrate", bag, "--method", method, "--params", prior, "--config", config,
+                    "--report", report, "--out", os.path.join(work, "clean.yaml")],
                    check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=600)
     return util.load_yaml(report)
 
@@ -124,7 +149,7 @@ class CalibrationMethod(unittest.TestCase):
             self.assertEqual(int(processor["resets (time went backwards)"]), 0)
             # The same estimates as the clean session's, offline: within a tenth of their sigmas.
             clean = clean_offline_report(rospy.get_param("~scenario"), rospy.get_param("~prior_file"),
-                                         "constant_rate")["scale_factor"][0]
+                                         "constant_rate", report["turntable_records"])["scale_factor"][0]
             k = r.scale_factor[0]
             worst = abs(k.mean - clean["mean"]) / k.mean_std
             for kind in ("cos", "sin"):

@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """Time faults on the live processor (sim time driven by this test): zero, duplicate and
-out-of-order stamps are dropped and counted; a forward gap is not integrated across (FLAG_GAP,
-dalpha 0); a /clock jump back resets the state (FLAG_RESET, alpha restarts); processing carries on
-after each fault, no output is NaN, and the input diagnostic counts every case; with /clock stopped
-the diagnostics go on and report the input as stalled."""
+out-of-order stamps are dropped and counted; a single sample stamped 1000 s ahead or 100 s back (a
+clock glitch, a stray message) is dropped and counted and costs nothing else; a forward gap is not
+integrated across (FLAG_GAP, dalpha 0) once ~jump_persist samples lie past it; a /clock jump back
+resets the state (FLAG_RESET, alpha restarts) once ~jump_persist samples lie past it; processing
+carries on after each fault, no output is NaN, and the input diagnostic counts every case; with
+/clock stopped the diagnostics go on and report the input as stalled."""
 import math
 import os
 import sys
@@ -55,6 +57,13 @@ class TimeFaults(unittest.TestCase):
         self.pub.publish(channels(self.seq, stamp, self.theta))
         time.sleep(0.002)
 
+    def stray(self, stamp):
+        """One extra message with a glitched stamp; /clock stays where it is."""
+        self.seq += 1
+        self.tick(self.t)
+        self.pub.publish(channels(self.seq, stamp, self.theta))
+        time.sleep(0.002)
+
     def good(self, n):
         for _ in range(n):
             self.t += DT
@@ -62,16 +71,21 @@ class TimeFaults(unittest.TestCase):
             self.send(self.t)
 
     def test_faults_are_dropped_counted_and_survived(self):
+        persist = 5                         # ~jump_persist: the first 4 samples past a real jump are dropped
         self.good(40)                       # 39 outputs
         self.send(0.0)                      # zero stamp
         self.send(self.t)                   # duplicate
         self.send(self.t - 0.002)           # out of order (within ~backward_reset)
         self.good(20)                       # 20 outputs, the first reports 3 rejected before it
-        self.t += 0.5                       # forward gap of 0.5 s > ~max_gap
-        self.good(20)                       # 20 outputs, the first flagged GAP with dalpha 0
+        self.stray(self.t + 1000.0)         # one sample 1000 s ahead: dropped
+        self.good(20)                       # 20 outputs, the first reports 1 rejected, no flag
+        self.stray(self.t - 100.0)          # one sample 100 s back: dropped
+        self.good(20)                       # 20 outputs, the first reports 1 rejected, no flag
+        self.t += 0.5                       # forward gap of 0.5 s > ~max_gap, for good
+        self.good(20)                       # 4 dropped, then 16 outputs, the first flagged GAP with dalpha 0
         self.t -= 50.0                      # /clock and stamps jump back 50 s (a bag loop)
-        self.good(20)                       # first sample re-anchors, 19 outputs, the first flagged RESET
-        expected = 39 + 20 + 20 + 19
+        self.good(20)                       # 4 dropped, the fifth re-anchors, 15 outputs, the first flagged RESET
+        expected = 39 + 20 + 20 + 20 + (20 - persist + 1) + (20 - persist)
         util.wait_for(lambda: len(self.outputs) >= expected, "%d outputs" % expected)
         # Keep sim time moving so that the diagnostics publish the final counters.
         deadline = time.time() + 20
@@ -86,19 +100,26 @@ class TimeFaults(unittest.TestCase):
             for v in (o.dalpha, o.alpha, o.rate, o.dt, o.scale_factor):
                 self.assertTrue(math.isfinite(v), o)
         self.assertEqual(out[39].rejected_before, 3)
+        for i in (59, 79):  # after each stray: that sample only
+            self.assertEqual(out[i].rejected_before, 1, i)
+            self.assertEqual(out[i].flags, 0, i)
+            self.assertLess(abs(out[i].dt - DT), 1e-6, i)
+        gap = 99
         gaps = [i for i, o in enumerate(out) if o.flags & GyroOutput.FLAG_GAP]
-        self.assertEqual(gaps, [59])
-        self.assertEqual(out[59].dalpha, 0.0)
-        self.assertAlmostEqual(out[59].dt, 0.5 + DT, places=6)
-        self.assertEqual(out[59].alpha, out[58].alpha)  # nothing integrated across the gap
+        self.assertEqual(gaps, [gap])
+        self.assertEqual(out[gap].rejected_before, persist - 1)
+        self.assertEqual(out[gap].dalpha, 0.0)
+        self.assertAlmostEqual(out[gap].dt, 0.5 + persist * DT, places=6)
+        self.assertEqual(out[gap].alpha, out[gap - 1].alpha)  # nothing integrated across the gap
+        reset = gap + 20 - persist + 1
         resets = [i for i, o in enumerate(self.outputs) if o.flags & GyroOutput.FLAG_RESET]
-        self.assertEqual(resets, [79])
+        self.assertEqual(resets, [reset])
         # After the reset alpha restarts: the first output holds one increment only.
-        self.assertEqual(out[79].alpha, out[79].dalpha)
-        self.assertLess(abs(out[79].dt - DT), 1e-6)
+        self.assertEqual(out[reset].alpha, out[reset].dalpha)
+        self.assertLess(abs(out[reset].dt - DT), 1e-6)
         # Between faults the angle follows the input: dtheta / K per step.
         k0 = -0.56
-        for i in (10, 45, 70, 90):
+        for i in (10, 45, 70, 90, 110, 125):
             self.assertAlmostEqual(out[i].dalpha, RATE * DT / k0, delta=1e-6)
 
         s = self.input_status
@@ -106,9 +127,10 @@ class TimeFaults(unittest.TestCase):
         self.assertEqual(s["zero stamps"], "1")
         self.assertEqual(s["duplicate stamps"], "1")
         self.assertEqual(s["out-of-order stamps"], "1")
+        self.assertEqual(s["stamp jumps dropped"], str(2 + 2 * (persist - 1)))
         self.assertEqual(s["gaps not integrated"], "1")
         self.assertEqual(s["resets (time went backwards)"], "1")
-        self.assertAlmostEqual(float(s["largest gap (s)"]), 0.5 + DT, places=6)
+        self.assertAlmostEqual(float(s["largest gap (s)"]), 0.5 + persist * DT, places=6)
 
     def test_stopped_clock_is_reported_as_stalled(self):
         # A paused player stops /clock and the input together: diagnostics go on (on the wall

@@ -188,10 +188,10 @@ class RecordedSession(unittest.TestCase):
                                                                        "precession_offline.bag"))
         code, log = roslaunch(["record.launch", "bag:=" + live, "simulate:=true", "record_outputs:=true",
                                "time_scale:=1.0", "scenario:=" + scenario, "parameter_file:=" + self.params],
-                              timeout=240)
+                              bags=[live])
         self.assertTrue(os.path.exists(live), log[-3000:])
         code, replay_log = roslaunch(["playback.launch", "bag:=" + live, "parameter_file:=" + self.params,
-                                      "record_to:=" + replay], timeout=240)
+                                      "record_to:=" + replay], bags=[replay])
         process = subprocess.run([HRG_BAG, "process", live, "--params", self.params, "--out", offline],
                                  stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
                                  timeout=120)

@@ -139,7 +139,7 @@ class ReportTest(unittest.TestCase):
         cls.pkg = rospy.get_param("~package_dir")
         cls.script = os.path.join(cls.pkg, "scripts", "hrg_report.py")
         sys.path.insert(0, os.path.join(cls.pkg, "scripts"))
-        cls.report_module = __import__("hrg_report")  # its YAML loader reads 1e-05 as yaml-cpp means it
+        cls.models_module = __import__("hrg_models")  # the scripts' YAML loader reads 1e-05 as yaml-cpp means it
         cls.prior = os.path.join(cls.pkg, "config", "params_uncalibrated.yaml")
         with open(os.path.join(cls.pkg, "test", "scenarios", "report_session.yaml")) as f:
             scenario = f.read()
@@ -170,7 +170,7 @@ class ReportTest(unittest.TestCase):
     def check_shown_numbers(self, page, report_path):
         """Every number the page shows with its data-q equals the report YAML's, to the digits shown."""
         with open(report_path) as f:
-            report = yaml.load(f, Loader=self.report_module.Loader)
+            report = yaml.load(f, Loader=self.models_module.Loader)
         checked = 0
         for q, shown in page.by_q.items():
             expected = lookup(report, q)

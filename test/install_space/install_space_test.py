@@ -73,10 +73,11 @@ class InstallSpace(unittest.TestCase):
 
     def test_report_scripts_find_their_templates_and_hrg_bag_in_the_install_space(self):
         lib = os.path.join(PREFIX, "lib", "hrg_gyro")
-        # The atomic writer both scripts import from beside themselves (hrg_report imports it).
-        self.assertTrue(os.path.isfile(os.path.join(lib, "hrg_output_file.py")))
-        p = run("/usr/bin/python3", "-c", "import sys; sys.path.insert(0, %r); import hrg_report; "
-                "print(hrg_report.find_template_dir()); print(hrg_report.hrg_bag_executable())" % lib)
+        # The modules the scripts import from beside themselves.
+        for module in ("hrg_output_file.py", "hrg_models.py", "hrg_report_validation.py", "hrg_report_figures.py"):
+            self.assertTrue(os.path.isfile(os.path.join(lib, module)), module)
+        p = run("/usr/bin/python3", "-c", "import sys; sys.path.insert(0, %r); import hrg_report, hrg_report_figures; "
+                "print(hrg_report.find_template_dir()); print(hrg_report_figures.hrg_bag_executable())" % lib)
         self.assertEqual(p.stdout.split(), [os.path.join(PREFIX, "share", "hrg_gyro", "templates"),
                                             os.path.join(lib, "hrg_bag")], p.stdout)
         for script in ("hrg_report.py", "hrg_batch.py"):

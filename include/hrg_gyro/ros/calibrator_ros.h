@@ -8,27 +8,25 @@
 // kept as .bak), a report is written next to it and the processor's `~reload` is called. `~stages`
 // runs several methods in a row: [correction_matrix, dual_rate] is the paper's two-stage
 // refinement (P first, then the residual K and D measured through the new P). The calibration
-// itself (stages, generator pairing, reports' names) is the core's: this class wires it to ROS.
+// itself is the core's: the stages and reports' names (core::StagedCalibration), the routing of every
+// input record into the run (core::CalibrationFeed, as hrg_bag calibrate and the offline pipeline
+// route theirs) and the field method's plan (core::FieldPlanRun); this class wires them to ROS.
 //
 // The field method (a still gyro, no table) reads `precession/state` in place of `turntable/state`
 // and commands the virtual rotation itself: it publishes core::fieldCommandPlan's commands on
 // `command/precession` as the gyro's own stream time (the precession state's stamps) passes, and a
-// rate of 0 when the run ends before the plan does. core::FieldPlanRun judges each precession state:
-// a command this run did not send aborts the run (nothing written, the reason on ~result), and a plan
-// that is over without complete data refuses it instead of waiting.
+// rate of 0 when the run ends before the plan does. core::FieldPlanRun::step judges each precession
+// state and says what is due: a command this run did not send aborts the run (nothing written, the
+// reason on ~result), and a plan that is over without complete data refuses it instead of waiting.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
 
-#include <condition_variable>
-#include <deque>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -38,10 +36,12 @@
 #include "hrg_gyro/StartCalibration.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
+#include "hrg_gyro/core/calibration/calibration_feed.h"
 #include "hrg_gyro/core/calibration/field_command_plan.h"
-#include "hrg_gyro/core/calibration/generator_pairing.h"
 #include "hrg_gyro/core/calibration/staged_calibration.h"
+#include "hrg_gyro/ros/calibrator_services.h"
 #include "hrg_gyro/ros/input_thread.h"
+#include "hrg_gyro/ros/job_worker.h"
 #include "hrg_gyro/ros/parameter_reader.h"
 
 namespace hrg_gyro {
@@ -60,14 +60,23 @@ class CalibratorRos {
   void stopVirtualRotation(const char* why);
 
  private:
+  // The constructor's parts: the calibration settings; the files (parameter file, report, output
+  // directory; the prior read once); the stages; the topics (and the model beside the reload service).
+  void readSettings();
+  void readOutputPaths();
+  void readStages();
+  void subscribe(int queue_size);
+
   void onTurntable(const TurntableState::ConstPtr& msg);
   void onPrecession(const PrecessionState::ConstPtr& msg);
-  /// Feeds a table (or, for the field method, precession loop) record and finishes when complete.
-  void addRotationRecord(const ros::Time& stamp, double angle, double rate, std::uint32_t seq);
-  /// The auto-finish check again once the waves reach the latest rotation record (the waves may lag it).
-  void checkFinishAfterWave(const ros::Time& stamp);
-  /// Field method: publishes the planned commands whose time has come at the state's stamp (the
-  /// plan's clock starts at the first precession state seen while the driver listens).
+  void onWave(const WaveState::ConstPtr& msg);
+  void onChannels(const ChannelAmplitudes::ConstPtr& msg);
+  void onTruth(const GroundTruth::ConstPtr& msg);
+  /// What a record fed asks for (feed_): a warning for a sweep given up, a restarted run noted, the
+  /// run finished.
+  void handle(const core::FeedStep& step);
+  /// Field method: one precession state of the plan (FieldPlanRun::step): the commands due sent, the
+  /// run aborted for a command it did not send, or finished refused when the plan is overdue.
   void advanceFieldPlan(const core::PrecessionReport& state);
   /// Field method: the run is aborted, nothing written (no file, no report), `outcome` published.
   void abortFieldRun(core::CalibrationOutcome outcome);
@@ -75,36 +84,38 @@ class CalibratorRos {
   void stopFieldPlan(const char* why);
   void publishPrecession(double rate);
   bool fieldRun() { return session() && core::traitsOf(session()->settings().method).virtual_rotation; }
-  void onWave(const WaveState::ConstPtr& msg);
-  void onChannels(const ChannelAmplitudes::ConstPtr& msg);
-  void onTruth(const GroundTruth::ConstPtr& msg);
   bool onStart(StartCalibration::Request& req, StartCalibration::Response& res);
   bool onFinish(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool onAbort(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
-  /// After a record was fed: when the session restarted its run (a stream went back for good,
-  /// settings backward_reset and backward_persist), counts it and resets the node's run state.
-  void noteRestart(std::uint64_t restarts_before);
-  /// Starts the next stage (or, with `restart`, the stage in progress again) with the current
-  /// parameter file as prior; false + reason on failure (then no stage is left).
-  bool startRun(bool restart, std::string* reason);
+  /// The session restarted its run (a stream went back for good, settings backward_reset and
+  /// jump_persist): counted, and the node's run state (skipped waves, the field plan) starts over.
+  void noteRestart();
+  /// Starts the next stage with the current parameter file as prior; false + reason on failure
+  /// (then no stage is left).
+  bool startRun(std::string* reason);
   core::CalibrationSession* session() { return calibration_->session(); }
   /// Fits, gates, writes, publishes, reloads; returns the outcome. Caller holds the mutex. With a
   /// `refusal` (gate, message), the run is refused for it whatever the fit's gates say.
   core::CalibrationOutcome finishRun(bool* written, std::string* message,
                                      const std::pair<std::string, std::string>& refusal = {});
-  /// The sweep is over and every raw channel of it has arrived (or given up on): fit, maybe finish.
-  void endGeneratorSweep();
-  /// The reload worker: calls the processor's ~reload off the callback threads, then starts the
-  /// next stage if there is one (it must see the wave through the new model).
-  void reloadLoop();
+  struct ReloadRequest {
+    bool start_next = false;  // start the next stage once the processor runs the new file
+    std::string calibration;  // the file's calibration method and time, to recognise its ModelInfo
+  };
+  /// The reload worker's job: calls the processor's ~reload off the callback threads, then starts
+  /// the next stage if there is one (it must see the wave through the new model).
+  void reload(const ReloadRequest& request);
 
   ros::NodeHandle nh_, pnh_;
   ParameterReader params_;
   std::mutex mutex_;  // session and state; never held while calling a service
   core::CalibrationSettings base_settings_;
   std::unique_ptr<core::StagedCalibration> calibration_;  // the stages and the run in progress
+  // Every input record goes through it into the run in progress (pointed at each run's session by
+  // startRun; used only while session() is not null).
+  core::CalibrationFeed feed_;
   std::string parameter_file_, report_file_, output_directory_, reload_service_;
   bool write_ = true;
   std::uint64_t runs_ = 0;
@@ -113,13 +124,7 @@ class CalibratorRos {
   std::uint64_t resets_ = 0, reported_resets_ = 0;
   bool last_accepted_ = false;
 
-  // Generator pairs: raw channels and the reference wave, matched by stamp, into the run.
-  core::GeneratorPairing pairing_;
-  // Truth and channels come over separate connections: when truth leaves the sweep, the sweep's
-  // last raw channels may still be in transit. The stage ends once the channels reach this stamp.
-  ros::Time sweep_end_, last_channels_stamp_;
-
-  InputThread input_;  // serves the four subscriptions below
+  InputThread input_;  // serves the five subscriptions below
   ros::Subscriber turntable_sub_, wave_sub_, channels_sub_, truth_sub_, precession_sub_;
   ros::Publisher result_pub_;
   // ~progress (std_msgs/Time): up to which stamp both streams are taken in (publishProgress); under
@@ -135,36 +140,21 @@ class CalibratorRos {
   };
   ros::Publisher command_pub_;  // command/precession, the field method's virtual rotation
 
-  // The field method's plan under way (under mutex_), and the newest wave stamp (the plan waits for
-  // the wave of its last segment before judging the data incomplete).
+  // The field method's plan under way (under mutex_).
   core::FieldPlanRun field_run_;
   std::uint64_t field_commands_sent_ = 0;
-  ros::Time last_wave_stamp_;
-  ros::ServiceServer start_srv_, finish_srv_, abort_srv_;
+  CalibratorServices services_;
   diagnostic_updater::Updater updater_;
   ros::WallTimer diagnostics_timer_;
 
-  std::mutex reload_mutex_;
-  std::condition_variable reload_cv_;
-  struct ReloadRequest {
-    bool start_next;          // start the next stage once the processor runs the new file
-    std::string calibration;  // the file's calibration method and time, to recognise its ModelInfo
-  };
-  std::deque<ReloadRequest> reload_requests_;
   // The processor's ModelInfo (latched): header.stamp is the last input stamp processed under the
   // previous model, so a stage that must see the wave through the new model skips waves up to it.
   ros::Subscriber model_sub_;
-  std::string model_calibration_;  // method + time of the latest ModelInfo (under reload_mutex_)
+  std::string model_calibration_;  // method + time of the latest ModelInfo (under the reload worker's lock)
   ros::Time model_since_;
-  std::condition_variable model_cv_;
   ros::Time skip_waves_until_;  // under mutex_
-  // The latest rotation record (turntable or precession state) that did not finish the run, and
-  // whether the waves have reached its stamp since (checkFinishAfterWave); under mutex_.
-  ros::Time last_rotation_stamp_;
-  bool waves_reached_rotation_ = true;
   std::uint64_t skipped_old_model_ = 0;
-  bool stopping_ = false;
-  std::thread reload_worker_;
+  JobWorker<ReloadRequest> reload_worker_;  // last: stopped (joined) first
 };
 
 }  // namespace hrg_gyro

@@ -15,11 +15,12 @@
 #include "hrg_gyro/GyroOutput.h"
 #include "hrg_gyro/PrecessionCommand.h"
 #include "hrg_gyro/PrecessionState.h"
+#include "hrg_gyro/TriadCalibrationResult.h"
 #include "hrg_gyro/TriadOutput.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
 #include "hrg_gyro/core/calibration/calibration_outcome.h"
-#include "hrg_gyro/core/calibration/triad_calibration.h"
+#include "hrg_gyro/core/calibration/triad/triad_calibration.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/processing/triad_combiner.h"
@@ -100,6 +101,12 @@ CalibrationResult toMessage(const core::CalibrationOutcome& outcome, bool writte
                             const ros::Time& stamp);
 /// The parts of an outcome a message carries (for summaries built from a received result).
 core::CalibrationOutcome fromMessage(const CalibrationResult& msg);
+
+/// A triad calibration's outcome as its result message: the body frame (header.frame_id), the axes,
+/// M, A = M^-1 and the bias with their standard errors, each axis's verdict, the gates, the notes and
+/// the outcome's reason. The run's stamp, files, what was written and reloaded (and why not, in
+/// `reason`) and its duration are the calibrator's to set.
+TriadCalibrationResult toMessage(const core::TriadOutcome& outcome);
 
 /// The fixture's position as logged, its quaternion as is: core::acceptFixtureOrientation decides
 /// whether it is a rotation (the live calibrator and `hrg_bag calibrate --method triad` alike).

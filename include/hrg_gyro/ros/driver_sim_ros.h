@@ -114,7 +114,6 @@ class DriverSimRos {
   // for each, and every timer under sim time waits for one.
   double clock_period_ = 0.0;
   static constexpr double kFinestAutoClockPeriod = 1e-3;  // s: "auto" publishes at most 1 kHz
-  static constexpr double kMaxPrecessionRate = 10.0;      // rad/s: the scenario schedule's bound too
   // s of wall time a /clock driven by another source may stand still before this driver, following
   // it, goes on at its own time_scale (the source not started yet, or done)
   static constexpr double kStillClock = 2.0;

@@ -35,6 +35,7 @@
 #include "hrg_gyro/core/processing/rate_noise_estimator.h"
 #include "hrg_gyro/ros/input_thread.h"
 #include "hrg_gyro/ros/parameter_reader.h"
+#include "hrg_gyro/ros/reload_record.h"
 
 namespace hrg_gyro {
 
@@ -112,8 +113,7 @@ class ProcessorRos {
   std::uint32_t last_seq_ = 0;
   std::uint64_t dropped_ = 0, dropped_reported_ = 0;
   core::ProcessorCounters reported_;
-  std::uint64_t reloads_ = 0, failed_reloads_ = 0;
-  std::string last_reload_error_;
+  ReloadRecord reload_{"processor", "model"};
   core::WaveState last_wave_;
   bool has_wave_ = false;
   std::uint8_t last_flags_ = 0;

@@ -32,7 +32,7 @@
 #include "hrg_gyro/TriadCalibrationResult.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
-#include "hrg_gyro/core/calibration/triad_feed.h"
+#include "hrg_gyro/core/calibration/triad/triad_feed.h"
 #include "hrg_gyro/ros/input_thread.h"
 #include "hrg_gyro/ros/parameter_reader.h"
 
@@ -58,6 +58,18 @@ class TriadCalibratorRos {
   bool onFinish(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool onAbort(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  // The constructor's parts, in its order (each throws naming the parameter):
+  /// The calibration settings (and the single-axis keys this mode does not use).
+  void readSettings();
+  /// ~triad_file and its axes, each axis's ~axis_parameter_files entry.
+  void readFiles();
+  /// ~report_file, ~output_directory (every file to write inside it, all distinct), ~write.
+  void readOutputs();
+  /// ~reload_services, "{axis}" expanded for each axis.
+  void readReloadServices();
+  /// Publishers, subscriptions, services, diagnostics, then the threads.
+  void serve(int queue_size, double heap_trim_period, bool autostart);
 
   /// A run on the files as they are now (the priors); throws std::runtime_error naming a bad one.
   std::unique_ptr<core::TriadFeed> newFeed() const;

@@ -3,7 +3,7 @@
 //
 // For each axis named in ~triad_file it subscribes `<axis>/output` (GyroOutput) and, for the axis's
 // rate variance, `<axis>/imu/data_raw` (the processor's Imu, angular_velocity_covariance[8]); the
-// two are paired by stamp (core::RateVariancePairing) and combined across axes by stamp
+// two are paired by stamp (core::TriadVariancePairing) and combined across axes by stamp
 // (core::TriadCombiner, the object `hrg_bag process --triad` runs, hence identical numbers). It
 // publishes `triad/output` (TriadOutput, every triad sample, flagged ones included) and
 // `imu/data_raw` (sensor_msgs/Imu, REP-145, in the file's frame_id; none for a sample flagged
@@ -26,10 +26,11 @@
 #include <vector>
 
 #include "hrg_gyro/GyroOutput.h"
-#include "hrg_gyro/core/processing/rate_variance_pairing.h"
 #include "hrg_gyro/core/processing/triad_combiner.h"
+#include "hrg_gyro/core/processing/triad_variance_pairing.h"
 #include "hrg_gyro/ros/input_thread.h"
 #include "hrg_gyro/ros/parameter_reader.h"
+#include "hrg_gyro/ros/reload_record.h"
 
 namespace hrg_gyro {
 
@@ -72,7 +73,7 @@ class TriadRos {
   std::mutex mutex_;  // the combiner, the pairings and the health (nodelets may run callbacks concurrently)
   std::string triad_file_;
   std::unique_ptr<core::TriadCombiner> combiner_;
-  std::array<core::RateVariancePairing, 3> pairings_;
+  std::array<core::TriadVariancePairing, 3> pairings_;
   double fixed_variance_ = -1.0;  // (rad/s)^2; negative: each axis's from its imu/data_raw
   double stall_timeout_ = 0.5;
   std::vector<core::AxisOutput> ready_;           // reused: outputs paired with their variance
@@ -92,8 +93,7 @@ class TriadRos {
   core::TriadCounters reported_;                     // the combiner's counters at the last triad report
   std::array<std::uint64_t, 3> reported_outputs_{};  // each axis's outputs received then
   ros::WallTime reported_wall_;                      // and when
-  std::uint64_t reloads_ = 0, failed_reloads_ = 0;
-  std::string last_reload_error_;
+  ReloadRecord reload_{"triad", "triad"};
   ros::Time last_stamp_;
 };
 

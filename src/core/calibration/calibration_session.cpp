@@ -7,8 +7,8 @@ namespace core {
 namespace {
 
 // The two streams reach a live calibrator through different queues and, under accelerated sim time,
-// may be tens of seconds of data apart: wave samples wait up to kMaxWait for the turntable stream,
-// and turntable history reaches kMaxWait back from both streams' newest stamps. Both buffers are
+// may be tens of seconds of data apart: wave samples wait up to kMaxWait for the rotation's stream,
+// and rotation history reaches kMaxWait back from both streams' newest stamps. Both buffers are
 // bounded by count as well, so memory stays constant whatever happens.
 constexpr double kMaxWait = 60.0;  // s of stamps
 constexpr std::size_t kMaxPending = 200000;
@@ -59,11 +59,11 @@ CalibrationSession::CalibrationSession(const CalibrationSettings& settings, cons
       prior_(prior),
       method_(makeCalibrationMethod(settings, prior)),
       detector_(settings.plateau),
-      turntable_(kMaxHistory + 1),
+      rotation_(kMaxHistory + 1),
       pending_(kMaxPending + 1),
       regulariser_(stampSettings(settings.table_clock)),
       clock_offset_(offsetSettings(settings.table_clock)),
-      turntable_timeline_(settings.stampRule()),
+      rotation_timeline_(settings.stampRule()),
       wave_timeline_(settings.stampRule()) {}
 
 bool CalibrationSession::plausible(Nanoseconds stamp, double angle, double rate) {
@@ -90,9 +90,9 @@ bool CalibrationSession::plausible(Nanoseconds stamp, double angle, double rate)
   return true;
 }
 
-bool CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double rate, std::uint64_t sequence) {
-  ++counters_.turntable;
-  ++counters_.turntable_total;
+bool CalibrationSession::addRotationRecord(Nanoseconds stamp, double angle, double rate, std::uint64_t sequence) {
+  ++counters_.rotation_records;
+  ++counters_.rotation_records_total;
   // The table's clock first: a known offset, then the line through a fixed-rate log's stamps (a
   // glitched stamp comes back as it was, and is dropped below like any other).
   // (A precession loop's state is stamped by the gyro's own driver: nothing to correct.)
@@ -102,14 +102,14 @@ bool CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double ra
   }
   // Values first: a glitched record must not move the stamp reference either.
   if (stamp > 0 && !plausible(stamp, angle, rate)) return false;
-  switch (turntable_timeline_.check(stamp, wave_timeline_.last())) {
+  switch (rotation_timeline_.check(stamp, wave_timeline_.last())) {
     case StampVerdict::kNext:
     case StampVerdict::kResumedAhead:  // a gap: the plateau detector sees it
       break;
     case StampVerdict::kNewTimeline:
       restart();
       wave_timeline_.expectJumpBack(kMaxWait);
-      counters_.turntable = 1;
+      counters_.rotation_records = 1;
       break;
     case StampVerdict::kNonPositive:
       ++counters_.rejected.bad_stamp;
@@ -131,36 +131,36 @@ bool CalibrationSession::addTurntable(Nanoseconds stamp, double angle, double ra
 
   judged_.clear();
   detector_.add(stamp, angle, rate, &judged_);
-  for (const PlateauRecord& r : judged_) turntable_.push_back(r);
+  for (const PlateauRecord& r : judged_) rotation_.push_back(r);
   drain();
   // Keep history for waiting samples and for wave samples that lag behind this stream.
   Nanoseconds keep_from = std::min(stamp, last_wave_stamp_ > 0 ? last_wave_stamp_ : stamp);
   if (!pending_.empty()) keep_from = std::min(keep_from, pending_.front().stamp);
   keep_from -= toNanoseconds(kMaxWait);
-  while (turntable_.size() > 2 && (turntable_[1].stamp < keep_from || turntable_.size() > kMaxHistory)) {
-    turntable_.pop_front();
+  while (rotation_.size() > 2 && (rotation_[1].stamp < keep_from || rotation_.size() > kMaxHistory)) {
+    rotation_.pop_front();
   }
   return true;
 }
 
 void CalibrationSession::restart() {
-  const TurntableRejects rejected = counters_.rejected;
+  const RotationRecordRejects rejected = counters_.rejected;
   const std::uint64_t restarts = counters_.restarts + 1;
   const std::uint64_t out_of_order = counters_.out_of_order;
   const std::uint64_t wave_jumps = counters_.wave_jumps;
-  const std::uint64_t turntable_total = counters_.turntable_total;
+  const std::uint64_t rotation_records_total = counters_.rotation_records_total;
   method_ = makeCalibrationMethod(settings_, prior_);
   detector_ = PlateauDetector(settings_.plateau);
   regulariser_ = TableStampRegulariser(stampSettings(settings_.table_clock));
   clock_offset_ = TableClockOffsetEstimator(offsetSettings(settings_.table_clock));
-  turntable_.clear();
+  rotation_.clear();
   pending_.clear();
   counters_ = SessionCounters();
   counters_.rejected = rejected;
   counters_.restarts = restarts;
   counters_.out_of_order = out_of_order;
   counters_.wave_jumps = wave_jumps;
-  counters_.turntable_total = turntable_total;
+  counters_.rotation_records_total = rotation_records_total;
   bad_angle_run_ = 0;
   has_last_good_ = false;
   last_good_stamp_ = 0;
@@ -174,13 +174,13 @@ void CalibrationSession::restart() {
 
 void CalibrationSession::addWave(Nanoseconds stamp, double theta, double frequency, double quadrature_ratio) {
   ++counters_.wave;
-  switch (wave_timeline_.check(stamp, turntable_timeline_.last())) {
+  switch (wave_timeline_.check(stamp, rotation_timeline_.last())) {
     case StampVerdict::kNext:
     case StampVerdict::kResumedAhead:
       break;
     case StampVerdict::kNewTimeline:
       restart();
-      turntable_timeline_.expectJumpBack(kMaxWait);
+      rotation_timeline_.expectJumpBack(kMaxWait);
       counters_.wave = 1;
       break;
     case StampVerdict::kJumpedBack:
@@ -199,7 +199,7 @@ void CalibrationSession::addWave(Nanoseconds stamp, double theta, double frequen
   }
   last_wave_stamp_ = stamp;
   pending_.push_back({stamp, theta, frequency});
-  // A turntable stream that stopped (or never started) must not make the queue grow without bound.
+  // A rotation stream that stopped (or never started) must not make the queue grow without bound.
   while (!pending_.empty() && (pending_.size() > kMaxPending || toSeconds(stamp - pending_.front().stamp) > kMaxWait)) {
     ++counters_.unsynchronized;
     pending_.pop_front();
@@ -216,7 +216,7 @@ void CalibrationSession::addGeneratorPair(Nanoseconds stamp, const ChannelVector
 }
 
 void CalibrationSession::drain() {
-  while (!pending_.empty() && !turntable_.empty() && pending_.front().stamp <= turntable_.back().stamp) {
+  while (!pending_.empty() && !rotation_.empty() && pending_.front().stamp <= rotation_.back().stamp) {
     classify(pending_.front());
     pending_.pop_front();
   }
@@ -225,13 +225,13 @@ void CalibrationSession::drain() {
 void CalibrationSession::classify(const WaveRecord& w) {
   // The last state at or before the sample and the first at or after it.
   const std::size_t after =
-      turntable_.lowerBound(w.stamp, [](const PlateauRecord& r, Nanoseconds t) { return r.stamp < t; });
-  if (after == turntable_.size() || (after == 0 && turntable_[0].stamp != w.stamp)) {
+      rotation_.lowerBound(w.stamp, [](const PlateauRecord& r, Nanoseconds t) { return r.stamp < t; });
+  if (after == rotation_.size() || (after == 0 && rotation_[0].stamp != w.stamp)) {
     ++counters_.unsynchronized;
     return;
   }
-  const PlateauRecord& b = turntable_[after];
-  const PlateauRecord& a = b.stamp == w.stamp ? b : turntable_[after - 1];
+  const PlateauRecord& b = rotation_[after];
+  const PlateauRecord& a = b.stamp == w.stamp ? b : rotation_[after - 1];
   if (toSeconds(b.stamp - a.stamp) > settings_.plateau.max_gap) {
     ++counters_.unsynchronized;
     return;
@@ -243,13 +243,13 @@ void CalibrationSession::classify(const WaveRecord& w) {
   s.plateau = b.plateau;
   const double span = toSeconds(b.stamp - a.stamp);
   const double f = span > 0.0 ? toSeconds(w.stamp - a.stamp) / span : 0.0;
-  s.table_angle = a.angle + f * (b.angle - a.angle);
-  s.table_rate = a.rate + f * (b.rate - a.rate);
+  s.rotation_angle = a.angle + f * (b.angle - a.angle);
+  s.rotation_rate = a.rate + f * (b.rate - a.rate);
   s.angle_logged = a.angle_logged && b.angle_logged;
-  s.angle_smooth_error = regularisedAngleError(s.table_rate);
+  s.angle_smooth_error = regularisedAngleError(s.rotation_rate);
   const bool settled = a.plateau.id == b.plateau.id && a.plateau.settled;
   // Every sample with the table around it, ramps included: the changes of rate show the clocks' offset.
-  clock_offset_.add(w.stamp, w.theta, s.table_angle, s.table_rate, b.plateau.id, b.plateau.rate, settled);
+  clock_offset_.add(w.stamp, w.theta, s.rotation_angle, s.rotation_rate, b.plateau.id, b.plateau.rate, settled);
   if (!settled) {
     ++counters_.unsettled;
     return;
@@ -261,8 +261,8 @@ void CalibrationSession::classify(const WaveRecord& w) {
 bool CalibrationSession::shouldFinish() const {
   if (settings_.auto_finish_idle <= 0.0 || !method_->complete()) return false;
   if (traitsOf(settings_.method).uses_generator_pairs) return generator_ended_;
-  if (turntable_.empty()) return false;
-  const PlateauRecord& last = turntable_.back();
+  if (rotation_.empty()) return false;
+  const PlateauRecord& last = rotation_.back();
   return last.plateau.is_static && toSeconds(last.stamp - last.plateau.start) >= settings_.auto_finish_idle;
 }
 
@@ -274,14 +274,14 @@ std::string CalibrationSession::plateauDiagnosis(bool* names_a_cause) const {
   const PlateauSettings& ps = settings_.plateau;
   const PlateauStatistics st = detector_.statistics();
   const std::string stream = traitsOf(settings_.method).virtual_rotation ? "precession state" : "turntable";
-  if (c.turntable == 0) {
+  if (c.rotation_records == 0) {
     return "no " + stream + " record arrived" +
            (c.rejected.total() > 0 ? " that was not a glitch (" + std::to_string(c.rejected.total()) + " dropped)"
                                    : std::string()) +
            ": check the " + stream + " stream";
   }
   if (c.wave == 0) {
-    return stream + " records arrived without the wave (" + std::to_string(c.turntable) + " " + stream +
+    return stream + " records arrived without the wave (" + std::to_string(c.rotation_records) + " " + stream +
            " records, no wave sample)";
   }
   if (c.unsynchronized > c.used + c.unsettled) {
@@ -399,18 +399,20 @@ CalibrationOutcome CalibrationSession::finish() const {
   o.quadrature_ratio = quadrature_count_ > 0 ? quadrature_sum_ / quadrature_count_ : 0.0;
   // A precession loop's state is on the gyro's clock: no table clock to measure.
   const CalibrationMethodTraits& traits = traitsOf(settings_.method);
-  if (!traits.uses_generator_pairs && !traits.virtual_rotation && counters_.turntable_total > 0) reportTableClock(&o);
+  if (!traits.uses_generator_pairs && !traits.virtual_rotation && counters_.rotation_records_total > 0)
+    reportTableClock(&o);
   diagnose(&o, prior_.correction);
-  o.turntable_records = counters_.turntable_total;
-  o.turntable_rejected = counters_.rejected;
+  o.rotation_records = counters_.rotation_records_total;
+  o.rotation_rejected = counters_.rejected;
   o.restarts = counters_.restarts;
   if (counters_.rejected.total() > 0) {
-    const TurntableRejects& r = counters_.rejected;
+    const RotationRecordRejects& r = counters_.rejected;
     o.notes.push_back(std::to_string(r.total()) + " glitched " +
                       (traits.virtual_rotation ? "precession states" : "turntable records") + " dropped (" +
                       std::to_string(r.bad_rate) + " bad rate, " + std::to_string(r.bad_angle) + " bad angle, " +
                       std::to_string(r.bad_stamp) + " zero stamp, " + std::to_string(r.duplicate) + " duplicate, " +
-                      std::to_string(r.out_of_order) + " out of order, " + std::to_string(r.stamp_jump) + " stamp jump)");
+                      std::to_string(r.out_of_order) + " out of order, " + std::to_string(r.stamp_jump) +
+                      " stamp jump)");
   }
   if (counters_.wave_jumps > 0) {
     o.notes.push_back(std::to_string(counters_.wave_jumps) +

@@ -8,46 +8,31 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "core/testing/angle_level_session.h"
+#include "core/testing/method_test_settings.h"
 
 namespace hrg_gyro {
 namespace core {
 namespace {
 
 using testing::AngleLevelGyro;
+using testing::calibrateAngleLevel;
+using testing::constantRateProfile;
+using testing::dualRateProfile;
+using testing::methodSettings;
+using testing::referenceGyro;
+using testing::referencePrior;
 
 AngleLevelGyro noisyReferenceGyro() {
   AngleLevelGyro g = testing::referenceGyro();
   g.noise = 1e-6;
   return g;
-}
-
-GyroParameters prior() {
-  GyroParameters p;
-  p.earth_rate.latitude = 0.9;
-  return p;
-}
-
-CalibrationSettings settings(CalibrationMethodKind method) {
-  CalibrationSettings s;
-  s.method = method;
-  s.scale_factor_orders = {2, 4};
-  s.drift_orders = {2};
-  return s;
-}
-
-TurntableProfile constantRateProfile() {
-  TurntableProfile p;
-  p.append(30.0, 0.0, 0.0, "rest");
-  p.append(0.1, 0.0, 0.5, "ramp");
-  p.append(250.0, 0.05, 0.0, "turn");
-  p.append(0.1, 0.05, -0.5, "ramp");
-  p.append(25.0, 0.0, 0.0, "rest");
-  return p;
 }
 
 enum Glitch {
@@ -72,7 +57,7 @@ struct Injected {
 // 100 s back.
 CalibrationOutcome run(const TurntableProfile& profile, CalibrationMethodKind method, int one_in, Injected* injected,
                        SessionCounters* counters = nullptr) {
-  CalibrationSession session(settings(method), prior());
+  CalibrationSession session(methodSettings(method), referencePrior());
   std::mt19937_64 random(42);
   std::uniform_int_distribution<int> pick(0, one_in - 1);
   int next_kind = 0;
@@ -83,36 +68,36 @@ CalibrationOutcome run(const TurntableProfile& profile, CalibrationMethodKind me
       ++injected->count[kind];
       switch (kind) {
         case kNanRate:
-          session.addTurntable(t, angle, NAN);
+          session.addRotationRecord(t, angle, NAN);
           break;
         case kAbsurdRate:
-          session.addTurntable(t, angle, 1e6);
+          session.addRotationRecord(t, angle, 1e6);
           break;
         case kInfAngle:
-          session.addTurntable(t, INFINITY, rate);
+          session.addRotationRecord(t, INFINITY, rate);
           break;
         case kZeroStamp:
-          session.addTurntable(0, angle, rate);
+          session.addRotationRecord(0, angle, rate);
           break;
         case kDuplicate:
-          session.addTurntable(previous, angle, rate);
+          session.addRotationRecord(previous, angle, rate);
           break;
         case kSlightlyBack:
-          session.addTurntable(previous - toNanoseconds(0.0005), angle, rate);
+          session.addRotationRecord(previous - toNanoseconds(0.0005), angle, rate);
           break;
         case kFarAhead:
-          session.addTurntable(t + toNanoseconds(100.0), angle, rate);
+          session.addRotationRecord(t + toNanoseconds(100.0), angle, rate);
           break;
         default:
           if (t <= toNanoseconds(100.0)) {  // not a stamp at all this early: a zero-stamp glitch
             --injected->count[kFarBack];
             ++injected->count[kZeroStamp];
           }
-          session.addTurntable(t - toNanoseconds(100.0), angle, rate);
+          session.addRotationRecord(t - toNanoseconds(100.0), angle, rate);
           break;
       }
     } else {
-      session.addTurntable(t, angle, rate);
+      session.addRotationRecord(t, angle, rate);
       previous = t;
     }
     if (one_in > 0 && pick(random) == 0) {
@@ -150,12 +135,12 @@ void expectSameWithin(const CalibrationOutcome& a, const CalibrationOutcome& b, 
 }
 
 void expectCounted(const CalibrationOutcome& o, const Injected& in) {
-  EXPECT_EQ(o.turntable_rejected.bad_rate, in.count[kNanRate] + in.count[kAbsurdRate]);
-  EXPECT_EQ(o.turntable_rejected.bad_angle, in.count[kInfAngle]);
-  EXPECT_EQ(o.turntable_rejected.bad_stamp, in.count[kZeroStamp]);
-  EXPECT_EQ(o.turntable_rejected.duplicate, in.count[kDuplicate]);
-  EXPECT_EQ(o.turntable_rejected.out_of_order, in.count[kSlightlyBack]);
-  EXPECT_EQ(o.turntable_rejected.stamp_jump, in.count[kFarAhead] + in.count[kFarBack]);
+  EXPECT_EQ(o.rotation_rejected.bad_rate, in.count[kNanRate] + in.count[kAbsurdRate]);
+  EXPECT_EQ(o.rotation_rejected.bad_angle, in.count[kInfAngle]);
+  EXPECT_EQ(o.rotation_rejected.bad_stamp, in.count[kZeroStamp]);
+  EXPECT_EQ(o.rotation_rejected.duplicate, in.count[kDuplicate]);
+  EXPECT_EQ(o.rotation_rejected.out_of_order, in.count[kSlightlyBack]);
+  EXPECT_EQ(o.rotation_rejected.stamp_jump, in.count[kFarAhead] + in.count[kFarBack]);
   EXPECT_EQ(o.restarts, 0u);
 }
 
@@ -171,7 +156,7 @@ TEST(CalibrationSessionTest, DualRateIgnoresOneGlitchedTurntableRecordInAThousan
   expectCounted(glitched, glitches);
   EXPECT_EQ(glitched.plateaus.size(), clean.plateaus.size());
   expectSameWithin(clean, glitched, 1.0);
-  EXPECT_EQ(clean.turntable_rejected.total(), 0u);
+  EXPECT_EQ(clean.rotation_rejected.total(), 0u);
 }
 
 TEST(CalibrationSessionTest, ConstantRateIgnoresOneGlitchedTurntableRecordInAThousand) {
@@ -183,25 +168,25 @@ TEST(CalibrationSessionTest, ConstantRateIgnoresOneGlitchedTurntableRecordInATho
   expectSameWithin(clean, glitched, 1.0);
   // The report carries the counts.
   const std::string report = emitCalibrationReport(glitched);
-  EXPECT_NE(report.find("turntable_rejected: {bad_rate: " + std::to_string(glitched.turntable_rejected.bad_rate)),
+  EXPECT_NE(report.find("turntable_rejected: {bad_rate: " + std::to_string(glitched.rotation_rejected.bad_rate)),
             std::string::npos)
       << report.substr(0, 2000);
 }
 
 TEST(CalibrationSessionTest, ZeroStampsAndLoneBackwardStampsDoNotRestartTheRun) {
-  CalibrationSession session(settings(CalibrationMethodKind::kDualRate), prior());
+  CalibrationSession session(methodSettings(CalibrationMethodKind::kDualRate), referencePrior());
   for (int i = 1; i <= 3000; ++i) {
     const Nanoseconds t = toNanoseconds(200.0 + i * 1e-3);
-    session.addTurntable(t, 0.0, 0.0);
+    session.addRotationRecord(t, 0.0, 0.0);
     if (i == 1000) {
-      for (int z = 0; z < 20; ++z) session.addTurntable(0, 0.0, 0.0);  // a burst of zero stamps
+      for (int z = 0; z < 20; ++z) session.addRotationRecord(0, 0.0, 0.0);  // a burst of zero stamps
     }
-    if (i == 2000) session.addTurntable(t - toNanoseconds(100.0), 0.0, 0.0);  // one stamp far back
+    if (i == 2000) session.addRotationRecord(t - toNanoseconds(100.0), 0.0, 0.0);  // one stamp far back
   }
   EXPECT_EQ(session.counters().restarts, 0u);
   EXPECT_EQ(session.counters().rejected.bad_stamp, 20u);
   EXPECT_EQ(session.counters().rejected.stamp_jump, 1u);
-  EXPECT_EQ(session.counters().turntable, 3021u);
+  EXPECT_EQ(session.counters().rotation_records, 3021u);
 }
 
 TEST(CalibrationSessionTest, APersistingBackwardTimelineRestartsTheRun) {
@@ -209,17 +194,17 @@ TEST(CalibrationSessionTest, APersistingBackwardTimelineRestartsTheRun) {
   // run restarts once and ends as the single pass does.
   const AngleLevelGyro g = noisyReferenceGyro();
   const TurntableProfile p = testing::dualRateProfile(0.05, -0.05, 120.0);
-  const CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
-  const CalibrationOutcome single = testing::calibrateAngleLevel(g, p, s, prior());
-  CalibrationSession session(s, prior());
+  const CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
+  const CalibrationOutcome single = testing::calibrateAngleLevel(g, p, s, referencePrior());
+  CalibrationSession session(s, referencePrior());
   testing::runAngleLevel(g, p, [&](Nanoseconds t, double angle, double rate, double theta) {
     if (toSeconds(t) > 100.0) return;
-    session.addTurntable(t, angle, rate);
+    session.addRotationRecord(t, angle, rate);
     session.addWave(t, theta, NAN);
   });
   EXPECT_EQ(session.counters().restarts, 0u);
   testing::runAngleLevel(g, p, [&](Nanoseconds t, double angle, double rate, double theta) {
-    session.addTurntable(t, angle, rate);
+    session.addRotationRecord(t, angle, rate);
     session.addWave(t, theta, NAN);
   });
   EXPECT_EQ(session.counters().restarts, 1u);
@@ -231,13 +216,13 @@ TEST(CalibrationSessionTest, APersistingBackwardTimelineRestartsTheRun) {
 }
 
 TEST(CalibrationSessionTest, JumpPersistOfOneRestartsOnAnyLongJump) {
-  CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
   s.jump_persist = 1;
-  CalibrationSession session(s, prior());
-  session.addTurntable(toNanoseconds(10.0), 0.0, 0.0);
-  session.addTurntable(toNanoseconds(9.8), 0.0, 0.0);  // within backward_reset: a glitch
+  CalibrationSession session(s, referencePrior());
+  session.addRotationRecord(toNanoseconds(10.0), 0.0, 0.0);
+  session.addRotationRecord(toNanoseconds(9.8), 0.0, 0.0);  // within backward_reset: a glitch
   EXPECT_EQ(session.counters().restarts, 0u);
-  EXPECT_TRUE(session.addTurntable(toNanoseconds(2.0), 0.0, 0.0));
+  EXPECT_TRUE(session.addRotationRecord(toNanoseconds(2.0), 0.0, 0.0));
   EXPECT_EQ(session.counters().restarts, 1u);
 }
 
@@ -255,7 +240,7 @@ struct TableLog {
 CalibrationOutcome runLogged(const AngleLevelGyro& g, const TurntableProfile& p, const CalibrationSettings& s,
                              const TableLog& log, SessionCounters* counters = nullptr, bool feed_wave = true,
                              double wave_offset = 0.0) {
-  CalibrationSession session(s, prior());
+  CalibrationSession session(s, referencePrior());
   std::mt19937_64 random(11);
   std::normal_distribution<double> normal;
   const long every = std::lround(g.rate_hz / log.log_hz);
@@ -267,7 +252,7 @@ CalibrationOutcome runLogged(const AngleLevelGyro& g, const TurntableProfile& p,
       const double reported =
           log.differenced_rate ? (std::isnan(previous) ? 0.0 : (logged - previous) * log.log_hz) : rate;
       previous = logged;
-      session.addTurntable(t, log.log_angle ? logged : NAN, reported + log.rate_noise * normal(random));
+      session.addRotationRecord(t, log.log_angle ? logged : NAN, reported + log.rate_noise * normal(random));
     }
     if (feed_wave) session.addWave(t + toNanoseconds(wave_offset), theta, NAN);
   });
@@ -286,7 +271,7 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 TEST(CalibrationSessionTest, EncoderNoiseWithTheRateDifferencedKeepsThePlateaus) {
   // 2 urad of encoder noise at 100 Hz with the rate differenced: 0.57 % of rate scatter at 0.05 rad/s.
   const TurntableProfile p = testing::dualRateProfile(0.05, -0.05, 120.0);
-  CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
   s.gates.max_rate_noise = 0.02;  // that gate judges the raw reported rate; not what is tested here
   SessionCounters clean_counters, angle_counters, rate_counters;
   const CalibrationOutcome clean = runLogged(noisyReferenceGyro(), p, s, TableLog(), &clean_counters);
@@ -312,7 +297,7 @@ TEST(CalibrationSessionTest, EncoderNoiseWithTheRateDifferencedKeepsThePlateaus)
 TEST(CalibrationSessionTest, RefusalNamesTheRateScatterThatHidesThePlateaus) {
   // The same stream, rate only, judged record by record (no smoothing): refused, and the reason
   // names the scatter, measured, and what to do.
-  CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
   s.plateau.smoothing_span = 0.0;
   TableLog noisy;
   noisy.encoder_noise = 2e-6;
@@ -338,7 +323,7 @@ TEST(CalibrationSessionTest, RefusalNamesTheScatterLeftAfterSmoothingARateOnlySt
   noisy.log_angle = false;
   noisy.rate_noise = 3e-3;
   const CalibrationOutcome o = runLogged(noisyReferenceGyro(), testing::dualRateProfile(0.05, -0.05, 120.0),
-                                         settings(CalibrationMethodKind::kDualRate), noisy);
+                                         methodSettings(CalibrationMethodKind::kDualRate), noisy);
   ASSERT_FALSE(o.accepted);
   std::printf("[ measured ] %s\n", o.reason.c_str());
   EXPECT_TRUE(contains(o.reason, "plateaus: reported rate scatter ")) << o.reason;
@@ -349,7 +334,7 @@ TEST(CalibrationSessionTest, RefusalNamesTheScatterLeftAfterSmoothingARateOnlySt
 }
 
 TEST(CalibrationSessionTest, RefusalNamesPlateausShorterThanTheSettleTime) {
-  CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
   const CalibrationOutcome o =
       runLogged(noisyReferenceGyro(), testing::dualRateProfile(0.05, -0.05, 1.5, 20), s, TableLog());
   ASSERT_FALSE(o.accepted);
@@ -365,7 +350,7 @@ TEST(CalibrationSessionTest, RefusalNamesPlateausShorterThanTheSettleTime) {
 
 TEST(CalibrationSessionTest, RefusalNamesAMissingOrUnsynchronizedWave) {
   const TurntableProfile p = testing::dualRateProfile(0.05, -0.05, 30.0);
-  const CalibrationSettings s = settings(CalibrationMethodKind::kDualRate);
+  const CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
   const CalibrationOutcome no_wave = runLogged(noisyReferenceGyro(), p, s, TableLog(), nullptr, false);
   ASSERT_FALSE(no_wave.accepted);
   EXPECT_TRUE(contains(no_wave.reason, "plateaus: turntable records arrived without the wave (")) << no_wave.reason;
@@ -377,13 +362,13 @@ TEST(CalibrationSessionTest, RefusalNamesAMissingOrUnsynchronizedWave) {
 }
 
 TEST(CalibrationSessionTest, ANanAngleIsRateOnlyFromTheStartAndAGlitchAfterALoggedAngle) {
-  CalibrationSession rate_only(settings(CalibrationMethodKind::kDualRate), prior());
-  for (int i = 1; i <= 100; ++i) EXPECT_TRUE(rate_only.addTurntable(toNanoseconds(i * 0.01), NAN, 0.05));
+  CalibrationSession rate_only(methodSettings(CalibrationMethodKind::kDualRate), referencePrior());
+  for (int i = 1; i <= 100; ++i) EXPECT_TRUE(rate_only.addRotationRecord(toNanoseconds(i * 0.01), NAN, 0.05));
   EXPECT_EQ(rate_only.counters().rejected.total(), 0u);
-  CalibrationSession logged(settings(CalibrationMethodKind::kDualRate), prior());
+  CalibrationSession logged(methodSettings(CalibrationMethodKind::kDualRate), referencePrior());
   for (int i = 1; i <= 100; ++i) {
     const double t = i * 0.01;
-    EXPECT_EQ(logged.addTurntable(toNanoseconds(t), i == 50 ? NAN : 0.05 * t, 0.05), i != 50) << i;
+    EXPECT_EQ(logged.addRotationRecord(toNanoseconds(t), i == 50 ? NAN : 0.05 * t, 0.05), i != 50) << i;
   }
   EXPECT_EQ(logged.counters().rejected.bad_angle, 1u);
   EXPECT_EQ(logged.counters().rejected.total(), 1u);
@@ -402,7 +387,7 @@ TEST(CalibrationSessionTest, StepMethodOnARateOnlyStreamUsesTheRateIntegral) {
     p.append(0.349, 0.1745, -0.5, "ramp");
     p.append(15.0, 0.0, 0.0, "rest");
   }
-  CalibrationSettings s = settings(CalibrationMethodKind::kStep);
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kStep);
   s.bins = 64;
   const CalibrationOutcome with_angle = runLogged(g, p, s, TableLog());
   TableLog rate_only;
@@ -435,7 +420,7 @@ TEST(CalibrationSessionTest, AFieldRunCallsItsStreamThePrecessionState) {
     const bool field = method == CalibrationMethodKind::kField;
     // The wave 1000 s after the stream: no sample has the stream around it.
     const CalibrationOutcome late =
-        runLogged(noisyReferenceGyro(), p, settings(method), TableLog(), nullptr, true, 1000.0);
+        runLogged(noisyReferenceGyro(), p, methodSettings(method), TableLog(), nullptr, true, 1000.0);
     ASSERT_FALSE(late.accepted);
     std::printf("[ measured ] %s: %s\n", nameOf(method).c_str(), late.reason.c_str());
     EXPECT_NE(note(late, field ? " wave samples had no precession state around them and were not used"
@@ -453,22 +438,72 @@ TEST(CalibrationSessionTest, AFieldRunCallsItsStreamThePrecessionState) {
     EXPECT_EQ(contains(line, "# precession states (the field method's stream)"), field) << line;
 
     // One record in a hundred has a NaN rate: dropped and counted under the stream's name.
-    CalibrationSession session(settings(method), prior());
+    CalibrationSession session(methodSettings(method), referencePrior());
     long i = 0;
     testing::runAngleLevel(noisyReferenceGyro(), p, [&](Nanoseconds t, double angle, double rate, double theta) {
-      session.addTurntable(t, angle, ++i % 100 == 0 ? NAN : rate);
+      session.addRotationRecord(t, angle, ++i % 100 == 0 ? NAN : rate);
       session.addWave(t, theta, NAN);
     });
     const CalibrationOutcome glitched = session.finish();
     const std::string dropped =
         note(glitched, field ? " glitched precession states dropped (" : " glitched turntable records dropped (");
     EXPECT_NE(dropped, "") << nameOf(method);
-    EXPECT_EQ(numberAfter(dropped, ""), static_cast<double>(glitched.turntable_rejected.total()));
-    EXPECT_GT(glitched.turntable_rejected.bad_rate, 0u);
+    EXPECT_EQ(numberAfter(dropped, ""), static_cast<double>(glitched.rotation_rejected.total()));
+    EXPECT_GT(glitched.rotation_rejected.bad_rate, 0u);
     if (field) {
       EXPECT_FALSE(mentions(glitched, "turntable")) << glitched.reason;
     }
   }
+}
+
+TEST(CalibrationSessionTest, NoTurntableDataMeansNoCalibration) {
+  CalibrationSession session(methodSettings(CalibrationMethodKind::kDualRate), GyroParameters());
+  // Samples wait up to 60 s for a turntable state, then are dropped (bounded memory).
+  for (int i = 0; i < 100000; ++i) session.addWave(toNanoseconds(1.0 + i * 1e-3), 0.2 - 0.028 * i * 1e-3, NAN);
+  EXPECT_EQ(session.counters().used, 0u);
+  EXPECT_GT(session.counters().unsynchronized, 39000u);
+  const CalibrationOutcome o = session.finish();
+  EXPECT_FALSE(o.accepted);
+}
+
+TEST(CalibrationSessionTest, SynchronisesStreamsArrivingOutOfStep) {
+  // The same session with the turntable stream delayed by 300 ms gives the same result.
+  const AngleLevelGyro g = referenceGyro();
+  const TurntableProfile p = dualRateProfile(0.05, -0.05, 120.0);
+  const CalibrationOutcome direct =
+      calibrateAngleLevel(g, p, methodSettings(CalibrationMethodKind::kDualRate), referencePrior());
+  CalibrationSession session(methodSettings(CalibrationMethodKind::kDualRate), referencePrior());
+  std::deque<std::tuple<Nanoseconds, double, double>> delayed;
+  testing::runAngleLevel(g, p, [&](Nanoseconds t, double angle, double rate, double theta) {
+    session.addWave(t, theta, NAN);
+    delayed.emplace_back(t, angle, rate);
+    if (delayed.size() > 300) {
+      session.addRotationRecord(std::get<0>(delayed.front()), std::get<1>(delayed.front()),
+                                std::get<2>(delayed.front()));
+      delayed.pop_front();
+    }
+  });
+  for (const auto& d : delayed) session.addRotationRecord(std::get<0>(d), std::get<1>(d), std::get<2>(d));
+  const CalibrationOutcome late = session.finish();
+  ASSERT_TRUE(late.accepted) << late.reason;
+  EXPECT_EQ(late.samples, direct.samples);
+  EXPECT_DOUBLE_EQ(late.scale_factor[0].cos[1], direct.scale_factor[0].cos[1]);
+}
+
+TEST(CalibrationSessionTest, AutoFinishWaitsForRestAfterCompleteData) {
+  const AngleLevelGyro g = referenceGyro();
+  CalibrationSettings s = methodSettings(CalibrationMethodKind::kDualRate);
+  s.auto_finish_idle = 10.0;
+  CalibrationSession session(s, referencePrior());
+  double finished_at = -1.0;
+  testing::runAngleLevel(g, dualRateProfile(0.05, -0.05, 120.0), [&](Nanoseconds t, double a, double r, double th) {
+    session.addRotationRecord(t, a, r);
+    session.addWave(t, th, NAN);
+    if (finished_at < 0 && session.shouldFinish()) finished_at = toSeconds(t);
+  });
+  // Plateaus end at ~5 + 0.1 + 120 + 0.2 + 120 + 0.1 = 245.4 s (+ the 1 s stamp offset); then 10 s of rest,
+  // found up to half a smoothing span after the table stopped and judged half a span later.
+  EXPECT_NEAR(finished_at, 1.0 + 245.4 + 10.0 + s.plateau.smoothing_span, 0.5);
 }
 
 }  // namespace

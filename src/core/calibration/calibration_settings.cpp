@@ -39,9 +39,11 @@ const std::vector<std::string> kFieldKeys = {"gain_orders",    "rate",         "
                                              "resonator",      "min_turns",    "max_excess_scatter",
                                              "max_gain_error", "max_drift_std"};
 const std::vector<std::string> kScalarKeys = {
-    "method",           "scale_factor_orders", "drift_orders",     "bins",           "window",
-    "window_span",      "group_tolerance",     "auto_finish_idle", "backward_reset", "backward_persist",
-    "bias_trend_order", "forward_jump",        "jump_persist"};
+    "method",         "scale_factor_orders", "drift_orders",    "bins",
+    "window",         "window_span",         "group_tolerance", "auto_finish_idle",
+    "backward_reset", "bias_trend_order",    "forward_jump",    "jump_persist"};
+// Former names parse() still reads, left out of keyPaths(): the template gives the current name only.
+const std::vector<std::string> kFormerKeys = {"backward_persist"};
 
 double positive(const YamlField& parent, const char* key, double fallback) {
   const double v = parent.getDouble(key, fallback);
@@ -100,6 +102,172 @@ std::optional<FieldResonator> parseFieldResonator(const YamlField& r, double rat
   return g;
 }
 
+/// The keys at the top level: the method, the fitted orders, the windows and the stamp rule.
+void parseTopLevelKeys(const YamlField& root, CalibrationSettings* s) {
+  if (root.has("method")) {
+    try {
+      s->method = parseCalibrationMethod(root["method"].asString());
+    } catch (const std::invalid_argument& e) {
+      root["method"].fail(e.what());
+    }
+  }
+  if (root.has("scale_factor_orders")) s->scale_factor_orders = parseEvenOrders(root["scale_factor_orders"]);
+  if (root.has("drift_orders")) s->drift_orders = parseEvenOrders(root["drift_orders"]);
+  s->bias_trend_order = static_cast<int>(root.getInteger("bias_trend_order", s->bias_trend_order));
+  if (s->bias_trend_order < 0 || s->bias_trend_order > 2) root["bias_trend_order"].fail("must be 0, 1 or 2");
+  s->bins = static_cast<int>(root.getInteger("bins", s->bins));
+  if (s->bins < 8 || s->bins > 4096) root["bins"].fail("must be in [8, 4096]");
+  s->window = positive(root, "window", s->window);
+  s->window_span = positive(root, "window_span", s->window_span);
+  s->group_tolerance = positive(root, "group_tolerance", s->group_tolerance);
+  s->auto_finish_idle = root.getDouble("auto_finish_idle", s->auto_finish_idle);
+  s->backward_reset = positive(root, "backward_reset", s->backward_reset);
+  s->forward_jump = positive(root, "forward_jump", s->forward_jump);
+  if (s->forward_jump > 600.0) root["forward_jump"].fail("must be at most 600 s");
+  // jump_persist, once backward_persist (before it applied to forward jumps too): either name, not both.
+  const char* persist_key = root.has("backward_persist") ? "backward_persist" : "jump_persist";
+  if (root.has("backward_persist") && root.has("jump_persist")) {
+    root["backward_persist"].fail("is the former name of jump_persist: give one of them");
+  }
+  s->jump_persist = static_cast<int>(root.getInteger(persist_key, s->jump_persist));
+  if (s->jump_persist < 1 || s->jump_persist > 1000) root[persist_key].fail("must be in [1, 1000]");
+}
+
+/// plateau/: how the plateau detector judges the rotation's records.
+void parsePlateauKeys(const YamlField& p, CalibrationSettings* s) {
+  p.rejectUnknownKeys(kPlateauKeys);
+  s->plateau.rate_tolerance = positive(p, "rate_tolerance", s->plateau.rate_tolerance);
+  s->plateau.relative_tolerance = p.getDouble("relative_tolerance", s->plateau.relative_tolerance);
+  if (s->plateau.relative_tolerance < 0.0) p["relative_tolerance"].fail("must be >= 0");
+  s->plateau.settle_time = p.getDouble("settle_time", s->plateau.settle_time);
+  if (s->plateau.settle_time < 0.0) p["settle_time"].fail("must be >= 0");
+  s->plateau.static_rate = positive(p, "static_rate", s->plateau.static_rate);
+  s->plateau.max_gap = positive(p, "max_gap", s->plateau.max_gap);
+  s->plateau.max_rate = positive(p, "max_rate", s->plateau.max_rate);
+  // Records wait half the span to be judged; wave samples wait for them at most a minute.
+  s->plateau.smoothing_span = p.getDouble("smoothing_span", s->plateau.smoothing_span);
+  if (!(s->plateau.smoothing_span >= 0.0 && s->plateau.smoothing_span <= 20.0))
+    p["smoothing_span"].fail("must be in [0, 20] s");
+}
+
+/// gates/: the quality limits.
+void parseGateKeys(const YamlField& g, CalibrationSettings* s) {
+  g.rejectUnknownKeys(kGateKeys);
+  QualityLimits& q = s->gates;
+  q.min_coverage = g.getDouble("min_coverage", q.min_coverage);
+  if (q.min_coverage < 0.0 || q.min_coverage > 1.0) g["min_coverage"].fail("must be in [0, 1]");
+  q.min_rate_separation = positive(g, "min_rate_separation", q.min_rate_separation);
+  q.max_rate_noise = positive(g, "max_rate_noise", q.max_rate_noise);
+  q.max_table_error = positive(g, "max_table_error", q.max_table_error);
+  const long min_samples = g.getInteger("min_samples", static_cast<long>(q.min_samples));
+  if (min_samples < 0) g["min_samples"].fail("must be >= 0");
+  q.min_samples = static_cast<std::uint64_t>(min_samples);
+  q.max_condition = positive(g, "max_condition", q.max_condition);
+  q.max_relative_residual = positive(g, "max_relative_residual", q.max_relative_residual);
+  q.max_k0_change = positive(g, "max_k0_change", q.max_k0_change);
+  q.max_harmonic_std = positive(g, "max_harmonic_std", q.max_harmonic_std);
+  q.min_steps = static_cast<int>(g.getInteger("min_steps", q.min_steps));
+  if (q.min_steps < 2) g["min_steps"].fail("must be >= 2");
+  q.min_dwell_time = g.getDouble("min_dwell_time", q.min_dwell_time);
+  const long min_pairs = g.getInteger("min_pairs", static_cast<long>(q.min_pairs));
+  if (min_pairs < 2) g["min_pairs"].fail("must be >= 2");
+  q.min_pairs = static_cast<std::uint64_t>(min_pairs);
+  q.max_p_condition = positive(g, "max_p_condition", q.max_p_condition);
+  q.max_trend_inflation = g.getDouble("max_trend_inflation", q.max_trend_inflation);
+  if (!(q.max_trend_inflation >= 1.0)) g["max_trend_inflation"].fail("must be >= 1 (a factor on K0's standard error)");
+  q.max_trend_k0_std = positive(g, "max_trend_k0_std", q.max_trend_k0_std);
+}
+
+/// table_clock/: the table's clock against the gyro's.
+void parseTableClockKeys(const YamlField& c, CalibrationSettings* s) {
+  c.rejectUnknownKeys(kTableClockKeys);
+  TableClockSettings& tc = s->table_clock;
+  tc.offset = c.getDouble("offset", tc.offset);
+  if (!(std::abs(tc.offset) <= 3600.0)) c["offset"].fail("must be a finite number of seconds, |offset| <= 3600");
+  tc.regularise = c.getBool("regularise", tc.regularise);
+  tc.window = c.getDouble("window", tc.window);
+  if (!(tc.window >= 1.0 && tc.window <= 600.0)) c["window"].fail("must be in [1, 600] s");
+  tc.max_jitter = positive(c, "max_jitter", tc.max_jitter);
+  tc.max_offset = positive(c, "max_offset", tc.max_offset);
+}
+
+/// field/: the field method's plan and gates.
+void parseFieldKeys(const YamlField& f, CalibrationSettings* s) {
+  f.requireMap();
+  f.rejectUnknownKeys(kFieldKeys);
+  FieldSettings& fs = s->field;
+  if (f.has("gain_orders")) fs.gain_orders = parseEvenOrders(f["gain_orders"]);
+  fs.rate = f.getDouble("rate", fs.rate);
+  if (!(fs.rate >= FieldSettings::kMinRate && fs.rate <= kMaxPrecessionRate)) {
+    f["rate"].fail("must be in [" + formatShort(FieldSettings::kMinRate) + ", " + formatShort(kMaxPrecessionRate) +
+                   "] rad/s (electrical)");
+  }
+  fs.turns = f.getDouble("turns", fs.turns);
+  if (!(fs.turns > 0.0 && fs.turns <= FieldSettings::kMaxTurns))
+    f["turns"].fail("must be in (0, 100] full turns per segment");
+  if (f.has("directions")) {
+    const YamlField d = f["directions"];
+    const auto raw = d.asIntegers();
+    fs.directions.clear();
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+      if (raw[i] != 1 && raw[i] != -1) d.at(i).fail("must be 1 or -1 (the sign of the commanded rate)");
+      fs.directions.push_back(static_cast<int>(raw[i]));
+    }
+    if (fs.directions.size() > FieldSettings::kMaxDirections) d.fail("at most 16 segments");
+    if (std::find(fs.directions.begin(), fs.directions.end(), 1) == fs.directions.end() ||
+        std::find(fs.directions.begin(), fs.directions.end(), -1) == fs.directions.end()) {
+      d.fail("need both signs (1 and -1): the two directions separate D from the gain, one alone is refused");
+    }
+  }
+  if (f.has("axis_earth_rate")) {
+    const YamlField a = f["axis_earth_rate"];
+    const char* problem = "must be 'vertical' or the Earth's rate about the sensitive axis in rad/s (|x| <= 7.29e-5)";
+    if (a.node().IsScalar() && a.node().Scalar() == "vertical") {
+      fs.axis_earth_rate = NAN;
+    } else {
+      try {
+        fs.axis_earth_rate = a.asDouble();
+      } catch (const ConfigError&) {
+        a.fail(problem);
+      }
+      if (!(std::abs(fs.axis_earth_rate) <= kEarthRotationRate * (1.0 + 1e-6))) a.fail(problem);
+    }
+  }
+  fs.rest = f.getDouble("rest", fs.rest);
+  if (!(fs.rest >= 0.0 && fs.rest <= FieldSettings::kMaxRest)) f["rest"].fail("must be in [0, 600] s");
+  if (f.has("resonator")) fs.resonator = parseFieldResonator(f["resonator"], fs.rate);
+  fs.min_turns = f.getDouble("min_turns", fs.min_turns);
+  if (!(fs.min_turns >= 0.0)) f["min_turns"].fail("must be >= 0");
+  fs.max_excess_scatter = f.getDouble("max_excess_scatter", fs.max_excess_scatter);
+  if (!(fs.max_excess_scatter >= 1.0)) f["max_excess_scatter"].fail("must be >= 1 (a ratio of scatters)");
+  fs.max_gain_error = positive(f, "max_gain_error", fs.max_gain_error);
+  fs.max_drift_std = positive(f, "max_drift_std", fs.max_drift_std);
+}
+
+/// thermal/: the thermal method's frequency nodes and slices.
+void parseThermalKeys(const YamlField& t, CalibrationSettings* s) {
+  t.rejectUnknownKeys(kThermalKeys);
+  ThermalSettings& ts = s->thermal;
+  if (t.has("frequency_nodes")) {
+    const YamlField nf = t["frequency_nodes"];
+    ts.frequency_nodes = nf.asDoubles();
+    if (ts.frequency_nodes.size() == 1) nf.fail("give at least 2 nodes, or none for automatic nodes (node_count)");
+    for (std::size_t j = 0; j < ts.frequency_nodes.size(); ++j) {
+      if (!(ts.frequency_nodes[j] > 0.0)) nf.at(j).fail("frequency must be positive (Hz)");
+      if (j > 0 && !(ts.frequency_nodes[j] > ts.frequency_nodes[j - 1]))
+        nf.at(j).fail("nodes must be strictly increasing");
+    }
+  }
+  ts.node_count = static_cast<int>(t.getInteger("node_count", ts.node_count));
+  if (ts.node_count < 2 || ts.node_count > 32) t["node_count"].fail("must be in [2, 32]");
+  if (t.has("interpolation") && !parseInterpolation(t["interpolation"].asString(), &ts.interpolation)) {
+    t["interpolation"].fail("expected natural_cubic_spline or piecewise_linear");
+  }
+  ts.slice_width = positive(t, "slice_width", ts.slice_width);
+  ts.max_slices = static_cast<int>(t.getInteger("max_slices", ts.max_slices));
+  if (ts.max_slices < 1 || ts.max_slices > 100000) t["max_slices"].fail("must be in [1, 100000]");
+}
+
 }  // namespace
 
 std::vector<std::string> CalibrationSettings::keyPaths() {
@@ -111,6 +279,8 @@ std::vector<std::string> CalibrationSettings::keyPaths() {
   for (const std::string& k : kFieldKeys) keys.push_back("field/" + k);
   return keys;
 }
+
+std::vector<std::string> CalibrationSettings::formerKeyPaths() { return kFormerKeys; }
 
 StampRule CalibrationSettings::stampRule() const {
   StampRule r;
@@ -124,170 +294,21 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   CalibrationSettings s;
   root.requireMap();
   std::vector<std::string> allowed = kScalarKeys;
+  allowed.insert(allowed.end(), kFormerKeys.begin(), kFormerKeys.end());
   allowed.insert(allowed.end(), {"plateau", "gates", "thermal", "table_clock", "field"});
   allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
   root.rejectUnknownKeys(allowed);
-  if (root.has("method")) {
-    try {
-      s.method = parseCalibrationMethod(root["method"].asString());
-    } catch (const std::invalid_argument& e) {
-      root["method"].fail(e.what());
-    }
-  }
-  if (root.has("scale_factor_orders")) s.scale_factor_orders = parseEvenOrders(root["scale_factor_orders"]);
-  if (root.has("drift_orders")) s.drift_orders = parseEvenOrders(root["drift_orders"]);
-  s.bias_trend_order = static_cast<int>(root.getInteger("bias_trend_order", s.bias_trend_order));
-  if (s.bias_trend_order < 0 || s.bias_trend_order > 2) root["bias_trend_order"].fail("must be 0, 1 or 2");
-  s.bins = static_cast<int>(root.getInteger("bins", s.bins));
-  if (s.bins < 8 || s.bins > 4096) root["bins"].fail("must be in [8, 4096]");
-  s.window = positive(root, "window", s.window);
-  s.window_span = positive(root, "window_span", s.window_span);
-  s.group_tolerance = positive(root, "group_tolerance", s.group_tolerance);
-  s.auto_finish_idle = root.getDouble("auto_finish_idle", s.auto_finish_idle);
-  s.backward_reset = positive(root, "backward_reset", s.backward_reset);
-  s.forward_jump = positive(root, "forward_jump", s.forward_jump);
-  if (s.forward_jump > 600.0) root["forward_jump"].fail("must be at most 600 s");
-  // jump_persist, once backward_persist (before it applied to forward jumps too): either name, not both.
-  const char* persist_key = root.has("backward_persist") ? "backward_persist" : "jump_persist";
-  if (root.has("backward_persist") && root.has("jump_persist")) {
-    root["backward_persist"].fail("is the former name of jump_persist: give one of them");
-  }
-  s.jump_persist = static_cast<int>(root.getInteger(persist_key, s.jump_persist));
-  if (s.jump_persist < 1 || s.jump_persist > 1000) root[persist_key].fail("must be in [1, 1000]");
-  if (root.has("plateau")) {
-    const YamlField p = root["plateau"];
-    p.rejectUnknownKeys(kPlateauKeys);
-    s.plateau.rate_tolerance = positive(p, "rate_tolerance", s.plateau.rate_tolerance);
-    s.plateau.relative_tolerance = p.getDouble("relative_tolerance", s.plateau.relative_tolerance);
-    if (s.plateau.relative_tolerance < 0.0) p["relative_tolerance"].fail("must be >= 0");
-    s.plateau.settle_time = p.getDouble("settle_time", s.plateau.settle_time);
-    if (s.plateau.settle_time < 0.0) p["settle_time"].fail("must be >= 0");
-    s.plateau.static_rate = positive(p, "static_rate", s.plateau.static_rate);
-    s.plateau.max_gap = positive(p, "max_gap", s.plateau.max_gap);
-    s.plateau.max_rate = positive(p, "max_rate", s.plateau.max_rate);
-    // Records wait half the span to be judged; wave samples wait for them at most a minute.
-    s.plateau.smoothing_span = p.getDouble("smoothing_span", s.plateau.smoothing_span);
-    if (!(s.plateau.smoothing_span >= 0.0 && s.plateau.smoothing_span <= 20.0))
-      p["smoothing_span"].fail("must be in [0, 20] s");
-  }
-  if (root.has("gates")) {
-    const YamlField g = root["gates"];
-    g.rejectUnknownKeys(kGateKeys);
-    QualityLimits& q = s.gates;
-    q.min_coverage = g.getDouble("min_coverage", q.min_coverage);
-    if (q.min_coverage < 0.0 || q.min_coverage > 1.0) g["min_coverage"].fail("must be in [0, 1]");
-    q.min_rate_separation = positive(g, "min_rate_separation", q.min_rate_separation);
-    q.max_rate_noise = positive(g, "max_rate_noise", q.max_rate_noise);
-    q.max_table_error = positive(g, "max_table_error", q.max_table_error);
-    const long min_samples = g.getInteger("min_samples", static_cast<long>(q.min_samples));
-    if (min_samples < 0) g["min_samples"].fail("must be >= 0");
-    q.min_samples = static_cast<std::uint64_t>(min_samples);
-    q.max_condition = positive(g, "max_condition", q.max_condition);
-    q.max_relative_residual = positive(g, "max_relative_residual", q.max_relative_residual);
-    q.max_k0_change = positive(g, "max_k0_change", q.max_k0_change);
-    q.max_harmonic_std = positive(g, "max_harmonic_std", q.max_harmonic_std);
-    q.min_steps = static_cast<int>(g.getInteger("min_steps", q.min_steps));
-    if (q.min_steps < 2) g["min_steps"].fail("must be >= 2");
-    q.min_dwell_time = g.getDouble("min_dwell_time", q.min_dwell_time);
-    const long min_pairs = g.getInteger("min_pairs", static_cast<long>(q.min_pairs));
-    if (min_pairs < 2) g["min_pairs"].fail("must be >= 2");
-    q.min_pairs = static_cast<std::uint64_t>(min_pairs);
-    q.max_p_condition = positive(g, "max_p_condition", q.max_p_condition);
-    q.max_trend_inflation = g.getDouble("max_trend_inflation", q.max_trend_inflation);
-    if (!(q.max_trend_inflation >= 1.0))
-      g["max_trend_inflation"].fail("must be >= 1 (a factor on K0's standard error)");
-    q.max_trend_k0_std = positive(g, "max_trend_k0_std", q.max_trend_k0_std);
-  }
-  if (root.has("table_clock")) {
-    const YamlField c = root["table_clock"];
-    c.rejectUnknownKeys(kTableClockKeys);
-    TableClockSettings& tc = s.table_clock;
-    tc.offset = c.getDouble("offset", tc.offset);
-    if (!(std::abs(tc.offset) <= 3600.0)) c["offset"].fail("must be a finite number of seconds, |offset| <= 3600");
-    tc.regularise = c.getBool("regularise", tc.regularise);
-    tc.window = c.getDouble("window", tc.window);
-    if (!(tc.window >= 1.0 && tc.window <= 600.0)) c["window"].fail("must be in [1, 600] s");
-    tc.max_jitter = positive(c, "max_jitter", tc.max_jitter);
-    tc.max_offset = positive(c, "max_offset", tc.max_offset);
-  }
-  if (root.has("field")) {
-    const YamlField f = root["field"];
-    f.requireMap();
-    f.rejectUnknownKeys(kFieldKeys);
-    FieldSettings& fs = s.field;
-    if (f.has("gain_orders")) fs.gain_orders = parseEvenOrders(f["gain_orders"]);
-    fs.rate = f.getDouble("rate", fs.rate);
-    if (!(fs.rate >= FieldSettings::kMinRate && fs.rate <= FieldSettings::kMaxRate))
-      f["rate"].fail("must be in [0.01, 10] rad/s (electrical)");
-    fs.turns = f.getDouble("turns", fs.turns);
-    if (!(fs.turns > 0.0 && fs.turns <= FieldSettings::kMaxTurns))
-      f["turns"].fail("must be in (0, 100] full turns per segment");
-    if (f.has("directions")) {
-      const YamlField d = f["directions"];
-      const auto raw = d.asIntegers();
-      fs.directions.clear();
-      for (std::size_t i = 0; i < raw.size(); ++i) {
-        if (raw[i] != 1 && raw[i] != -1) d.at(i).fail("must be 1 or -1 (the sign of the commanded rate)");
-        fs.directions.push_back(static_cast<int>(raw[i]));
-      }
-      if (fs.directions.size() > FieldSettings::kMaxDirections) d.fail("at most 16 segments");
-      if (std::find(fs.directions.begin(), fs.directions.end(), 1) == fs.directions.end() ||
-          std::find(fs.directions.begin(), fs.directions.end(), -1) == fs.directions.end()) {
-        d.fail("need both signs (1 and -1): the two directions separate D from the gain, one alone is refused");
-      }
-    }
-    if (f.has("axis_earth_rate")) {
-      const YamlField a = f["axis_earth_rate"];
-      const char* problem = "must be 'vertical' or the Earth's rate about the sensitive axis in rad/s (|x| <= 7.29e-5)";
-      if (a.node().IsScalar() && a.node().Scalar() == "vertical") {
-        fs.axis_earth_rate = NAN;
-      } else {
-        try {
-          fs.axis_earth_rate = a.asDouble();
-        } catch (const ConfigError&) {
-          a.fail(problem);
-        }
-        if (!(std::abs(fs.axis_earth_rate) <= kEarthRotationRate * (1.0 + 1e-6))) a.fail(problem);
-      }
-    }
-    fs.rest = f.getDouble("rest", fs.rest);
-    if (!(fs.rest >= 0.0 && fs.rest <= FieldSettings::kMaxRest)) f["rest"].fail("must be in [0, 600] s");
-    if (f.has("resonator")) fs.resonator = parseFieldResonator(f["resonator"], fs.rate);
-    fs.min_turns = f.getDouble("min_turns", fs.min_turns);
-    if (!(fs.min_turns >= 0.0)) f["min_turns"].fail("must be >= 0");
-    fs.max_excess_scatter = f.getDouble("max_excess_scatter", fs.max_excess_scatter);
-    if (!(fs.max_excess_scatter >= 1.0)) f["max_excess_scatter"].fail("must be >= 1 (a ratio of scatters)");
-    fs.max_gain_error = positive(f, "max_gain_error", fs.max_gain_error);
-    fs.max_drift_std = positive(f, "max_drift_std", fs.max_drift_std);
-  }
+  parseTopLevelKeys(root, &s);
+  if (root.has("plateau")) parsePlateauKeys(root["plateau"], &s);
+  if (root.has("gates")) parseGateKeys(root["gates"], &s);
+  if (root.has("table_clock")) parseTableClockKeys(root["table_clock"], &s);
+  if (root.has("field")) parseFieldKeys(root["field"], &s);
   // The plan's keys are each bounded; so is the whole plan (with the plateau's settle time) when it will run.
   if (s.method == CalibrationMethodKind::kField) {
     const std::string problem = fieldPlanLengthProblem(s);
     if (!problem.empty()) throw ConfigError("field", problem);
   }
-  if (root.has("thermal")) {
-    const YamlField t = root["thermal"];
-    t.rejectUnknownKeys(kThermalKeys);
-    ThermalSettings& ts = s.thermal;
-    if (t.has("frequency_nodes")) {
-      const YamlField nf = t["frequency_nodes"];
-      ts.frequency_nodes = nf.asDoubles();
-      if (ts.frequency_nodes.size() == 1) nf.fail("give at least 2 nodes, or none for automatic nodes (node_count)");
-      for (std::size_t j = 0; j < ts.frequency_nodes.size(); ++j) {
-        if (!(ts.frequency_nodes[j] > 0.0)) nf.at(j).fail("frequency must be positive (Hz)");
-        if (j > 0 && !(ts.frequency_nodes[j] > ts.frequency_nodes[j - 1]))
-          nf.at(j).fail("nodes must be strictly increasing");
-      }
-    }
-    ts.node_count = static_cast<int>(t.getInteger("node_count", ts.node_count));
-    if (ts.node_count < 2 || ts.node_count > 32) t["node_count"].fail("must be in [2, 32]");
-    if (t.has("interpolation") && !parseInterpolation(t["interpolation"].asString(), &ts.interpolation)) {
-      t["interpolation"].fail("expected natural_cubic_spline or piecewise_linear");
-    }
-    ts.slice_width = positive(t, "slice_width", ts.slice_width);
-    ts.max_slices = static_cast<int>(t.getInteger("max_slices", ts.max_slices));
-    if (ts.max_slices < 1 || ts.max_slices > 100000) t["max_slices"].fail("must be in [1, 100000]");
-  }
+  if (root.has("thermal")) parseThermalKeys(root["thermal"], &s);
   return s;
 }
 

@@ -160,6 +160,10 @@ TEST(CalibrationSettingsTest, KeyPathsListEveryKeyOnce) {
                         "field/directions", "field/gain_orders", "field/resonator"}) {
     EXPECT_EQ(std::count(keys.begin(), keys.end(), k), 1) << k;
   }
+  // A former name is read but not listed: the template, which must hold every listed key, gives the new one.
+  EXPECT_EQ(std::count(keys.begin(), keys.end(), "backward_persist"), 0);
+  const std::vector<std::string> former = CalibrationSettings::formerKeyPaths();
+  EXPECT_EQ(std::count(former.begin(), former.end(), "backward_persist"), 1);
 }
 
 // Each range check says the range it applies: the bounds of the message are accepted, a step beyond
@@ -180,8 +184,14 @@ TEST(CalibrationSettingsTest, RangeChecksMatchTheirMessages) {
   EXPECT_EQ(parse("bins: 8").bins, 8);
   EXPECT_EQ(parse("bins: 4096").bins, 4096);
   EXPECT_EQ(refusedKey("bins: 4097"), "bins");
-  EXPECT_EQ(parse("backward_persist: 1000").jump_persist, 1000);
+  EXPECT_EQ(parse("jump_persist: 1000").jump_persist, 1000);
+  EXPECT_EQ(refusedKey("jump_persist: 1001"), "jump_persist");
+  EXPECT_EQ(parse("backward_persist: 7").jump_persist, 7);  // its former name
   EXPECT_EQ(refusedKey("backward_persist: 1001"), "backward_persist");
+  EXPECT_EQ(refusedKey("{backward_persist: 5, jump_persist: 5}"), "backward_persist");
+  EXPECT_DOUBLE_EQ(parse("forward_jump: 600").forward_jump, 600.0);
+  EXPECT_EQ(refusedKey("forward_jump: 600.5"), "forward_jump");
+  EXPECT_EQ(refusedKey("forward_jump: 0"), "forward_jump");
   EXPECT_DOUBLE_EQ(parse("plateau: {smoothing_span: 20}").plateau.smoothing_span, 20.0);
   EXPECT_EQ(refusedKey("plateau: {smoothing_span: 20.5}"), "plateau.smoothing_span");
   EXPECT_DOUBLE_EQ(parse("gates: {min_coverage: 1}").gates.min_coverage, 1.0);

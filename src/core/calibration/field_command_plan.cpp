@@ -68,8 +68,17 @@ double FieldPlanRun::overdueMargin(const CalibrationSettings& s) {
   return s.plateau.settle_time + s.plateau.smoothing_span + 1.0;
 }
 
+namespace {
+
+std::vector<PlannedPrecession> checkedPlan(const CalibrationSettings& settings) {
+  checkFieldPlan(settings);
+  return fieldCommandPlan(settings);
+}
+
+}  // namespace
+
 FieldPlanRun::FieldPlanRun(const CalibrationSettings& settings, std::string self)
-    : plan_(fieldCommandPlan(settings)),
+    : plan_(checkedPlan(settings)),
       margin_(overdueMargin(settings)),
       self_(std::move(self)),
       needed_("coverage " + formatShort(100 * settings.gates.min_coverage, 3) + " % and " +
@@ -93,6 +102,39 @@ bool FieldPlanRun::nextDue(Nanoseconds now, PlannedPrecession* command) {
 void FieldPlanRun::stop() {
   sent_rates_.push_back(0.0);
   next_ = plan_.size();
+}
+
+bool FieldPlanRun::end() {
+  if (!midway()) return false;
+  stop();
+  return true;
+}
+
+void FieldPlanRun::restart() {
+  next_ = 0;
+  sent_rates_.clear();
+  started_ = false;
+  start_ = 0;
+  base_commands_ = 0;
+  last_checked_ = 0;
+}
+
+FieldPlanStep FieldPlanRun::step(const PrecessionReport& report, const std::function<bool()>& driver_listens,
+                                 const CalibrationSession& session, Nanoseconds wave_now) {
+  FieldPlanStep out;
+  // Someone else turns the wave: the run's data are no longer what its plan made them.
+  out.foreign = check(report);
+  if (!out.foreign.empty()) return out;
+  if (!started_) {
+    if (!driver_listens()) return out;
+    start(report);
+  }
+  PlannedPrecession p;
+  while (nextDue(report.stamp, &p)) out.due.push_back(p);
+  // The progress (words) is asked for only once the plan is over.
+  if (session.complete() || next_ < plan_.size()) return out;
+  out.overdue = overdue(report.stamp, wave_now, session.progress().summary);
+  return out;
 }
 
 namespace {

@@ -92,6 +92,7 @@ TEST(FieldCommandPlanTest, TheLoopsLagAtThePlannedRateIsPredictedForAKnownGyro) 
     EXPECT_EQ(std::string(e.what()).rfind("field/rate", 0), 0u) << e.what();
   }
   EXPECT_NO_THROW(fieldCommandPlan(s));  // the plan itself can be made (a simulation may want it)
+  EXPECT_THROW(FieldPlanRun(s, "/calibrator"), std::invalid_argument) << "but not run";
 }
 
 // The shipped settings with two short segments: rest 5 s, +0.2 and -0.2 rad/s.
@@ -231,6 +232,67 @@ TEST(FieldPlanRunTest, APlanOverWithoutItsDataEndsTheRunSayingWhatItHolds) {
   // Not before the plan is over, nor for a plan that never started.
   FieldPlanRun waiting(s, "/calibrator");
   EXPECT_EQ(waiting.overdue(at(1000.0), at(1000.0), progress), "");
+}
+
+// What the live calibrator does with each precession state, in one step: the plan waits for the
+// driver to listen, sends what is due, stops on a stranger's command, and says when it is overdue.
+TEST(FieldPlanRunTest, AStepDoesWhatOnePrecessionStateAsks) {
+  CalibrationSettings s = twoSegments();
+  s.method = CalibrationMethodKind::kField;
+  GyroParameters prior;
+  prior.earth_rate.latitude = 0.9;
+  const CalibrationSession session(s, prior);  // no data: never complete
+  FieldPlanRun run(s, "/calibrator");
+  bool listens = false;
+  int asked = 0;
+  auto driver = [&] {
+    ++asked;
+    return listens;
+  };
+  FieldPlanStep step = run.step(state(0.0, 0.0, 3, ""), driver, session, 0);
+  EXPECT_TRUE(step.due.empty()) << "commands sent before the driver listens would be lost";
+  EXPECT_FALSE(run.started());
+  listens = true;
+  step = run.step(state(0.1, 0.0, 3, ""), driver, session, 0);
+  ASSERT_EQ(step.due.size(), 1u);
+  EXPECT_EQ(step.due[0].rate, 0.0);
+  EXPECT_TRUE(run.started());
+  step = run.step(state(5.1, 0.0, 4, "/calibrator"), driver, session, at(5.0));
+  ASSERT_EQ(step.due.size(), 1u);
+  EXPECT_EQ(step.due[0].rate, 0.2);
+  EXPECT_EQ(asked, 2) << "asked only while the plan waits to start";
+  EXPECT_EQ(run.sent(), 2u);
+  // Past the plan's end without the data: overdue, with what the session holds.
+  const double end = 0.1 + run.plan().back().time, margin = FieldPlanRun::overdueMargin(s);
+  step = run.step(state(end + margin, 0.2, 5, "/calibrator"), driver, session, at(end + margin));
+  ASSERT_EQ(step.due.size(), 2u);  // -0.2, then 0
+  EXPECT_TRUE(step.foreign.empty());
+  EXPECT_EQ(step.overdue, run.overdue(at(end + margin), at(end + margin), session.progress().summary));
+  EXPECT_NE(step.overdue, "");
+  // A stranger's command: the run stops there, nothing else due.
+  FieldPlanRun other(s, "/calibrator");
+  other.step(state(0.0, 0.0, 3, ""), driver, session, 0);
+  step = other.step(state(5.1, 0.2, 5, "/teleop"), driver, session, 0);
+  EXPECT_NE(step.foreign.find("/teleop"), std::string::npos) << step.foreign;
+  EXPECT_TRUE(step.due.empty());
+}
+
+TEST(FieldPlanRunTest, ARunThatEndsMidwayCommandsZeroAndARestartedOneBeginsAgain) {
+  FieldPlanRun run = runningPlan(3);  // 0 and +0.2 sent
+  EXPECT_TRUE(run.end()) << "the wave is turning: command 0";
+  EXPECT_FALSE(run.midway());
+  EXPECT_FALSE(run.end()) << "once";
+  FieldPlanRun unstarted(twoSegments(), "/calibrator");
+  EXPECT_FALSE(unstarted.end()) << "nothing commanded yet";
+  run.restart();
+  EXPECT_FALSE(run.started());
+  EXPECT_EQ(run.sent(), 0u);
+  EXPECT_EQ(run.plan().size(), 4u);
+  PlannedPrecession p;
+  EXPECT_FALSE(run.nextDue(at(100.0), &p)) << "it waits for its next start";
+  run.start(state(100.0, 0.0, 9, ""));
+  ASSERT_TRUE(run.nextDue(at(100.0), &p));
+  EXPECT_EQ(p.rate, 0.0);
 }
 
 TEST(FieldPlanRunTest, ARefusalComesFirstAndIsTheReason) {

@@ -5,65 +5,33 @@
 #include <sstream>
 
 #include "hrg_gyro/core/calibration/field_command_plan.h"
+#include "hrg_gyro/core/calibration/outcome_from_fits.h"
 #include "hrg_gyro/core/common/units.h"
 
 namespace hrg_gyro {
 namespace core {
-namespace {
-
-double largestStd(const HarmonicFitResult& f) {
-  double m = f.mean_std;
-  for (std::size_t j = 0; j < f.orders.size(); ++j) m = std::max({m, f.cos_std[j], f.sin_std[j]});
-  return m;
-}
-
-GroupSummary summarize(const RateGroup& g, double min_bin_time) {
-  GroupSummary s;
-  s.rate = g.meanRate();
-  s.rate_std = g.rateStd();
-  s.duration = g.rates().totalTime();
-  s.samples = g.rates().samples();
-  s.coverage = g.rates().coverage(min_bin_time);
-  s.turns = g.rates().thetaSwept() / kPi;
-  return s;
-}
-
-}  // namespace
-
 FieldMethod::FieldMethod(const CalibrationSettings& s)
     : settings_(s),
       // The wave turns at about the commanded rate: one radian of theta per radian of psi.
       groups_(s.bins, s.window, s.window_span, 1.0, maxFittedOrder(s.field.gain_orders, s.drift_orders),
               s.group_tolerance, s.plateau.max_gap),
-      regression_(s.field.gain_orders, s.drift_orders, s.bins, s.bias_trend_order) {}
-
-double FieldMethod::windowFor(double rate) const {
-  const int top = maxFittedOrder(settings_.field.gain_orders, settings_.drift_orders);
-  const double span = std::min(settings_.window_span, 1.0 / top);
-  const double sweep = std::abs(rate);
-  return sweep > 0.0 ? std::min(settings_.window, span / sweep) : settings_.window;
-}
+      regression_(s.field.gain_orders, s.drift_orders, s.bins, s.bias_trend_order),
+      chains_(s, maxFittedOrder(s.field.gain_orders, s.drift_orders), 1.0) {}
 
 void FieldMethod::addSample(const PlateauSample& s) {
   // At rest (w_v = 0) the wave hardly moves: nothing to separate.
-  if (s.plateau.is_static || !std::isfinite(s.theta) || !std::isfinite(s.table_angle) || !std::isfinite(s.table_rate))
+  if (s.plateau.is_static || !std::isfinite(s.theta) || !std::isfinite(s.rotation_angle) ||
+      !std::isfinite(s.rotation_rate))
     return;
-  groups_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.table_rate);
+  groups_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.rotation_rate);
   ++samples_;
   if (std::isfinite(s.frequency)) {
     frequency_sum_ += s.frequency;
     ++frequency_count_;
   }
-  const bool gap = in_chain_ && toSeconds(s.stamp - last_stamp_) > settings_.plateau.max_gap;
-  if (!in_chain_ || s.plateau.id != chain_plateau_ || gap || s.stamp <= last_stamp_) {
-    const int group = regressionGroupOf(&group_rates_, s.plateau.rate, settings_.group_tolerance);
-    regression_.startChain(group, windowFor(s.plateau.rate));
-    in_chain_ = true;
-    chain_plateau_ = s.plateau.id;
-  }
+  chains_.follow(s, &regression_);
   // psi is the driver's own integral of the command: exact, and continuous (never wrapped).
-  regression_.add(s.stamp, s.theta, s.table_angle);
-  last_stamp_ = s.stamp;
+  regression_.add(s.stamp, s.theta, s.rotation_angle);
 }
 
 void FieldMethod::directionGroups(int* positive, int* negative) const {
@@ -104,44 +72,10 @@ CalibrationProgress FieldMethod::progress() const {
   return p;
 }
 
-CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
-  CalibrationOutcome o;
-  o.method = kind();
+double FieldMethod::gateDirections(const RateGroup& gp, const RateGroup& gm, CalibrationOutcome* out) const {
+  CalibrationOutcome& o = *out;
   const QualityLimits& q = settings_.gates;
   const FieldSettings& fs = settings_.field;
-  if (prior.drift.frequencyDependent()) {
-    // One session stands at one temperature: it cannot refresh a D(theta, f), and a flat D would
-    // silently drop the thermal calibration's dependence.
-    o.gate("prior_drift", false, 1.0, 0.0,
-           "the prior's D(theta) depends on the resonator frequency (a thermal calibration); the field method "
-           "refreshes one D(theta) at the session's temperature and would lose that: refresh it with the thermal "
-           "method");
-    o.decide();
-    return o;
-  }
-  for (std::size_t i : groups_.byDuration()) {
-    const RateGroup& g = groups_.groups()[i];
-    o.plateaus.push_back(summarize(g, minBinTime(g.meanRate())));
-  }
-  o.samples = samples_;
-  o.gate("samples", samples_ >= q.min_samples, static_cast<double>(samples_), static_cast<double>(q.min_samples),
-         std::to_string(samples_) + " wave samples while the wave was precessed");
-  int plus, minus;
-  directionGroups(&plus, &minus);
-  const int directions = (plus >= 0) + (minus >= 0);
-  o.gate("directions", directions == 2, directions, 2.0,
-         directions == 2 ? "virtual rotation in both directions"
-                         : std::string("need the wave precessed both ways (the two separate D from the gain), found ") +
-                               (plus >= 0    ? "only positive"
-                                : minus >= 0 ? "only negative"
-                                             : "no") +
-                               " rates");
-  if (directions < 2) {
-    o.decide();
-    return o;
-  }
-  const RateGroup& gp = groups_.groups()[plus];
-  const RateGroup& gm = groups_.groups()[minus];
   FieldReport& r = o.field;  // present once the fit gave its numbers
   r.positive_rate = gp.meanRate();
   r.negative_rate = gm.meanRate();
@@ -159,13 +93,14 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
   o.gate("turns", turns >= fs.min_turns, turns, fs.min_turns,
          formatShort(r.positive_turns, 3) + " full turns of theta at " + formatShort(r.positive_rate, 3) + " rad/s, " +
              formatShort(r.negative_turns, 3) + " at " + formatShort(r.negative_rate, 3) + " rad/s");
-  // psi carries no Earth rate: the regression's D is the still gyro's whole rate, D + K Omega_s.
-  const IncrementFit e = regression_.solve(0.0, 0.0, min_bin_time, q.max_condition);
-  if (!e.ok) {
-    o.gate("fit", false, 0.0, 0.0, e.reason);
-    o.decide();
-    return o;
-  }
+  return min_bin_time;
+}
+
+HarmonicFitResult FieldMethod::driftFromFit(const IncrementFit& e, const GyroParameters& prior,
+                                            CalibrationOutcome* out) const {
+  CalibrationOutcome& o = *out;
+  const FieldSettings& fs = settings_.field;
+  FieldReport& r = o.field;
   r.present = true;
   r.virtual_rate_gain = e.k;
   r.measured_drift = e.d;
@@ -197,7 +132,14 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
   for (BinnedCurvePoint& p : o.binned) p.d -= k_prior(p.theta, frequency) * r.earth_rate;
   o.smoothing_factor = 1.0;
   if (e.trend.order > 0) o.bias_trend = e.trend;
+  return d;
+}
 
+void FieldMethod::gateFit(const IncrementFit& e, const HarmonicFitResult& d, CalibrationOutcome* out) const {
+  CalibrationOutcome& o = *out;
+  const QualityLimits& q = settings_.gates;
+  const FieldSettings& fs = settings_.field;
+  FieldReport& r = o.field;
   o.gate("fit_condition", e.k.condition_number <= q.max_condition, e.k.condition_number, q.max_condition,
          "regression condition number " + formatShort(e.k.condition_number));
   // Stillness from D's harmonics: their regressors oscillate, so the block sandwich measures their
@@ -220,7 +162,7 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
   o.gate("virtual_rate_gain", gain_error <= fs.max_gain_error, gain_error, fs.max_gain_error,
          "the precession loop realised " + formatShort(e.k.mean, 8) + " of the commanded rate (+- " +
              formatShort(e.k.mean_std, 2) + ")");
-  const double worst = largestStd(d);
+  const double worst = largestTermStd(d);
   o.gate("drift_std", worst <= fs.max_drift_std, worst, fs.max_drift_std,
          "largest standard error of a D term " + formatShort(worst, 3) + " rad/s");
   // The loops trail the precessed wave; what they leave that keeps its sign in both directions is
@@ -249,6 +191,12 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
                "standard error x" + formatShort(t.k0_inflation, 3) + ")" +
                (separable ? std::string() : ": order the directions so that a trend cancels (+ - - +)"));
   }
+}
+
+void FieldMethod::noteResult(const IncrementFit& e, const GyroParameters& prior, CalibrationOutcome* out) const {
+  CalibrationOutcome& o = *out;
+  const FieldReport& r = o.field;
+  const bool axis_rate_given = !std::isnan(settings_.field.axis_earth_rate);
   o.notes.push_back("K kept from the prior (K0 = " + formatShort(r.k0_prior, 9) +
                     "): a still gyro is turned by its precession loop, never by a rotation, so nothing in this "
                     "session scales with a body rate; refresh K on a table");
@@ -263,6 +211,54 @@ CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
                     formatShort(toModel(e.k).peakDeviation(), 3) + "); window " + formatShort(e.mean_window) +
                     " s, angle noise " + formatShort(e.angle_noise) + " rad, " + std::to_string(e.increments) +
                     " increments in " + std::to_string(e.blocks) + " blocks");
+}
+
+CalibrationOutcome FieldMethod::finish(const GyroParameters& prior) const {
+  CalibrationOutcome o;
+  o.method = kind();
+  const QualityLimits& q = settings_.gates;
+  if (prior.drift.frequencyDependent()) {
+    // One session stands at one temperature: it cannot refresh a D(theta, f), and a flat D would
+    // silently drop the thermal calibration's dependence.
+    o.gate("prior_drift", false, 1.0, 0.0,
+           "the prior's D(theta) depends on the resonator frequency (a thermal calibration); the field method "
+           "refreshes one D(theta) at the session's temperature and would lose that: refresh it with the thermal "
+           "method");
+    o.decide();
+    return o;
+  }
+  for (std::size_t i : groups_.byDuration()) {
+    const RateGroup& g = groups_.groups()[i];
+    o.plateaus.push_back(summarizeGroup(g, minBinTime(g.meanRate())));
+  }
+  o.samples = samples_;
+  o.gate("samples", samples_ >= q.min_samples, static_cast<double>(samples_), static_cast<double>(q.min_samples),
+         std::to_string(samples_) + " wave samples while the wave was precessed");
+  int plus, minus;
+  directionGroups(&plus, &minus);
+  const int directions = (plus >= 0) + (minus >= 0);
+  o.gate("directions", directions == 2, directions, 2.0,
+         directions == 2 ? "virtual rotation in both directions"
+                         : std::string("need the wave precessed both ways (the two separate D from the gain), found ") +
+                               (plus >= 0    ? "only positive"
+                                : minus >= 0 ? "only negative"
+                                             : "no") +
+                               " rates");
+  if (directions < 2) {
+    o.decide();
+    return o;
+  }
+  const double min_bin_time = gateDirections(groups_.groups()[plus], groups_.groups()[minus], &o);
+  // psi carries no Earth rate: the regression's D is the still gyro's whole rate, D + K Omega_s.
+  const IncrementFit e = regression_.solve(0.0, 0.0, min_bin_time, q.max_condition);
+  if (!e.ok) {
+    o.gate("fit", false, 0.0, 0.0, e.reason);
+    o.decide();
+    return o;
+  }
+  const HarmonicFitResult d = driftFromFit(e, prior, &o);
+  gateFit(e, d, &o);
+  noteResult(e, prior, &o);
   o.parameters = prior;
   o.parameters.drift = toModel(d);
   o.parameters.calibration.method = ParameterOrigin::calibratedBy(o.method);

@@ -5,6 +5,7 @@
 #include <ctime>
 #include <sstream>
 
+#include "hrg_gyro/core/calibration/outcome_from_fits.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/estimation/thermal_estimator.h"
 
@@ -37,7 +38,7 @@ void ThermalMethod::addSample(const PlateauSample& s) {
     ++out_of_range_;
     return;
   }
-  if (!rates_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.table_rate, s.frequency)) {
+  if (!rates_.add(s.stamp, s.theta, s.theta, s.plateau.id, s.plateau.rate, s.rotation_rate, s.frequency)) {
     ++slice_limit_;
     return;
   }
@@ -171,12 +172,8 @@ double ThermalMethod::gateNodes(const std::vector<double>& n, const ThermalEstim
     k0_max = std::max(k0_max, k.mean);
     const double k0_prior = prior.scale_factor.meanAt(n[j]);
     change = std::max(change, std::abs(k.mean - k0_prior) / std::abs(k0_prior));
-    double s = 0.0;
-    for (std::size_t i = 0; i < k.orders.size(); ++i) {
-      hstd = std::max({hstd, k.cos_std[i] / std::abs(k.mean), k.sin_std[i] / std::abs(k.mean)});
-      s += k.orders[i] * std::hypot(k.cos[i], k.sin[i]);
-    }
-    slope = std::max(slope, s * std::abs(k.mean));
+    if (!k.orders.empty()) hstd = std::max(hstd, largestHarmonicStd(k) / std::abs(k.mean));
+    slope = std::max(slope, slopeBound(k) * std::abs(k.mean));
     k0_abs_mean += std::abs(k.mean) / static_cast<double>(n.size());
     o->nonlinearity_ppm = std::max(o->nonlinearity_ppm, 1e6 * e.k_model.peakDeviation(n[j]) / std::abs(k.mean));
   }

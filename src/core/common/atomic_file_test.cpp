@@ -22,8 +22,10 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "core/testing/concurrent_writers.h"
+#include "core/testing/output_directory_test_base.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -52,26 +54,7 @@ struct stat statOf(const std::string& path) {
   return st;
 }
 
-class AtomicFileTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    char tmpl[] = "/tmp/hrg_atomic_file_test_XXXXXX";
-    ASSERT_NE(::mkdtemp(tmpl), nullptr);
-    dir_ = tmpl;
-  }
-  void TearDown() override {
-    fault_injection::setOutputFileFault({});
-    fs::remove_all(dir_);
-  }
-  std::string at(const std::string& name) const { return dir_ + "/" + name; }
-  /// Every name in `dir` (default: the test directory).
-  std::set<std::string> listing(const std::string& dir = "") const {
-    std::set<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir.empty() ? dir_ : dir)) names.insert(e.path().filename().string());
-    return names;
-  }
-  std::string dir_;
-};
+class AtomicFileTest : public OutputDirectoryTestBase {};
 
 TEST_F(AtomicFileTest, NewFileGetsTheDocumentedModeNarrowedByTheUmask) {
   const mode_t old_umask = ::umask(027);
@@ -290,15 +273,9 @@ TEST_F(AtomicFileTest, FailureAtAnyStepLeavesTheOldFileIntact) {
   writeText(path, "old content\n");
   writeText(path + ".bak", "older content\n");
   const ino_t inode = statOf(path).st_ino;
-  struct Case {
-    OutputFileStep step;
-    int error;
-    const char* message;
-  };
-  for (const Case& c :
-       {Case{OutputFileStep::kWrite, ENOSPC, "No space left on device"},
-        Case{OutputFileStep::kSync, EIO, "Input/output error"}, Case{OutputFileStep::kBackup, EDQUOT, "quota"},
-        Case{OutputFileStep::kRename, EXDEV, "cross-device"}}) {
+  std::vector<OutputFileFault> faults = faultsBeforeTheRename();
+  faults.push_back({OutputFileStep::kRename, EXDEV, "cross-device"});
+  for (const OutputFileFault& c : faults) {
     fault_injection::setOutputFileFault(
         [&](OutputFileStep step, const std::string&) { return step == c.step ? c.error : 0; });
     try {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+#include <vector>
 
 namespace hrg_gyro {
 namespace core {
@@ -19,6 +20,17 @@ StampRule rule(double backward_reset, double forward_jump, int persist) {
   r.persist = persist;
   return r;
 }
+
+/// The verdicts on `stamps` (s) in turn, of a timeline whose first record was at `first`.
+std::vector<StampVerdict> verdicts(const StampRule& r, double first, const std::vector<double>& stamps) {
+  StampTimeline t(r);
+  EXPECT_EQ(t.check(s(first)), StampVerdict::kNext);
+  std::vector<StampVerdict> out;
+  for (double stamp : stamps) out.push_back(t.check(s(stamp)));
+  return out;
+}
+
+using V = StampVerdict;
 
 TEST(StampTimelineTest, ClassifiesGlitches) {
   StampTimeline t(rule(0.5, 0.1, 3));
@@ -54,10 +66,7 @@ TEST(StampTimelineTest, AJumpAheadThatPersistsIsAGap) {
 }
 
 TEST(StampTimelineTest, AStepWithinForwardJumpIsNoJump) {
-  StampTimeline t(rule(0.5, 0.1, 5));
-  t.check(s(10.0));
-  EXPECT_EQ(t.check(s(10.1)), StampVerdict::kNext);
-  EXPECT_EQ(t.check(s(10.2000001)), StampVerdict::kJumpedAhead);
+  EXPECT_EQ(verdicts(rule(0.5, 0.1, 5), 10.0, {10.1, 10.2000001}), (std::vector<V>{V::kNext, V::kJumpedAhead}));
 }
 
 TEST(StampTimelineTest, AStreamRejoiningTheOthersIsNoJump) {
@@ -93,12 +102,9 @@ TEST(StampTimelineTest, OnlyAPersistingEarlierTimelineIsNew) {
 }
 
 TEST(StampTimelineTest, ARecordSlightlyBehindEndsTheCount) {
-  StampTimeline t(rule(0.5, 0.5, 3));
-  t.check(s(100.0));
-  EXPECT_EQ(t.check(s(1.0)), StampVerdict::kJumpedBack);
-  EXPECT_EQ(t.check(s(1.1)), StampVerdict::kJumpedBack);
-  EXPECT_EQ(t.check(s(99.9)), StampVerdict::kBehind);  // the old timeline goes on
-  EXPECT_EQ(t.check(s(1.2)), StampVerdict::kJumpedBack);
+  // 99.9: the old timeline goes on, and the count of records on the earlier one starts again.
+  EXPECT_EQ(verdicts(rule(0.5, 0.5, 3), 100.0, {1.0, 1.1, 99.9, 1.2}),
+            (std::vector<V>{V::kJumpedBack, V::kJumpedBack, V::kBehind, V::kJumpedBack}));
 }
 
 TEST(StampTimelineTest, ScatteredFarStampsAreNoTimeline) {
@@ -118,10 +124,7 @@ TEST(StampTimelineTest, ScatteredFarStampsAreNoTimeline) {
 }
 
 TEST(StampTimelineTest, PersistOneTakesEveryJumpAtOnce) {
-  StampTimeline t(rule(0.5, 0.1, 1));
-  t.check(s(10.0));
-  EXPECT_EQ(t.check(s(20.0)), StampVerdict::kResumedAhead);
-  EXPECT_EQ(t.check(s(5.0)), StampVerdict::kNewTimeline);
+  EXPECT_EQ(verdicts(rule(0.5, 0.1, 1), 10.0, {20.0, 5.0}), (std::vector<V>{V::kResumedAhead, V::kNewTimeline}));
 }
 
 TEST(StampTimelineTest, FollowsAnotherStreamBack) {

@@ -24,6 +24,16 @@ std::vector<double> HarmonicFitResult::termStds() const {
   return t;
 }
 
+HarmonicModel toModel(const HarmonicFitResult& fit) { return HarmonicModel(fit.orders, fit.mean, fit.cos, fit.sin); }
+
+std::vector<int> mergeOrders(const std::vector<int>& a, const std::vector<int>& b) {
+  std::vector<int> out(a);
+  out.insert(out.end(), b.begin(), b.end());
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 HarmonicFitResult selectOrders(const HarmonicFitResult& fit, const std::vector<int>& orders) {
   HarmonicFitResult r = fit;
   r.orders = orders;

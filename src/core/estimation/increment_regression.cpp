@@ -383,6 +383,163 @@ IncrementRegression::Solved IncrementRegression::solveColumns(const std::vector<
   return out;
 }
 
+IncrementRegression::Columns IncrementRegression::fittedColumns() const {
+  const int n_k = static_cast<int>(k_orders_.size()), n_all = static_cast<int>(all_orders_.size());
+  const int t0 = 1 + 2 * n_k, n_kterms = 1 + 2 * n_k, trend0 = t0 + 1 + 2 * n_all;
+  auto orderIndex = [&](int k) {
+    return static_cast<int>(std::lower_bound(all_orders_.begin(), all_orders_.end(), k) - all_orders_.begin());
+  };
+  Columns c;
+  for (int j = 0; j < n_kterms; ++j) c.sel.push_back(j);
+  c.sel.push_back(t0);
+  for (int k : d_orders_) c.sel.push_back(t0 + 1 + orderIndex(k));
+  for (int k : d_orders_) c.sel.push_back(t0 + 1 + n_all + orderIndex(k));
+  c.without_trend = c.sel;
+  c.trend_at = static_cast<int>(c.sel.size());
+  for (int j = 0; j < trend_order_; ++j) c.sel.push_back(trend0 + j);
+  return c;
+}
+
+Eigen::VectorXd IncrementRegression::earthRateShift(const std::vector<int>& sel, const Eigen::VectorXd& beta,
+                                                    const Eigen::MatrixXd& total, double earth_rate,
+                                                    double earth_rate_std, double reference_time,
+                                                    double max_condition) const {
+  const int p = static_cast<int>(sel.size());
+  Eigen::VectorXd earth_shift = Eigen::VectorXd::Zero(p);
+  if (earth_rate_std > 0.0) {
+    const Eigen::MatrixXd s = regressorMap(earth_rate + earth_rate_std, reference_time) * total *
+                              regressorMap(earth_rate + earth_rate_std, reference_time).transpose();
+    const LeastSquaresSolution moved =
+        solveNormalEquations(submatrix(s, sel, sel), column(s, sel, m_), ColumnScaling::kUnitNorm, max_condition);
+    if (moved.ok) earth_shift = (moved.coefficients - beta).cwiseAbs();
+  }
+  return earth_shift;
+}
+
+IncrementRegression::Terms IncrementRegression::correctedTerms(const Solved& solved, const Eigen::VectorXd& earth_shift,
+                                                               IncrementFit* fit) const {
+  const int n_k = static_cast<int>(k_orders_.size()), n_d = static_cast<int>(d_orders_.size());
+  const int n_kterms = 1 + 2 * n_k;
+  const Eigen::VectorXd& beta = solved.solution.coefficients;
+  const Eigen::MatrixXd& sandwich = solved.sandwich;
+  const Eigen::MatrixXd& white = solved.white;
+  const int p = static_cast<int>(beta.size());
+  // Noise of theta inside the basis attenuates order k by exp(-k^2 s^2 / 2); undo it. A tenth of the
+  // correction is taken as its uncertainty: the noise is estimated well (0.05 % at 0.2 rad), but
+  // noise correlated from sample to sample would make the estimate off by more.
+  auto attenuation = [&](int k) { return std::exp(-0.5 * k * k * fit->angle_noise * fit->angle_noise); };
+  std::vector<double> scale(p, 1.0);
+  for (int j = 0; j < n_k; ++j) scale[1 + j] = scale[1 + n_k + j] = attenuation(k_orders_[j]);
+  for (int j = 0; j < n_d; ++j) scale[n_kterms + 1 + j] = scale[n_kterms + 1 + n_d + j] = attenuation(d_orders_[j]);
+
+  Terms terms;
+  terms.value.resize(p);
+  terms.total_std.resize(p);
+  for (int i = 0; i < p; ++i) {
+    terms.value[i] = beta(i) * scale[i];
+    const double statistical = std::sqrt(std::max(sandwich(i, i), white(i, i))) * scale[i];
+    const double noise = std::sqrt(std::max(0.0, white(i, i))) * scale[i];
+    const double beyond = std::sqrt(std::max(0.0, sandwich(i, i) - white(i, i))) * scale[i];
+    const double earth = earth_shift(i);
+    const double basis = 0.1 * std::abs(beta(i)) * (1.0 - scale[i]);
+    terms.total_std[i] = std::sqrt(statistical * statistical + earth * earth + basis * basis);
+    IncrementErrorBudget* part =
+        i < n_kterms ? &fit->budget : (i < n_kterms + 1 + 2 * n_d ? &fit->drift_budget : nullptr);
+    if (part) {
+      part->statistical.push_back(statistical);
+      part->angle_noise.push_back(noise);
+      part->beyond_noise.push_back(beyond);
+      part->earth_rate.push_back(earth);
+      part->basis_noise.push_back(basis);
+    }
+  }
+  return terms;
+}
+
+void IncrementRegression::fillFit(const Terms& terms, const std::vector<int>& orders, int offset,
+                                  double condition_number, HarmonicFitResult* f) const {
+  const int h = static_cast<int>(orders.size());
+  f->ok = true;
+  f->orders = orders;
+  f->mean = terms.value[offset];
+  f->mean_std = terms.total_std[offset];
+  for (int j = 0; j < h; ++j) {
+    f->cos.push_back(terms.value[offset + 1 + j]);
+    f->cos_std.push_back(terms.total_std[offset + 1 + j]);
+    f->sin.push_back(terms.value[offset + 1 + h + j]);
+    f->sin_std.push_back(terms.total_std[offset + 1 + h + j]);
+  }
+  f->condition_number = condition_number;
+  f->points = increments_;
+}
+
+void IncrementRegression::fitTrend(const Columns& columns, const Terms& terms, const LeastSquaresSolution& solution,
+                                   const Eigen::MatrixXd& map, const Eigen::MatrixXd& total, double reference_time,
+                                   BiasTrendFit* trend) const {
+  const int trend_at = columns.trend_at;
+  trend->order = trend_order_;
+  for (int j = 0; j < trend_order_; ++j) {
+    trend->coefficients.push_back(terms.value[trend_at + j]);
+    trend->stds.push_back(terms.total_std[trend_at + j]);
+  }
+  trend->reference_time = reference_time;
+  trend->reference_stamp = session_origin_ + toNanoseconds(reference_time);
+  trend->span = last_session_time_;
+  // How the design confuses the trend with K0, from its geometry alone (the normal inverse): the
+  // same fit without the trend, and the correlation of K0 with the linear term.
+  const std::vector<int>& sel_without_trend = columns.without_trend;
+  const Eigen::MatrixXd s = map * total * map.transpose();
+  const LeastSquaresSolution without =
+      solveNormalEquations(submatrix(s, sel_without_trend, sel_without_trend), column(s, sel_without_trend, m_),
+                           ColumnScaling::kUnitNorm, std::numeric_limits<double>::infinity());
+  const Eigen::MatrixXd& inv = solution.normal_inverse;
+  if (without.ok && without.normal_inverse(0, 0) > 0.0) {
+    trend->k0_inflation = std::sqrt(inv(0, 0) / without.normal_inverse(0, 0));
+  }
+  trend->k0_correlation = inv(0, trend_at) / std::sqrt(inv(0, 0) * inv(trend_at, trend_at));
+}
+
+void IncrementRegression::binCurves(const std::vector<int>& sel, const Eigen::VectorXd& beta,
+                                    const Eigen::MatrixXd& map, double earth_rate, double min_bin_time,
+                                    IncrementFit* fit) const {
+  const int p = static_cast<int>(sel.size());
+  // Binned curves of the two groups with the most data: the fitted model at the bin centre plus the
+  // bin's mean residual rate, separated into K and D by the two groups' rates.
+  std::vector<std::pair<double, int>> by_time;
+  for (const auto& gt : group_time_) by_time.emplace_back(gt.second, gt.first);
+  std::sort(by_time.rbegin(), by_time.rend());
+  double k_ss = 0.0, d_ss = 0.0;
+  if (by_time.size() >= 2) {
+    const auto& b1 = bins_by_group_.at(by_time[0].second);
+    const auto& b2 = bins_by_group_.at(by_time[1].second);
+    const HarmonicModel k_model = toModel(fit->k), d_model = toModel(fit->d);
+    for (int b = 0; b < bins_; ++b) {
+      if (b1[b].dt < min_bin_time || b2[b].dt < min_bin_time || b1[b].dt <= 0.0 || b2[b].dt <= 0.0) continue;
+      auto residualRate = [&](const BinSums& s) {
+        const Eigen::VectorXd w = map * s.w;
+        double model = 0.0;
+        for (int i = 0; i < p; ++i) model += w(sel[i]) * beta(i);
+        return (w(m_) - model) / s.dt;
+      };
+      const double r1 = residualRate(b1[b]), r2 = residualRate(b2[b]);
+      const double w1 = b1[b].dphi / b1[b].dt + earth_rate, w2 = b2[b].dphi / b2[b].dt + earth_rate;
+      if (!(std::abs(w1 - w2) > 0.0)) continue;
+      BinnedCurvePoint point;
+      point.theta = (b + 0.5) * kPi / bins_;
+      const double k_residual = (r1 - r2) / (w1 - w2), d_residual = (r2 * w1 - r1 * w2) / (w1 - w2);
+      point.k = k_model(point.theta) + k_residual;
+      point.d = d_model(point.theta) + d_residual;
+      point.weight = std::min(b1[b].dt, b2[b].dt);
+      fit->binned.push_back(point);
+      k_ss += k_residual * k_residual;
+      d_ss += d_residual * d_residual;
+    }
+  }
+  const double shown = static_cast<double>(fit->binned.size());
+  fit->k.residual_rms = shown > 0 ? std::sqrt(k_ss / shown) : 0.0;
+  fit->d.residual_rms = shown > 0 ? std::sqrt(d_ss / shown) : 0.0;
+}
+
 IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std, double min_bin_time,
                                         double max_condition) const {
   if (in_chain_ && !chain_means_.empty()) {
@@ -393,21 +550,9 @@ IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std
   }
   IncrementFit fit;
   fit.angle_weight = weighted_chain_time_ > 0.0 ? angle_weight_time_ / weighted_chain_time_ : 1.0;
-  const int n_k = static_cast<int>(k_orders_.size()), n_d = static_cast<int>(d_orders_.size());
-  const int n_all = static_cast<int>(all_orders_.size());
-  const int t0 = 1 + 2 * n_k, n_kterms = 1 + 2 * n_k, trend0 = t0 + 1 + 2 * n_all;
-  auto orderIndex = [&](int k) {
-    return static_cast<int>(std::lower_bound(all_orders_.begin(), all_orders_.end(), k) - all_orders_.begin());
-  };
-  // Fitted columns: the K block, T, the T harmonics of D's orders (mean, cos..., sin...), the trend.
-  std::vector<int> sel;
-  for (int j = 0; j < n_kterms; ++j) sel.push_back(j);
-  sel.push_back(t0);
-  for (int k : d_orders_) sel.push_back(t0 + 1 + orderIndex(k));
-  for (int k : d_orders_) sel.push_back(t0 + 1 + n_all + orderIndex(k));
-  const std::vector<int> sel_without_trend = sel;
-  const int trend_at = static_cast<int>(sel.size());  // the trend's first coefficient
-  for (int j = 0; j < trend_order_; ++j) sel.push_back(trend0 + j);
+  const int n_kterms = 1 + 2 * static_cast<int>(k_orders_.size());
+  const Columns columns = fittedColumns();
+  const std::vector<int>& sel = columns.sel;
   const int p = static_cast<int>(sel.size());
 
   std::vector<Block> blocks = blocks_;
@@ -435,120 +580,14 @@ IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std
   }
   const LeastSquaresSolution& solution = solved.solution;
   const Eigen::VectorXd& beta = solution.coefficients;
-  const Eigen::MatrixXd& sandwich = solved.sandwich;
-  const Eigen::MatrixXd& white = solved.white;
   // Earth-rate uncertainty: refit with the rate moved by its standard deviation.
-  Eigen::VectorXd earth_shift = Eigen::VectorXd::Zero(p);
-  if (earth_rate_std > 0.0) {
-    const Eigen::MatrixXd s = regressorMap(earth_rate + earth_rate_std, reference_time) * total *
-                              regressorMap(earth_rate + earth_rate_std, reference_time).transpose();
-    const LeastSquaresSolution moved =
-        solveNormalEquations(submatrix(s, sel, sel), column(s, sel, m_), ColumnScaling::kUnitNorm, max_condition);
-    if (moved.ok) earth_shift = (moved.coefficients - beta).cwiseAbs();
-  }
-  // Noise of theta inside the basis attenuates order k by exp(-k^2 s^2 / 2); undo it. A tenth of the
-  // correction is taken as its uncertainty: the noise is estimated well (0.05 % at 0.2 rad), but
-  // noise correlated from sample to sample would make the estimate off by more.
-  auto attenuation = [&](int k) { return std::exp(-0.5 * k * k * fit.angle_noise * fit.angle_noise); };
-  std::vector<double> scale(p, 1.0);
-  for (int j = 0; j < n_k; ++j) scale[1 + j] = scale[1 + n_k + j] = attenuation(k_orders_[j]);
-  for (int j = 0; j < n_d; ++j) scale[n_kterms + 1 + j] = scale[n_kterms + 1 + n_d + j] = attenuation(d_orders_[j]);
-
-  std::vector<double> value(p), total_std(p);
-  IncrementErrorBudget& budget = fit.budget;
-  for (int i = 0; i < p; ++i) {
-    value[i] = beta(i) * scale[i];
-    const double statistical = std::sqrt(std::max(sandwich(i, i), white(i, i))) * scale[i];
-    const double noise = std::sqrt(std::max(0.0, white(i, i))) * scale[i];
-    const double beyond = std::sqrt(std::max(0.0, sandwich(i, i) - white(i, i))) * scale[i];
-    const double earth = earth_shift(i);
-    const double basis = 0.1 * std::abs(beta(i)) * (1.0 - scale[i]);
-    total_std[i] = std::sqrt(statistical * statistical + earth * earth + basis * basis);
-    IncrementErrorBudget* part = i < n_kterms ? &budget : (i < n_kterms + 1 + 2 * n_d ? &fit.drift_budget : nullptr);
-    if (part) {
-      part->statistical.push_back(statistical);
-      part->angle_noise.push_back(noise);
-      part->beyond_noise.push_back(beyond);
-      part->earth_rate.push_back(earth);
-      part->basis_noise.push_back(basis);
-    }
-  }
-  auto fill = [&](HarmonicFitResult* f, const std::vector<int>& orders, int offset) {
-    const int h = static_cast<int>(orders.size());
-    f->ok = true;
-    f->orders = orders;
-    f->mean = value[offset];
-    f->mean_std = total_std[offset];
-    for (int j = 0; j < h; ++j) {
-      f->cos.push_back(value[offset + 1 + j]);
-      f->cos_std.push_back(total_std[offset + 1 + j]);
-      f->sin.push_back(value[offset + 1 + h + j]);
-      f->sin_std.push_back(total_std[offset + 1 + h + j]);
-    }
-    f->condition_number = solution.condition_number;
-    f->points = increments_;
-  };
-  fill(&fit.k, k_orders_, 0);
-  fill(&fit.d, d_orders_, n_kterms);
-
-  if (trend_order_ > 0) {
-    BiasTrendFit& trend = fit.trend;
-    trend.order = trend_order_;
-    for (int j = 0; j < trend_order_; ++j) {
-      trend.coefficients.push_back(value[trend_at + j]);
-      trend.stds.push_back(total_std[trend_at + j]);
-    }
-    trend.reference_time = reference_time;
-    trend.reference_stamp = session_origin_ + toNanoseconds(reference_time);
-    trend.span = last_session_time_;
-    // How the design confuses the trend with K0, from its geometry alone (the normal inverse): the
-    // same fit without the trend, and the correlation of K0 with the linear term.
-    const Eigen::MatrixXd s = map * total * map.transpose();
-    const LeastSquaresSolution without =
-        solveNormalEquations(submatrix(s, sel_without_trend, sel_without_trend), column(s, sel_without_trend, m_),
-                             ColumnScaling::kUnitNorm, std::numeric_limits<double>::infinity());
-    const Eigen::MatrixXd& inv = solution.normal_inverse;
-    if (without.ok && without.normal_inverse(0, 0) > 0.0) {
-      trend.k0_inflation = std::sqrt(inv(0, 0) / without.normal_inverse(0, 0));
-    }
-    trend.k0_correlation = inv(0, trend_at) / std::sqrt(inv(0, 0) * inv(trend_at, trend_at));
-  }
-
-  // Binned curves of the two groups with the most data: the fitted model at the bin centre plus the
-  // bin's mean residual rate, separated into K and D by the two groups' rates.
-  std::vector<std::pair<double, int>> by_time;
-  for (const auto& gt : group_time_) by_time.emplace_back(gt.second, gt.first);
-  std::sort(by_time.rbegin(), by_time.rend());
-  double k_ss = 0.0, d_ss = 0.0;
-  if (by_time.size() >= 2) {
-    const auto& b1 = bins_by_group_.at(by_time[0].second);
-    const auto& b2 = bins_by_group_.at(by_time[1].second);
-    const HarmonicModel k_model = toModel(fit.k), d_model = toModel(fit.d);
-    for (int b = 0; b < bins_; ++b) {
-      if (b1[b].dt < min_bin_time || b2[b].dt < min_bin_time || b1[b].dt <= 0.0 || b2[b].dt <= 0.0) continue;
-      auto residualRate = [&](const BinSums& s) {
-        const Eigen::VectorXd w = map * s.w;
-        double model = 0.0;
-        for (int i = 0; i < p; ++i) model += w(sel[i]) * beta(i);
-        return (w(m_) - model) / s.dt;
-      };
-      const double r1 = residualRate(b1[b]), r2 = residualRate(b2[b]);
-      const double w1 = b1[b].dphi / b1[b].dt + earth_rate, w2 = b2[b].dphi / b2[b].dt + earth_rate;
-      if (!(std::abs(w1 - w2) > 0.0)) continue;
-      BinnedCurvePoint point;
-      point.theta = (b + 0.5) * kPi / bins_;
-      const double k_residual = (r1 - r2) / (w1 - w2), d_residual = (r2 * w1 - r1 * w2) / (w1 - w2);
-      point.k = k_model(point.theta) + k_residual;
-      point.d = d_model(point.theta) + d_residual;
-      point.weight = std::min(b1[b].dt, b2[b].dt);
-      fit.binned.push_back(point);
-      k_ss += k_residual * k_residual;
-      d_ss += d_residual * d_residual;
-    }
-  }
-  const double shown = static_cast<double>(fit.binned.size());
-  fit.k.residual_rms = shown > 0 ? std::sqrt(k_ss / shown) : 0.0;
-  fit.d.residual_rms = shown > 0 ? std::sqrt(d_ss / shown) : 0.0;
+  const Eigen::VectorXd earth_shift =
+      earthRateShift(sel, beta, total, earth_rate, earth_rate_std, reference_time, max_condition);
+  const Terms terms = correctedTerms(solved, earth_shift, &fit);
+  fillFit(terms, k_orders_, 0, solution.condition_number, &fit.k);
+  fillFit(terms, d_orders_, n_kterms, solution.condition_number, &fit.d);
+  if (trend_order_ > 0) fitTrend(columns, terms, solution, map, total, reference_time, &fit.trend);
+  binCurves(sel, beta, map, earth_rate, min_bin_time, &fit);
   fit.ok = true;
   return fit;
 }

@@ -23,6 +23,77 @@ std::string milliseconds(double s) {
   return buf;
 }
 
+struct OffsetRange {
+  double lo, hi;  // the smallest and the largest transition offset, s
+};
+
+/// offset = a + rate_error (t - mean t) through the transitions' offsets, by least squares where the
+/// changes span a minute or more: the offset, the rate error and their standard errors, the spread,
+/// whether the offset stepped. Needs at least one transition.
+OffsetRange fitOffsets(TableClockOffsetResult* result) {
+  TableClockOffsetResult& r = *result;
+  const double n = static_cast<double>(r.transitions.size());
+  double noise = 0.0, lo = r.transitions.front().offset, hi = lo, mean_t = 0.0, mean_offset = 0.0;
+  const Nanoseconds t0 = r.transitions.front().stamp;
+  for (const TableClockTransition& t : r.transitions) {
+    noise += t.offset_noise * t.offset_noise;
+    lo = std::min(lo, t.offset);
+    hi = std::max(hi, t.offset);
+    mean_t += toSeconds(t.stamp - t0) / n;
+    mean_offset += t.offset / n;
+  }
+  double stt = 0.0, sto = 0.0;
+  for (const TableClockTransition& t : r.transitions) {
+    const double dt = toSeconds(t.stamp - t0) - mean_t;
+    stt += dt * dt;
+    sto += dt * (t.offset - mean_offset);
+  }
+  const double span = toSeconds(r.transitions.back().stamp - t0);
+  r.rate_estimated = n >= 3.0 && span >= kMinDriftSpan && stt > 0.0;
+  if (r.rate_estimated) r.rate_error = sto / stt;
+  double scatter = 0.0, chi = 0.0;
+  for (const TableClockTransition& t : r.transitions) {
+    const double residual = t.offset - mean_offset - r.rate_error * (toSeconds(t.stamp - t0) - mean_t);
+    scatter += residual * residual;
+    if (t.offset_noise > 0.0) chi += std::pow(residual / t.offset_noise, 2);
+  }
+  const double fitted = r.rate_estimated ? 2.0 : 1.0;
+  // The noise of the mean (and of the slope), or, where the offsets disagree more than that, their
+  // scatter about the line.
+  const double residual_variance = n > fitted ? scatter / (n - fitted) : 0.0;
+  const double noise_variance = noise / n;
+  r.offset = mean_offset;
+  r.offset_std = std::sqrt(std::max(noise_variance, n >= 3.0 ? residual_variance : 0.0) / n);
+  if (r.rate_estimated) {
+    r.rate_error_std = std::sqrt(std::max(noise_variance, residual_variance) / stt);
+  }
+  r.spread = hi - lo;
+  r.changed =
+      n > fitted + 1.0 && chi / (n - fitted) > kChangedChiSquare && std::sqrt(residual_variance) > kChangedSpread / 3;
+  r.estimated = true;
+  return {lo, hi};
+}
+
+/// The note of an estimated offset: how many changes, their range, the clock's drift, a step.
+void describe(const OffsetRange& range, std::size_t broken, TableClockOffsetResult* result) {
+  TableClockOffsetResult& r = *result;
+  r.note = std::to_string(r.transitions.size()) + " changes of rate, offsets " + milliseconds(range.lo) + " to " +
+           milliseconds(range.hi);
+  if (broken > 0) r.note += " (" + std::to_string(broken) + " more left out: a gap in the samples)";
+  if (r.rate_estimated && std::abs(r.rate_error) > 3.0 * r.rate_error_std) {
+    char drift[96];
+    std::snprintf(drift, sizeof drift, "%.3g +- %.2g", 1e6 * r.rate_error, 1e6 * r.rate_error_std);
+    r.note += std::string("; the table's clock runs ") + drift + " ppm " + (r.rate_error > 0.0 ? "fast" : "slow") +
+              " against the gyro's";
+  }
+  if (r.changed) {
+    r.note +=
+        ": they disagree far beyond their noise and a steady drift, so the offset stepped during the session: from " +
+        milliseconds(r.transitions.front().offset) + " at the first change to " +
+        milliseconds(r.transitions.back().offset) + " at the last";
+  }
+}
+
 }  // namespace
 
 TableClockOffsetEstimator::TableClockOffsetEstimator(const TableClockOffsetSettings& settings) : settings_(settings) {
@@ -130,114 +201,67 @@ void TableClockOffsetEstimator::add(Nanoseconds stamp, double theta, double tabl
   tail_.clear();
 }
 
+bool TableClockOffsetEstimator::measure(const Transition& tr, ModelPairEvaluator* models, double earth_rate,
+                                        double frequency, double k0, TableClockTransition* out) {
+  // theta - I along the path: constant where the logged table angle is the true one shifted by a
+  // constant, so its means on the two sides differ by K0 offset (W_b - W_a).
+  double integral = 0.0, k_previous = 0.0, d_previous = 0.0;
+  double sum[2] = {0.0, 0.0}, squares[2] = {0.0, 0.0};
+  double count[2] = {0.0, 0.0};
+  double k_change = 0.0, k_count = 0.0;  // K over the change: its harmonics are not K0's
+  for (std::size_t i = 0; i < tr.samples.size(); ++i) {
+    const Sample& s = tr.samples[i];
+    double kk, dd;
+    models->evaluate(s.theta, frequency, &kk, &dd);
+    if (i > 0) {
+      const Sample& p = tr.samples[i - 1];
+      const double dt = s.t - p.t;
+      integral += 0.5 * (kk + k_previous) * (s.phi - p.phi + earth_rate * dt) + 0.5 * (dd + d_previous) * dt;
+    }
+    k_previous = kk;
+    d_previous = dd;
+    if (s.side == 0) {
+      k_change += kk;
+      k_count += 1.0;
+      continue;
+    }
+    const int side = s.side > 0 ? 1 : 0;
+    const double y = s.theta - integral;
+    sum[side] += y;
+    squares[side] += y * y;
+    count[side] += 1.0;
+  }
+  if (count[0] < 3.0 || count[1] < 3.0) return false;
+  const double change = (k_count > 0.0 ? k_change / k_count : k0) * (tr.rate_after - tr.rate_before);
+  TableClockTransition& t = *out;
+  t.stamp = tr.left;
+  t.rate_before = tr.rate_before;
+  t.rate_after = tr.rate_after;
+  const double mean0 = sum[0] / count[0], mean1 = sum[1] / count[1];
+  t.offset = (mean1 - mean0) / change;
+  const double var0 = std::max(0.0, squares[0] / count[0] - mean0 * mean0) / (count[0] - 1.0);
+  const double var1 = std::max(0.0, squares[1] / count[1] - mean1 * mean1) / (count[1] - 1.0);
+  t.offset_noise = std::sqrt(var0 + var1) / std::abs(change);
+  return true;
+}
+
 TableClockOffsetResult TableClockOffsetEstimator::estimate(const HarmonicModel& k, const HarmonicModel& d,
                                                            double earth_rate, double frequency) const {
   TableClockOffsetResult r;
   ModelPairEvaluator models(k, d);
   const double k0 = k.meanAt(frequency);
   for (const Transition& tr : done_) {
-    // theta - I along the path: constant where the logged table angle is the true one shifted by a
-    // constant, so its means on the two sides differ by K0 offset (W_b - W_a).
-    double integral = 0.0, k_previous = 0.0, d_previous = 0.0;
-    double sum[2] = {0.0, 0.0}, squares[2] = {0.0, 0.0};
-    double count[2] = {0.0, 0.0};
-    double k_change = 0.0, k_count = 0.0;  // K over the change: its harmonics are not K0's
-    for (std::size_t i = 0; i < tr.samples.size(); ++i) {
-      const Sample& s = tr.samples[i];
-      double kk, dd;
-      models.evaluate(s.theta, frequency, &kk, &dd);
-      if (i > 0) {
-        const Sample& p = tr.samples[i - 1];
-        const double dt = s.t - p.t;
-        integral += 0.5 * (kk + k_previous) * (s.phi - p.phi + earth_rate * dt) + 0.5 * (dd + d_previous) * dt;
-      }
-      k_previous = kk;
-      d_previous = dd;
-      if (s.side == 0) {
-        k_change += kk;
-        k_count += 1.0;
-        continue;
-      }
-      const int side = s.side > 0 ? 1 : 0;
-      const double y = s.theta - integral;
-      sum[side] += y;
-      squares[side] += y * y;
-      count[side] += 1.0;
-    }
-    if (count[0] < 3.0 || count[1] < 3.0) continue;
-    const double change = (k_count > 0.0 ? k_change / k_count : k0) * (tr.rate_after - tr.rate_before);
     TableClockTransition t;
-    t.stamp = tr.left;
-    t.rate_before = tr.rate_before;
-    t.rate_after = tr.rate_after;
-    const double mean0 = sum[0] / count[0], mean1 = sum[1] / count[1];
-    t.offset = (mean1 - mean0) / change;
-    const double var0 = std::max(0.0, squares[0] / count[0] - mean0 * mean0) / (count[0] - 1.0);
-    const double var1 = std::max(0.0, squares[1] / count[1] - mean1 * mean1) / (count[1] - 1.0);
-    t.offset_noise = std::sqrt(var0 + var1) / std::abs(change);
-    r.transitions.push_back(t);
+    if (measure(tr, &models, earth_rate, frequency, k0, &t)) r.transitions.push_back(t);
   }
-  const double n = static_cast<double>(r.transitions.size());
-  if (n < 1.0) {
+  if (r.transitions.empty()) {
     r.note = done_.empty() ? "no change of the table's rate was seen settled on both sides by both streams"
                            : "the changes of rate seen had too few samples on their plateaus";
     if (broken_ > 0) r.note += " (" + std::to_string(broken_) + " left out: a gap in the samples)";
     return r;
   }
-  double noise = 0.0, lo = r.transitions.front().offset, hi = lo, mean_t = 0.0, mean_offset = 0.0;
-  const Nanoseconds t0 = r.transitions.front().stamp;
-  for (const TableClockTransition& t : r.transitions) {
-    noise += t.offset_noise * t.offset_noise;
-    lo = std::min(lo, t.offset);
-    hi = std::max(hi, t.offset);
-    mean_t += toSeconds(t.stamp - t0) / n;
-    mean_offset += t.offset / n;
-  }
-  // offset = a + rate_error (t - mean t), by least squares where the changes span a minute or more.
-  double stt = 0.0, sto = 0.0;
-  for (const TableClockTransition& t : r.transitions) {
-    const double dt = toSeconds(t.stamp - t0) - mean_t;
-    stt += dt * dt;
-    sto += dt * (t.offset - mean_offset);
-  }
-  const double span = toSeconds(r.transitions.back().stamp - t0);
-  r.rate_estimated = n >= 3.0 && span >= kMinDriftSpan && stt > 0.0;
-  if (r.rate_estimated) r.rate_error = sto / stt;
-  double scatter = 0.0, chi = 0.0;
-  for (const TableClockTransition& t : r.transitions) {
-    const double residual = t.offset - mean_offset - r.rate_error * (toSeconds(t.stamp - t0) - mean_t);
-    scatter += residual * residual;
-    if (t.offset_noise > 0.0) chi += std::pow(residual / t.offset_noise, 2);
-  }
-  const double fitted = r.rate_estimated ? 2.0 : 1.0;
-  // The noise of the mean (and of the slope), or, where the offsets disagree more than that, their
-  // scatter about the line.
-  const double residual_variance = n > fitted ? scatter / (n - fitted) : 0.0;
-  const double noise_variance = noise / n;
-  r.offset = mean_offset;
-  r.offset_std = std::sqrt(std::max(noise_variance, n >= 3.0 ? residual_variance : 0.0) / n);
-  if (r.rate_estimated) {
-    r.rate_error_std = std::sqrt(std::max(noise_variance, residual_variance) / stt);
-  }
-  r.spread = hi - lo;
-  r.changed =
-      n > fitted + 1.0 && chi / (n - fitted) > kChangedChiSquare && std::sqrt(residual_variance) > kChangedSpread / 3;
-  r.estimated = true;
-  r.note = std::to_string(r.transitions.size()) + " changes of rate, offsets " + milliseconds(lo) + " to " +
-           milliseconds(hi);
-  if (broken_ > 0) r.note += " (" + std::to_string(broken_) + " more left out: a gap in the samples)";
-  if (r.rate_estimated && std::abs(r.rate_error) > 3.0 * r.rate_error_std) {
-    char drift[96];
-    std::snprintf(drift, sizeof drift, "%.3g +- %.2g", 1e6 * r.rate_error, 1e6 * r.rate_error_std);
-    r.note += std::string("; the table's clock runs ") + drift + " ppm " + (r.rate_error > 0.0 ? "fast" : "slow") +
-              " against the gyro's";
-  }
-  if (r.changed) {
-    r.note +=
-        ": they disagree far beyond their noise and a steady drift, so the offset stepped during the session: from " +
-        milliseconds(r.transitions.front().offset) + " at the first change to " +
-        milliseconds(r.transitions.back().offset) + " at the last";
-  }
+  const OffsetRange range = fitOffsets(&r);
+  describe(range, broken_, &r);
   return r;
 }
 

@@ -1,6 +1,6 @@
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
 
-#include "hrg_gyro/core/calibration/generator_pairing.h"
+#include "hrg_gyro/core/calibration/calibration_feed.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -11,30 +11,21 @@ OfflineCalibration calibrateOnSimulation(const SimulationConfig& scenario,
   GyroSimulator sim(scenario);
   GyroProcessor proc(processor, parameters);
   CalibrationSession session(calibration, *parameters);
-  GeneratorPairing pairing([&session](Nanoseconds t, const ChannelVector& raw, const ChannelVector& reference) {
-    session.addGeneratorPair(t, raw, reference);
-  });
-  // The field method synchronises with the precession loop's state, as the live calibrator does.
-  const bool virtual_rotation = traitsOf(calibration.method).virtual_rotation;
+  CalibrationFeed feed(&session, &proc);
   SimulationSample s;
   while (sim.next(&s)) {
     if (s.truth.generator) {
-      if (!s.channels_delivered) continue;
-      pairing.addRaw(s.stamp, s.z);
-      pairing.addReference(s.stamp, {s.truth.amplitude, s.truth.quadrature, s.truth.theta, s.truth.phase});
+      if (s.channels_delivered)
+        feed.addSweepSample(s.stamp, s.z, {s.truth.amplitude, s.truth.quadrature, s.truth.theta, s.truth.phase});
       continue;
     }
-    // What the table controller logged, not the truth; or what the precession loop executed.
-    if (virtual_rotation) {
-      if (sim.hasPrecessionLoop()) session.addTurntable(s.stamp, s.precession.angle, s.precession.rate, s.index);
-    } else {
-      for (const TurntableLogRecord& record : s.turntable)
-        session.addTurntable(record.stamp, record.angle, record.rate, record.index);
-    }
-    if (!s.channels_delivered) continue;
-    const ProcessorResult r = proc.process({s.stamp + s.channels_stamp_offset, s.z, s.frequency, s.temperature});
-    if (r.has_wave)
-      session.addWave(s.stamp, r.wave.theta, s.frequency, quadratureRatio(r.wave.quadrature, r.wave.amplitude));
+    // What the table controller logged, not the truth; or what the precession loop executed (the
+    // feed takes the one the method synchronises with, as the live calibrator does).
+    if (sim.hasPrecessionLoop()) feed.addPrecessionState(s.stamp, s.precession.angle, s.precession.rate, s.index);
+    for (const TurntableLogRecord& record : s.turntable)
+      feed.addTableState(record.stamp, record.angle, record.rate, record.index);
+    if (s.channels_delivered)
+      feed.addWaveChannels({s.stamp + s.channels_stamp_offset, s.z, s.frequency, s.temperature}, s.stamp);
   }
   OfflineCalibration out;
   out.outcome = session.finish();

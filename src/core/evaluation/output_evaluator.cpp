@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
+#include "hrg_gyro/core/estimation/binned_rate_fit.h"
 #include "hrg_gyro/core/model/harmonic_basis.h"
 
 namespace hrg_gyro {
@@ -54,8 +54,8 @@ EvaluationResult OutputEvaluator::result() const {
   }
   const RateGroup& g1 = groups_.groups()[order[0]];
   const RateGroup& g2 = groups_.groups()[order[1]];
-  const DualRateEstimate e = estimateDualRate(g1.rates(), g1.meanRate(), g2.rates(), g2.meanRate(), settings_.orders,
-                                              settings_.orders, 0.25 * settings_.window);
+  const BinnedTwoRateFit e = fitBinnedTwoRates(g1.rates(), g1.meanRate(), g2.rates(), g2.meanRate(), settings_.orders,
+                                               settings_.orders, 0.25 * settings_.window);
   if (!e.ok) {
     r.reason = e.reason;
     return r;

@@ -8,6 +8,14 @@
 
 namespace hrg_gyro {
 namespace core {
+namespace {
+
+/// A simulated axis's channels as its driver sends them (a glitched stamp included).
+ChannelSample channelSample(const SimulationSample& a) {
+  return {a.stamp + a.channels_stamp_offset, a.z, a.frequency, a.temperature};
+}
+
+}  // namespace
 
 OfflineTriadCalibration calibrateOnTriadSimulation(const TriadSimulationConfig& scenario,
                                                    const std::array<GyroParameters, 3>& priors,
@@ -16,19 +24,17 @@ OfflineTriadCalibration calibrateOnTriadSimulation(const TriadSimulationConfig& 
                                                    const TriadParameters& prior_triad,
                                                    const ProcessorConfig& processor) {
   TriadSimulator sim(scenario);
-  std::array<std::unique_ptr<GyroProcessor>, 3> processors;
-  for (int i = 0; i < 3; ++i)
-    processors[i] = std::make_unique<GyroProcessor>(processor, std::make_shared<const GyroParameters>(priors[i]));
+  TriadProcessor processors(processor, priors);
   TriadCalibration calibration(axis_settings, triad_settings, priors, prior_triad);
   TriadSample s;
+  ProcessorResult r;
   while (sim.next(&s)) {
     // In the order `hrg_bag simulate` writes them at the sample's stamp: the axes, the table, the fixture.
-    for (int i = 0; i < 3; ++i) {
+    for (std::size_t i = 0; i < 3; ++i) {
       const SimulationSample& a = s.axes[i];
       if (!a.channels_delivered) continue;
-      const ProcessorResult r =
-          processors[i]->process({a.stamp + a.channels_stamp_offset, a.z, a.frequency, a.temperature});
-      if (r.has_wave) calibration.addWave(i, a.stamp, r.wave.theta, a.frequency);
+      processors.process(i, channelSample(a), &r);
+      if (r.has_wave) calibration.addWave(static_cast<int>(i), a.stamp, r.wave.theta, a.frequency);
     }
     for (const TurntableLogRecord& record : s.turntable)
       calibration.addTurntable(record.stamp, record.angle, record.rate, record.index);
@@ -44,17 +50,16 @@ OfflineTriadCalibration calibrateOnTriadSimulation(const TriadSimulationConfig& 
   }
   OfflineTriadCalibration out;
   out.outcome = calibration.finish();
-  for (int i = 0; i < 3; ++i) out.processors[i] = processors[i]->counters();
+  for (std::size_t i = 0; i < 3; ++i) out.processors[i] = processors.processor(i).counters();
   out.simulated_seconds = sim.duration();
   return out;
 }
 
 namespace {
 
-/// One set of files on the simulated triad: its processors, its combiner, its sums per segment.
+/// One set of files on the simulated triad: its processing chain, its sums per segment.
 struct VerifiedChain {
-  std::array<std::unique_ptr<GyroProcessor>, 3> processors;
-  std::unique_ptr<TriadCombiner> combiner;
+  std::unique_ptr<TriadProcessor> triad;
   std::vector<Eigen::Vector3d> published, exact;  // rad, summed increments per segment
   std::vector<double> seconds;
   std::vector<TriadBodySample> completed;
@@ -85,11 +90,10 @@ std::vector<TriadVerification> verifyTriadOnSimulation(const TriadSimulationConf
 
   std::vector<VerifiedChain> chains(files.size());
   for (std::size_t c = 0; c < files.size(); ++c) {
-    for (int i = 0; i < 3; ++i)
-      chains[c].processors[i] =
-          std::make_unique<GyroProcessor>(processor, std::make_shared<const GyroParameters>(files[c].axes[i]));
-    chains[c].combiner = std::make_unique<TriadCombiner>(TriadCombinerSettings(),
-                                                         std::make_shared<const TriadParameters>(files[c].triad));
+    TriadProcessorSettings settings;
+    settings.processor = processor;
+    chains[c].triad = std::make_unique<TriadProcessor>(settings, files[c].axes,
+                                                       std::make_shared<const TriadParameters>(files[c].triad));
     chains[c].published.assign(segments.size(), Eigen::Vector3d::Zero());
     chains[c].exact.assign(segments.size(), Eigen::Vector3d::Zero());
     chains[c].seconds.assign(segments.size(), 0.0);
@@ -114,6 +118,7 @@ std::vector<TriadVerification> verifyTriadOnSimulation(const TriadSimulationConf
 
   TriadSimulator sim(scenario);
   TriadSample s;
+  ProcessorResult r;
   while (sim.next(&s)) {
     const double t = 1e-9 * static_cast<double>(s.stamp) - scenario.start_time;
     while (cursor < windows.size() && windows[cursor].end < t - 1.0) ++cursor;  // samples arrive within 1 s
@@ -121,15 +126,8 @@ std::vector<TriadVerification> verifyTriadOnSimulation(const TriadSimulationConf
       for (std::size_t i = 0; i < 3; ++i) {
         const SimulationSample& a = s.axes[i];
         if (!a.channels_delivered) continue;
-        const ProcessorResult r =
-            chain.processors[i]->process({a.stamp + a.channels_stamp_offset, a.z, a.frequency, a.temperature});
-        if (!r.has_output) continue;
-        AxisOutput out;
-        out.stamp = a.stamp;
-        out.dt = r.increment.dt;
-        out.dalpha = r.increment.dalpha;
-        out.flags = r.flags;
-        chain.combiner->add(i, out, &chain.completed);
+        chain.triad->process(i, channelSample(a), &r);
+        chain.triad->release(nullptr, &chain.completed);
       }
       accumulate(&chain);
     }
@@ -139,11 +137,11 @@ std::vector<TriadVerification> verifyTriadOnSimulation(const TriadSimulationConf
   for (std::size_t c = 0; c < files.size(); ++c) {
     VerifiedChain& chain = chains[c];
     cursor = 0;
-    chain.combiner->flush(&chain.completed);
+    chain.triad->finish(nullptr, &chain.completed);
     accumulate(&chain);
     TriadVerification& v = results[c];
     v.name = files[c].name;
-    v.combiner = chain.combiner->counters();
+    v.combiner = chain.triad->combiner().counters();
     double sum_square = 0.0;
     int turning = 0;
     for (std::size_t k = 0; k < segments.size(); ++k) {

@@ -1,7 +1,7 @@
 // Theta-binned rates, the harmonic fit with its standard errors, and plateau detection.
 #include <gtest/gtest.h>
 
-#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
+#include "hrg_gyro/core/estimation/binned_rate_fit.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/estimation/plateau_detector.h"
 #include "hrg_gyro/core/estimation/theta_binned_rates.h"

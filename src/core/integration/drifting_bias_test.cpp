@@ -16,30 +16,17 @@ namespace core {
 namespace {
 
 using testing::AngleLevelGyro;
+using testing::nominalGyro;
+using testing::referencePrior;
 using testing::TableImperfections;
 
-constexpr double kNominalNoise = 1.1e-5;  // rad per wave sample at 1 kHz
-constexpr double kPlateau = 226.0;        // s: four plateaus and their ramps make a 16-minute session
-
-GyroParameters prior() {
-  GyroParameters p;
-  p.earth_rate.latitude = 0.9;
-  return p;
-}
+constexpr double kPlateau = 226.0;  // s: four plateaus and their ramps make a 16-minute session
 
 CalibrationSettings settings(int trend_order) {
   CalibrationSettings s;
   s.method = CalibrationMethodKind::kDualRate;
   s.bias_trend_order = trend_order;
   return s;
-}
-
-AngleLevelGyro gyro(std::uint64_t seed) {
-  AngleLevelGyro g = testing::referenceGyro();
-  g.k = HarmonicModel({2, 4, 6, 8}, -0.56, {-6e-4, 2e-3, 1e-4, -5e-5}, {4e-4, 0.0, -1e-4, 0.0});
-  g.noise = kNominalNoise;
-  g.seed = seed;
-  return g;
 }
 
 /// The trend that moves D0 by `change` rad/s over the profile.
@@ -54,7 +41,7 @@ struct SessionResult {
 
 SessionResult calibrate(const AngleLevelGyro& g, const TurntableProfile& profile, int trend_order) {
   SessionResult r;
-  r.outcome = testing::calibrateTableSession(g, TableImperfections(), profile, settings(trend_order), prior());
+  r.outcome = testing::calibrateTableSession(g, TableImperfections(), profile, settings(trend_order), referencePrior());
   if (r.outcome.scale_factor.empty() || !r.outcome.scale_factor[0].ok) return r;
   const HarmonicModel k = toModel(r.outcome.scale_factor[0]);
   r.k_peak_ppm = testing::peakErrorPpm(k, g.k);
@@ -65,12 +52,27 @@ SessionResult calibrate(const AngleLevelGyro& g, const TurntableProfile& profile
   return r;
 }
 
+/// The gyro of `seed` whose D0 moves by 1e-6 rad/s over the profile, calibrated with a constant bias
+/// and with a linear trend.
+struct TrendComparison {
+  AngleLevelGyro gyro;
+  SessionResult constant, fitted;
+};
+
+TrendComparison calibrateWithAndWithoutTrend(const TurntableProfile& profile, std::uint64_t seed) {
+  TrendComparison c;
+  c.gyro = nominalGyro(seed);
+  c.gyro.bias_trend = trendFor(profile, 1e-6);
+  c.constant = calibrate(c.gyro, profile, 0);
+  c.fitted = calibrate(c.gyro, profile, 1);
+  return c;
+}
+
 TEST(DriftingBiasTest, ALinearTrendIsFittedWithKInTheOrderThatWouldAliasIt) {
   const TurntableProfile alternating = testing::dualRateProfile(0.05, -0.05, kPlateau, 2);
-  AngleLevelGyro g = gyro(11);
-  g.bias_trend = trendFor(alternating, 1e-6);
-  const SessionResult constant = calibrate(g, alternating, 0);
-  const SessionResult fitted = calibrate(g, alternating, 1);
+  const TrendComparison run = calibrateWithAndWithoutTrend(alternating, 11);
+  const AngleLevelGyro& g = run.gyro;
+  const SessionResult &constant = run.constant, &fitted = run.fitted;
   std::printf(
       "alternating + - + -, D0 trend 1e-6 rad/s over %.0f s: constant-bias fit K0 %+.2f ppm, peak %.2f ppm; "
       "trend fitted K0 %+.2f ppm, peak %.2f ppm, trend %.3e +- %.1e rad/s^2 (injected %.3e), K0 sigma x%.2f, "
@@ -91,10 +93,8 @@ TEST(DriftingBiasTest, ALinearTrendIsFittedWithKInTheOrderThatWouldAliasIt) {
 
 TEST(DriftingBiasTest, TheBalancedOrderCancelsTheTrendEvenUnfitted) {
   const TurntableProfile balanced = testing::balancedDualRateProfile(0.05, -0.05, kPlateau, 4);
-  AngleLevelGyro g = gyro(12);
-  g.bias_trend = trendFor(balanced, 1e-6);
-  const SessionResult constant = calibrate(g, balanced, 0);
-  const SessionResult fitted = calibrate(g, balanced, 1);
+  const TrendComparison run = calibrateWithAndWithoutTrend(balanced, 12);
+  const SessionResult &constant = run.constant, &fitted = run.fitted;
   std::printf(
       "balanced + - - +, same trend: constant-bias fit K0 %+.2f ppm, peak %.2f ppm; trend fitted K0 %+.2f "
       "ppm, peak %.2f ppm, K0 sigma x%.2f\n",
@@ -151,7 +151,7 @@ Coverage coverage(AngleLevelGyro g, const TurntableProfile& profile, int seeds, 
 
 TEST(DriftingBiasTest, ReportedSigmasCoverTheErrorOver20Seeds) {
   const TurntableProfile alternating = testing::dualRateProfile(0.05, -0.05, 150.0, 2);
-  AngleLevelGyro trend = gyro(0);
+  AngleLevelGyro trend = nominalGyro(0);
   trend.bias_trend = trendFor(alternating, 1e-6);
   const Coverage c = coverage(trend, alternating, 20);
   std::printf("linear trend, + - + -, 20 seeds: %d of %d coefficients within 3 sigma (%.1f %%), worst peak %.2f ppm\n",
@@ -167,7 +167,7 @@ TEST(DriftingBiasTest, ARandomWalkOfTheBiasWidensTheSigmasHonestly) {
   // trend are not defined for a random walk). Measured here: 97.2 %, worst peak 3.96 ppm; at three
   // times the walk (1e-6 rad/s over the session) the sandwich no longer keeps up: 83.9 %, 14.2 ppm.
   const TurntableProfile alternating = testing::dualRateProfile(0.05, -0.05, 150.0, 2);
-  AngleLevelGyro walk = gyro(0);
+  AngleLevelGyro walk = nominalGyro(0);
   walk.bias_random_walk = 3e-7 / std::sqrt(alternating.duration());
   const Coverage c = coverage(walk, alternating, 20, false);
   std::printf(
@@ -183,16 +183,16 @@ TEST(DriftingBiasTest, ATrendTheSessionCannotSeparateIsRefusedNamingTheOrder) {
   // stays known to about a ppm and the session is accepted; with three times the noise it would be
   // left at several ppm: refused.
   const TurntableProfile two = testing::dualRateProfile(0.05, -0.05, 120.0, 1);
-  AngleLevelGyro g = gyro(13);
+  AngleLevelGyro g = nominalGyro(13);
   g.k = HarmonicModel({2, 4}, -0.56, {-6e-4, 2e-3}, {4e-4, 0.0});
   g.bias_trend = trendFor(two, 1e-6);
   CalibrationSettings s = settings(1);
   s.scale_factor_orders = {2, 4};
   s.drift_orders = {2};
-  const CalibrationOutcome quiet = testing::calibrateTableSession(g, TableImperfections(), two, s, prior());
+  const CalibrationOutcome quiet = testing::calibrateTableSession(g, TableImperfections(), two, s, referencePrior());
   EXPECT_TRUE(quiet.accepted) << quiet.reason;
-  g.noise = 3.0 * kNominalNoise;
-  const CalibrationOutcome o = testing::calibrateTableSession(g, TableImperfections(), two, s, prior());
+  g.noise = 3.0 * testing::kNominalNoise;
+  const CalibrationOutcome o = testing::calibrateTableSession(g, TableImperfections(), two, s, referencePrior());
   std::printf("+ - at 3x noise: K0 sigma x%.2f, correlation %.2f: %s\n", o.bias_trend.k0_inflation,
               o.bias_trend.k0_correlation, o.reason.c_str());
   EXPECT_FALSE(o.accepted);
@@ -201,7 +201,7 @@ TEST(DriftingBiasTest, ATrendTheSessionCannotSeparateIsRefusedNamingTheOrder) {
   EXPECT_GT(o.bias_trend.k0_inflation, 3.0);
   // Without the trend the same session is accepted: a user who knows the bias is stable says so.
   s.bias_trend_order = 0;
-  const CalibrationOutcome stable = testing::calibrateTableSession(g, TableImperfections(), two, s, prior());
+  const CalibrationOutcome stable = testing::calibrateTableSession(g, TableImperfections(), two, s, referencePrior());
   EXPECT_TRUE(stable.accepted) << stable.reason;
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/testing/angle_level_session.h"
+#include "core/testing/model_errors.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -27,13 +28,8 @@ struct Case {
   double coverage_plateau = 150;  ///< s per plateau in the coverage sessions (gaps need longer)
 };
 
-constexpr double kNominalNoise = 1.1e-5;  // rad per wave sample at 1 kHz
-
-GyroParameters prior() {
-  GyroParameters p;
-  p.earth_rate.latitude = 0.9;
-  return p;
-}
+using testing::kNominalNoise;
+using testing::referencePrior;
 
 CalibrationSettings settings() {
   CalibrationSettings s;
@@ -53,9 +49,7 @@ HarmonicModel strongK() { return HarmonicModel({2, 4, 6, 8}, -0.56, {-6e-4, -0.0
 
 std::vector<Case> cases() {
   std::vector<Case> out;
-  AngleLevelGyro g = testing::referenceGyro();
-  g.k = HarmonicModel({2, 4, 6, 8}, -0.56, {-6e-4, 2e-3, 1e-4, -5e-5}, {4e-4, 0.0, -1e-4, 0.0});
-  g.noise = kNominalNoise;
+  AngleLevelGyro g = testing::nominalGyro(7);
   TableImperfections perfect;
   out.push_back({"nominal", g, perfect});
   TableImperfections ripple;
@@ -83,12 +77,6 @@ std::vector<Case> cases() {
   gaps.gap_length = 1.5;
   out.push_back({"1 % dropped samples, 1.5 s gap every 47 s", g, gaps, true, 180});
   return out;
-}
-
-double maxHarmonicStdPpm(const HarmonicFitResult& k) {
-  double m = 0.0;
-  for (std::size_t j = 0; j < k.orders.size(); ++j) m = std::max({m, k.cos_std[j], k.sin_std[j]});
-  return 1e6 * m / std::abs(k.mean);
 }
 
 TEST(DualRateAccuracyTest, TableSessionIsFastAndLogsTheAngleTurned) {
@@ -142,11 +130,11 @@ TEST(DualRateAccuracyTest, PeakErrorAgainstTheExactModelPerImperfection) {
   for (const Case& c : all) {
     const auto start = std::chrono::steady_clock::now();
     const CalibrationOutcome o = testing::calibrateTableSession(
-        c.gyro, c.table, testing::dualRateProfile(0.05, -0.05, 300.0), settings(), prior());
+        c.gyro, c.table, testing::dualRateProfile(0.05, -0.05, 300.0), settings(), referencePrior());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     ASSERT_TRUE(o.accepted) << c.name << ": " << o.reason;
     const double peak = testing::peakErrorPpm(o.parameters.scale_factor, c.gyro.k);
-    const double sigma = maxHarmonicStdPpm(o.scale_factor[0]);
+    const double sigma = testing::maxHarmonicStdPpm(o.scale_factor[0]);
     std::printf("%-50s peak K error %.3f ppm, largest reported harmonic sigma %.3f ppm (%.2f s)\n", c.name.c_str(),
                 peak, sigma, seconds);
     if (c.nominal_noise) {
@@ -170,7 +158,7 @@ TEST(DualRateAccuracyTest, ReportedStandardErrorsCoverTheActualErrors) {
       g.rate_hz = 100.0;
       g.noise = c.gyro.noise * std::sqrt(10.0);
       const CalibrationOutcome o = testing::calibrateTableSession(
-          g, c.table, testing::dualRateProfile(0.05, -0.05, c.coverage_plateau), settings(), prior());
+          g, c.table, testing::dualRateProfile(0.05, -0.05, c.coverage_plateau), settings(), referencePrior());
       ASSERT_TRUE(o.accepted) << c.name << " seed " << seed << ": " << o.reason;
       const HarmonicFitResult& k = o.scale_factor[0];
       const HarmonicModel& truth = c.gyro.k;

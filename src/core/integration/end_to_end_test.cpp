@@ -3,6 +3,7 @@
 // "injected" model it is compared with and the correction-matrix stage.
 #include <gtest/gtest.h>
 
+#include "core/testing/shipped_scenarios.h"
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/simulation/injected_model.h"
@@ -11,9 +12,7 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-SimulationConfig shippedScenario(const std::string& name) {
-  return SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/" + name, nodeOnlyScenarioKeys());
-}
+using testing::shippedScenario;
 
 std::shared_ptr<const GyroParameters> uncalibrated() {
   return std::make_shared<const GyroParameters>(

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/testing/shipped_scenarios.h"
 #include "hrg_gyro/core/calibration/field_command_plan.h"
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
 #include "hrg_gyro/core/resonator/first_order_model.h"
@@ -21,9 +22,7 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-SimulationConfig shippedScenario(const std::string& name) {
-  return SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/" + name, nodeOnlyScenarioKeys());
-}
+using testing::shippedScenario;
 
 CalibrationSettings fieldSettings() {
   CalibrationSettings s;

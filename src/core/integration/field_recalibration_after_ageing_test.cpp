@@ -14,6 +14,9 @@
 #include <chrono>
 #include <cstdio>
 
+#include "core/testing/angle_level_session.h"
+#include "core/testing/model_errors.h"
+#include "core/testing/shipped_scenarios.h"
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
 #include "hrg_gyro/core/simulation/injected_model.h"
 
@@ -21,9 +24,8 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-SimulationConfig shippedScenario(const std::string& name) {
-  return SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/" + name, nodeOnlyScenarioKeys());
-}
+using testing::shippedScenario;
+using testing::worstNormalisedError;
 
 /// The ageing: the shell's damping anisotropy grows by half and its axis turns by 0.5 electrical
 /// rad; the bias from outside the shell moves by 5e-6 rad/s.
@@ -35,27 +37,7 @@ SimulationConfig aged(SimulationConfig c) {
 }
 
 /// The table sessions: +-0.1 rad/s, one full turn of theta per plateau (as resonator_calibration_test).
-TurntableProfile dualRateProfile() {
-  TurntableProfile p;
-  p.append(5.0, 0.0, 0.0, "start");
-  p.append(0.2, 0.0, 0.5, "ramp");
-  p.append(118.0, 0.1, 0.0, "plus");
-  p.append(0.4, 0.1, -0.5, "ramp");
-  p.append(118.0, -0.1, 0.0, "minus");
-  p.append(0.2, -0.1, 0.5, "ramp");
-  p.append(25.0, 0.0, 0.0, "rest");
-  return p;
-}
-
-/// Largest |estimate - reference| / sigma over the terms of a fit (sigmas the estimate's).
-double worstNormalisedError(const HarmonicFitResult& estimate, const HarmonicFitResult& reference) {
-  double worst = std::abs(estimate.mean - reference.mean) / estimate.mean_std;
-  for (std::size_t j = 0; j < estimate.orders.size(); ++j) {
-    worst = std::max(worst, std::abs(estimate.cos[j] - reference.cos[j]) / estimate.cos_std[j]);
-    worst = std::max(worst, std::abs(estimate.sin[j] - reference.sin[j]) / estimate.sin_std[j]);
-  }
-  return worst;
-}
+TurntableProfile dualRateProfile() { return testing::dualRateProfile(0.1, -0.1, 118.0); }
 
 TEST(FieldRecalibrationAfterAgeing, FieldCalibrationRestoresTheDriftAndTheAngleError) {
   const auto start = std::chrono::steady_clock::now();

@@ -10,7 +10,8 @@
 
 #include <cstdio>
 
-#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
+#include "core/testing/model_errors.h"
+#include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/simulation/injected_model.h"
@@ -79,14 +80,9 @@ Measured calibrate(const std::string& name, const SimulationConfig& c, Calibrati
   if (!m.run.outcome.scale_factor.empty() && m.run.outcome.scale_factor[0].ok) {
     const HarmonicFitResult& fit = m.run.outcome.scale_factor[0];
     const HarmonicModel estimate = toModel(fit);
-    const double offset = estimate.meanAt(NAN) - truth.meanAt(NAN);
-    double peak = 0.0;
-    for (int i = 0; i < 2048; ++i) {
-      const double theta = kPi * i / 2048;
-      peak = std::max(peak, std::abs(estimate(theta, NAN) - truth(theta, NAN) - offset));
-    }
-    m.residual_ppm = 1e6 * peak / k0;
-    m.k0_ppm = 1e6 * offset / k0;
+    const testing::ModelResidual residual = testing::residualAgainst(estimate, NAN, truth, NAN, 2048);
+    m.residual_ppm = residual.nonlinearity_ppm;
+    m.k0_ppm = residual.scale_ppm;
     m.k0_sigma_ppm = 1e6 * fit.mean_std / k0;
     double var = 0.0;
     for (std::size_t j = 0; j < fit.orders.size(); ++j)
@@ -138,7 +134,7 @@ TEST(RealSessionImperfectionsTest, GlitchedTableRecords) {
   c.turntable_log.glitches.per_record = {1e-3, 1e-3, 1e-3, 1e-3, 1e-3};
   const Measured m = calibrate("1e-3 glitched records per kind", c);
   expectWithinOnePpm(m);
-  const TurntableRejects& r = m.run.session.rejected;
+  const RotationRecordRejects& r = m.run.session.rejected;
   EXPECT_GT(r.bad_rate + r.bad_angle + r.bad_stamp + r.out_of_order, 0u);
   EXPECT_EQ(m.run.session.restarts, 0u);
 }

@@ -7,6 +7,9 @@
 #include <chrono>
 #include <cstdio>
 
+#include "core/testing/angle_level_session.h"
+#include "core/testing/model_errors.h"
+#include "core/testing/shipped_scenarios.h"
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
 #include "hrg_gyro/core/simulation/injected_model.h"
 
@@ -14,32 +17,14 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-SimulationConfig shippedScenario(const std::string& name) {
-  return SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/" + name, nodeOnlyScenarioKeys());
-}
-
-/// Largest |estimate - injected| / sigma over the terms of a fit.
-double worstNormalisedError(const HarmonicFitResult& estimate, const HarmonicFitResult& injected) {
-  double worst = std::abs(estimate.mean - injected.mean) / estimate.mean_std;
-  for (std::size_t j = 0; j < estimate.orders.size(); ++j) {
-    worst = std::max(worst, std::abs(estimate.cos[j] - injected.cos[j]) / estimate.cos_std[j]);
-    worst = std::max(worst, std::abs(estimate.sin[j] - injected.sin[j]) / estimate.sin_std[j]);
-  }
-  return worst;
-}
+using testing::shippedScenario;
+using testing::worstNormalisedError;
 
 TEST(ResonatorCalibration, DualRateRecoversTheDriftTheDefectsPredict) {
   SimulationConfig c = shippedScenario("resonator_dual_rate.yaml");
   ASSERT_TRUE(c.dynamics.averaged());
   // The shipped session, shortened for test time: +-0.1 rad/s, one full turn of theta per plateau.
-  c.profile = TurntableProfile();
-  c.profile.append(5.0, 0.0, 0.0, "start");
-  c.profile.append(0.2, 0.0, 0.5, "ramp");
-  c.profile.append(118.0, 0.1, 0.0, "plus");
-  c.profile.append(0.4, 0.1, -0.5, "ramp");
-  c.profile.append(118.0, -0.1, 0.0, "minus");
-  c.profile.append(0.2, -0.1, 0.5, "ramp");
-  c.profile.append(25.0, 0.0, 0.0, "rest");
+  c.profile = testing::dualRateProfile(0.1, -0.1, 118.0);
   auto prior = std::make_shared<GyroParameters>();
   prior->earth_rate.latitude = c.latitude;
   CalibrationSettings settings;

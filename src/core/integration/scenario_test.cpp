@@ -212,7 +212,7 @@ TEST(Scenarios, ShippedScenariosParseAndDescribeTheSameGyro) {
                                          "dual_rate_drifting.yaml",
                                          "dual_rate_table_clock.yaml"};
   // Every scenario file is checked here, but diagnosis.yaml (its isotropic resonator differs), the
-  // triad's (TriadScenariosAreWhatTheySay) and the resonator's (ResonatorScenariosDescribeTheSameShell).
+  // triad's (the Triad...Scenario tests) and the resonator's (ResonatorScenariosDescribeTheSameShell).
   std::set<std::string> files;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) files.insert(entry.path().filename().string());
   files.erase("diagnosis.yaml");
@@ -294,21 +294,23 @@ void plateausAndRest(const TurntableProfile& p, std::vector<Plateau>* plateaus, 
 // axis's theta by 2 pi, moves of 10 s; triad_verification.yaml the same triad in tilted positions
 // (the table's axis along a body diagonal) at +-0.08 rad/s; test/scenarios/triad_short.yaml its short
 // form for the tests.
-TEST(Scenarios, TriadScenariosAreWhatTheySay) {
-  const std::string dir = std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/";
-  const TriadSimulationConfig cal = TriadSimulationConfig::load(dir + "triad.yaml", nodeOnlyScenarioKeys());
-  const TriadSimulationConfig ver =
-      TriadSimulationConfig::load(dir + "triad_verification.yaml", nodeOnlyScenarioKeys());
-  const TriadSimulationConfig brief = TriadSimulationConfig::load(
-      std::string(HRG_GYRO_SOURCE_DIR) + "/test/scenarios/triad_short.yaml", nodeOnlyScenarioKeys());
+const std::string kScenarioDir = std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/";
+const std::string kTriadShort = std::string(HRG_GYRO_SOURCE_DIR) + "/test/scenarios/triad_short.yaml";
+/// The calibration's six positions: each axis up, then down.
+const std::vector<std::string> kTriadUps = {"+z", "-z", "+x", "-x", "+y", "-y"};
+
+TriadSimulationConfig loadTriadScenario(const std::string& path) {
+  return TriadSimulationConfig::load(path, nodeOnlyScenarioKeys());
+}
+
+TEST(Scenarios, TriadScenariosShareOneTriadOfTheShippedGyro) {
+  const TriadSimulationConfig cal = loadTriadScenario(kScenarioDir + "triad.yaml");
   // One triad in the three files, word for word.
-  const std::string axes = between(readFile(dir + "triad.yaml"), "  axes:", "  # ---- The session");
-  EXPECT_EQ(between(readFile(dir + "triad_verification.yaml"), "  axes:", "  # ---- The session"), axes);
-  EXPECT_EQ(between(readFile(std::string(HRG_GYRO_SOURCE_DIR) + "/test/scenarios/triad_short.yaml"),
-                    "  axes:", "  # ---- The session"),
-            axes);
+  const std::string axes = between(readFile(kScenarioDir + "triad.yaml"), "  axes:", "  # ---- The session");
+  EXPECT_EQ(between(readFile(kScenarioDir + "triad_verification.yaml"), "  axes:", "  # ---- The session"), axes);
+  EXPECT_EQ(between(readFile(kTriadShort), "  axes:", "  # ---- The session"), axes);
   // The shipped gyro on each axis, a little different on each.
-  const SimulationConfig shipped = SimulationConfig::load(dir + "dual_rate.yaml", nodeOnlyScenarioKeys());
+  const SimulationConfig shipped = SimulationConfig::load(kScenarioDir + "dual_rate.yaml", nodeOnlyScenarioKeys());
   for (int i = 0; i < 3; ++i) {
     SCOPED_TRACE(i);
     const TriadAxisConfig& a = cal.axes[i];
@@ -330,17 +332,19 @@ TEST(Scenarios, TriadScenariosAreWhatTheySay) {
   }
   EXPECT_EQ(cal.axes[0].resonator.scale_factor, shipped.resonator.scale_factor);
   EXPECT_EQ(cal.axes[0].pickoff.misplacement, shipped.pickoff.misplacement);
+}
 
-  // The calibration session: six positions, each axis up and down, a perfect fixture.
-  const std::vector<std::string> ups = {"+z", "-z", "+x", "-x", "+y", "-y"};
-  ASSERT_EQ(cal.positions.size(), ups.size());
+TEST(Scenarios, TriadCalibrationScenarioTurnsEachAxisUpAndDown) {
+  const TriadSimulationConfig cal = loadTriadScenario(kScenarioDir + "triad.yaml");
+  // Six positions, each axis up and down, a perfect fixture.
+  ASSERT_EQ(cal.positions.size(), kTriadUps.size());
   EXPECT_EQ(cal.fixture_error_std, 0.0);
   EXPECT_EQ(cal.turntable.wobble.amplitude, 0.0);
-  for (std::size_t k = 0; k < ups.size(); ++k) {
-    SCOPED_TRACE(ups[k]);
+  for (std::size_t k = 0; k < kTriadUps.size(); ++k) {
+    SCOPED_TRACE(kTriadUps[k]);
     const FixturePositionConfig& p = cal.positions[k];
     Eigen::Matrix3d r;
-    ASSERT_TRUE(rotationForUp(ups[k], &r));
+    ASSERT_TRUE(rotationForUp(kTriadUps[k], &r));
     EXPECT_EQ(p.nominal, r);
     EXPECT_EQ(p.error, Eigen::Vector3d::Zero());
     EXPECT_EQ(p.move, k == 0 ? 0.0 : 10.0);
@@ -349,7 +353,7 @@ TEST(Scenarios, TriadScenariosAreWhatTheySay) {
     plateausAndRest(p.profile, &plateaus, &rest);
     EXPECT_GE(rest, 60.0);
     ASSERT_EQ(plateaus.size(), 4u);
-    const int up = ups[k][1] - 'x';
+    const int up = kTriadUps[k][1] - 'x';
     for (const Plateau& q : plateaus) {
       EXPECT_EQ(std::abs(q.rate), 0.05);
       // The up axis's theta sweeps at least 2 pi on each plateau (today's dual-rate coverage).
@@ -357,9 +361,12 @@ TEST(Scenarios, TriadScenariosAreWhatTheySay) {
     }
   }
   EXPECT_NEAR(cal.duration(), 5910.8, 1e-6);
+}
 
-  // The verification session: every axis senses 1/sqrt(3) of the table's rate, +-0.08 rad/s, and each
-  // plateau sweeps every axis's theta by at least 2 pi.
+TEST(Scenarios, TriadVerificationScenarioTurnsTheTableAboutBodyDiagonals) {
+  const TriadSimulationConfig ver = loadTriadScenario(kScenarioDir + "triad_verification.yaml");
+  // Every axis senses 1/sqrt(3) of the table's rate, +-0.08 rad/s, and each plateau sweeps every
+  // axis's theta by at least 2 pi.
   EXPECT_GE(ver.positions.size(), 4u);
   for (const FixturePositionConfig& p : ver.positions) {
     SCOPED_TRACE(p.name);
@@ -387,13 +394,16 @@ TEST(Scenarios, TriadScenariosAreWhatTheySay) {
     diagonals.col(static_cast<Eigen::Index>(k)) = ver.positions[k].nominal.transpose() * Eigen::Vector3d::UnitZ();
   }
   EXPECT_EQ(Eigen::FullPivLU<Eigen::MatrixXd>(diagonals).rank(), 3);
+}
 
-  // The tests' short session: the calibration's positions at +-0.4 rad/s, one plateau of each, ten minutes.
-  ASSERT_EQ(brief.positions.size(), ups.size());
-  for (std::size_t k = 0; k < ups.size(); ++k) {
+TEST(Scenarios, TriadShortScenarioIsTheCalibrationInTenMinutes) {
+  const TriadSimulationConfig brief = loadTriadScenario(kTriadShort);
+  // The calibration's positions at +-0.4 rad/s, one plateau of each, ten minutes.
+  ASSERT_EQ(brief.positions.size(), kTriadUps.size());
+  for (std::size_t k = 0; k < kTriadUps.size(); ++k) {
     Eigen::Matrix3d r;
-    rotationForUp(ups[k], &r);
-    EXPECT_EQ(brief.positions[k].nominal, r) << ups[k];
+    rotationForUp(kTriadUps[k], &r);
+    EXPECT_EQ(brief.positions[k].nominal, r) << kTriadUps[k];
     std::vector<Plateau> plateaus;
     double rest;
     plateausAndRest(brief.positions[k].profile, &plateaus, &rest);

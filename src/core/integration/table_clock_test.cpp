@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/testing/angle_level_session.h"
+#include "core/testing/model_errors.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -16,26 +17,10 @@ namespace {
 using testing::AngleLevelGyro;
 using testing::TableImperfections;
 
-constexpr double kNominalNoise = 1.1e-5;  // rad per wave sample at 1 kHz
-
-GyroParameters prior() {
-  GyroParameters p;
-  p.earth_rate.latitude = 0.9;
-  return p;
-}
-
 CalibrationSettings settings() {
   CalibrationSettings s;
   s.method = CalibrationMethodKind::kDualRate;
   return s;
-}
-
-AngleLevelGyro gyro(std::uint64_t seed) {
-  AngleLevelGyro g = testing::referenceGyro();
-  g.k = HarmonicModel({2, 4, 6, 8}, -0.56, {-6e-4, 2e-3, 1e-4, -5e-5}, {4e-4, 0.0, -1e-4, 0.0});
-  g.noise = kNominalNoise;
-  g.seed = seed;
-  return g;
 }
 
 /// A controller on its own clock: 100 Hz, a 2 urad encoder, the drive's rate, offset and jitter.
@@ -49,27 +34,22 @@ TableImperfections ownClock(double offset, double jitter) {
   return t;
 }
 
-double maxHarmonicStdPpm(const HarmonicFitResult& k) {
-  double m = 0.0;
-  for (std::size_t j = 0; j < k.orders.size(); ++j) m = std::max({m, k.cos_std[j], k.sin_std[j]});
-  return 1e6 * m / std::abs(k.mean);
-}
-
 TEST(TableClockTest, AnOffsetAndJitterAreMeasuredAndLeaveKWithin1Ppm) {
   const TurntableProfile profile = testing::dualRateProfile(0.05, -0.05, 226.0, 2);
-  const AngleLevelGyro g = gyro(21);
+  const AngleLevelGyro g = testing::nominalGyro(21);
   const TableImperfections table = ownClock(0.1, 2e-3);
-  const CalibrationOutcome o = testing::calibrateTableSession(g, table, profile, settings(), prior());
+  const CalibrationOutcome o = testing::calibrateTableSession(g, table, profile, settings(), testing::referencePrior());
   ASSERT_TRUE(o.accepted) << o.reason;
   const double peak = testing::peakErrorPpm(toModel(o.scale_factor[0]), g.k);
   const TableClockReport& c = o.table_clock;
   CalibrationSettings as_logged = settings();
   as_logged.table_clock.regularise = false;
-  const CalibrationOutcome raw = testing::calibrateTableSession(g, table, profile, as_logged, prior());
+  const CalibrationOutcome raw =
+      testing::calibrateTableSession(g, table, profile, as_logged, testing::referencePrior());
   std::printf(
       "table at 100 Hz, offset 100 ms, jitter 2 ms: peak K error %.2f ppm (sigma %.3f ppm); offset %.3f +- "
       "%.3f ms from %zu changes, jitter %.3f ms; stamps as logged: %s\n",
-      peak, maxHarmonicStdPpm(o.scale_factor[0]), 1e3 * c.offset.offset, 1e3 * c.offset.offset_std,
+      peak, testing::maxHarmonicStdPpm(o.scale_factor[0]), 1e3 * c.offset.offset, 1e3 * c.offset.offset_std,
       c.offset.transitions.size(), 1e3 * c.stamps.jitter, raw.reason.c_str());
   EXPECT_LE(peak, 1.0);
   EXPECT_TRUE(c.stamps.fixed_rate) << c.stamps.note;
@@ -88,11 +68,11 @@ TEST(TableClockTest, AnOffsetAndJitterAreMeasuredAndLeaveKWithin1Ppm) {
 
 TEST(TableClockTest, AClockStepIsFollowedAndShowsInTheOffsets) {
   const TurntableProfile profile = testing::dualRateProfile(0.05, -0.05, 226.0, 2);
-  const AngleLevelGyro g = gyro(22);
+  const AngleLevelGyro g = testing::nominalGyro(22);
   TableImperfections table = ownClock(0.05, 1e-3);
   table.clock_step_at = 480.0;  // between the second and the third plateau
   table.clock_step = 0.025;     // two and a half records: a whole number would look like lost records
-  const CalibrationOutcome o = testing::calibrateTableSession(g, table, profile, settings(), prior());
+  const CalibrationOutcome o = testing::calibrateTableSession(g, table, profile, settings(), testing::referencePrior());
   ASSERT_TRUE(o.accepted) << o.reason;
   const TableClockReport& c = o.table_clock;
   std::printf("clock step of 25 ms: %llu step(s) found, offsets: %s; peak K error %.2f ppm\n",
@@ -110,10 +90,10 @@ TEST(TableClockTest, AClockRunningAtAnotherRateIsMeasuredAndKUndoneOfIt) {
   // A table computer whose clock runs 10 ppm fast: the table angle is stretched by 10 ppm against the
   // gyro's time, and K with it. The offsets' drift over the session measures it.
   const TurntableProfile profile = testing::dualRateProfile(0.05, -0.05, 226.0, 2);
-  const AngleLevelGyro g = gyro(24);
+  const AngleLevelGyro g = testing::nominalGyro(24);
   TableImperfections table = ownClock(0.05, 1e-3);
   table.clock_rate_error = 1e-5;
-  const CalibrationOutcome o = testing::calibrateTableSession(g, table, profile, settings(), prior());
+  const CalibrationOutcome o = testing::calibrateTableSession(g, table, profile, settings(), testing::referencePrior());
   ASSERT_TRUE(o.accepted) << o.reason;
   const TableClockReport& c = o.table_clock;
   const double k0_error = 1e6 * (o.scale_factor[0].mean - g.k.meanAt(NAN)) / 0.56;
@@ -131,9 +111,9 @@ TEST(TableClockTest, AClockRunningAtAnotherRateIsMeasuredAndKUndoneOfIt) {
 
 TEST(TableClockTest, AnOffsetBeyondTheLimitIsRefusedWithTheValueToSet) {
   const TurntableProfile profile = testing::dualRateProfile(0.05, -0.05, 150.0, 1);
-  const AngleLevelGyro g = gyro(23);
+  const AngleLevelGyro g = testing::nominalGyro(23);
   const TableImperfections table = ownClock(0.8, 1e-3);
-  const CalibrationOutcome o = testing::calibrateTableSession(g, table, profile, settings(), prior());
+  const CalibrationOutcome o = testing::calibrateTableSession(g, table, profile, settings(), testing::referencePrior());
   std::printf("offset 800 ms: %s\n", o.reason.c_str());
   EXPECT_FALSE(o.accepted);
   EXPECT_EQ(o.reason.rfind("table_clock: the table's stamps are 8", 0), 0u) << o.reason;
@@ -141,7 +121,8 @@ TEST(TableClockTest, AnOffsetBeyondTheLimitIsRefusedWithTheValueToSet) {
   // Told the offset, the session is accepted and what is left of it is nothing.
   CalibrationSettings told = settings();
   told.table_clock.offset = 0.8;
-  const CalibrationOutcome corrected = testing::calibrateTableSession(g, table, profile, told, prior());
+  const CalibrationOutcome corrected =
+      testing::calibrateTableSession(g, table, profile, told, testing::referencePrior());
   ASSERT_TRUE(corrected.accepted) << corrected.reason;
   EXPECT_NEAR(corrected.table_clock.offset.offset, 0.0, 1e-3);
 }
@@ -151,8 +132,9 @@ TEST(TableClockTest, ReportedSigmasCoverTheErrorOver20Seeds) {
   int within = 0, total = 0, offsets_within = 0;
   double worst_peak = 0.0;
   for (int seed = 1; seed <= 20; ++seed) {
-    const AngleLevelGyro g = gyro(2000 + seed);
-    const CalibrationOutcome o = testing::calibrateTableSession(g, ownClock(0.1, 2e-3), profile, settings(), prior());
+    const AngleLevelGyro g = testing::nominalGyro(2000 + seed);
+    const CalibrationOutcome o =
+        testing::calibrateTableSession(g, ownClock(0.1, 2e-3), profile, settings(), testing::referencePrior());
     ASSERT_TRUE(o.accepted) << "seed " << seed << ": " << o.reason;
     const HarmonicFitResult& k = o.scale_factor[0];
     double truth[64];

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "core/testing/angle_level_session.h"
+#include "core/testing/model_errors.h"
 #include "hrg_gyro/core/calibration/thermal_method.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
@@ -13,7 +14,7 @@ namespace {
 
 using testing::AngleLevelGyro;
 using testing::calibrateAngleLevel;
-using testing::dualRateProfile;
+using testing::referencePrior;
 
 constexpr double kF0 = 5000.0;
 
@@ -43,12 +44,6 @@ AngleLevelGyro thermalGyro(double f_start, double f_end, double duration) {
   return g;
 }
 
-GyroParameters prior() {
-  GyroParameters p;
-  p.earth_rate.latitude = 0.9;
-  return p;
-}
-
 CalibrationSettings thermalSettings() {
   CalibrationSettings s;
   s.method = CalibrationMethodKind::kThermal;
@@ -60,25 +55,19 @@ CalibrationSettings thermalSettings() {
 /// Peak over theta of |K_est - K_true - (K0_est - K0_true)| / |K0_true| at frequency f, ppm: the
 /// nonlinearity a compensation with K_est leaves.
 double residualNonlinearityPpm(const HarmonicModel& estimate, const HarmonicModel& truth, double f) {
-  const double offset = estimate.meanAt(f) - truth.meanAt(f);
-  double peak = 0.0;
-  for (int i = 0; i < 512; ++i) {
-    const double theta = kPi * i / 512;
-    peak = std::max(peak, std::abs(estimate(theta, f) - truth(theta, f) - offset));
-  }
-  return 1e6 * peak / std::abs(truth.meanAt(f));
+  return testing::residualAgainst(estimate, f, truth, f, 512).nonlinearity_ppm;
 }
 
 double scaleErrorPpm(const HarmonicModel& estimate, const HarmonicModel& truth, double f) {
-  return 1e6 * (estimate.meanAt(f) - truth.meanAt(f)) / std::abs(truth.meanAt(f));
+  return testing::residualAgainst(estimate, f, truth, f, 512).scale_ppm;
 }
 
 // Plateaus of dual_rate.yaml (4 pairs at +-0.05 rad/s) while the frequency ramps 4996 -> 5004 Hz.
-const TurntableProfile kRampProfile = dualRateProfile(0.05, -0.05, 226.0, 4);
+const TurntableProfile kRampProfile = testing::dualRateProfile(0.05, -0.05, 226.0, 4);
 
 TEST(Thermal, RecoversFrequencyDependentKAndDAcrossARamp) {
   const AngleLevelGyro g = thermalGyro(4996.0, 5004.0, kRampProfile.duration());
-  const CalibrationOutcome o = calibrateAngleLevel(g, kRampProfile, thermalSettings(), prior());
+  const CalibrationOutcome o = calibrateAngleLevel(g, kRampProfile, thermalSettings(), referencePrior());
   ASSERT_TRUE(o.accepted) << o.reason << "\n" << emitCalibrationReport(o);
   // Automatic nodes: 3 by default, evenly over the frequencies seen.
   ASSERT_EQ(o.frequency_nodes.size(), 3u);
@@ -122,10 +111,10 @@ TEST(Thermal, AFrequencyIndependentModelLeavesPpmThatTheSplineRemoves) {
   g.noise = 4.9e-6;
   CalibrationSettings dual = thermalSettings();
   dual.method = CalibrationMethodKind::kDualRate;
-  CalibrationSession thermal_session(thermalSettings(), prior()), dual_session(dual, prior());
+  CalibrationSession thermal_session(thermalSettings(), referencePrior()), dual_session(dual, referencePrior());
   testing::runAngleLevel(g, kRampProfile, [&](Nanoseconds t, double angle, double rate, double theta, double f) {
     for (CalibrationSession* s : {&thermal_session, &dual_session}) {
-      s->addTurntable(t, angle, rate);
+      s->addRotationRecord(t, angle, rate);
       s->addWave(t, theta, f);
     }
   });
@@ -158,7 +147,7 @@ TEST(Thermal, StandardErrorsDescribeTheActualErrors) {
   // itself carries deterministic errors of up to 5e-8 in K0 and 1.5e-8 in the 2 theta terms --
   // the dual_rate method noise free errs by the same -- comparable to the standard errors here.)
   const AngleLevelGyro clean = thermalGyro(4996.0, 5004.0, kRampProfile.duration());
-  const CalibrationOutcome reference = calibrateAngleLevel(clean, kRampProfile, thermalSettings(), prior());
+  const CalibrationOutcome reference = calibrateAngleLevel(clean, kRampProfile, thermalSettings(), referencePrior());
   ASSERT_TRUE(reference.accepted) << reference.reason;
   double z2 = 0.0;
   int n = 0;
@@ -166,7 +155,7 @@ TEST(Thermal, StandardErrorsDescribeTheActualErrors) {
     AngleLevelGyro g = clean;
     g.noise = 4.9e-6;
     g.seed = seed;
-    const CalibrationOutcome o = calibrateAngleLevel(g, kRampProfile, thermalSettings(), prior());
+    const CalibrationOutcome o = calibrateAngleLevel(g, kRampProfile, thermalSettings(), referencePrior());
     ASSERT_TRUE(o.accepted) << o.reason;
     ASSERT_EQ(o.frequency_nodes, reference.frequency_nodes);
     for (std::size_t j = 0; j < o.frequency_nodes.size(); ++j) {
@@ -190,7 +179,7 @@ TEST(Thermal, ExplicitNodesAndTheirRange) {
   CalibrationSettings s = thermalSettings();
   s.thermal.frequency_nodes = {4997.0, 5000.0, 5003.0};
   s.thermal.interpolation = Interpolation::kPiecewiseLinear;
-  const CalibrationOutcome o = calibrateAngleLevel(g, kRampProfile, s, prior());
+  const CalibrationOutcome o = calibrateAngleLevel(g, kRampProfile, s, referencePrior());
   ASSERT_TRUE(o.accepted) << o.reason;
   EXPECT_EQ(o.frequency_nodes, s.thermal.frequency_nodes);
   EXPECT_EQ(o.parameters.scale_factor.interpolator().kind(), Interpolation::kPiecewiseLinear);
@@ -214,12 +203,13 @@ TEST(Thermal, RefusesWithoutFrequencyOrCoverage) {
   g.frequency = nullptr;
   g.k = HarmonicModel({2}, -0.56, {1e-4}, {0.0});
   g.d = HarmonicModel(1e-5);
-  CalibrationOutcome o = calibrateAngleLevel(g, dualRateProfile(0.05, -0.05, 120.0), thermalSettings(), prior());
+  CalibrationOutcome o =
+      calibrateAngleLevel(g, testing::dualRateProfile(0.05, -0.05, 120.0), thermalSettings(), referencePrior());
   EXPECT_FALSE(o.accepted);
   EXPECT_NE(o.reason.find("samples"), std::string::npos) << o.reason;
   // A constant frequency spans no range.
   g.frequency = [](double) { return kF0; };
-  o = calibrateAngleLevel(g, dualRateProfile(0.05, -0.05, 120.0), thermalSettings(), prior());
+  o = calibrateAngleLevel(g, testing::dualRateProfile(0.05, -0.05, 120.0), thermalSettings(), referencePrior());
   EXPECT_FALSE(o.accepted);
   EXPECT_NE(o.reason.find("frequency_nodes"), std::string::npos) << o.reason;
   // Too many nodes for one pair of plateaus across the ramp: some node interval misses theta at
@@ -227,7 +217,7 @@ TEST(Thermal, RefusesWithoutFrequencyOrCoverage) {
   g.frequency = [](double t) { return 4996.0 + 8.0 * t / 250.0; };
   CalibrationSettings s = thermalSettings();
   s.thermal.node_count = 6;
-  o = calibrateAngleLevel(g, dualRateProfile(0.05, -0.05, 120.0), s, prior());
+  o = calibrateAngleLevel(g, testing::dualRateProfile(0.05, -0.05, 120.0), s, referencePrior());
   EXPECT_FALSE(o.accepted);
   EXPECT_NE(o.reason.find("coverage"), std::string::npos) << o.reason;
 }
@@ -236,10 +226,10 @@ TEST(Thermal, ProgressAndCompletionFollowTheNodeIntervals) {
   const AngleLevelGyro g = thermalGyro(4996.0, 5004.0, kRampProfile.duration());
   CalibrationSettings s = thermalSettings();
   s.thermal.frequency_nodes = {4996.0, 5000.0, 5004.0};
-  CalibrationSession session(s, prior());
+  CalibrationSession session(s, referencePrior());
   double complete_at = -1.0;
   testing::runAngleLevel(g, kRampProfile, [&](Nanoseconds t, double angle, double rate, double theta, double f) {
-    session.addTurntable(t, angle, rate);
+    session.addRotationRecord(t, angle, rate);
     session.addWave(t, theta, f);
     if (complete_at < 0.0 && session.complete()) complete_at = toSeconds(t);
   });

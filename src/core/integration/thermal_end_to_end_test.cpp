@@ -7,6 +7,8 @@
 #include <chrono>
 
 #include "core/testing/angle_level_session.h"
+#include "core/testing/model_errors.h"
+#include "core/testing/shipped_scenarios.h"
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/simulation/injected_model.h"
@@ -15,26 +17,12 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
-SimulationConfig shippedScenario(const std::string& name) {
-  return SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/" + name, nodeOnlyScenarioKeys());
-}
+using testing::shippedScenario;
 
 /// What a compensation with `estimate` leaves at frequency f against the exact model `truth` of
 /// that temperature: peak nonlinearity and scale error, ppm of |K0|.
-struct Residual {
-  double nonlinearity_ppm = 0.0, scale_ppm = 0.0;
-};
-Residual residualAgainst(const HarmonicModel& estimate, const HarmonicModel& truth, double f) {
-  Residual r;
-  const double k0 = std::abs(truth.meanAt(NAN)), offset = estimate.meanAt(f) - truth.meanAt(NAN);
-  double peak = 0.0;
-  for (int i = 0; i < 512; ++i) {
-    const double theta = kPi * i / 512;
-    peak = std::max(peak, std::abs(estimate(theta, f) - truth(theta, NAN) - offset));
-  }
-  r.nonlinearity_ppm = 1e6 * peak / k0;
-  r.scale_ppm = 1e6 * offset / k0;
-  return r;
+testing::ModelResidual residualAgainst(const HarmonicModel& estimate, const HarmonicModel& truth, double f) {
+  return testing::residualAgainst(estimate, f, truth, NAN, 512);
 }
 
 TEST(ThermalEndToEnd, RampCalibrationBringsTheResidualBelowOnePpmAcrossTheRange) {
@@ -51,7 +39,7 @@ TEST(ThermalEndToEnd, RampCalibrationBringsTheResidualBelowOnePpmAcrossTheRange)
   while (sim.next(&s)) {
     const ProcessorResult r = processor.process({s.stamp, s.z, s.frequency, s.temperature});
     for (CalibrationSession* session : {&thermal_session, &dual_session}) {
-      session->addTurntable(s.stamp, s.truth.table_angle, s.truth.table_rate);
+      session->addRotationRecord(s.stamp, s.truth.table_angle, s.truth.table_rate);
       if (r.has_wave) session->addWave(s.stamp, r.wave.theta, s.frequency);
     }
   }
@@ -91,8 +79,8 @@ TEST(ThermalEndToEnd, RampCalibrationBringsTheResidualBelowOnePpmAcrossTheRange)
         computeEffectiveModel(atTemperature(cal, temperature), prior->correction, thermal_settings.scale_factor_orders,
                               thermal_settings.drift_orders);
     const HarmonicModel truth = toModel(exact.scale_factor);
-    const Residual a = residualAgainst(thermal.parameters.scale_factor, truth, f);
-    const Residual b = residualAgainst(dual.parameters.scale_factor, truth, f);
+    const testing::ModelResidual a = residualAgainst(thermal.parameters.scale_factor, truth, f);
+    const testing::ModelResidual b = residualAgainst(dual.parameters.scale_factor, truth, f);
     std::printf(
         "[ measured ] %4.1f degC %.1f Hz: frequency-independent %6.2f ppm (scale %+6.2f), thermal %.3f ppm "
         "(scale %+.3f)\n",

@@ -2,6 +2,8 @@
 // at each temperature.
 #include <gtest/gtest.h>
 
+#include "core/testing/shipped_scenarios.h"
+#include "core/testing/simulator_pairs.h"
 #include "hrg_gyro/core/simulation/gyro_simulator.h"
 
 namespace hrg_gyro {
@@ -10,9 +12,7 @@ namespace {
 
 YamlField parse(const std::string& text) { return YamlField(YAML::Load(text), ""); }
 
-SimulationConfig shippedScenario(const std::string& name) {
-  return SimulationConfig::load(std::string(HRG_GYRO_SOURCE_DIR) + "/config/scenarios/" + name, nodeOnlyScenarioKeys());
-}
+using testing::shippedScenario;
 
 template <typename F>
 void expectConfigError(F&& f, const std::string& key) {
@@ -109,21 +109,13 @@ TEST(ThermalSimulation, NeutralThermalSectionLeavesTheSignalBitIdentical) {
   neutral.thermal.profile = TemperatureProfile(21.0);
   neutral.thermal.frequency_coefficient = 0.4;
   GyroSimulator a(plain), b(neutral);
-  SimulationSample sa, sb;
-  int n = 0;
-  while (a.next(&sa)) {
-    ASSERT_TRUE(b.next(&sb));
-    ASSERT_EQ(sa.stamp, sb.stamp);
-    for (int i = 0; i < 4; ++i) ASSERT_EQ(sa.z[i], sb.z[i]) << n;
-    EXPECT_EQ(sa.truth.theta, sb.truth.theta);
+  const int n = testing::stepTogether(&a, &b, [](const SimulationSample& sa, const SimulationSample& sb, int) {
     EXPECT_TRUE(std::isnan(sa.temperature) && std::isnan(sa.truth.temperature));
     EXPECT_EQ(sb.temperature, 21.0);
     EXPECT_EQ(sb.truth.temperature, 21.0);
     EXPECT_EQ(sa.frequency, 5000.0);
     EXPECT_EQ(sb.frequency, 5000.0);
-    ++n;
-  }
-  EXPECT_FALSE(b.next(&sb));
+  });
   EXPECT_GT(n, 2000);
 }
 
@@ -145,17 +137,11 @@ TEST(ThermalSimulation, AtConstantTemperatureItIsTheFrozenGyro) {
   EXPECT_DOUBLE_EQ(frozen.resonator.scale_factor(0.0), -0.56 - 5e-7 * 15.0 - 2e-4 + 1.5e-7 * 15.0 + 1e-4);
   EXPECT_DOUBLE_EQ(frozen.resonator.drift(0.0), 1e-5 + 2e-7 * 15.0 + 2e-5 + 1e-7 * 15.0);
   GyroSimulator a(hot), b(frozen);
-  SimulationSample sa, sb;
-  int n = 0;
-  while (a.next(&sa)) {
-    ASSERT_TRUE(b.next(&sb));
-    for (int i = 0; i < 4; ++i) ASSERT_EQ(sa.z[i], sb.z[i]) << n;
-    ASSERT_EQ(sa.truth.theta, sb.truth.theta) << n;
+  const int n = testing::stepTogether(&a, &b, [&](const SimulationSample& sa, const SimulationSample&, int) {
     EXPECT_EQ(sa.temperature, 40.0);
     EXPECT_DOUBLE_EQ(sa.frequency, 5000.0 + 0.4 * 15.0);
     EXPECT_DOUBLE_EQ(sa.truth.amplitude, frozen.resonator.amplitude);
-    ++n;
-  }
+  });
   EXPECT_GT(n, 600);
 }
 

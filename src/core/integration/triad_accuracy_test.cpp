@@ -209,32 +209,40 @@ OfflineTriadCalibration calibrateShortSession(const TriadSimulationConfig& scena
   return calibrateOnTriadSimulation(scenario, uncalibratedAxes(), axis_settings, triad_settings, TriadParameters());
 }
 
+/// The short session of `scenario` calibrated and accepted with its six positions, and its matrix
+/// against the prediction (compareWithPrediction); `what` names the disturbance in the printed line.
+struct PredictedMove {
+  TriadOutcome outcome;
+  double moved = 0.0, explained = 0.0;  ///< urad
+};
+void calibrateAgainstPrediction(const TriadSimulationConfig& scenario, const std::string& what, PredictedMove* m) {
+  m->outcome = calibrateShortSession(scenario).outcome;
+  const TriadOutcome& o = m->outcome;
+  ASSERT_TRUE(o.accepted) << o.reason;
+  ASSERT_EQ(o.positions.size(), 6u);
+  compareWithPrediction(scenario, o, &m->moved, &m->explained);
+  std::printf(
+      "[ measured ] %s: the matrix moves by up to %.2f urad; the estimate lies within %.3f urad of the "
+      "prediction; chi-square per axis %.1f %.1f %.1f\n",
+      what.c_str(), m->moved, m->explained, o.fit_chi_square(0), o.fit_chi_square(1), o.fit_chi_square(2));
+}
+
 TEST(TriadAccuracyTest, AFixtureOffByTensOfMicroradiansMovesTheMatrixByWhatItPredicts) {
   TriadSimulationConfig scenario = TriadSimulationConfig::load(source("test/scenarios/triad_short.yaml"));
-  const double e = 40e-6;
+  const double e = 40e-6;  // the printed line's 40 urad
   const Eigen::Vector3d errors[] = {{e, 0, 0}, {0, -e, 0}, {0, e, e}, {-e, 0, e}, {e, e, 0}, {0, 0, -e}};
   ASSERT_EQ(scenario.positions.size(), 6u);
   for (std::size_t p = 0; p < 6; ++p) scenario.positions[p].error = errors[p];
-  const OfflineTriadCalibration run = calibrateShortSession(scenario);
-  const TriadOutcome& o = run.outcome;
-  ASSERT_TRUE(o.accepted) << o.reason;
-  ASSERT_EQ(o.positions.size(), 6u);
-  double moved = 0.0, explained = 0.0;
-  compareWithPrediction(scenario, o, &moved, &explained);
-  std::printf(
-      "[ measured ] fixture errors of %.0f urad: the matrix moves by up to %.2f urad; the estimate lies "
-      "within %.3f urad of the prediction\n",
-      1e6 * e, moved, explained);
-  // The positions then disagree beyond their noise: the fit's chi-square says so, and the reported
-  // standard errors widen with it.
-  std::printf(
-      "[ measured ] chi-square over the positions per axis %.1f %.1f %.1f (3 degrees of freedom); largest "
-      "reported sigma of an angle %.2f urad\n",
-      o.fit_chi_square(0), o.fit_chi_square(1), o.fit_chi_square(2),
-      1e6 * (o.body_to_axis_std.array() * (1.0 - Eigen::Matrix3d::Identity().array())).maxCoeff());
+  PredictedMove m;
+  ASSERT_NO_FATAL_FAILURE(calibrateAgainstPrediction(scenario, "fixture errors of 40 urad", &m));
+  // The positions then disagree beyond their noise (3 degrees of freedom per axis): the fit's
+  // chi-square says so, and the reported standard errors widen with it.
+  const TriadOutcome& o = m.outcome;
+  std::printf("[ measured ] largest reported sigma of an angle %.2f urad\n",
+              1e6 * (o.body_to_axis_std.array() * (1.0 - Eigen::Matrix3d::Identity().array())).maxCoeff());
   EXPECT_GT(o.fit_chi_square.maxCoeff(), 30.0);
-  EXPECT_GT(moved, 10.0);
-  EXPECT_LE(explained, 2.0);
+  EXPECT_GT(m.moved, 10.0);
+  EXPECT_LE(m.explained, 2.0);
 }
 
 // A platter that wobbles tilts the fixture by the same rotation, fixed in the platter, in every
@@ -244,18 +252,10 @@ TEST(TriadAccuracyTest, APlatterThatWobblesMovesTheMatrixByWhatItPredicts) {
   TriadSimulationConfig scenario = TriadSimulationConfig::load(source("test/scenarios/triad_short.yaml"));
   scenario.turntable.wobble.amplitude = 40e-6;
   scenario.turntable.wobble.direction = 0.5;  // rad from the platter's x: both parts present
-  const OfflineTriadCalibration run = calibrateShortSession(scenario);
-  const TriadOutcome& o = run.outcome;
-  ASSERT_TRUE(o.accepted) << o.reason;
-  ASSERT_EQ(o.positions.size(), 6u);
-  double moved = 0.0, explained = 0.0;
-  compareWithPrediction(scenario, o, &moved, &explained);
-  std::printf(
-      "[ measured ] a platter wobbling by 40 urad: the matrix moves by up to %.2f urad; the estimate lies "
-      "within %.3f urad of the prediction; chi-square per axis %.1f %.1f %.1f\n",
-      moved, explained, o.fit_chi_square(0), o.fit_chi_square(1), o.fit_chi_square(2));
-  EXPECT_GT(moved, 5.0);
-  EXPECT_LE(explained, 2.0);
+  PredictedMove m;
+  ASSERT_NO_FATAL_FAILURE(calibrateAgainstPrediction(scenario, "a platter wobbling by 40 urad", &m));
+  EXPECT_GT(m.moved, 5.0);
+  EXPECT_LE(m.explained, 2.0);
 }
 
 }  // namespace

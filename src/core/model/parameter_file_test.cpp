@@ -12,11 +12,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <set>
 #include <sstream>
 
 #include "core/testing/concurrent_writers.h"
+#include "core/testing/uniform_draws.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -104,13 +104,12 @@ TEST(ParameterFileTest, ValidTextParses) {
 }
 
 TEST(ParameterFileTest, RoundTripIsExact) {
-  std::mt19937_64 rng(1);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  testing::UniformDraws u(1);
   for (int trial = 0; trial < 50; ++trial) {
     GyroParameters p = sampleParameters();
-    p.scale_factor = HarmonicModel({2, 4}, -0.3 - 0.3 * std::abs(u(rng)), {1e-3 * u(rng), 1e-4 * u(rng)},
-                                   {1e-3 * u(rng), std::ldexp(u(rng), -40)});
-    p.correction.p = {1e-3 * u(rng), 1e-3 * u(rng), 1e-3 * u(rng), 1e-3 * u(rng)};
+    p.scale_factor =
+        HarmonicModel({2, 4}, -0.3 - 0.3 * std::abs(u()), {1e-3 * u(), 1e-4 * u()}, {1e-3 * u(), std::ldexp(u(), -40)});
+    p.correction.p = {1e-3 * u(), 1e-3 * u(), 1e-3 * u(), 1e-3 * u()};
     const std::string text = emitParameters(p);
     const GyroParameters back = parseParameterText(text);
     EXPECT_TRUE(back == p) << text;

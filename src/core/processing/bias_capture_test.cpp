@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <random>
 
 #include "hrg_gyro/core/common/yaml_field.h"
@@ -90,29 +91,28 @@ TEST(BiasCaptureTest, AngleNoiseAveragesOut) {
   EXPECT_NEAR(r.new_d0, 2e-4, 5 * std::sqrt(2.0) * sigma / 10.0 * 0.56 + 1e-9);
 }
 
-TEST(BiasCaptureTest, RefusesMotion) {
+/// A capture of `duration` s on a gyro whose table turns at `rate(t)`, run for `run_for` s.
+BiasCaptureResult captureWhileTurning(double duration, const std::function<double(double)>& rate, double run_for) {
   const GyroParameters real = truth(1e-4);
   BiasCaptureSettings settings;
-  settings.duration = 10.0;
+  settings.duration = duration;
   BiasCapture capture(settings, real);
+  run(&capture, real, real, rate, run_for);
+  return capture.result();
+}
+
+TEST(BiasCaptureTest, RefusesMotion) {
   // Someone turns the table by 0.01 rad/s for a second in the middle.
-  run(
-      &capture, real, real, [](double t) { return t > 4.0 && t < 5.0 ? 0.01 : 0.0; }, 20.0);
-  ASSERT_TRUE(capture.finished());
-  const BiasCaptureResult r = capture.result();
+  const BiasCaptureResult r = captureWhileTurning(
+      10.0, [](double t) { return t > 4.0 && t < 5.0 ? 0.01 : 0.0; }, 20.0);
   EXPECT_FALSE(r.accepted);
   EXPECT_NE(r.reason.find("moved"), std::string::npos) << r.reason;
   EXPECT_LT(r.seconds, 6.0);  // ended as soon as the motion was seen
 }
 
 TEST(BiasCaptureTest, RefusesConstantRotation) {
-  const GyroParameters real = truth(1e-4);
-  BiasCaptureSettings settings;
-  settings.duration = 5.0;
-  BiasCapture capture(settings, real);
-  run(
-      &capture, real, real, [](double) { return 0.02; }, 10.0);
-  const BiasCaptureResult r = capture.result();
+  const BiasCaptureResult r = captureWhileTurning(
+      5.0, [](double) { return 0.02; }, 10.0);
   EXPECT_FALSE(r.accepted);
   EXPECT_NE(r.reason.find("turning"), std::string::npos) << r.reason;
 }

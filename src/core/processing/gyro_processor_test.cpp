@@ -254,14 +254,6 @@ TEST(FrequencyInterpolatorRangeTest, ASingleNodeIsValidAtEveryFiniteFrequency) {
   EXPECT_FALSE(nodes.inRange(5011.0));
 }
 
-}  // namespace
-}  // namespace core
-}  // namespace hrg_gyro
-
-namespace hrg_gyro {
-namespace core {
-namespace {
-
 TEST(GyroProcessorModelSwapTest, ANewCorrectionMatrixDoesNotStepTheAngle) {
   auto p = std::make_shared<GyroParameters>();
   GyroProcessor proc(ProcessorConfig{}, p);
@@ -327,14 +319,6 @@ TEST(ProcessorConfigTest, AcceptsTheDefaultsAndNamesTheKeyOfEachRefusal) {
     EXPECT_THROW(validate(c), ConfigError);
   }
 }
-
-}  // namespace
-}  // namespace core
-}  // namespace hrg_gyro
-
-namespace hrg_gyro {
-namespace core {
-namespace {
 
 // Every field of two results, bit for bit (NaN included).
 void expectIdentical(const ProcessorResult& a, const ProcessorResult& b, std::size_t i) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <random>
 
+#include "core/testing/refusal.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
 
@@ -97,20 +98,10 @@ TEST(RateNoiseEstimatorTest, PrecessedOutputsAreNoNoiseOfTheGyro) {
 TEST(RateNoiseEstimatorTest, RefusesAPerfectGyroAndNamesTheParameter) {
   RateNoiseSettings s;
   s.configured_variance = 0.0;
-  try {
-    RateNoiseEstimator e(s);
-    FAIL() << "a zero variance was accepted";
-  } catch (const ConfigError& e) {
-    EXPECT_EQ(e.key(), "angular_velocity_variance");
-  }
+  EXPECT_EQ(refusedKey([&] { RateNoiseEstimator e(s); }), "angular_velocity_variance");
   s.configured_variance = -1.0;
   s.initial_variance = NAN;
-  try {
-    RateNoiseEstimator e(s);
-    FAIL() << "a NaN initial variance was accepted";
-  } catch (const ConfigError& e) {
-    EXPECT_EQ(e.key(), "initial_angular_velocity_variance");
-  }
+  EXPECT_EQ(refusedKey([&] { RateNoiseEstimator e(s); }), "initial_angular_velocity_variance");
 }
 
 }  // namespace

@@ -12,9 +12,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include "core/testing/refusal.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
 
@@ -460,42 +465,24 @@ TEST(TriadCombinerTest, AVarianceStandsUntilTheNextOne) {
 }
 
 TEST(TriadCombinerTest, BadSettingsNameTheirParameter) {
-  auto key = [](TriadCombinerSettings s) {
-    try {
-      s.validate();
-    } catch (const ConfigError& e) {
-      return e.key();
-    }
-    return std::string();
-  };
-  TriadCombinerSettings s;
-  EXPECT_EQ(key(s), "");
-  s.stamp_tolerance = -1e-3;
-  EXPECT_EQ(key(s), "stamp_tolerance");
-  s = TriadCombinerSettings();
-  s.max_wait = 0.0;
-  EXPECT_EQ(key(s), "max_wait");
-  s = TriadCombinerSettings();
-  s.max_pending = 0;
-  EXPECT_EQ(key(s), "max_pending");
-  s = TriadCombinerSettings();
-  s.initial_rate_variance = NAN;
-  EXPECT_EQ(key(s), "initial_angular_velocity_variance");
-  s.initial_rate_variance = 5e-324;
-  EXPECT_EQ(key(s), "initial_angular_velocity_variance");
-  s = TriadCombinerSettings();
-  s.max_rate = INFINITY;
-  EXPECT_EQ(key(s), "max_rate");
-  s = TriadCombinerSettings();
-  s.backward_reset = NAN;
-  EXPECT_EQ(key(s), "backward_reset");
-  s = TriadCombinerSettings();
-  s.forward_jump = 0.0;
-  EXPECT_EQ(key(s), "forward_jump");
-  s = TriadCombinerSettings();
-  s.jump_persist = 0;
-  EXPECT_EQ(key(s), "jump_persist");
-  EXPECT_THROW(TriadCombiner(s, misalignedTriad()), std::invalid_argument);
+  EXPECT_EQ(refusedKey([] { TriadCombinerSettings().validate(); }), "accepted");
+  // Each setting spoiled alone in otherwise default settings, and the key the refusal must name.
+  const std::vector<std::pair<std::function<void(TriadCombinerSettings*)>, std::string>> spoiled = {
+      {[](TriadCombinerSettings* s) { s->stamp_tolerance = -1e-3; }, "stamp_tolerance"},
+      {[](TriadCombinerSettings* s) { s->max_wait = 0.0; }, "max_wait"},
+      {[](TriadCombinerSettings* s) { s->max_pending = 0; }, "max_pending"},
+      {[](TriadCombinerSettings* s) { s->initial_rate_variance = NAN; }, "initial_angular_velocity_variance"},
+      {[](TriadCombinerSettings* s) { s->initial_rate_variance = 5e-324; }, "initial_angular_velocity_variance"},
+      {[](TriadCombinerSettings* s) { s->max_rate = INFINITY; }, "max_rate"},
+      {[](TriadCombinerSettings* s) { s->backward_reset = NAN; }, "backward_reset"},
+      {[](TriadCombinerSettings* s) { s->forward_jump = 0.0; }, "forward_jump"},
+      {[](TriadCombinerSettings* s) { s->jump_persist = 0; }, "jump_persist"}};
+  for (const auto& [spoil, key] : spoiled) {
+    TriadCombinerSettings s;
+    spoil(&s);
+    EXPECT_EQ(refusedKey([&] { s.validate(); }), key);
+    EXPECT_THROW(TriadCombiner(s, misalignedTriad()), std::invalid_argument) << key;
+  }
 }
 
 // A value from a menu that a broken stream, a bad clock and a fuzzer would send.

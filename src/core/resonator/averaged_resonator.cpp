@@ -40,7 +40,7 @@ ModalForce toModalForce(const WaveFrameForce& w, double cos_theta, double sin_th
   return f;
 }
 
-AveragedResonator::AveragedResonator(const ResonatorParameters& parameters) : parameters_(parameters) {
+AveragedResonator::AveragedResonator(const ShellParameters& parameters) : parameters_(parameters) {
   parameters_.validate();
   w0_ = parameters_.angularFrequency();
   inverse_damping_time_ = 1.0 / parameters_.damping_time;

@@ -6,9 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 #include <vector>
 
+#include "core/testing/resonator_cases.h"
+#include "core/testing/uniform_draws.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
 
@@ -17,30 +18,25 @@ namespace core {
 namespace {
 
 TEST(ResonatorAveragedEquations, WaveFrameAndModalForcesAreInverses) {
-  std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  testing::UniformDraws u(7);
   for (int i = 0; i < 200; ++i) {
-    const double theta = 4.0 * u(rng), tau = 4.0 * u(rng), w0 = 3000.0;
-    WaveFrameForce w{u(rng), u(rng), u(rng), u(rng)};
+    const double theta = 4.0 * u(), tau = 4.0 * u(), w0 = 3000.0;
+    WaveFrameForce w{u(), u(), u(), u()};
     const ModalForce f = toModalForce(w, std::cos(theta), std::sin(theta), std::cos(tau), std::sin(tau), w0);
     const WaveFrameForce back = toWaveFrame(f, std::cos(theta), std::sin(theta), std::cos(tau), std::sin(tau), w0);
-    EXPECT_NEAR(back.antinode_velocity, w.antinode_velocity, 1e-13);
-    EXPECT_NEAR(back.antinode_displacement, w.antinode_displacement, 1e-13);
-    EXPECT_NEAR(back.node_velocity, w.node_velocity, 1e-13);
-    EXPECT_NEAR(back.node_displacement, w.node_displacement, 1e-13);
+    testing::expectNear(back, w, 1e-13);
   }
 }
 
 TEST(ResonatorAveragedEquations, IdealShellTurnsAtK0TimesTheBodyRateWhateverTheQuadratureAndForce) {
-  ResonatorParameters p;  // no anisotropy: only the mean damping and the Coriolis coupling
+  ShellParameters p;  // no anisotropy: only the mean damping and the Coriolis coupling
   const AveragedResonator resonator(p);
-  std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  testing::UniformDraws u(11);
   for (int i = 0; i < 100; ++i) {
-    const WaveParameters wave{1.0 + 0.2 * u(rng), 0.3 * u(rng), 5.0 * u(rng), 3.0 * u(rng)};
-    const double rate = 2.0 * u(rng);
+    const WaveParameters wave{1.0 + 0.2 * u(), 0.3 * u(), 5.0 * u(), 3.0 * u()};
+    const double rate = 2.0 * u();
     // A force with no node-velocity or antinode-displacement part changes A and B only.
-    const WaveFrameForce w{u(rng), 0.0, 0.0, u(rng)};
+    const WaveFrameForce w{u(), 0.0, 0.0, u()};
     const ModalForce f = toModalForce(w, std::cos(wave.theta), std::sin(wave.theta), std::cos(wave.phase),
                                       std::sin(wave.phase), p.angularFrequency());
     const WaveRates r = resonator.rates(wave, rate, f, 0.0);
@@ -53,7 +49,7 @@ TEST(ResonatorAveragedEquations, IdealShellTurnsAtK0TimesTheBodyRateWhateverTheQ
 
 // The oscillator of the header, integrated at the carrier: x, y and their rates.
 struct Oscillator {
-  ResonatorParameters p;
+  ShellParameters p;
   double omega;  // body rate, rad/s
   ModalForce f;
 
@@ -87,7 +83,7 @@ struct Discrepancy {
 // steps per period) and demodulated period by period, against the averaged equations over the same
 // time. The force is scaled with f0 so that the slow motion is the same at every f0.
 Discrepancy compare(double f0) {
-  ResonatorParameters p;
+  ShellParameters p;
   p.frequency = f0;
   p.bryan_factor = 0.28;
   p.damping_time = 4.0;

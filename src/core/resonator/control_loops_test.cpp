@@ -17,8 +17,8 @@ namespace {
 using testing::runResonator;
 
 // A shell with a split and a damping anisotropy, an ideal drive: the loops see only the shell.
-ResonatorParameters splitShell() {
-  ResonatorParameters p;
+ShellParameters splitShell() {
+  ShellParameters p;
   p.damping_time = 600.0;
   p.damping_anisotropy = 4e-5;
   p.damping_axis = 0.4;
@@ -28,7 +28,7 @@ ResonatorParameters splitShell() {
 }
 
 TEST(ResonatorLoops, EnergyLoopRestoresTheSetpointAndItsEffortMeasuresTheDamping) {
-  const ResonatorParameters p = splitShell();
+  const ShellParameters p = splitShell();
   LoopSettings loops;
   ResonatorDynamics d(p, loops, DriveChainErrors(), {0.8, 0.0, 0.3, 0.3});  // E = 0.64, setpoint 1
   // A second-order loop of 5 Hz, damping ratio 0.707: the error's envelope falls as
@@ -48,7 +48,7 @@ TEST(ResonatorLoops, EnergyLoopRestoresTheSetpointAndItsEffortMeasuresTheDamping
 }
 
 TEST(ResonatorLoops, QuadratureLoopNullsBAndItsEffortMeasuresTheSplit) {
-  const ResonatorParameters p = splitShell();
+  const ShellParameters p = splitShell();
   LoopSettings loops;
   ResonatorDynamics d(p, loops, DriveChainErrors(), {1.0, 0.05, 0.2, 0.3});
   // 20 Hz: exp(-zeta wn t) = exp(-88.9 t).
@@ -66,7 +66,7 @@ TEST(ResonatorLoops, QuadratureLoopNullsBAndItsEffortMeasuresTheSplit) {
 }
 
 TEST(ResonatorLoops, PhaseLoopFollowsTheWavesOwnFrequency) {
-  const ResonatorParameters p = splitShell();
+  const ShellParameters p = splitShell();
   LoopSettings loops;
   ResonatorDynamics d(p, loops, DriveChainErrors(), {1.0, 0.0, 0.2, 0.25});  // 50 mrad from the setpoint
   runResonator(&d, 1.0, 0.0, 0.0, false);
@@ -78,7 +78,7 @@ TEST(ResonatorLoops, PhaseLoopFollowsTheWavesOwnFrequency) {
 }
 
 TEST(ResonatorLoops, PrecessionTurnsAnIdealShellAtTheCommandedRate) {
-  ResonatorParameters p;  // isotropic
+  ShellParameters p;  // isotropic
   LoopSettings loops;
   ResonatorDynamics d(p, loops, DriveChainErrors(), {1.0, 0.02, 0.1, 0.3});
   runResonator(&d, 1.0, 0.0, 0.0, false);
@@ -88,7 +88,7 @@ TEST(ResonatorLoops, PrecessionTurnsAnIdealShellAtTheCommandedRate) {
 }
 
 TEST(ResonatorLoops, AnOpenLoopLeavesItsQuantityToTheShell) {
-  ResonatorParameters p;
+  ShellParameters p;
   p.damping_time = 2.0;
   LoopSettings loops;
   loops.energy_bandwidth = 0.0;

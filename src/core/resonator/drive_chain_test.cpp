@@ -6,6 +6,9 @@
 #include <cmath>
 #include <string>
 
+#include "core/testing/refusal.h"
+#include "core/testing/resonator_cases.h"
+
 namespace hrg_gyro {
 namespace core {
 namespace {
@@ -20,10 +23,7 @@ WaveFrameForce throughChain(const DriveChainErrors& e, const WaveFrameForce& com
 TEST(ResonatorDriveChain, AnIdealChainRealisesTheCommand) {
   const WaveFrameForce c{0.3, -0.2, 0.7, 0.1};
   const WaveFrameForce f = throughChain(DriveChainErrors(), c, 0.9, -0.4);
-  EXPECT_NEAR(f.antinode_velocity, c.antinode_velocity, 1e-14);
-  EXPECT_NEAR(f.antinode_displacement, c.antinode_displacement, 1e-14);
-  EXPECT_NEAR(f.node_velocity, c.node_velocity, 1e-14);
-  EXPECT_NEAR(f.node_displacement, c.node_displacement, 1e-14);
+  testing::expectNear(f, c, 1e-14);
 }
 
 TEST(ResonatorDriveChain, ForcerImbalanceTurnsAntinodeForceOntoTheNode) {
@@ -83,10 +83,8 @@ TEST(ResonatorDriveChain, OnTheWaveIsTheChainThroughTheElectrodes) {
       const WaveFrameForce c{0.3, -0.2, 0.7, 0.1};
       const WaveFrameForce via = throughChain(e, c, theta, tau);
       const WaveFrameForce direct = chain.onWave(c, std::cos(2.0 * theta), std::sin(2.0 * theta));
-      EXPECT_NEAR(direct.antinode_velocity, via.antinode_velocity, 1e-14);
-      EXPECT_NEAR(direct.antinode_displacement, via.antinode_displacement, 1e-14);
-      EXPECT_NEAR(direct.node_velocity, via.node_velocity, 1e-14);
-      EXPECT_NEAR(direct.node_displacement, via.node_displacement, 1e-14);
+      SCOPED_TRACE(theta);
+      testing::expectNear(direct, via, 1e-14);
     }
   }
 }
@@ -94,12 +92,8 @@ TEST(ResonatorDriveChain, OnTheWaveIsTheChainThroughTheElectrodes) {
 TEST(ResonatorDriveChain, ErrorsAreValidatedByName) {
   DriveChainErrors e;
   e.phase_error = 2.0;
-  try {
-    DriveChain chain(e);
-    FAIL() << "accepted a lag beyond pi/2";
-  } catch (const std::invalid_argument& ex) {
-    EXPECT_NE(std::string(ex.what()).find("phase_error"), std::string::npos) << ex.what();
-  }
+  const std::string refused = refusal([&] { DriveChain chain(e); });  // a lag beyond pi/2
+  EXPECT_NE(refused.find("phase_error"), std::string::npos) << refused;
   e = DriveChainErrors();
   e.gain_error_s = -1.0;
   EXPECT_THROW(DriveChain{e}, std::invalid_argument);

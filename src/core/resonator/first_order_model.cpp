@@ -6,7 +6,7 @@
 namespace hrg_gyro {
 namespace core {
 
-ResonatorModel firstOrderModel(const ResonatorParameters& p, const LoopSettings& loops, const DriveChainErrors& drive) {
+ResonatorModel firstOrderModel(const ShellParameters& p, const LoopSettings& loops, const DriveChainErrors& drive) {
   p.validate();
   loops.validate();
   drive.validate();
@@ -57,7 +57,7 @@ LoopLag loopLag(const LoopSettings& loops, double bandwidth, double omega) {
 
 }  // namespace
 
-HarmonicModel precessionLagDrift(const ResonatorParameters& p, const LoopSettings& loops, const DriveChainErrors& drive,
+HarmonicModel precessionLagDrift(const ShellParameters& p, const LoopSettings& loops, const DriveChainErrors& drive,
                                  double virtual_rate) {
   firstOrderModel(p, loops, drive);  // the same validation
   if (!std::isfinite(virtual_rate)) throw std::invalid_argument("precession lag: the virtual rate must be finite");

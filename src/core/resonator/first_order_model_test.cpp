@@ -20,6 +20,7 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
+using testing::loopTrackingBound;
 using testing::RateSample;
 using testing::ResonatorCase;
 using testing::runResonator;
@@ -46,20 +47,6 @@ SecondOrder neglected(const ResonatorCase& c) {
         std::max(e.gain, std::abs(m.virtual_rate_gain(theta) - steady.virtualRateGain(theta) * lagFactor(c, m, theta)));
   }
   return e;
-}
-
-// The loops' tracking for a wave turning at `rate` (see steady_state_response_test.cpp).
-double loopTrackingBound(const ResonatorCase& c, double rate, double quadrature_lag) {
-  const LoopSettings& l = c.loops;
-  const double gamma = 0.5 * (c.drive.gain_error_c - c.drive.gain_error_s);
-  const double sweep = 2.0 * std::abs(rate);
-  const double ki_e = l.integralGain(l.energy_bandwidth), ki_q = l.integralGain(l.quadrature_bandwidth);
-  const double energy = l.energy_bandwidth > 0.0 ? gamma * gamma * std::abs(rate) * sweep * sweep / ki_e : 0.0;
-  const double quadrature =
-      0.5 * std::abs(c.shell.frequency_split * std::sin(c.drive.phase_error)) * sweep * sweep / ki_q;
-  const double lag =
-      quadrature_lag * std::abs(rate) * 2.0 * l.damping_ratio * sweep / (kTwoPi * l.quadrature_bandwidth);
-  return energy + quadrature + lag;
 }
 
 HarmonicFitResult fitRates(const std::vector<RateSample>& samples, const std::vector<int>& orders) {

@@ -20,7 +20,7 @@ WaveParameters advanced(const WaveParameters& w, const WaveRates& r, double h) {
 
 }  // namespace
 
-ResonatorDynamics::ResonatorDynamics(const ResonatorParameters& parameters, const LoopSettings& loops,
+ResonatorDynamics::ResonatorDynamics(const ShellParameters& parameters, const LoopSettings& loops,
                                      const DriveChainErrors& drive, const WaveParameters& initial)
     : resonator_(parameters), loops_(loops), drive_(drive), wave_(initial) {
   if (!standing(initial)) {

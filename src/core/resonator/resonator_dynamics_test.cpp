@@ -16,7 +16,7 @@ namespace {
 // No anisotropy, no drive error, the loops still settling from a wave far from their setpoints,
 // a body rate that ramps, holds and reverses: the wave angle is K0 times the body angle, to rounding.
 TEST(ResonatorDynamics, IdealShellTurnsByExactlyK0TimesTheBodyAngle) {
-  ResonatorParameters p;
+  ShellParameters p;
   LoopSettings loops;
   ResonatorDynamics d(p, loops, DriveChainErrors(), {0.85, 0.12, 0.4, -0.5});
   const double k0 = p.scaleFactor(), dt = 1e-3;
@@ -42,7 +42,7 @@ TEST(ResonatorDynamics, IdealShellTurnsByExactlyK0TimesTheBodyAngle) {
 
 TEST(ResonatorDynamics, AStepRunsWholeControlPeriods) {
   LoopSettings loops;  // 5 kHz
-  ResonatorDynamics d(ResonatorParameters(), loops, DriveChainErrors(), {1.0, 0.0, 0.0, 0.3});
+  ResonatorDynamics d(ShellParameters(), loops, DriveChainErrors(), {1.0, 0.0, 0.0, 0.3});
   ASSERT_TRUE(d.step(1e-3, {}));
   EXPECT_EQ(d.controlPeriods(), 5u);
   ASSERT_TRUE(d.step(0.3e-3, {}));  // 1.5 periods: two shorter ones
@@ -53,7 +53,7 @@ TEST(ResonatorDynamics, AStepRunsWholeControlPeriods) {
 }
 
 TEST(ResonatorDynamics, TheAngleRateInputAddsToTheDrift) {
-  ResonatorDynamics d(ResonatorParameters(), LoopSettings(), DriveChainErrors(), {1.0, 0.0, 0.2, 0.3});
+  ResonatorDynamics d(ShellParameters(), LoopSettings(), DriveChainErrors(), {1.0, 0.0, 0.2, 0.3});
   ResonatorInputs in;
   in.angle_rate = 1e-5;
   for (int i = 0; i < 1000; ++i) ASSERT_TRUE(d.step(1e-3, in));
@@ -61,12 +61,12 @@ TEST(ResonatorDynamics, TheAngleRateInputAddsToTheDrift) {
 }
 
 TEST(ResonatorDynamics, RefusesAWaveThatDoesNotStand) {
-  const ResonatorParameters p;
+  const ShellParameters p;
   const LoopSettings l;
   const DriveChainErrors e;
   EXPECT_THROW(ResonatorDynamics(p, l, e, {0.5, 0.5, 0.0, 0.0}), std::invalid_argument);
   EXPECT_THROW(ResonatorDynamics(p, l, e, {1.0, 0.0, NAN, 0.0}), std::invalid_argument);
-  ResonatorParameters bad;
+  ShellParameters bad;
   bad.bryan_factor = 1.2;
   EXPECT_THROW(ResonatorDynamics(bad, l, e, {1.0, 0.0, 0.0, 0.0}), std::invalid_argument);
   ResonatorDynamics d(p, l, e, {1.0, 0.0, 0.0, 0.0});
@@ -74,7 +74,7 @@ TEST(ResonatorDynamics, RefusesAWaveThatDoesNotStand) {
   // A large split with the quadrature loop open and the wave half way between the split's axes: the
   // two modes beat and the wave travels within a quarter of the beat (pi / (2 Dw) = 79 ms); the step
   // says so and keeps the last standing wave.
-  ResonatorParameters split;
+  ShellParameters split;
   split.frequency_split = 20.0;
   split.frequency_axis = -0.25 * kPi;
   LoopSettings open;

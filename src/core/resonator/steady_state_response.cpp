@@ -6,7 +6,7 @@
 namespace hrg_gyro {
 namespace core {
 
-SteadyStateResponse::SteadyStateResponse(const ResonatorParameters& parameters, const LoopSettings& loops,
+SteadyStateResponse::SteadyStateResponse(const ShellParameters& parameters, const LoopSettings& loops,
                                          const DriveChainErrors& drive)
     : parameters_(parameters), drive_(drive) {
   parameters_.validate();

@@ -16,6 +16,7 @@ namespace hrg_gyro {
 namespace core {
 namespace {
 
+using testing::loopTrackingBound;
 using testing::ResonatorCase;
 using testing::runResonator;
 
@@ -52,32 +53,10 @@ TEST(ResonatorSteadyState, AWaveHeldStillDriftsAsTheClosedFormSays) {
   EXPECT_LT(worstRestDeviation(open, &largest), 1e-10);
 }
 
-// What the closed form and the first-order lag leave out for a wave turning at `rate` (rad/s): the
-// loops are PI loops, so a source that changes as the wave turns (at 2 |rate|, d(source)/dt^2 =
-// -(2 rate)^2 source) is followed by an effort short by (2 rate)^2 / ki of it, and the quadrature
-// loop's B trails with a phase 2 zeta (2 rate) / wn beyond the first-order lag. Through the drive chain:
-//   - the energy loop's effort against the precession force's leak onto the antinode
-//     (gamma sin 2th n_v) is short by that much, and leaks back by gamma sin 2th: gamma^2 |rate| (2 rate)^2 / ki_E;
-//   - the quadrature loop's effort against the split (Dw/2), turned into precession by the lag phi:
-//     (Dw/2) |sin phi| (2 rate)^2 / ki_Q;
-//   - the quadrature lag's next order: L |rate| 2 zeta (2 rate) / wn_Q.
-double loopTrackingBound(const ResonatorCase& c, double rate, double quadrature_lag) {
-  const LoopSettings& l = c.loops;
-  const double gamma = 0.5 * (c.drive.gain_error_c - c.drive.gain_error_s);
-  const double sweep = 2.0 * std::abs(rate);
-  const double ki_e = l.integralGain(l.energy_bandwidth), ki_q = l.integralGain(l.quadrature_bandwidth);
-  const double energy = l.energy_bandwidth > 0.0 ? gamma * gamma * std::abs(rate) * sweep * sweep / ki_e : 0.0;
-  const double quadrature =
-      0.5 * std::abs(c.shell.frequency_split * std::sin(c.drive.phase_error)) * sweep * sweep / ki_q;
-  const double lag =
-      quadrature_lag * std::abs(rate) * 2.0 * l.damping_ratio * sweep / (kTwoPi * l.quadrature_bandwidth);
-  return energy + quadrature + lag;
-}
-
 // Sweeping theta through two full turns (4 pi) each way at 2 rad/s electrical: each millisecond's rate
 // against D(theta) + G_v(theta) w_v, scaled by the quadrature loop's lag (first_order_model.h). The
-// measured deviation, 8.3e-8 rad/s, is the loops' tracking above (its bound is 9.2e-8 rad/s here,
-// 7.3e-8 of it the energy loop's); the test allows 1.5 times the bound.
+// measured deviation, 8.3e-8 rad/s, is the loops' tracking (testing::loopTrackingBound; its bound is
+// 9.2e-8 rad/s here, 7.3e-8 of it the energy loop's); the test allows 1.5 times the bound.
 TEST(ResonatorSteadyState, TheVirtualRateIsRealisedWithTheClosedFormGain) {
   const ResonatorCase c = testing::realisticResonator();
   const SteadyStateResponse steady(c.shell, c.loops, c.drive);

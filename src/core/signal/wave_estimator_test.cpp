@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/testing/same_bits.h"
+#include "core/testing/uniform_draws.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/signal/theta_unwrapper.h"
 
@@ -17,14 +18,13 @@ namespace core {
 namespace {
 
 TEST(WaveEstimatorTest, RecoversRandomWaves) {
-  std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  testing::UniformDraws u(11);
   for (int trial = 0; trial < 500; ++trial) {
     WaveParameters w;
-    w.amplitude = 0.2 + std::abs(u(rng));
-    w.quadrature = 0.3 * w.amplitude * u(rng);
-    w.theta = 0.499 * kPi * u(rng);  // principal range of atan2(S, R)/2
-    w.phase = 0.999 * kPi * u(rng);
+    w.amplitude = 0.2 + std::abs(u());
+    w.quadrature = 0.3 * w.amplitude * u();
+    w.theta = 0.499 * kPi * u();  // principal range of atan2(S, R)/2
+    w.phase = 0.999 * kPi * u();
     WaveState s;
     ASSERT_EQ(estimateWave(idealChannels(w), WaveLimits{}, &s), WaveStatus::kOk);
     EXPECT_NEAR(s.theta, w.theta, 1e-12);

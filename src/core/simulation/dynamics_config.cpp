@@ -1,7 +1,13 @@
 #include "hrg_gyro/core/simulation/dynamics_config.h"
 
 #include <cmath>
+#include <initializer_list>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hrg_gyro/core/calibration/calibration_outcome.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -16,6 +22,15 @@ void validateIn(const YamlField& section, const Settings& settings) {
   } catch (const std::invalid_argument& e) {
     section.fail(e.what());
   }
+}
+
+/// A section of numbers: a map of `fields`' keys only, each read over the default it points to.
+void readNumbers(const YamlField& section, std::initializer_list<std::pair<const char*, double*>> fields) {
+  section.requireMap();
+  std::vector<std::string> keys;
+  for (const auto& f : fields) keys.push_back(f.first);
+  section.rejectUnknownKeys(keys);
+  for (const auto& f : fields) *f.second = section.getDouble(f.first, *f.second);
 }
 
 }  // namespace
@@ -33,29 +48,23 @@ DynamicsConfig parseDynamicsSection(const YamlField& d, double frequency, double
   c.shell.frequency = frequency;
   if (d.has("shell")) {
     const YamlField s = d["shell"];
-    s.requireMap();
-    s.rejectUnknownKeys(
-        {"bryan_factor", "damping_time", "damping_anisotropy", "damping_axis", "frequency_split", "frequency_axis"});
-    c.shell.bryan_factor = s.getDouble("bryan_factor", c.shell.bryan_factor);
-    c.shell.damping_time = s.getDouble("damping_time", c.shell.damping_time);
-    c.shell.damping_anisotropy = s.getDouble("damping_anisotropy", c.shell.damping_anisotropy);
-    c.shell.damping_axis = s.getDouble("damping_axis", c.shell.damping_axis);
-    c.shell.frequency_split = s.getDouble("frequency_split", c.shell.frequency_split);
-    c.shell.frequency_axis = s.getDouble("frequency_axis", c.shell.frequency_axis);
+    readNumbers(s, {{"bryan_factor", &c.shell.bryan_factor},
+                    {"damping_time", &c.shell.damping_time},
+                    {"damping_anisotropy", &c.shell.damping_anisotropy},
+                    {"damping_axis", &c.shell.damping_axis},
+                    {"frequency_split", &c.shell.frequency_split},
+                    {"frequency_axis", &c.shell.frequency_axis}});
     validateIn(s, c.shell);
   }
   c.loops.energy = amplitude * amplitude;
   c.loops.phase = phase;
   if (d.has("loops")) {
     const YamlField l = d["loops"];
-    l.requireMap();
-    l.rejectUnknownKeys(
-        {"energy_bandwidth", "quadrature_bandwidth", "phase_bandwidth", "damping_ratio", "control_rate"});
-    c.loops.energy_bandwidth = l.getDouble("energy_bandwidth", c.loops.energy_bandwidth);
-    c.loops.quadrature_bandwidth = l.getDouble("quadrature_bandwidth", c.loops.quadrature_bandwidth);
-    c.loops.phase_bandwidth = l.getDouble("phase_bandwidth", c.loops.phase_bandwidth);
-    c.loops.damping_ratio = l.getDouble("damping_ratio", c.loops.damping_ratio);
-    c.loops.control_rate = l.getDouble("control_rate", c.loops.control_rate);
+    readNumbers(l, {{"energy_bandwidth", &c.loops.energy_bandwidth},
+                    {"quadrature_bandwidth", &c.loops.quadrature_bandwidth},
+                    {"phase_bandwidth", &c.loops.phase_bandwidth},
+                    {"damping_ratio", &c.loops.damping_ratio},
+                    {"control_rate", &c.loops.control_rate}});
     validateIn(l, c.loops);
   }
   // The simulator steps the resonator per carrier period, the loops a whole number of times in each.
@@ -72,12 +81,10 @@ DynamicsConfig parseDynamicsSection(const YamlField& d, double frequency, double
   }
   if (d.has("drive")) {
     const YamlField r = d["drive"];
-    r.requireMap();
-    r.rejectUnknownKeys({"gain_error_c", "gain_error_s", "phase_error", "virtual_rate_gain_error"});
-    c.drive.gain_error_c = r.getDouble("gain_error_c", c.drive.gain_error_c);
-    c.drive.gain_error_s = r.getDouble("gain_error_s", c.drive.gain_error_s);
-    c.drive.phase_error = r.getDouble("phase_error", c.drive.phase_error);
-    c.drive.virtual_rate_gain_error = r.getDouble("virtual_rate_gain_error", c.drive.virtual_rate_gain_error);
+    readNumbers(r, {{"gain_error_c", &c.drive.gain_error_c},
+                    {"gain_error_s", &c.drive.gain_error_s},
+                    {"phase_error", &c.drive.phase_error},
+                    {"virtual_rate_gain_error", &c.drive.virtual_rate_gain_error}});
     validateIn(r, c.drive);
   }
   c.settle_time = d.getDouble("settle_time", c.settle_time);
@@ -95,7 +102,9 @@ DynamicsConfig parseDynamicsSection(const YamlField& d, double frequency, double
       if (!(p.time >= 0.0)) e["time"].fail("must be >= 0 (s from the scenario start)");
       if (!c.commands.empty() && !(p.time > c.commands.back().time))
         e["time"].fail("must increase from command to command");
-      if (!(std::abs(p.rate) <= 10.0)) e["rate"].fail("must be within +-10 rad/s (electrical)");
+      if (!(std::abs(p.rate) <= kMaxPrecessionRate)) {
+        e["rate"].fail("must be within +-" + formatShort(kMaxPrecessionRate) + " rad/s (electrical)");
+      }
       c.commands.push_back(p);
     }
   }

@@ -149,6 +149,35 @@ void GyroSimulator::stamp(double t_center, SimulationSample* out) const {
   out->stamp = toNanoseconds(config_.start_time + t_center);
 }
 
+void GyroSimulator::advanceTime(double h) {
+  // Kahan summation keeps 24 h of 200 us steps exact to the nanosecond.
+  const double y = h - t_compensation_;
+  const double sum_t = t_ + y;
+  t_compensation_ = (sum_t - t_) - y;
+  t_ = sum_t;
+}
+
+double GyroSimulator::closeWindow(const ChannelVector& sum, int m, double t_start, SimulationSample* out) const {
+  out->z = sum / m;
+  out->frequency = frequency_;
+  out->temperature = temperature_;
+  out->periods = static_cast<std::uint32_t>(m);
+  const double t_center = 0.5 * (t_start + t_);
+  stamp(t_center, out);
+  return t_center;
+}
+
+void GyroSimulator::setTruthWave(double amplitude, double quadrature, double phase, double t_center, bool generator,
+                                 TruthState* truth) const {
+  truth->amplitude = amplitude;
+  truth->quadrature = quadrature;
+  truth->phase = phase;
+  truth->frequency = frequency_;
+  truth->temperature = temperature_;
+  truth->bias = injectedBias(t_center);
+  truth->generator = generator;
+}
+
 bool GyroSimulator::next(SimulationSample* out) {
   if (done()) return false;
   const double t_start = t_;
@@ -208,18 +237,9 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
     theta_ = theta_end;
     boundary_theta[p + 1] = theta_;
     boundary_input_angle[p + 1] = input_angle_;
-    // Kahan summation keeps 24 h of 200 us steps exact to the nanosecond.
-    const double y = h - t_compensation_;
-    const double sum_t = t_ + y;
-    t_compensation_ = (sum_t - t_) - y;
-    t_ = sum_t;
+    advanceTime(h);
   }
-  out->z = sum / m;
-  out->frequency = frequency_;
-  out->temperature = temperature_;
-  out->periods = static_cast<std::uint32_t>(m);
-  const double t_center = 0.5 * (t_start + t_);
-  stamp(t_center, out);
+  const double t_center = closeWindow(sum, m, t_start, out);
   // Truth at the window centre, theta interpolated between the period boundaries around it.
   const double pos = 0.5 * m;
   const int lo = std::min(static_cast<int>(pos), m - 1);
@@ -241,13 +261,7 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
     truth.inertial_rate = truth.table_rate + earth_rate_;
     truth.inertial_angle = truth.table_angle + earth_rate_ * t_center;
   }
-  truth.amplitude = amplitude_;
-  truth.quadrature = rc.quadrature;
-  truth.phase = rc.phase;
-  truth.frequency = frequency_;
-  truth.temperature = temperature_;
-  truth.bias = injectedBias(t_center);
-  truth.generator = false;
+  setTruthWave(amplitude_, rc.quadrature, rc.phase, t_center, false, &truth);
   logTurntable(t_center, out);
 }
 
@@ -287,31 +301,17 @@ void GyroSimulator::nextResonator(SimulationSample* out) {
     }
     theta_ = theta_end;
     virtual_angle_ += virtual_rate_ * h;
-    const double y = h - t_compensation_;
-    const double sum_t = t_ + y;
-    t_compensation_ = (sum_t - t_) - y;
-    t_ = sum_t;
+    advanceTime(h);
   }
   const WaveParameters& wave = dynamics_->wave();
   frequency_ = dynamics_->referenceFrequency();
-  out->z = sum / m;
-  out->frequency = frequency_;
-  out->temperature = temperature_;
-  out->periods = static_cast<std::uint32_t>(m);
-  const double t_center = 0.5 * (t_start + t_);
-  stamp(t_center, out);
+  const double t_center = closeWindow(sum, m, t_start, out);
   TruthState& truth = out->truth;
   truth.theta = boundary_theta[0] + frac * (boundary_theta[1] - boundary_theta[0]);
   config_.profile.evaluate(t_center - generatorDuration(), &truth.table_angle, &truth.table_rate, &truth.segment);
   truth.inertial_rate = truth.table_rate + earth_rate_;
   truth.inertial_angle = truth.table_angle + earth_rate_ * t_center;
-  truth.amplitude = wave.amplitude;
-  truth.quadrature = wave.quadrature;
-  truth.phase = wave.phase;
-  truth.frequency = frequency_;
-  truth.temperature = temperature_;
-  truth.bias = injectedBias(t_center);
-  truth.generator = false;
+  setTruthWave(wave.amplitude, wave.quadrature, wave.phase, t_center, false, &truth);
   out->precession.rate = virtual_rate_;
   out->precession.angle = boundary_psi[0] + frac * (boundary_psi[1] - boundary_psi[0]);
   out->precession.commands = precession_commands_;
@@ -336,25 +336,15 @@ void GyroSimulator::nextGenerator(SimulationSample* out) {
   for (int p = 0; p < m; ++p) sum += synth_.period(wave, wave.theta);
   const double t_start = t_;
   t_ = (index_ + 1) * config_.outputPeriod();
-  out->z = sum / m;
-  out->frequency = frequency_;
-  out->temperature = temperature_;
-  out->periods = static_cast<std::uint32_t>(m);
-  stamp(0.5 * (t_start + t_), out);
+  const double t_center = closeWindow(sum, m, t_start, out);
   TruthState& truth = out->truth;
   truth = TruthState();
   truth.theta = wave.theta;
-  truth.amplitude = wave.amplitude;
-  truth.quadrature = wave.quadrature;
-  truth.phase = wave.phase;
-  truth.frequency = frequency_;
-  truth.temperature = temperature_;
-  truth.bias = injectedBias(0.5 * (t_start + t_));
+  setTruthWave(wave.amplitude, wave.quadrature, wave.phase, t_center, true, &truth);
   truth.inertial_rate = earth_rate_;
-  truth.inertial_angle = earth_rate_ * 0.5 * (t_start + t_);
-  truth.generator = true;
+  truth.inertial_angle = earth_rate_ * t_center;
   truth.segment = &generator_label_;
-  logTurntable(0.5 * (t_start + t_), out);
+  logTurntable(t_center, out);
   if (++generator_outputs_in_state_ >= per_state) {
     generator_outputs_in_state_ = 0;
     ++generator_state_;

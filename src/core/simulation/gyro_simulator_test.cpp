@@ -5,6 +5,7 @@
 
 #include <cstring>
 
+#include "core/testing/simulator_pairs.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/resonator/first_order_model.h"
@@ -189,17 +190,10 @@ TEST(GyroSimulatorTest, BiasDriftOfZerosIsTheRunWithout) {
       "resonator: {samples_per_period: 8, rate_noise: 1.0e-5";
   GyroSimulator a(SimulationConfig::parse(parseYaml(scenario + "}\n")));
   GyroSimulator b(SimulationConfig::parse(parseYaml(scenario + ", bias_drift: {rate: 0.0, random_walk: 0.0}}\n")));
-  SimulationSample sa, sb;
-  int n = 0;
-  while (a.next(&sa)) {
-    ASSERT_TRUE(b.next(&sb));
-    for (int i = 0; i < 4; ++i) ASSERT_EQ(sa.z[i], sb.z[i]) << n;
-    ASSERT_EQ(sa.truth.theta, sb.truth.theta) << n;
+  const int n = testing::stepTogether(&a, &b, [](const SimulationSample& sa, const SimulationSample& sb, int) {
     EXPECT_EQ(sa.truth.bias, 0.0);  // the default intrinsic D is zero
     EXPECT_EQ(sb.truth.bias, 0.0);
-    ++n;
-  }
-  EXPECT_FALSE(b.next(&sb));
+  });
   EXPECT_GT(n, 2000);
 }
 
@@ -372,21 +366,13 @@ TEST(GyroSimulatorTest, AnAxisInputOfTheTableRateGivesTheSingleAxisSamples) {
   c.resonator.periods_per_output = 25;
   const TableRateInput input(c);
   GyroSimulator single(c), axis(c, &input);
-  SimulationSample a, b;
-  int n = 0;
-  while (single.next(&a)) {
-    ASSERT_TRUE(axis.next(&b));
-    ASSERT_EQ(a.stamp, b.stamp);
-    for (int i = 0; i < 4; ++i) ASSERT_EQ(a.z[i], b.z[i]) << n;
-    ASSERT_EQ(a.truth.theta, b.truth.theta) << n;
+  const int n = testing::stepTogether(&single, &axis, [](const SimulationSample& a, const SimulationSample& b, int n) {
     EXPECT_EQ(a.truth.inertial_rate, b.truth.inertial_rate) << n;
     // Simpson on the RK4 grid of a piecewise-linear rate: exact up to the summation's rounding.
     EXPECT_NEAR(b.truth.inertial_angle, a.truth.inertial_angle, 1e-12 * (1.0 + std::abs(a.truth.inertial_angle))) << n;
     EXPECT_EQ(a.turntable.size(), 1u);
     EXPECT_TRUE(b.turntable.empty()) << "an axis of a triad logs no table records";
-    ++n;
-  }
-  EXPECT_FALSE(axis.next(&b));
+  });
   EXPECT_GT(n, 6000);
 }
 
@@ -589,13 +575,7 @@ TEST(GyroSimulatorTest, HarmonicDynamicsSectionIsTheRunWithout) {
       "turntable: {latitude: 0.9, profile: [{type: rate, rate: 0.1, duration: 1.0}]}\n";
   GyroSimulator a(SimulationConfig::parse(YamlField(YAML::Load(scenario), "")));
   GyroSimulator b(SimulationConfig::parse(YamlField(YAML::Load(scenario + "dynamics: {model: harmonic}\n"), "")));
-  SimulationSample sa, sb;
-  while (a.next(&sa)) {
-    ASSERT_TRUE(b.next(&sb));
-    ASSERT_EQ(sa.z, sb.z);
-    ASSERT_EQ(sa.truth.theta, sb.truth.theta);
-  }
-  EXPECT_FALSE(b.next(&sb));
+  testing::stepTogether(&a, &b);
 }
 
 }  // namespace

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "hrg_gyro/core/common/units.h"
-#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
+#include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
 #include "hrg_gyro/core/simulation/intrinsic_model.h"
 #include "hrg_gyro/core/simulation/signal_synthesizer.h"

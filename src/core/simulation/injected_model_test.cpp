@@ -7,7 +7,7 @@
 
 #include <cstdio>
 
-#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
+#include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
 #include "hrg_gyro/core/simulation/intrinsic_model.h"
 #include "hrg_gyro/core/simulation/signal_synthesizer.h"

@@ -173,18 +173,23 @@ YAML::Node loadScenarioDocument(const std::string& path) {
   }
 }
 
-SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
+void parseScenarioTopLevel(const YamlField& root, std::vector<std::string> keys,
+                           const std::vector<std::string>& extra_keys, std::uint64_t* seed, double* start_time) {
   root.requireMap();
-  std::vector<std::string> allowed = {"seed",      "start_time", "resonator", "pickoff", "turntable",
-                                      "generator", "thermal",    "channels",  "dynamics"};
-  allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
-  root.rejectUnknownKeys(allowed);
+  keys.insert(keys.end(), extra_keys.begin(), extra_keys.end());
+  root.rejectUnknownKeys(keys);
+  const long s = root.getInteger("seed", 1);
+  if (s < 0) root["seed"].fail("must be >= 0");
+  *seed = static_cast<std::uint64_t>(s);
+  *start_time = root.getDouble("start_time", *start_time);
+  if (!(*start_time > 0.0)) root["start_time"].fail("must be positive (time 0 means 'unset' in ROS)");
+}
+
+SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
   SimulationConfig c;
-  const long seed = root.getInteger("seed", 1);
-  if (seed < 0) root["seed"].fail("must be >= 0");
-  c.seed = static_cast<std::uint64_t>(seed);
-  c.start_time = root.getDouble("start_time", c.start_time);
-  if (!(c.start_time > 0.0)) root["start_time"].fail("must be positive (time 0 means 'unset' in ROS)");
+  parseScenarioTopLevel(
+      root, {"seed", "start_time", "resonator", "pickoff", "turntable", "generator", "thermal", "channels", "dynamics"},
+      extra_keys, &c.seed, &c.start_time);
 
   if (root.has("resonator")) c.resonator = parseResonatorSection(root["resonator"]);
   if (root.has("pickoff")) c.pickoff = parsePickoffSection(root["pickoff"], c.resonator.amplitude);

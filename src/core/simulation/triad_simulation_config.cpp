@@ -232,16 +232,8 @@ SimulationConfig TriadSimulationConfig::axisScenario(int axis) const {
 }
 
 TriadSimulationConfig TriadSimulationConfig::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
-  root.requireMap();
-  std::vector<std::string> allowed = {"seed", "start_time", "triad"};
-  allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
-  root.rejectUnknownKeys(allowed);
   TriadSimulationConfig c;
-  const long seed = root.getInteger("seed", 1);
-  if (seed < 0) root["seed"].fail("must be >= 0");
-  c.seed = static_cast<std::uint64_t>(seed);
-  c.start_time = root.getDouble("start_time", c.start_time);
-  if (!(c.start_time > 0.0)) root["start_time"].fail("must be positive (time 0 means 'unset' in ROS)");
+  parseScenarioTopLevel(root, {"seed", "start_time", "triad"}, extra_keys, &c.seed, &c.start_time);
 
   const YamlField t = root["triad"];
   t.requireMap();

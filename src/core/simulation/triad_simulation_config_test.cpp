@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/triad_file.h"
 
 namespace hrg_gyro {
 namespace core {

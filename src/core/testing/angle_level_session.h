@@ -52,6 +52,26 @@ inline AngleLevelGyro referenceGyro() {
   return g;
 }
 
+/// White wave-angle noise per sample of the calibration tests' gyro at 1 kHz, rad.
+constexpr double kNominalNoise = 1.1e-5;
+
+/// referenceGyro() with K harmonics up to order 8 and the nominal wave noise: the gyro of the
+/// table-session tests.
+inline AngleLevelGyro nominalGyro(std::uint64_t seed) {
+  AngleLevelGyro g = referenceGyro();
+  g.k = HarmonicModel({2, 4, 6, 8}, -0.56, {-6e-4, 2e-3, 1e-4, -5e-5}, {4e-4, 0.0, -1e-4, 0.0});
+  g.noise = kNominalNoise;
+  g.seed = seed;
+  return g;
+}
+
+/// The prior of the calibration tests: the nominal parameters at the reference gyro's latitude.
+inline GyroParameters referencePrior() {
+  GyroParameters p;
+  p.earth_rate.latitude = 0.9;
+  return p;
+}
+
 /// Calls sink(stamp, table_angle, table_rate_reported, theta_measured, frequency) for every sample.
 inline void runAngleLevel(const AngleLevelGyro& g, const TurntableProfile& profile,
                           const std::function<void(Nanoseconds, double, double, double, double)>& sink) {
@@ -197,7 +217,7 @@ inline CalibrationOutcome calibrateTableSession(const AngleLevelGyro& g, const T
                                                 const GyroParameters& prior) {
   CalibrationSession session(settings, prior);
   runTableSession(
-      g, table, profile, [&](const TableRecord& r) { session.addTurntable(r.stamp, r.angle, r.rate, r.seq); },
+      g, table, profile, [&](const TableRecord& r) { session.addRotationRecord(r.stamp, r.angle, r.rate, r.seq); },
       [&](Nanoseconds t, double theta, double frequency) { session.addWave(t, theta, frequency); });
   return session.finish();
 }
@@ -234,7 +254,7 @@ inline CalibrationOutcome calibrateAngleLevel(const AngleLevelGyro& g, const Tur
                                               SessionCounters* counters = nullptr) {
   CalibrationSession session(settings, prior);
   runAngleLevel(g, profile, [&](Nanoseconds t, double angle, double rate, double theta, double frequency) {
-    session.addTurntable(t, angle, rate);
+    session.addRotationRecord(t, angle, rate);
     session.addWave(t, theta, frequency);
   });
   if (counters) *counters = session.counters();

@@ -1,7 +1,10 @@
 // Test support for the resonator: a shell with every defect at a realistic size, its loops and its
-// drive chain; and a run of the closed-loop resonator at 1 kHz that records the angle rate of each
+// drive chain; the bound of what the loops' tracking leaves out for a turning wave; forces compared
+// component by component; and a run of the closed-loop resonator at 1 kHz that records the angle rate of each
 // step against the angle at the step's middle.
 #pragma once
+
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,7 +18,7 @@ namespace core {
 namespace testing {
 
 struct ResonatorCase {
-  ResonatorParameters shell;
+  ShellParameters shell;
   LoopSettings loops;
   DriveChainErrors drive;
 
@@ -49,6 +52,36 @@ inline ResonatorCase realisticResonator() {
   c.drive.phase_error = 1e-3;
   c.drive.virtual_rate_gain_error = 3e-3;
   return c;
+}
+
+/// What the closed form and the first-order lag leave out for a wave turning at `rate` (rad/s): the
+/// loops are PI loops, so a source that changes as the wave turns (at 2 |rate|, d(source)/dt^2 =
+/// -(2 rate)^2 source) is followed by an effort short by (2 rate)^2 / ki of it, and the quadrature
+/// loop's B trails with a phase 2 zeta (2 rate) / wn beyond the first-order lag. Through the drive chain:
+///   - the energy loop's effort against the precession force's leak onto the antinode
+///     (gamma sin 2th n_v) is short by that much, and leaks back by gamma sin 2th: gamma^2 |rate| (2 rate)^2 / ki_E;
+///   - the quadrature loop's effort against the split (Dw/2), turned into precession by the lag phi:
+///     (Dw/2) |sin phi| (2 rate)^2 / ki_Q;
+///   - the quadrature lag's next order: L |rate| 2 zeta (2 rate) / wn_Q.
+inline double loopTrackingBound(const ResonatorCase& c, double rate, double quadrature_lag) {
+  const LoopSettings& l = c.loops;
+  const double gamma = 0.5 * (c.drive.gain_error_c - c.drive.gain_error_s);
+  const double sweep = 2.0 * std::abs(rate);
+  const double ki_e = l.integralGain(l.energy_bandwidth), ki_q = l.integralGain(l.quadrature_bandwidth);
+  const double energy = l.energy_bandwidth > 0.0 ? gamma * gamma * std::abs(rate) * sweep * sweep / ki_e : 0.0;
+  const double quadrature =
+      0.5 * std::abs(c.shell.frequency_split * std::sin(c.drive.phase_error)) * sweep * sweep / ki_q;
+  const double lag =
+      quadrature_lag * std::abs(rate) * 2.0 * l.damping_ratio * sweep / (kTwoPi * l.quadrature_bandwidth);
+  return energy + quadrature + lag;
+}
+
+/// Each of the four components of `a` within `tolerance` of `b`'s.
+inline void expectNear(const WaveFrameForce& a, const WaveFrameForce& b, double tolerance) {
+  EXPECT_NEAR(a.antinode_velocity, b.antinode_velocity, tolerance);
+  EXPECT_NEAR(a.antinode_displacement, b.antinode_displacement, tolerance);
+  EXPECT_NEAR(a.node_velocity, b.node_velocity, tolerance);
+  EXPECT_NEAR(a.node_displacement, b.node_displacement, tolerance);
 }
 
 /// The angle rate over one step and where the wave was.

@@ -70,6 +70,22 @@ class Bytes {
   std::vector<std::uint8_t>& out_;
 };
 
+// A connection record (its header: op, topic, conn; its data: the type's name, MD5 and definition), as
+// a chunk carries it before the connection's first message and the index section at the end again.
+void connectionRecord(Bytes* out, std::uint32_t id, const std::string& topic, const std::string& datatype,
+                      const std::string& md5sum, const std::string& definition) {
+  const std::size_t header = out->beginLength();
+  out->numberField("op", kOpConnection);
+  out->textField("topic", topic);
+  out->numberField("conn", id);
+  out->endLength(header);
+  const std::size_t data = out->beginLength();
+  out->textField("type", datatype);
+  out->textField("md5sum", md5sum);
+  out->textField("message_definition", definition);
+  out->endLength(data);
+}
+
 }  // namespace
 
 BagFileWriter::BagFileWriter(const std::string& path, Compression compression, std::uint32_t chunk_threshold)
@@ -123,16 +139,7 @@ std::uint8_t* BagFileWriter::beginMessage(std::uint32_t connection, const ros::T
   if (!c.in_file) {
     // A connection's record goes into the first chunk that carries it (and into the index at the end).
     c.in_file = true;
-    const std::size_t header = out.beginLength();
-    out.numberField("op", kOpConnection);
-    out.textField("topic", c.topic);
-    out.numberField("conn", connection);
-    out.endLength(header);
-    const std::size_t data = out.beginLength();
-    out.textField("type", c.datatype);
-    out.textField("md5sum", c.md5sum);
-    out.textField("message_definition", c.definition);
-    out.endLength(data);
+    connectionRecord(&out, connection, c.topic, c.datatype, c.md5sum, c.definition);
   }
   // A recycled chunk keeps its connections' index lists (emptied, with their capacity).
   ChunkIndex* index = nullptr;
@@ -271,16 +278,7 @@ void BagFileWriter::close() {
   Bytes out(&scratch_);
   for (std::size_t id = 0; id < connections_.size(); ++id) {
     const Connection& c = connections_[id];
-    const std::size_t header = out.beginLength();
-    out.numberField("op", kOpConnection);
-    out.textField("topic", c.topic);
-    out.numberField("conn", static_cast<std::uint32_t>(id));
-    out.endLength(header);
-    const std::size_t data = out.beginLength();
-    out.textField("type", c.datatype);
-    out.textField("md5sum", c.md5sum);
-    out.textField("message_definition", c.definition);
-    out.endLength(data);
+    connectionRecord(&out, static_cast<std::uint32_t>(id), c.topic, c.datatype, c.md5sum, c.definition);
   }
   for (const ChunkInfo& chunk : chunks_) {
     const std::size_t header = out.beginLength();

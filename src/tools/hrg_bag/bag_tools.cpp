@@ -225,34 +225,65 @@ void addTopicOptions(CLI::App& command, GyroTopics* chosen, bool turntable_and_t
       ->check(tools::notEmpty());
 }
 
-GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable,
-                      TopicNeed precession) {
+namespace {
+
+/// Each topic of the bag with its type.
+std::map<std::string, std::string> topicTypes(const rosbag::Bag& bag) {
   rosbag::View all(bag);
   std::map<std::string, std::string> types;
   for (const rosbag::ConnectionInfo* c : all.getConnections()) types[c->topic] = c->datatype;
-  auto pick = [&](const std::string& topic, const std::string& option, const std::string& type, bool required) {
-    if (!topic.empty()) {
-      const auto it = types.find(topic);
-      if (it == types.end()) throw UsageError("topic " + topic + " (--" + option + ") is not in the bag");
-      if (it->second != type) throw UsageError("topic " + topic + " has type " + it->second + ", expected " + type);
-      return topic;
-    }
-    std::vector<std::string> found;
-    for (const auto& kv : types) {
-      if (kv.second == type) found.push_back(kv.first);
-    }
-    if (found.size() > 1) {
-      throw UsageError("several " + type + " topics in the bag; choose one with --" + option);
-    }
-    if (found.empty()) {
-      if (required) {
-        std::string listing;
-        for (const auto& kv : types) listing += "\n  " + kv.first + " [" + kv.second + "]";
-        throw UsageError("no " + type + " topic in the bag; it holds:" + (listing.empty() ? " nothing" : listing));
-      }
-      return std::string();
-    }
-    return found.front();
+  return types;
+}
+
+/// findTopic among `types`.
+std::string findTopicOfType(const std::map<std::string, std::string>& types, const std::string& chosen,
+                            const std::string& type, const std::string& option, bool required,
+                            const std::string& missing_hint) {
+  if (!chosen.empty()) {
+    const auto it = types.find(chosen);
+    if (it == types.end()) throw UsageError("topic " + chosen + " (--" + option + ") is not in the bag");
+    if (it->second != type) throw UsageError("topic " + chosen + " has type " + it->second + ", expected " + type);
+    return chosen;
+  }
+  std::vector<std::string> found;
+  for (const auto& kv : types) {
+    if (kv.second == type) found.push_back(kv.first);
+  }
+  if (found.size() > 1) throw UsageError("several " + type + " topics in the bag; choose one with --" + option);
+  if (!found.empty()) return found.front();
+  if (required) {
+    std::string listing;
+    for (const auto& kv : types) listing += "\n  " + kv.first + " [" + kv.second + "]";
+    throw UsageError("no " + type + " topic in the bag" + missing_hint +
+                     "; it holds:" + (listing.empty() ? " nothing" : listing));
+  }
+  return std::string();
+}
+
+}  // namespace
+
+std::string findTopic(const rosbag::Bag& bag, const std::string& chosen, const std::string& type,
+                      const std::string& option, bool required, const std::string& missing_hint) {
+  return findTopicOfType(topicTypes(bag), chosen, type, option, required, missing_hint);
+}
+
+[[noreturn]] void rethrowBagReadError(std::uint64_t samples) {
+  try {
+    throw;
+  } catch (const rosbag::BagException& e) {
+    throw UsageError(std::string("bag read error after ") + std::to_string(samples) +
+                     " samples (truncated?): " + e.what());
+  } catch (const ros::serialization::StreamOverrunException& e) {
+    throw UsageError(std::string("bag read error after ") + std::to_string(samples) +
+                     " samples: a message shorter than its type (corrupt?): " + e.what());
+  }
+}
+
+GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable,
+                      TopicNeed precession) {
+  const std::map<std::string, std::string> types = topicTypes(bag);
+  const auto pick = [&](const std::string& topic, const std::string& option, const std::string& type, bool required) {
+    return findTopicOfType(types, topic, type, option, required, std::string());
   };
   GyroTopics t;
   t.channels =
@@ -446,11 +477,8 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
     }
     if (blocks[filling].count > 0 || blocks[filling].state_count > 0) submit(&blocks[filling]);
     worker.finish();  // rethrows what the processing or the sink threw
-  } catch (const rosbag::BagException& e) {
-    throw UsageError(std::string("bag read error after ") + std::to_string(n) + " samples (truncated?): " + e.what());
-  } catch (const ros::serialization::StreamOverrunException& e) {
-    throw UsageError(std::string("bag read error after ") + std::to_string(n) +
-                     " samples: a message shorter than its type (corrupt?): " + e.what());
+  } catch (...) {
+    rethrowBagReadError(n);
   }
   progress.finish(n);
   return n;

@@ -78,6 +78,18 @@ enum class TopicNeed { kNo, kIfPresent, kRequired };
 GyroTopics findTopics(const rosbag::Bag& bag, const GyroTopics& chosen, bool need_channels, bool need_turntable,
                       TopicNeed precession = TopicNeed::kNo);
 
+/// `chosen` (an option's topic: its type checked), or else the bag's single topic of `type`; "" when
+/// there is none and none is `required`. A UsageError names `option` for a topic not in the bag or of
+/// another type, and for several of the type; one that is required and missing says what the bag
+/// holds (after `missing_hint`).
+std::string findTopic(const rosbag::Bag& bag, const std::string& chosen, const std::string& type,
+                      const std::string& option, bool required, const std::string& missing_hint = std::string());
+
+/// For a `catch (...)` around a loop over a bag's messages: a truncated or corrupt bag
+/// (rosbag::BagException, a message shorter than its type) becomes a UsageError saying after how many
+/// `samples`; anything else is rethrown as it is.
+[[noreturn]] void rethrowBagReadError(std::uint64_t samples);
+
 /// Reads hrg_gyro/PrecessionState records, also those of bags recorded before the message had its
 /// `source` field (an earlier MD5 sum; `source` is then empty). Like ReusedMessageReader, without a
 /// heap allocation per message once warm.

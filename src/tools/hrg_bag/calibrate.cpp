@@ -8,11 +8,12 @@
 #include "bag_tools.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
+#include "hrg_gyro/core/calibration/calibration_feed.h"
 #include "hrg_gyro/core/calibration/calibration_session.h"
-#include "hrg_gyro/core/calibration/generator_pairing.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "read_messages.h"
 #include "triad_calibrate.h"
 
 namespace hrg_gyro {
@@ -64,9 +65,9 @@ int runTriad(const CalibrateOptions& o) {
   return runTriadCalibrate(t);
 }
 
-int runCalibrate(const CalibrateOptions& o) {
+/// Before anything is read: the triad's options refused, the processor's limits, the outputs.
+void checkSingleAxisUsage(const CalibrateOptions& o) {
   using namespace bag_tools;
-  if (chosenMethod(o) == core::CalibrationMethodKind::kTriad) return runTriad(o);
   const bool triad_options = !o.triad.triad.empty() || !o.triad.axis_params.empty() || !o.triad.axis_out.empty() ||
                              !o.triad.axis_channels.empty() || !o.triad.fixture_topic.empty();
   if (triad_options) {
@@ -78,6 +79,11 @@ int runCalibrate(const CalibrateOptions& o) {
   // calibrator refreshes its parameter file. The report and the plot may never replace it.
   checkOutputPaths({o.bag, o.config}, {o.out, o.report, o.plot});
   checkOutputPaths({o.params}, {o.report, o.plot});
+}
+
+/// The calibrator's settings: --config's, through the node's own parser, and --method over its method.
+core::CalibrationSettings readSettings(const CalibrateOptions& o) {
+  using bag_tools::UsageError;
   core::CalibrationSettings settings;
   if (!o.config.empty()) {
     YAML::Node root;
@@ -94,8 +100,99 @@ int runCalibrate(const CalibrateOptions& o) {
     }
   }
   if (!o.method.empty()) settings.method = core::parseCalibrationMethod(o.method);  // checked by --method's validator
+  return settings;
+}
+
+/// The bag's records, in record order, through the calibrator's record switch (channels through
+/// `processor`) into `session`.
+void feedBag(rosbag::Bag& bag, const bag_tools::GyroTopics& topics, const core::CalibrationMethodTraits& method,
+             core::GyroProcessor& processor, core::CalibrationSession& session) {
+  using namespace bag_tools;
+  std::vector<std::string> wanted{topics.channels};
+  // The field method synchronises with the precession loop's state in place of the table's.
+  if (method.virtual_rotation) {
+    wanted.push_back(topics.precession);
+  } else if (!topics.turntable.empty()) {
+    wanted.push_back(topics.turntable);
+  }
+  if (!topics.truth.empty()) wanted.push_back(topics.truth);
+  rosbag::View view(bag, rosbag::TopicQuery(wanted));
+  Progress progress("calibrate", view.size());
+  core::CalibrationFeed feed(&session, &processor);
+  PrecessionStateReader precession_reader;  // also a bag recorded before PrecessionState.source
+  PrecessionState precession;
+  const std::uint64_t n = readMessages(view, progress, [&](const rosbag::MessageInstance& m) {
+    const std::string& topic = m.getTopic();
+    if (topic == topics.channels) {
+      const ChannelAmplitudes::ConstPtr c = m.instantiate<ChannelAmplitudes>();
+      if (c) feed.addChannels(fromMessage(*c));
+    } else if (topic == topics.precession) {
+      if (precession_reader.read(m, &precession)) {
+        feed.addPrecessionState(toNanoseconds(precession.header.stamp), precession.angle, precession.rate,
+                                precession.header.seq);
+      }
+    } else if (topic == topics.turntable) {
+      const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
+      if (t) feed.addTableState(toNanoseconds(t->header.stamp), t->angle, t->rate, t->header.seq);
+    } else {
+      const GroundTruth::ConstPtr g = m.instantiate<GroundTruth>();
+      if (!g) return;
+      if (g->generator) {
+        feed.addReference(toNanoseconds(g->header.stamp), {g->amplitude, g->quadrature, g->theta, g->phase});
+      } else {
+        feed.addSweepEnd(toNanoseconds(g->header.stamp));
+      }
+    }
+  });
+  progress.finish(n);
+}
+
+/// The verdict, the gates, the notes, what the rotation stream held and the diagnosis, on stdout.
+void printOutcome(const core::CalibrationOutcome& outcome) {
+  std::cout << "calibrate: " << core::nameOf(outcome.method) << " " << (outcome.accepted ? "ACCEPTED" : "REFUSED");
+  if (!outcome.accepted) std::cout << ": " << outcome.reason;
+  std::cout << "\n";
+  for (const core::GateResult& g : outcome.gates) {
+    std::cout << "  " << (g.passed ? "pass" : "FAIL") << "  " << g.name << ": " << g.message << "\n";
+  }
+  for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
+  const core::RotationRecordRejects& r = outcome.rotation_rejected;
+  // A field run's table stream is the precession loop's state.
+  std::cout << "calibrate: "
+            << (core::traitsOf(outcome.method).virtual_rotation ? "precession states " : "turntable records ")
+            << outcome.rotation_records << ", dropped " << r.total() << " (bad rate " << r.bad_rate << ", bad angle "
+            << r.bad_angle << ", zero stamp " << r.bad_stamp << ", duplicate " << r.duplicate << ", out of order "
+            << r.out_of_order << ", stamp jump " << r.stamp_jump << "), restarts " << outcome.restarts << "\n";
+  for (const core::DefectDiagnosis& d : outcome.diagnosis) {
+    std::cout << "calibrate: root-cause diagnosis (first order, read against the P in force) " << core::describe(d);
+  }
+}
+
+/// The parameter file, written when the calibration is accepted (and said either way).
+void writeParameters(const CalibrateOptions& o, const core::CalibrationOutcome& outcome) {
+  if (!outcome.accepted) {
+    std::cout << "calibrate: " << o.out << " not written\n";
+    return;
+  }
+  try {
+    core::saveParameterFile(o.out, outcome.parameters);
+  } catch (const std::exception& e) {
+    throw bag_tools::OutputError(std::string("the calibration was accepted but not written: ") + e.what());
+  }
+  if (outcome.scale_factor.empty()) {
+    std::cout << "calibrate: wrote " << o.out << " (D refreshed, K kept from " << o.params << ")\n";
+  } else {
+    std::cout << "calibrate: wrote " << o.out << " (peak nonlinearity of the new K: " << outcome.nonlinearity_ppm
+              << " ppm)\n";
+  }
+}
+
+int runCalibrate(const CalibrateOptions& o) {
+  using namespace bag_tools;
+  if (chosenMethod(o) == core::CalibrationMethodKind::kTriad) return runTriad(o);
+  checkSingleAxisUsage(o);
+  const core::CalibrationSettings settings = readSettings(o);
   const core::CalibrationMethodTraits& method = core::traitsOf(settings.method);
-  const std::string& out_path = o.out;
   if (settings.method == core::CalibrationMethodKind::kField && o.params.empty()) {
     // The field method keeps K and the latitude from its prior: the nominal one would be written back
     // as if a table had calibrated it.
@@ -111,61 +208,9 @@ int runCalibrate(const CalibrateOptions& o) {
   if (method.uses_generator_pairs && topics.truth.empty()) {
     throw UsageError(std::string(method.name) + " needs the generator reference (a GroundTruth topic)");
   }
-
   core::GyroProcessor processor(o.processor, prior);
   core::CalibrationSession session(settings, *prior);
-  core::GeneratorPairing pairing(
-      [&session](core::Nanoseconds t, const core::ChannelVector& raw, const core::ChannelVector& reference) {
-        session.addGeneratorPair(t, raw, reference);
-      });
-  std::vector<std::string> wanted{topics.channels};
-  // The field method synchronises with the precession loop's state in place of the table's.
-  if (method.virtual_rotation) {
-    wanted.push_back(topics.precession);
-  } else if (!topics.turntable.empty()) {
-    wanted.push_back(topics.turntable);
-  }
-  if (!topics.truth.empty()) wanted.push_back(topics.truth);
-  rosbag::View view(*bag, rosbag::TopicQuery(wanted));
-  Progress progress("calibrate", view.size());
-  PrecessionStateReader precession_reader;  // also a bag recorded before PrecessionState.source
-  PrecessionState precession;
-  std::uint64_t n = 0;
-  try {
-    for (const rosbag::MessageInstance& m : view) {
-      ++n;
-      progress.update(n, n);
-      if (m.getTopic() == topics.channels) {
-        const ChannelAmplitudes::ConstPtr c = m.instantiate<ChannelAmplitudes>();
-        if (!c) continue;
-        const core::ChannelSample in = fromMessage(*c);
-        if (method.uses_generator_pairs) {
-          pairing.addRaw(in.stamp, in.z);
-          continue;
-        }
-        const core::ProcessorResult r = processor.process(in);
-        if (r.has_wave) {
-          session.addWave(in.stamp, r.wave.theta, in.frequency,
-                          core::quadratureRatio(r.wave.quadrature, r.wave.amplitude));
-        }
-      } else if (m.getTopic() == topics.precession) {
-        if (precession_reader.read(m, &precession)) {
-          session.addTurntable(toNanoseconds(precession.header.stamp), precession.angle, precession.rate,
-                               precession.header.seq);
-        }
-      } else if (m.getTopic() == topics.turntable) {
-        const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
-        if (t) session.addTurntable(toNanoseconds(t->header.stamp), t->angle, t->rate, t->header.seq);
-      } else {
-        const GroundTruth::ConstPtr g = m.instantiate<GroundTruth>();
-        if (!g || !g->generator) continue;
-        pairing.addReference(toNanoseconds(g->header.stamp), {g->amplitude, g->quadrature, g->theta, g->phase});
-      }
-    }
-  } catch (const rosbag::BagException& e) {
-    throw UsageError(std::string("bag read error (truncated?): ") + e.what());
-  }
-  progress.finish(n);
+  feedBag(*bag, topics, method, processor, session);
   core::CalibrationOutcome outcome = session.finish();
   outcome.parameters.calibration.source = o.bag;
   if (!o.report.empty()) {
@@ -173,38 +218,8 @@ int runCalibrate(const CalibrateOptions& o) {
     report.stream() << core::emitCalibrationReport(outcome);
     report.commit();
   }
-  std::cout << "calibrate: " << core::nameOf(outcome.method) << " " << (outcome.accepted ? "ACCEPTED" : "REFUSED");
-  if (!outcome.accepted) std::cout << ": " << outcome.reason;
-  std::cout << "\n";
-  for (const core::GateResult& g : outcome.gates) {
-    std::cout << "  " << (g.passed ? "pass" : "FAIL") << "  " << g.name << ": " << g.message << "\n";
-  }
-  for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
-  const core::TurntableRejects& r = outcome.turntable_rejected;
-  // A field run's table stream is the precession loop's state.
-  std::cout << "calibrate: "
-            << (core::traitsOf(outcome.method).virtual_rotation ? "precession states " : "turntable records ")
-            << outcome.turntable_records << ", dropped " << r.total() << " (bad rate " << r.bad_rate << ", bad angle "
-            << r.bad_angle << ", zero stamp " << r.bad_stamp << ", duplicate " << r.duplicate << ", out of order "
-            << r.out_of_order << ", stamp jump " << r.stamp_jump << "), restarts " << outcome.restarts << "\n";
-  for (const core::DefectDiagnosis& d : outcome.diagnosis) {
-    std::cout << "calibrate: root-cause diagnosis (first order, read against the P in force) " << core::describe(d);
-  }
-  if (outcome.accepted) {
-    try {
-      core::saveParameterFile(out_path, outcome.parameters);
-    } catch (const std::exception& e) {
-      throw OutputError(std::string("the calibration was accepted but not written: ") + e.what());
-    }
-    if (outcome.scale_factor.empty()) {
-      std::cout << "calibrate: wrote " << out_path << " (D refreshed, K kept from " << o.params << ")\n";
-    } else {
-      std::cout << "calibrate: wrote " << out_path << " (peak nonlinearity of the new K: " << outcome.nonlinearity_ppm
-                << " ppm)\n";
-    }
-  } else {
-    std::cout << "calibrate: " << out_path << " not written\n";
-  }
+  printOutcome(outcome);
+  writeParameters(o, outcome);
   if (!o.plot.empty()) plot("calibration", o.report, o.plot);
   return outcome.accepted ? 0 : 1;
 }
@@ -223,6 +238,66 @@ CLI::Validator knownMethod() {
       "");
 }
 
+/// BAG, --method, the outputs, the prior and the settings; the topics and the processor's limits.
+void addRunOptions(CLI::App& cmd, CalibrateOptions* o) {
+  using namespace bag_tools;
+  cmd.add_option("BAG", o->bag,
+                 "input bag: channels, turntable state or, for field, the precession state (and the generator "
+                 "reference)")
+      ->required();
+  cmd.add_option("--method", o->method,
+                 core::calibrationMethodNames("|") + " (default: --config's, else " +
+                     core::nameOf(core::CalibrationSettings().method) + ")")
+      ->check(knownMethod());
+  cmd.add_option("--out", o->out,
+                 "calibrated parameter file (triad: the triad file), written atomically only when every gate passes")
+      ->required()
+      ->check(tools::notEmpty());
+  cmd.add_option("--params", o->params,
+                 "prior parameter file (default: the nominal model at latitude 0; required by --method field)")
+      ->check(tools::notEmpty());
+  cmd.add_option("--config", o->config,
+                 "calibrator settings (YAML: bins, window, gates/..., thermal/..., as the node's)")
+      ->check(tools::notEmpty());
+  CLI::Option* report =
+      cmd.add_option("--report", o->report, "calibration report (YAML), written either way")->check(tools::notEmpty());
+  cmd.add_option("--plot", o->plot, "PNG drawn from the report")->needs(report)->check(tools::notEmpty());
+  addTopicOptions(cmd, &o->topics, true);
+  cmd.add_option("--precession-topic", o->topics.precession,
+                 "field: the precession loop's hrg_gyro/PrecessionState topic (default: the only one in the bag)")
+      ->check(tools::notEmpty());
+  addProcessorOptions(cmd, &o->processor);
+}
+
+/// --method triad's own inputs.
+void addTriadOptions(CLI::App& cmd, bag_tools::TriadCalibrateOptions* t) {
+  cmd.add_option("--triad", t->triad, "triad: prior triad file (axis names and order, frame_id; default nominal)")
+      ->check(tools::notEmpty());
+  cmd.add_option("--axis-params", t->axis_params, "triad: NAME=FILE, each axis's prior parameter file (all three)");
+  cmd.add_option("--axis-out", t->axis_out,
+                 "triad: NAME=FILE, each axis's calibrated parameter file (default: NAME.yaml beside --out)");
+  cmd.add_option("--axis-channels", t->axis_channels, "triad: NAME=TOPIC, an axis's channels (default /NAME/channels)");
+  cmd.add_option("--fixture-topic", t->fixture_topic,
+                 "triad: the fixture's positions (hrg_gyro/FixturePosition; default: the bag's single one)")
+      ->check(bag_tools::topicName());
+}
+
+constexpr const char* kCalibrateFooter =
+    "Processes the bag's channels with the prior parameters and runs the calibrator's method with its\n"
+    "quality gates on the turntable plateaus. Thermal writes K and D as splines over the resonator\n"
+    "frequency (the bag's channels must carry it).\n"
+    "Field (docs/field_calibration.md): a still gyro whose precession loop turned the wave both ways; reads\n"
+    "the loop's state (hrg_gyro/PrecessionState) in place of the table, refreshes D(theta) and keeps K.\n"
+    "Triad (docs/triad.md): each axis's channels through its own processor, the table and the fixture's\n"
+    "positions; writes each axis's parameter file and the triad file as one set: all four written,\n"
+    "synced and read back before the first is replaced, none replaced on a failure.\n"
+    "Every output replaces its path only when complete; an output that is the same file as an input\n"
+    "or another output is refused before anything runs, but for --out naming the --params file (triad:\n"
+    "--out the --triad file, --axis-out NAME=F the --axis-params NAME=F file): the prior is then\n"
+    "refreshed in place when the calibration is accepted (the old file kept as .bak).\n"
+    "Exit 0 accepted, 1 refused by a gate, 2 bad usage or unreadable input, 3 an output could not\n"
+    "be written (nothing left at its path, an existing file unchanged).";
+
 }  // namespace
 
 namespace bag_tools {
@@ -230,59 +305,9 @@ namespace bag_tools {
 Command addCalibrateCommand(CLI::App& root) {
   auto o = std::make_shared<CalibrateOptions>();
   CLI::App* cmd = root.add_subcommand("calibrate", "the calibrator offline, with its quality gates");
-  cmd->add_option("BAG", o->bag,
-                  "input bag: channels, turntable state or, for field, the precession state (and the generator "
-                  "reference)")
-      ->required();
-  cmd->add_option("--method", o->method,
-                  core::calibrationMethodNames("|") + " (default: --config's, else " +
-                      core::nameOf(core::CalibrationSettings().method) + ")")
-      ->check(knownMethod());
-  cmd->add_option("--out", o->out,
-                  "calibrated parameter file (triad: the triad file), written atomically only when every gate passes")
-      ->required()
-      ->check(tools::notEmpty());
-  cmd->add_option("--params", o->params,
-                  "prior parameter file (default: the nominal model at latitude 0; required by --method field)")
-      ->check(tools::notEmpty());
-  cmd->add_option("--config", o->config,
-                  "calibrator settings (YAML: bins, window, gates/..., thermal/..., as the node's)")
-      ->check(tools::notEmpty());
-  CLI::Option* report =
-      cmd->add_option("--report", o->report, "calibration report (YAML), written either way")->check(tools::notEmpty());
-  cmd->add_option("--plot", o->plot, "PNG drawn from the report")->needs(report)->check(tools::notEmpty());
-  addTopicOptions(*cmd, &o->topics, true);
-  cmd->add_option("--precession-topic", o->topics.precession,
-                  "field: the precession loop's hrg_gyro/PrecessionState topic (default: the only one in the bag)")
-      ->check(tools::notEmpty());
-  addProcessorOptions(*cmd, &o->processor);
-  cmd->add_option("--triad", o->triad.triad,
-                  "triad: prior triad file (axis names and order, frame_id; default nominal)")
-      ->check(tools::notEmpty());
-  cmd->add_option("--axis-params", o->triad.axis_params,
-                  "triad: NAME=FILE, each axis's prior parameter file (all three)");
-  cmd->add_option("--axis-out", o->triad.axis_out,
-                  "triad: NAME=FILE, each axis's calibrated parameter file (default: NAME.yaml beside --out)");
-  cmd->add_option("--axis-channels", o->triad.axis_channels,
-                  "triad: NAME=TOPIC, an axis's channels (default /NAME/channels)");
-  cmd->add_option("--fixture-topic", o->triad.fixture_topic,
-                  "triad: the fixture's positions (hrg_gyro/FixturePosition; default: the bag's single one)")
-      ->check(topicName());
-  cmd->footer(
-      "Processes the bag's channels with the prior parameters and runs the calibrator's method with its\n"
-      "quality gates on the turntable plateaus. Thermal writes K and D as splines over the resonator\n"
-      "frequency (the bag's channels must carry it).\n"
-      "Field (docs/field_calibration.md): a still gyro whose precession loop turned the wave both ways; reads\n"
-      "the loop's state (hrg_gyro/PrecessionState) in place of the table, refreshes D(theta) and keeps K.\n"
-      "Triad (docs/triad.md): each axis's channels through its own processor, the table and the fixture's\n"
-      "positions; writes each axis's parameter file and the triad file as one set: all four written,\n"
-      "synced and read back before the first is replaced, none replaced on a failure.\n"
-      "Every output replaces its path only when complete; an output that is the same file as an input\n"
-      "or another output is refused before anything runs, but for --out naming the --params file (triad:\n"
-      "--out the --triad file, --axis-out NAME=F the --axis-params NAME=F file): the prior is then\n"
-      "refreshed in place when the calibration is accepted (the old file kept as .bak).\n"
-      "Exit 0 accepted, 1 refused by a gate, 2 bad usage or unreadable input, 3 an output could not\n"
-      "be written (nothing left at its path, an existing file unchanged).");
+  addRunOptions(*cmd, o.get());
+  addTriadOptions(*cmd, &o->triad);
+  cmd->footer(kCalibrateFooter);
   return [o] { return runCalibrate(*o); };
 }
 

@@ -8,6 +8,7 @@
 #include "bag_tools.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "read_messages.h"
 
 namespace hrg_gyro {
 
@@ -42,37 +43,31 @@ int runExport(const ExportOptions& o) {
   if (turntable) wanted.push_back(topics.turntable);
   rosbag::View view(*bag, rosbag::TopicQuery(wanted));
   Progress progress("export", view.size());
-  std::uint64_t n = 0, channel_count = 0, turntable_count = 0;
-  try {
-    for (const rosbag::MessageInstance& m : view) {
-      ++n;
-      progress.update(n, n);
-      if (m.getTopic() == topics.channels) {
-        const ChannelAmplitudes::ConstPtr c = m.instantiate<ChannelAmplitudes>();
-        if (!c) continue;
-        std::ostream& out = channels.stream();
-        out << toNanoseconds(c->header.stamp);
-        for (double v : {c->c_in, c->c_quad, c->s_in, c->s_quad, c->frequency, c->temperature}) {
-          out << ',';
-          writeNumber(out, v);
-        }
-        out << ',' << c->periods << '\n';
-        ++channel_count;
-      } else {
-        const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
-        if (!t) continue;
-        std::ostream& out = turntable->stream();
-        out << toNanoseconds(t->header.stamp) << ',';
-        writeNumber(out, t->angle);
+  std::uint64_t channel_count = 0, turntable_count = 0;
+  const std::uint64_t n = readMessages(view, progress, [&](const rosbag::MessageInstance& m) {
+    if (m.getTopic() == topics.channels) {
+      const ChannelAmplitudes::ConstPtr c = m.instantiate<ChannelAmplitudes>();
+      if (!c) return;
+      std::ostream& out = channels.stream();
+      out << toNanoseconds(c->header.stamp);
+      for (double v : {c->c_in, c->c_quad, c->s_in, c->s_quad, c->frequency, c->temperature}) {
         out << ',';
-        writeNumber(out, t->rate);
-        out << '\n';
-        ++turntable_count;
+        writeNumber(out, v);
       }
+      out << ',' << c->periods << '\n';
+      ++channel_count;
+    } else {
+      const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
+      if (!t) return;
+      std::ostream& out = turntable->stream();
+      out << toNanoseconds(t->header.stamp) << ',';
+      writeNumber(out, t->angle);
+      out << ',';
+      writeNumber(out, t->rate);
+      out << '\n';
+      ++turntable_count;
     }
-  } catch (const rosbag::BagException& e) {
-    throw UsageError(std::string("bag read error (truncated?): ") + e.what());
-  }
+  });
   channels.commit();
   if (turntable) turntable->commit();
   progress.finish(n);

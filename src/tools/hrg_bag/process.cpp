@@ -187,6 +187,165 @@ struct ProcessOptions {
   bag_tools::TriadOptions triad;
 };
 
+// One input sample's messages and row.
+struct ProcessedSample {
+  ros::Time stamp;
+  std::uint32_t seq = 0;
+  const char* status = "";
+  bool has_wave = false, has_output = false;
+  double alpha = 0.0;
+  WaveState wave;
+  GyroOutput output;
+};
+
+// Where the processed samples go: the output bag (/wave, /output) and the CSV, each a temporary until
+// commit(). A dry run has neither and only counts.
+class ProcessOutputs {
+ public:
+  explicit ProcessOutputs(const ProcessOptions& o) {
+    using bag_tools::OutputBag;
+    using bag_tools::OutputText;
+    if (!o.out.empty()) out_ = std::make_unique<OutputBag>(o.out, o.compression);
+    if (!o.csv.empty()) {
+      csv_file_ = std::make_unique<OutputText>(o.csv);
+      csv_file_->stream()
+          << "stamp,seq,status,dt,dtheta,dalpha,dalpha_earth_fixed,alpha,rate,theta_mid,frequency,scale_factor,drift,"
+             "rejected_before,flags,theta,amplitude,quadrature,phase\n";
+      row_ = std::make_unique<CsvOutput>(csv_file_->stream());
+    }
+  }
+  bool dryRun() const { return !out_ && !row_; }
+  std::uint64_t precessed() const { return precessed_; }
+
+  void write(const ProcessedSample& x) {
+    if (x.has_output && (x.output.flags & core::kFlagPrecessing)) ++precessed_;
+    if (dryRun()) return;
+    if (out_ && x.has_wave) out_->write(wave_topic_, x.stamp, x.wave);
+    if (out_ && x.has_output) out_->write(output_topic_, x.stamp, x.output);
+    if (row_) writeRow(x);
+  }
+
+  void commit() {
+    if (csv_file_) {
+      row_->finish();
+      csv_file_->commit();
+    }
+    if (out_) out_->commit();
+  }
+
+ private:
+  void writeRow(const ProcessedSample& x) {
+    const GyroOutput& output = x.output;
+    CsvRow& c = row_->next();
+    c.sec = x.stamp.sec;
+    c.nsec = x.stamp.nsec;
+    c.seq = x.seq;
+    c.status = x.status;
+    c.has_output = x.has_output;
+    c.has_wave = x.has_wave;
+    c.dt = output.dt;
+    c.dtheta = output.dtheta;
+    c.dalpha = output.dalpha;
+    c.dalpha_earth_fixed = output.dalpha_earth_fixed;
+    c.rate = output.rate;
+    c.theta_mid = output.theta_mid;
+    c.frequency = output.frequency;
+    c.scale_factor = output.scale_factor;
+    c.drift = output.drift;
+    c.rejected_before = output.rejected_before;
+    c.flags = output.flags;
+    c.alpha = x.alpha;
+    c.theta = x.wave.theta;
+    c.amplitude = x.wave.amplitude;
+    c.quadrature = x.wave.quadrature;
+    c.phase = x.wave.phase;
+    row_->endRow();
+  }
+
+  const std::string wave_topic_ = "/wave", output_topic_ = "/output";
+  std::unique_ptr<bag_tools::OutputBag> out_;
+  std::unique_ptr<bag_tools::OutputText> csv_file_;
+  std::unique_ptr<CsvOutput> row_;
+  std::uint64_t precessed_ = 0;
+};
+
+// An output waits, as in the node, until the precession state has reached its stamp; the samples
+// behind it wait too, so the bag and the CSV keep the input's order.
+class PrecessionOrderedWriter {
+ public:
+  PrecessionOrderedWriter(core::PrecessionWatch* watch, ProcessOutputs* outputs) : watch_(watch), outputs_(outputs) {}
+
+  void add(ProcessedSample& x) {
+    if (held_.empty()) {
+      // Nothing waits: a sample without an output, or one decided at once, goes straight out.
+      core::PrecessionDecision d;
+      if (!x.has_output) return outputs_->write(x);
+      if (watch_->next(&d)) {
+        if (d.flagged()) x.output.flags |= core::kFlagPrecessing;
+        return outputs_->write(x);
+      }
+    }
+    held_.push_back(x);
+    drain();
+  }
+
+  /// Writes the held samples the watch has decided, in order.
+  void drain() {
+    core::PrecessionDecision d;
+    while (!held_.empty()) {
+      ProcessedSample& x = held_.front();
+      if (x.has_output) {
+        if (!watch_->next(&d)) return;
+        if (d.flagged()) x.output.flags |= core::kFlagPrecessing;
+      }
+      outputs_->write(x);
+      held_.pop_front();
+    }
+  }
+
+ private:
+  core::PrecessionWatch* watch_;
+  ProcessOutputs* outputs_;
+  std::deque<ProcessedSample> held_;
+};
+
+/// The single gyro's options beyond what the command line checks (the triad's are its own).
+void checkSingleGyroOptions(const ProcessOptions& o) {
+  using bag_tools::UsageError;
+  if (o.params.empty()) {
+    throw UsageError("--params is required (the gyro's parameter file; for a triad, --triad with --axis-params)");
+  }
+  bag_tools::checkProcessorConfig(o.processor);
+  try {
+    core::PrecessionWatchSettings w;
+    w.hold = o.precession_hold;
+    w.validate();
+  } catch (const core::ConfigError& e) {
+    throw UsageError("--precession-hold: " + e.problem());
+  }
+}
+
+/// The summary on stderr; exit 1 when no sample was accepted.
+int reportProcess(const core::ProcessorCounters& c, std::uint64_t outputs, const std::string& precession_topic,
+                  const core::PrecessionWatchCounters& p, std::uint64_t precessed) {
+  std::cerr << "process: " << c.received << " samples, " << outputs << " outputs, " << c.rejected() << " rejected, "
+            << c.gaps << " gaps, " << c.resets << " resets, " << c.stamp_jumps << " stamp jumps dropped\n";
+  if (!precession_topic.empty()) {
+    std::cerr << "process: precession state from " << precession_topic << ": " << p.states << " records ("
+              << p.dropped_states << " dropped), " << precessed << " outputs flagged PRECESSING (" << p.unknown
+              << " of them with the state unknown)\n";
+  }
+  if (c.accepted == 0) {
+    // Nothing usable: an output file of rejections only is not a successful run.
+    std::cerr << "process: no sample accepted (" << c.non_finite << " non-finite, " << c.no_signal << " no signal, "
+              << c.degenerate << " degenerate, " << c.amplitude_out_of_range << " amplitude out of range, "
+              << c.zero_stamp << " zero stamp, " << c.duplicate << " duplicate, " << c.out_of_order << " out of order, "
+              << c.stamp_jumps << " stamp jumps, " << c.jumps << " jumps)\n";
+    return 1;
+  }
+  return 0;
+}
+
 int runProcess(const ProcessOptions& o) {
   using namespace bag_tools;
   if (!o.triad.triad_file.empty()) {
@@ -196,107 +355,28 @@ int runProcess(const ProcessOptions& o) {
     }
     return runTriadProcess(o.bag, o.out, o.csv, o.compression, o.processor, o.triad);
   }
-  if (o.params.empty()) {
-    throw UsageError("--params is required (the gyro's parameter file; for a triad, --triad with --axis-params)");
-  }
-  checkProcessorConfig(o.processor);
-  try {
-    core::PrecessionWatchSettings w;
-    w.hold = o.precession_hold;
-    w.validate();
-  } catch (const core::ConfigError& e) {
-    throw UsageError("--precession-hold: " + e.problem());
-  }
+  checkSingleGyroOptions(o);
   checkOutputPaths({o.bag, o.params}, {o.out, o.csv});
   const auto params = std::make_shared<const core::GyroParameters>(core::loadParameterFile(o.params));
   const std::unique_ptr<rosbag::Bag> in = openBag(o.bag);
   const GyroTopics topics = findTopics(*in, o.topics, true, false, TopicNeed::kIfPresent);
-  // Both outputs are temporaries until the whole bag has been processed.
-  std::unique_ptr<OutputBag> out;
-  if (!o.out.empty()) out = std::make_unique<OutputBag>(o.out, o.compression);
-  std::unique_ptr<OutputText> csv_file;
-  std::unique_ptr<CsvOutput> row;
-  if (!o.csv.empty()) {
-    csv_file = std::make_unique<OutputText>(o.csv);
-    csv_file->stream()
-        << "stamp,seq,status,dt,dtheta,dalpha,dalpha_earth_fixed,alpha,rate,theta_mid,frequency,scale_factor,drift,"
-           "rejected_before,flags,theta,amplitude,quadrature,phase\n";
-    row = std::make_unique<CsvOutput>(csv_file->stream());
-  }
+  ProcessOutputs outputs(o);  // both temporaries until the whole bag has been processed
   core::GyroProcessor processor(o.processor, params);
   // The processor node's rule for the precession loop's state (~precession_hold, backward_reset).
   core::PrecessionWatchSettings watch_settings;
   watch_settings.hold = o.precession_hold;
   watch_settings.backward_reset = o.processor.backward_reset;
   core::PrecessionWatch watch(watch_settings);
-  std::uint64_t outputs = 0, precessed = 0;
-  const std::string wave_topic = "/wave", output_topic = "/output";
-  // One input sample's messages and row. An output waits, as in the node, until the precession state
-  // has reached its stamp; the samples behind it wait too, so the bag and the CSV keep the input's order.
-  struct Sample {
-    ros::Time stamp;
-    std::uint32_t seq = 0;
-    const char* status = "";
-    bool has_wave = false, has_output = false;
-    double alpha = 0.0;
-    WaveState wave;
-    GyroOutput output;
-  };
-  std::deque<Sample> held;
-  Sample current;
+  PrecessionOrderedWriter writer(&watch, &outputs);
+  std::uint64_t output_count = 0;
+  ProcessedSample current;
   core::Nanoseconds previous_accepted = 0;  // an output covers (the previous accepted stamp, its own]
-  const bool dry_run = !out && !row;        // the summary only
-  const auto write = [&](const Sample& x) {
-    if (x.has_output && (x.output.flags & core::kFlagPrecessing)) ++precessed;
-    if (dry_run) return;
-    if (out && x.has_wave) out->write(wave_topic, x.stamp, x.wave);
-    if (out && x.has_output) out->write(output_topic, x.stamp, x.output);
-    if (row) {
-      const GyroOutput& output = x.output;
-      CsvRow& c = row->next();
-      c.sec = x.stamp.sec;
-      c.nsec = x.stamp.nsec;
-      c.seq = x.seq;
-      c.status = x.status;
-      c.has_output = x.has_output;
-      c.has_wave = x.has_wave;
-      c.dt = output.dt;
-      c.dtheta = output.dtheta;
-      c.dalpha = output.dalpha;
-      c.dalpha_earth_fixed = output.dalpha_earth_fixed;
-      c.rate = output.rate;
-      c.theta_mid = output.theta_mid;
-      c.frequency = output.frequency;
-      c.scale_factor = output.scale_factor;
-      c.drift = output.drift;
-      c.rejected_before = output.rejected_before;
-      c.flags = output.flags;
-      c.alpha = x.alpha;
-      c.theta = x.wave.theta;
-      c.amplitude = x.wave.amplitude;
-      c.quadrature = x.wave.quadrature;
-      c.phase = x.wave.phase;
-      row->endRow();
-    }
-  };
-  // Writes the held samples the watch has decided, in order.
-  const auto drain = [&] {
-    core::PrecessionDecision d;
-    while (!held.empty()) {
-      Sample& x = held.front();
-      if (x.has_output) {
-        if (!watch.next(&d)) return;
-        if (d.flagged()) x.output.flags |= core::kFlagPrecessing;
-      }
-      write(x);
-      held.pop_front();
-    }
-  };
+  const bool dry_run = outputs.dryRun();    // the summary only
   replayChannels(
       *in, topics.channels, processor,
       [&](const ChannelAmplitudes& msg, const core::ProcessorResult& r) {
-        outputs += r.has_output ? 1 : 0;
-        Sample& x = current;
+        output_count += r.has_output ? 1 : 0;
+        ProcessedSample& x = current;
         x.stamp = msg.header.stamp;
         x.has_wave = r.has_wave;
         x.has_output = r.has_output;
@@ -314,48 +394,17 @@ int runProcess(const ProcessOptions& o) {
         } else if (r.has_output) {
           x.output.flags = r.flags;
         }
-        if (held.empty()) {
-          // Nothing waits: a sample without an output, or one decided at once, goes straight out.
-          core::PrecessionDecision d;
-          if (!x.has_output) return write(x);
-          if (watch.next(&d)) {
-            if (d.flagged()) x.output.flags |= core::kFlagPrecessing;
-            return write(x);
-          }
-        }
-        held.push_back(x);
-        drain();
+        writer.add(x);
       },
       "process", topics.precession,
       [&](const PrecessionState& state) {
         watch.addState({toNanoseconds(state.header.stamp), state.rate, state.angle});
-        drain();
+        writer.drain();
       });
   watch.finish();  // the bag has ended: what still waits is decided with the records it holds
-  drain();
-  if (csv_file) {
-    row->finish();
-    csv_file->commit();
-  }
-  if (out) out->commit();
-  const core::ProcessorCounters& c = processor.counters();
-  std::cerr << "process: " << c.received << " samples, " << outputs << " outputs, " << c.rejected() << " rejected, "
-            << c.gaps << " gaps, " << c.resets << " resets, " << c.stamp_jumps << " stamp jumps dropped\n";
-  if (!topics.precession.empty()) {
-    const core::PrecessionWatchCounters& p = watch.counters();
-    std::cerr << "process: precession state from " << topics.precession << ": " << p.states << " records ("
-              << p.dropped_states << " dropped), " << precessed << " outputs flagged PRECESSING (" << p.unknown
-              << " of them with the state unknown)\n";
-  }
-  if (c.accepted == 0) {
-    // Nothing usable: an output file of rejections only is not a successful run.
-    std::cerr << "process: no sample accepted (" << c.non_finite << " non-finite, " << c.no_signal << " no signal, "
-              << c.degenerate << " degenerate, " << c.amplitude_out_of_range << " amplitude out of range, "
-              << c.zero_stamp << " zero stamp, " << c.duplicate << " duplicate, " << c.out_of_order << " out of order, "
-              << c.stamp_jumps << " stamp jumps, " << c.jumps << " jumps)\n";
-    return 1;
-  }
-  return 0;
+  writer.drain();
+  outputs.commit();
+  return reportProcess(processor.counters(), output_count, topics.precession, watch.counters(), outputs.precessed());
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <deque>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -12,44 +13,41 @@
 #include "bag_tools.h"
 #include "csv_text.h"
 #include "hrg_gyro/core/model/parameter_file.h"
-#include "hrg_gyro/core/model/triad_parameters.h"
+#include "hrg_gyro/core/model/triad_file.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "reused_message_reader.h"
+#include "triad_axis_options.h"
 
 namespace hrg_gyro {
 namespace bag_tools {
 namespace {
 
-/// One axis of the triad: its processor, and the variance its processor node's Imu would carry.
-struct Axis {
+/// One axis of the triad and where the bag holds it.
+struct AxisInput {
   std::string name, parameter_file, topic;
-  std::unique_ptr<core::GyroProcessor> processor;
-  std::unique_ptr<core::RateNoiseEstimator> noise;
-  core::ProcessorResult result;
   std::string frame_id;  // of its outputs, as triad.launch names it
-  std::uint64_t outputs = 0;
 };
 
-/// NAME=VALUE items of a per-axis option (--axis-params, --axis-channels): each name an axis of the
-/// triad, given once. A UsageError names what is wrong.
-std::map<std::string, std::string> perAxis(const std::vector<std::string>& items, const core::TriadParameters& triad,
-                                           const std::string& option) {
-  std::map<std::string, std::string> out;
-  for (const std::string& item : items) {
-    const std::size_t eq = item.find('=');
-    if (eq == std::string::npos || eq == 0 || eq + 1 == item.size()) {
-      throw UsageError("--" + option + " expects NAME=VALUE with NAME an axis of the triad (" + triad.axes[0] + ", " +
-                       triad.axes[1] + ", " + triad.axes[2] + "), got '" + item + "'");
+/// The chain's settings from the options, each refusal naming its option.
+core::TriadProcessorSettings checkedSettings(const core::ProcessorConfig& processor, const TriadOptions& o) {
+  checkProcessorConfig(processor);
+  core::TriadProcessorSettings s;
+  s.processor = processor;
+  s.noise = o.noise;
+  s.combiner = o.combiner;
+  s.combiner.initial_rate_variance = o.noise.initial_variance;  // the nodes' defaults agree
+  try {
+    o.noise.validate();
+    s.combiner.validate();
+  } catch (const core::ConfigError& e) {
+    std::string option = e.key();
+    if (option == "max_rate" || option == "backward_reset" || option == "forward_jump" || option == "jump_persist") {
+      option = "triad_" + option;  // the processors' options have these names
     }
-    const std::string axis = item.substr(0, eq);
-    if (std::find(triad.axes.begin(), triad.axes.end(), axis) == triad.axes.end()) {
-      throw UsageError("--" + option + " " + item + ": '" + axis + "' is not an axis of the triad (its axes: " +
-                       triad.axes[0] + ", " + triad.axes[1] + ", " + triad.axes[2] + ")");
-    }
-    if (!out.emplace(axis, item.substr(eq + 1)).second)
-      throw UsageError("--" + option + " gives axis " + axis + " twice");
+    std::replace(option.begin(), option.end(), '_', '-');
+    throw UsageError("--" + option + ": " + e.problem());
   }
-  return out;
+  return s;
 }
 
 /// The axis's channels: `chosen` (--axis-channels), or /AXIS/channels, or the one ChannelAmplitudes
@@ -84,6 +82,35 @@ std::string axisTopic(const rosbag::Bag& bag, const std::string& axis, const std
   throw UsageError("several " + type + " topics end in " + suffix + " in the bag: one triad per bag");
 }
 
+/// The axes in the triad's order: names, parameter files (--axis-params), topics in `bag`.
+std::array<AxisInput, 3> axisInputs(const TriadOptions& o, const core::TriadParameters& triad) {
+  const std::map<std::string, std::string> given = perAxis(o.axis_params, "axis-params");
+  checkAxisNames(given, triad.axes, "axis-params");
+  std::array<AxisInput, 3> axes;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const auto it = given.find(triad.axes[a]);
+    if (it == given.end()) {
+      throw UsageError("--axis-params " + triad.axes[a] + "=FILE missing: each axis's parameter file is needed");
+    }
+    axes[a].name = triad.axes[a];
+    axes[a].parameter_file = it->second;
+    axes[a].frame_id = axes[a].name + "_gyro_link";
+  }
+  return axes;
+}
+
+/// Each axis's channels topic in `bag`, --axis-channels NAME=TOPIC choosing it.
+void findAxisTopics(const rosbag::Bag& bag, const TriadOptions& o, std::array<AxisInput, 3>* axes) {
+  const std::array<std::string, 3> names{{(*axes)[0].name, (*axes)[1].name, (*axes)[2].name}};
+  const std::map<std::string, std::string> channels = perAxis(o.axis_channels, "axis-channels");
+  checkAxisNames(channels, names, "axis-channels");
+  for (AxisInput& a : *axes) {
+    const auto chosen = channels.find(a.name);
+    a.topic = axisTopic(bag, a.name, chosen == channels.end() ? std::string() : chosen->second);
+  }
+  checkDistinctAxisTopics(names, {{(*axes)[0].topic, (*axes)[1].topic, (*axes)[2].topic}});
+}
+
 const char* kCsvHeader =
     "stamp,flags,dt,delta_angle_x,delta_angle_y,delta_angle_z,angular_velocity_x,angular_velocity_y,"
     "angular_velocity_z,cov_xx,cov_xy,cov_xz,cov_yx,cov_yy,cov_yz,cov_zx,cov_zy,cov_zz\n";
@@ -102,6 +129,143 @@ void formatRow(const TriadOutput& m, CsvText* text) {
   text->number(m.angular_velocity.z);
   for (double c : m.angular_velocity_covariance) text->number(c);
   text->endRow();
+}
+
+/// Where the triad's messages go, as the live nodes publish them: each axis's GyroOutput (once the
+/// chain hands it on), /triad/output and /imu/data_raw into the bag; the CSV's rows.
+class TriadOutputs {
+ public:
+  TriadOutputs(const std::string& out_path, const std::string& csv_path, const std::string& compression,
+               const std::string& frame_id, const std::array<AxisInput, 3>& axes)
+      : frame_id_(frame_id) {
+    if (!out_path.empty()) bag_ = std::make_unique<OutputBag>(out_path, compression);
+    if (!csv_path.empty()) {
+      csv_ = std::make_unique<OutputText>(csv_path);
+      csv_->stream() << kCsvHeader;
+    }
+    for (std::size_t a = 0; a < 3; ++a) {
+      axis_frames_[a] = axes[a].frame_id;
+      axis_topics_[a] = "/" + axes[a].name + "/output";
+    }
+  }
+
+  /// An axis's output, as its processor node makes it, until its verdict comes (release order).
+  void hold(std::size_t axis, const std_msgs::Header& channels_header, const core::ProcessorResult& r) {
+    if (!bag_) return;
+    std_msgs::Header header = channels_header;
+    header.frame_id = axis_frames_[axis];
+    held_[axis].push_back(toOutputMessage(header, r));
+  }
+
+  /// The outputs decided, with their flags, then the triad samples they completed.
+  void write(const std::vector<core::TriadAxisOutput>& outputs, const std::vector<core::TriadBodySample>& samples) {
+    if (bag_) {
+      for (const core::TriadAxisOutput& o : outputs) {
+        GyroOutput& m = held_[o.axis].front();
+        m.flags = o.output.flags;
+        bag_->write(axis_topics_[o.axis], m.header.stamp, m);
+        held_[o.axis].pop_front();
+      }
+    }
+    for (const core::TriadBodySample& s : samples) {
+      const TriadOutput m = toTriadOutputMessage(s, frame_id_);
+      if (bag_) {
+        bag_->write("/triad/output", m.header.stamp, m);
+        if (s.integrated()) bag_->write("/imu/data_raw", m.header.stamp, toImuMessage(s, frame_id_));
+      }
+      if (csv_) {
+        formatRow(m, &text_);
+        if (text_.size() > (1u << 20)) flushText();
+      }
+    }
+  }
+
+  void commit() {
+    if (csv_) {
+      flushText();
+      csv_->commit();
+    }
+    if (bag_) bag_->commit();
+  }
+
+ private:
+  void flushText() {
+    csv_->stream().write(text_.data(), static_cast<std::streamsize>(text_.size()));
+    text_.clear();
+  }
+
+  std::string frame_id_;
+  std::array<std::string, 3> axis_frames_, axis_topics_;
+  std::unique_ptr<OutputBag> bag_;
+  std::unique_ptr<OutputText> csv_;
+  CsvText text_;
+  std::array<std::deque<GyroOutput>, 3> held_;
+};
+
+/// The bag's channels through `triad`, in record order, into `outputs`; the input's end flushes the
+/// combiner. Returns the channel messages read.
+std::uint64_t replayTriad(const rosbag::Bag& bag, const std::array<AxisInput, 3>& axes, core::TriadProcessor* triad,
+                          TriadOutputs* outputs) {
+  std::vector<std::string> topics;
+  std::map<std::string, std::size_t> axis_of_topic;
+  for (std::size_t a = 0; a < 3; ++a) {
+    topics.push_back(axes[a].topic);
+    axis_of_topic[axes[a].topic] = a;
+  }
+  rosbag::View view(bag, rosbag::TopicQuery(topics));
+  Progress progress("process --triad", view.size());
+  ReusedMessageReader<ChannelAmplitudes> reader;
+  ChannelAmplitudes msg;
+  core::ProcessorResult result;
+  std::vector<core::TriadAxisOutput> decided;
+  std::vector<core::TriadBodySample> completed;
+  std::uint64_t n = 0;
+  try {
+    for (const rosbag::MessageInstance& instance : view) {
+      if (!reader.read(instance, &msg)) continue;
+      ++n;
+      const std::size_t axis = axis_of_topic.at(instance.getTopic());
+      triad->process(axis, fromMessage(msg), &result);
+      if (result.has_output) {
+        outputs->hold(axis, msg.header, result);
+        decided.clear();
+        completed.clear();
+        triad->release(&decided, &completed);
+        outputs->write(decided, completed);
+      }
+      if (n % 4096 == 0) progress.update(n, n);
+    }
+  } catch (...) {
+    rethrowBagReadError(n);
+  }
+  progress.finish(n);
+  decided.clear();
+  completed.clear();
+  triad->finish(&decided, &completed);
+  outputs->write(decided, completed);
+  return n;
+}
+
+/// What the run did, on stderr; the exit code: 1 when nothing was combined from all three axes.
+int summarize(const core::TriadProcessor& triad, const std::array<AxisInput, 3>& axes) {
+  const core::TriadCounters& c = triad.combiner().counters();
+  std::cerr << "process: triad " << triad.combiner().parameters().frame_id << ": " << c.samples << " samples, "
+            << c.integrated << " combined, " << c.gaps << " gaps, " << c.resets << " resets, " << c.axis_flagged
+            << " axis flagged, " << c.timeouts << " waited out, " << c.carried
+            << " stamps skipped by an axis (carried into the next)\n";
+  for (std::size_t a = 0; a < 3; ++a) {
+    const core::ProcessorCounters& p = triad.processor(a).counters();
+    const core::TriadAxisCounters& t = c.axes[a];
+    std::cerr << "  axis " << axes[a].name << " (" << axes[a].topic << ", " << axes[a].parameter_file
+              << "): " << p.received << " samples, " << triad.outputs(a) << " outputs, " << p.rejected()
+              << " rejected, " << t.missing << " stamps missing, " << t.mismatched << " intervals mismatched, "
+              << p.stamp_jumps + t.stamp_jumps << " stamp jumps dropped\n";
+  }
+  if (c.integrated == 0) {
+    std::cerr << "process: no triad sample combined from all three axes\n";
+    return 1;
+  }
+  return 0;
 }
 
 }  // namespace
@@ -163,144 +327,22 @@ CLI::Option* addTriadOptions(CLI::App& command, TriadOptions* o) {
 
 int runTriadProcess(const std::string& bag_path, const std::string& out_path, const std::string& csv_path,
                     const std::string& compression, const core::ProcessorConfig& processor, const TriadOptions& o) {
-  checkProcessorConfig(processor);
-  core::TriadCombinerSettings combiner_settings = o.combiner;
-  combiner_settings.initial_rate_variance = o.noise.initial_variance;  // the node's defaults agree
-  try {
-    o.noise.validate();
-    combiner_settings.validate();
-  } catch (const core::ConfigError& e) {
-    std::string option = e.key();
-    if (option == "max_rate" || option == "backward_reset" || option == "forward_jump" || option == "jump_persist") {
-      option = "triad_" + option;  // the processors' options have these names
-    }
-    std::replace(option.begin(), option.end(), '_', '-');
-    throw UsageError("--" + option + ": " + e.problem());
-  }
+  const core::TriadProcessorSettings settings = checkedSettings(processor, o);
   const auto triad = std::make_shared<const core::TriadParameters>(core::loadTriadFile(o.triad_file));
-  const std::map<std::string, std::string> given = perAxis(o.axis_params, *triad, "axis-params");
-  const std::map<std::string, std::string> channels = perAxis(o.axis_channels, *triad, "axis-channels");
-  std::array<std::string, 3> files;
-  for (std::size_t a = 0; a < 3; ++a) {
-    const auto it = given.find(triad->axes[a]);
-    if (it == given.end()) {
-      throw UsageError("--axis-params " + triad->axes[a] + "=FILE missing: each axis's parameter file is needed");
-    }
-    files[a] = it->second;
-  }
+  std::array<AxisInput, 3> axes = axisInputs(o, *triad);
   std::vector<std::string> inputs{bag_path, o.triad_file};
-  inputs.insert(inputs.end(), files.begin(), files.end());
+  for (const AxisInput& a : axes) inputs.push_back(a.parameter_file);
   checkOutputPaths(inputs, {out_path, csv_path});
-
-  std::array<Axis, 3> axes;
-  for (std::size_t a = 0; a < 3; ++a) {
-    axes[a].name = triad->axes[a];
-    axes[a].parameter_file = files[a];
-    axes[a].processor = std::make_unique<core::GyroProcessor>(
-        processor, std::make_shared<const core::GyroParameters>(core::loadParameterFile(files[a])));
-    axes[a].noise = std::make_unique<core::RateNoiseEstimator>(o.noise);
-    axes[a].frame_id = axes[a].name + "_gyro_link";
-  }
+  std::array<core::GyroParameters, 3> parameters;
+  for (std::size_t a = 0; a < 3; ++a) parameters[a] = core::loadParameterFile(axes[a].parameter_file);
   const std::unique_ptr<rosbag::Bag> bag = openBag(bag_path);
-  std::vector<std::string> topics;
-  std::map<std::string, std::size_t> axis_of_topic;
-  for (std::size_t a = 0; a < 3; ++a) {
-    const auto chosen = channels.find(axes[a].name);
-    axes[a].topic = axisTopic(*bag, axes[a].name, chosen == channels.end() ? std::string() : chosen->second);
-    topics.push_back(axes[a].topic);
-    axis_of_topic[axes[a].topic] = a;
-  }
-  checkDistinctAxisTopics(triad->axes, {{axes[0].topic, axes[1].topic, axes[2].topic}});
-  std::unique_ptr<OutputBag> out;
-  if (!out_path.empty()) out = std::make_unique<OutputBag>(out_path, compression);
-  std::unique_ptr<OutputText> csv;
-  CsvText text;
-  if (!csv_path.empty()) {
-    csv = std::make_unique<OutputText>(csv_path);
-    csv->stream() << kCsvHeader;
-  }
+  findAxisTopics(*bag, o, &axes);
 
-  core::TriadCombiner combiner(combiner_settings, triad);
-  std::vector<core::TriadBodySample> completed;
-  const auto write = [&](const std::vector<core::TriadBodySample>& samples) {
-    for (const core::TriadBodySample& s : samples) {
-      const TriadOutput m = toTriadOutputMessage(s, triad->frame_id);
-      if (out) {
-        out->write("/triad/output", m.header.stamp, m);
-        if (s.integrated()) out->write("/imu/data_raw", m.header.stamp, toImuMessage(s, triad->frame_id));
-      }
-      if (csv) {
-        formatRow(m, &text);
-        if (text.size() > (1u << 20)) {
-          csv->stream().write(text.data(), static_cast<std::streamsize>(text.size()));
-          text.clear();
-        }
-      }
-    }
-  };
-
-  rosbag::View view(*bag, rosbag::TopicQuery(topics));
-  Progress progress("process --triad", view.size());
-  ReusedMessageReader<ChannelAmplitudes> reader;
-  ChannelAmplitudes msg;
-  std::uint64_t n = 0;
-  try {
-    for (const rosbag::MessageInstance& instance : view) {
-      if (!reader.read(instance, &msg)) continue;
-      ++n;
-      Axis& axis = axes[axis_of_topic.at(instance.getTopic())];
-      const std::size_t a = static_cast<std::size_t>(&axis - axes.data());
-      axis.processor->process(fromMessage(msg), &axis.result);
-      const core::ProcessorResult& r = axis.result;
-      if (!r.has_output) continue;
-      // What the axis's processor node publishes: its output, and its Imu's variance for a sample
-      // without a gap or reset (for those it publishes no Imu).
-      std_msgs::Header header = msg.header;
-      header.frame_id = axis.frame_id;
-      const GyroOutput output = toOutputMessage(header, r);
-      ++axis.outputs;
-      axis.noise->add(r.alpha, r.increment.dt, r.flags);
-      core::AxisOutput in = toAxisOutput(output);
-      if (!(r.flags & (core::kFlagGap | core::kFlagReset))) in.rate_variance = axis.noise->variance();
-      if (out) out->write("/" + axis.name + "/output", output.header.stamp, output);
-      completed.clear();
-      combiner.add(a, in, &completed);
-      write(completed);
-      if (n % 4096 == 0) progress.update(n, n);
-    }
-  } catch (const rosbag::BagException& e) {
-    throw UsageError(std::string("bag read error after ") + std::to_string(n) + " samples (truncated?): " + e.what());
-  } catch (const ros::serialization::StreamOverrunException& e) {
-    throw UsageError(std::string("bag read error after ") + std::to_string(n) +
-                     " samples: a message shorter than its type (corrupt?): " + e.what());
-  }
-  progress.finish(n);
-  // The stamps some axis never delivered, as the gaps they are.
-  completed.clear();
-  combiner.flush(&completed);
-  write(completed);
-  if (csv) {
-    csv->stream().write(text.data(), static_cast<std::streamsize>(text.size()));
-    csv->commit();
-  }
-  if (out) out->commit();
-  const core::TriadCounters& c = combiner.counters();
-  std::cerr << "process: triad " << triad->frame_id << ": " << c.samples << " samples, " << c.integrated
-            << " combined, " << c.gaps << " gaps, " << c.resets << " resets, " << c.axis_flagged << " axis flagged, "
-            << c.timeouts << " waited out, " << c.carried << " stamps skipped by an axis (carried into the next)\n";
-  for (std::size_t a = 0; a < 3; ++a) {
-    const core::ProcessorCounters& p = axes[a].processor->counters();
-    const core::TriadAxisCounters& t = c.axes[a];
-    std::cerr << "  axis " << axes[a].name << " (" << axes[a].topic << ", " << axes[a].parameter_file
-              << "): " << p.received << " samples, " << axes[a].outputs << " outputs, " << p.rejected() << " rejected, "
-              << t.missing << " stamps missing, " << t.mismatched << " intervals mismatched, "
-              << p.stamp_jumps + t.stamp_jumps << " stamp jumps dropped\n";
-  }
-  if (c.integrated == 0) {
-    std::cerr << "process: no triad sample combined from all three axes\n";
-    return 1;
-  }
-  return 0;
+  core::TriadProcessor chain(settings, parameters, triad);
+  TriadOutputs outputs(out_path, csv_path, compression, triad->frame_id, axes);
+  replayTriad(*bag, axes, &chain, &outputs);
+  outputs.commit();
+  return summarize(chain, axes);
 }
 
 }  // namespace bag_tools

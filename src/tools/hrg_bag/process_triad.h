@@ -1,16 +1,15 @@
-// hrg_bag process --triad: three gyros' channels through three processors and the triad combiner,
-// offline. The same core objects and message conversions as the live processor and triad nodes
-// (GyroProcessor, RateNoiseEstimator for the variance each processor's Imu carries, TriadCombiner),
-// so the TriadOutput stream is bit for bit the triad node's on the same channels.
+// hrg_bag process --triad: three gyros' channels through the triad's processing chain offline
+// (core::TriadProcessor: per axis the processor node's GyroProcessor and RateNoiseEstimator for the
+// variance its Imu carries, then the triad node's TriadCombiner) with the same message conversions as
+// the live processor and triad nodes, so the TriadOutput stream is bit for bit the triad node's on the
+// same channels.
 #pragma once
 
 #include <CLI/CLI.hpp>
 #include <string>
 #include <vector>
 
-#include "hrg_gyro/core/processing/gyro_processor.h"
-#include "hrg_gyro/core/processing/rate_noise_estimator.h"
-#include "hrg_gyro/core/processing/triad_combiner.h"
+#include "hrg_gyro/core/processing/triad_processor.h"
 
 namespace hrg_gyro {
 namespace bag_tools {

@@ -97,7 +97,8 @@ int runSimulate(const SimulateOptions& o) {
     }
     updatePrecessionSource(s, std::string(), &precession_source);
     if (sim.hasPrecessionLoop()) {
-      bag.write("/precession/state", stamp, toPrecessionStateMessage(s, trueHeader(ch.header, stamp), precession_source));
+      bag.write("/precession/state", stamp,
+                toPrecessionStateMessage(s, trueHeader(ch.header, stamp), precession_source));
     }
     progress.update(sim.elapsed(), ++seq);
   }

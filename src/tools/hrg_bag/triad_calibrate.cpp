@@ -9,45 +9,29 @@
 #include "bag_tools.h"
 #include "hrg_gyro/FixturePosition.h"
 #include "hrg_gyro/TurntableState.h"
-#include "hrg_gyro/core/calibration/triad_calibration.h"
-#include "hrg_gyro/core/calibration/triad_feed.h"
-#include "hrg_gyro/core/calibration/triad_result_files.h"
+#include "hrg_gyro/core/calibration/triad/triad_calibration.h"
+#include "hrg_gyro/core/calibration/triad/triad_result_files.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/output_directory.h"
 #include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/model/triad_file.h"
+#include "hrg_gyro/core/processing/triad_processor.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "triad_axis_options.h"
 
 namespace hrg_gyro {
 namespace bag_tools {
 namespace {
 
-/// NAME=VALUE items of a per-axis option, each name given once (whether the names are the triad's
-/// axes is checked once the triad file is read: checkAxisNames).
-std::map<std::string, std::string> perAxis(const std::vector<std::string>& items, const std::string& option) {
-  std::map<std::string, std::string> out;
-  for (const std::string& item : items) {
-    const std::size_t eq = item.find('=');
-    const std::string name = eq == std::string::npos ? std::string() : item.substr(0, eq);
-    const std::string value = eq == std::string::npos ? std::string() : item.substr(eq + 1);
-    if (name.empty() || value.empty()) {
-      throw UsageError("--" + option + " expects NAME=VALUE with NAME an axis of the triad, got '" + item + "'");
-    }
-    if (!out.emplace(name, value).second) throw UsageError("--" + option + " gives axis " + name + " twice");
-  }
-  return out;
-}
-
-/// Each name of a per-axis option one of the triad's axes.
-void checkAxisNames(const std::map<std::string, std::string>& given, const std::array<std::string, 3>& axes,
-                    const std::string& option) {
-  for (const auto& kv : given) {
-    const std::string& name = kv.first;
-    if (name != axes[0] && name != axes[1] && name != axes[2]) {
-      throw UsageError("--" + option + " " + name + "=" + kv.second + ": '" + name +
-                       "' is not an axis of the triad (its axes: " + axes[0] + ", " + axes[1] + ", " + axes[2] + ")");
-    }
-  }
-}
+/// The run's inputs once read and checked: the priors and settings, each axis's files and topics.
+struct TriadInputs {
+  core::TriadParameters prior_triad;
+  std::array<core::GyroParameters, 3> prior_axes;
+  core::CalibrationSettings axis_settings;
+  core::TriadCalibrationSettings triad_settings;
+  std::array<std::string, 3> channel_topics, outs;  // in the triad's axis order
+  std::string turntable_topic, fixture_topic;
+};
 
 /// Every path against every other before anything is read (core::checkTriadPaths): an output may be
 /// its own prior only (--out the --triad file, --axis-out NAME=F the --axis-params NAME=F file),
@@ -98,41 +82,9 @@ void loadSettings(const std::string& path, core::CalibrationSettings* axis, core
   }
 }
 
-std::string topicType(const rosbag::Bag& bag, const std::string& topic) {
-  rosbag::View view(bag, rosbag::TopicQuery(topic));
-  for (const rosbag::ConnectionInfo* c : view.getConnections()) return c->datatype;
-  return std::string();
-}
-
-/// `topic`, or else the bag's single topic of `type`; UsageError naming the option otherwise.
-std::string findTopic(const rosbag::Bag& bag, const std::string& topic, const std::string& type,
-                      const std::string& option) {
-  std::map<std::string, std::string> types;
-  rosbag::View all(bag);
-  for (const rosbag::ConnectionInfo* c : all.getConnections()) types[c->topic] = c->datatype;
-  if (!topic.empty()) {
-    const auto it = types.find(topic);
-    if (it == types.end()) throw UsageError("topic " + topic + " (--" + option + ") is not in the bag");
-    if (it->second != type) throw UsageError("topic " + topic + " has type " + it->second + ", expected " + type);
-    return topic;
-  }
-  std::vector<std::string> found;
-  for (const auto& kv : types)
-    if (kv.second == type) found.push_back(kv.first);
-  if (found.size() == 1) return found.front();
-  if (found.empty()) {
-    throw UsageError("no " + type + " topic in the bag" +
-                     (type == ros::message_traits::datatype<FixturePosition>()
-                          ? ": a triad session logs the fixture's position (docs/triad.md)"
-                          : std::string()));
-  }
-  throw UsageError("several " + type + " topics in the bag; choose one with --" + option);
-}
-
-}  // namespace
-
-int runTriadCalibrate(const TriadCalibrateOptions& o) {
-  checkProcessorConfig(o.processor);
+/// The prior triad file (--triad; "" the nominal triad) and the axes' per-axis options against its
+/// axis names: each axis's prior parameter file, output file and channels topic.
+void readPriors(const TriadCalibrateOptions& o, TriadInputs* in) {
   const std::map<std::string, std::string> params = perAxis(o.axis_params, "axis-params");
   std::map<std::string, std::string> outs = perAxis(o.axis_out, "axis-out");
   const std::map<std::string, std::string> channels = perAxis(o.axis_channels, "axis-channels");
@@ -141,115 +93,114 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
     if (!outs.count(kv.first)) outs[kv.first] = core::directoryOf(o.out) + "/" + kv.first + ".yaml";
   }
   checkPaths(o, params, outs);
-
-  const core::TriadParameters prior_triad = [&] {
-    if (o.triad.empty()) return core::TriadParameters();
+  if (!o.triad.empty()) {
     try {
-      return core::loadTriadFile(o.triad);
+      in->prior_triad = core::loadTriadFile(o.triad);
     } catch (const std::exception& e) {
       throw UsageError("--triad " + o.triad + ": " + e.what());
     }
-  }();
-  const std::array<std::string, 3>& axes = prior_triad.axes;
+  }
+  const std::array<std::string, 3>& axes = in->prior_triad.axes;
   checkAxisNames(params, axes, "axis-params");
   checkAxisNames(outs, axes, "axis-out");
   checkAxisNames(channels, axes, "axis-channels");
-  std::array<std::string, 3> channel_topics;
   for (int i = 0; i < 3; ++i) {
-    channel_topics[i] = channels.count(axes[i]) ? channels.at(axes[i]) : "/" + axes[i] + "/channels";
+    in->channel_topics[i] = channels.count(axes[i]) ? channels.at(axes[i]) : "/" + axes[i] + "/channels";
   }
-  checkDistinctAxisTopics(axes, channel_topics);
+  checkDistinctAxisTopics(axes, in->channel_topics);
   for (const std::string& a : axes) {
     if (!params.count(a)) {
       throw UsageError("--axis-params " + a + "=FILE missing: each axis's prior parameter file is needed (its P is " +
                        "kept, and its latitude places the Earth's rate)");
     }
   }
-
-  core::CalibrationSettings axis_settings;
-  core::TriadCalibrationSettings triad_settings;
-  loadSettings(o.config, &axis_settings, &triad_settings);
-  std::array<core::GyroParameters, 3> prior_axes;
+  loadSettings(o.config, &in->axis_settings, &in->triad_settings);
   for (int i = 0; i < 3; ++i) {
+    in->outs[i] = outs.at(axes[i]);
     try {
-      prior_axes[i] = core::loadParameterFile(params.at(axes[i]));
+      in->prior_axes[i] = core::loadParameterFile(params.at(axes[i]));
     } catch (const std::exception& e) {
       throw UsageError("--axis-params " + axes[i] + "=" + params.at(axes[i]) + ": " + e.what());
     }
   }
   for (int i = 1; i < 3; ++i) {
-    if (!(prior_axes[i].earth_rate == prior_axes[0].earth_rate)) {
+    if (!(in->prior_axes[i].earth_rate == in->prior_axes[0].earth_rate)) {
       throw UsageError("the axes' parameter files disagree on the Earth's rate (earth_rate: enabled, latitude): " +
                        axes[0] + " and " + axes[i] + " sit at one site");
     }
   }
+}
 
-  const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
-  const std::string turntable =
-      findTopic(*bag, o.turntable_topic, ros::message_traits::datatype<TurntableState>(), "turntable-topic");
-  const std::string fixture =
-      findTopic(*bag, o.fixture_topic, ros::message_traits::datatype<FixturePosition>(), "fixture-topic");
+/// The table's and the fixture's topics, and each axis's channels topic checked in the bag.
+void findSessionTopics(const rosbag::Bag& bag, const TriadCalibrateOptions& o, TriadInputs* in) {
+  in->turntable_topic =
+      findTopic(bag, o.turntable_topic, ros::message_traits::datatype<TurntableState>(), "turntable-topic", true);
+  in->fixture_topic = findTopic(bag, o.fixture_topic, ros::message_traits::datatype<FixturePosition>(), "fixture-topic",
+                                true, ": a triad session logs the fixture's position (docs/triad.md)");
+  const std::string wanted = ros::message_traits::datatype<ChannelAmplitudes>();
   for (int i = 0; i < 3; ++i) {
-    const std::string type = topicType(*bag, channel_topics[i]);
-    const std::string wanted = ros::message_traits::datatype<ChannelAmplitudes>();
+    const std::string& topic = in->channel_topics[i];
+    rosbag::View view(bag, rosbag::TopicQuery(topic));
+    std::string type;
+    for (const rosbag::ConnectionInfo* c : view.getConnections()) type = c->datatype;
+    const std::string& axis = in->prior_triad.axes[i];
     if (type.empty()) {
-      throw UsageError("axis " + axes[i] + ": topic " + channel_topics[i] + " is not in the bag (--axis-channels " +
-                       axes[i] + "=TOPIC names another)");
+      throw UsageError("axis " + axis + ": topic " + topic + " is not in the bag (--axis-channels " + axis +
+                       "=TOPIC names another)");
     }
-    if (type != wanted) throw UsageError("topic " + channel_topics[i] + " has type " + type + ", expected " + wanted);
+    if (type != wanted) throw UsageError("topic " + topic + " has type " + type + ", expected " + wanted);
   }
+}
 
-  std::array<std::unique_ptr<core::GyroProcessor>, 3> processors;
-  for (int i = 0; i < 3; ++i) {
-    processors[i] =
-        std::make_unique<core::GyroProcessor>(o.processor, std::make_shared<const core::GyroParameters>(prior_axes[i]));
-  }
-  core::TriadCalibration calibration(axis_settings, triad_settings, prior_axes, prior_triad);
-  std::vector<std::string> wanted{channel_topics.begin(), channel_topics.end()};
-  wanted.push_back(turntable);
-  wanted.push_back(fixture);
-  rosbag::View view(*bag, rosbag::TopicQuery(wanted));
+/// The bag's table, fixture and channels (each axis's through its processor) into the calibration,
+/// in record order; its outcome.
+core::TriadOutcome calibrate(const rosbag::Bag& bag, const TriadCalibrateOptions& o, const TriadInputs& in) {
+  core::TriadProcessor processors(o.processor, in.prior_axes);
+  core::TriadCalibration calibration(in.axis_settings, in.triad_settings, in.prior_axes, in.prior_triad);
+  std::vector<std::string> wanted{in.channel_topics.begin(), in.channel_topics.end()};
+  wanted.push_back(in.turntable_topic);
+  wanted.push_back(in.fixture_topic);
+  rosbag::View view(bag, rosbag::TopicQuery(wanted));
   Progress progress("calibrate", view.size());
+  core::ProcessorResult r;
   std::uint64_t n = 0;
   try {
     for (const rosbag::MessageInstance& m : view) {
       ++n;
       progress.update(n, n);
       const std::string& topic = m.getTopic();
-      if (topic == turntable) {
+      if (topic == in.turntable_topic) {
         const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
         if (t) calibration.addTurntable(toNanoseconds(t->header.stamp), t->angle, t->rate, t->header.seq);
         continue;
       }
-      if (topic == fixture) {
+      if (topic == in.fixture_topic) {
         const FixturePosition::ConstPtr f = m.instantiate<FixturePosition>();
-        if (!f) continue;
-        calibration.addFixture(fromMessage(*f));  // checked there: not a rotation, a bad stamp (as live)
+        if (f) calibration.addFixture(fromMessage(*f));  // checked there: not a rotation, a bad stamp (as live)
         continue;
       }
-      for (int i = 0; i < 3; ++i) {
-        if (topic != channel_topics[i]) continue;
+      for (std::size_t i = 0; i < 3; ++i) {
+        if (topic != in.channel_topics[i]) continue;
         const ChannelAmplitudes::ConstPtr c = m.instantiate<ChannelAmplitudes>();
         if (!c) break;
-        const core::ChannelSample in = fromMessage(*c);
-        const core::ProcessorResult r = processors[i]->process(in);
-        if (r.has_wave) calibration.addWave(i, in.stamp, r.wave.theta, in.frequency);
+        const core::ChannelSample sample = fromMessage(*c);
+        processors.process(i, sample, &r);
+        if (r.has_wave) calibration.addWave(static_cast<int>(i), sample.stamp, r.wave.theta, sample.frequency);
         break;
       }
     }
-  } catch (const rosbag::BagException& e) {
-    throw UsageError(std::string("bag read error (truncated?): ") + e.what());
+  } catch (...) {
+    rethrowBagReadError(n);
   }
   progress.finish(n);
-
   core::TriadOutcome outcome = calibration.finish();
   outcome.triad.calibration.source = o.bag;
   for (core::CalibrationOutcome& a : outcome.axes) a.parameters.calibration.source = o.bag;
-  if (!o.report.empty()) {
-    OutputText report(o.report);
-    report.stream() << core::emitTriadReport(outcome);
-    report.commit();
-  }
+  return outcome;
+}
+
+/// The verdict, the gates and notes, each axis, M and the bias on stdout.
+void printOutcome(const core::TriadOutcome& outcome) {
   std::cout << "calibrate: triad " << (outcome.accepted ? "ACCEPTED" : "REFUSED");
   if (!outcome.accepted) std::cout << ": " << outcome.reason;
   std::cout << "\n";
@@ -259,7 +210,7 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
   for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
   for (int i = 0; i < 3; ++i) {
     const core::CalibrationOutcome& a = outcome.axes[i];
-    std::cout << "calibrate: axis " << axes[i] << " " << (a.accepted ? "accepted" : "refused")
+    std::cout << "calibrate: axis " << outcome.axis_names[i] << " " << (a.accepted ? "accepted" : "refused")
               << ", peak nonlinearity of its K " << a.nonlinearity_ppm << " ppm\n";
   }
   if (outcome.positions_fitted > 0) {
@@ -272,13 +223,13 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
     std::cout << "calibrate: body bias " << outcome.triad.bias.transpose() << " rad/s (std "
               << outcome.triad.bias_std.transpose() << ")\n";
   }
-  if (!outcome.accepted) {
-    std::cout << "calibrate: nothing written\n";
-    return 1;
-  }
+}
+
+/// The axes' files and the triad file written as one set.
+void writeResult(const core::TriadOutcome& outcome, const TriadCalibrateOptions& o, const TriadInputs& in) {
   core::TriadResultPaths paths;
   paths.triad = o.out;
-  for (int i = 0; i < 3; ++i) paths.axes[i] = outs.at(axes[i]);
+  paths.axes = in.outs;
   const std::vector<std::string> set{paths.axes[0], paths.axes[1], paths.axes[2], paths.triad};
   try {
     core::saveTriadResult(outcome, paths);
@@ -289,6 +240,28 @@ int runTriadCalibrate(const TriadCalibrateOptions& o) {
   } catch (const std::exception& e) {
     throw OutputError(std::string("the calibration was accepted but not written: ") + e.what());
   }
+}
+
+}  // namespace
+
+int runTriadCalibrate(const TriadCalibrateOptions& o) {
+  checkProcessorConfig(o.processor);
+  TriadInputs in;
+  readPriors(o, &in);
+  const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
+  findSessionTopics(*bag, o, &in);
+  const core::TriadOutcome outcome = calibrate(*bag, o, in);
+  if (!o.report.empty()) {
+    OutputText report(o.report);
+    report.stream() << core::emitTriadReport(outcome);
+    report.commit();
+  }
+  printOutcome(outcome);
+  if (!outcome.accepted) {
+    std::cout << "calibrate: nothing written\n";
+    return 1;
+  }
+  writeResult(outcome, o, in);
   return 0;
 }
 

@@ -1,7 +1,8 @@
 // The interface every calibration method implements, and the samples it receives.
 //
-// The session (calibration_session.h) synchronises the wave and turntable streams and hands each
-// method only samples taken on a settled turntable plateau, labelled with that plateau. A method
+// The session (calibration_session.h) synchronises the wave with the rotation it is measured against
+// (the turntable's, or in a field run the rotation the precession loop commands) and hands each
+// method only samples taken on a settled plateau of that rotation, labelled with that plateau. A method
 // accumulates in memory that does not grow with the session length, says when its data are
 // complete, and turns them into a CalibrationOutcome with its quality gates.
 #pragma once
@@ -23,13 +24,14 @@ struct PlateauSample {
   double theta = 0.0;      ///< measured electrical angle, rad (continuous)
   double frequency = NAN;  ///< Hz
   PlateauState plateau;    ///< settled plateau this sample belongs to
-  /// rad, a continuous angle of the table at the stamp: the logged angle interpolated, or (in a
-  /// rate-only stream, angle_logged false) the integral of the reported rate.
-  double table_angle = 0.0;
-  double table_rate = 0.0;    ///< rad/s, as reported, interpolated at the stamp
-  bool angle_logged = false;  ///< the turntable stream logs the table angle
-  /// rad^2: the variance the regularised stamps (table_stamp_regulariser.h) leave on table_angle, an
-  /// error smooth in time that the angle's own scatter does not show (0: stamps as logged).
+  /// rad, a continuous angle of the rotation at the stamp -- the table's, or in a field run the
+  /// commanded virtual angle psi: the logged angle interpolated, or (in a rate-only turntable stream,
+  /// angle_logged false) the integral of the reported rate.
+  double rotation_angle = 0.0;
+  double rotation_rate = 0.0;  ///< rad/s, as reported, interpolated at the stamp
+  bool angle_logged = false;   ///< the rotation's stream logs its angle (a precession state always does)
+  /// rad^2: the variance the regularised stamps (table_stamp_regulariser.h) leave on rotation_angle,
+  /// an error smooth in time that the angle's own scatter does not show (0: stamps as logged).
   double angle_smooth_error = 0.0;
 };
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "hrg_gyro/core/estimation/binned_rate_fit.h"
 #include "hrg_gyro/core/estimation/defect_diagnosis.h"
-#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/estimation/increment_regression.h"
 #include "hrg_gyro/core/estimation/table_clock_offset.h"
@@ -23,8 +23,9 @@ class Emitter;
 namespace hrg_gyro {
 namespace core {
 
-/// Turntable records dropped before the plateau detector, by reason.
-struct TurntableRejects {
+/// Records of the rotation's stream (turntable states, or in a field run precession states) dropped
+/// before the plateau detector, by reason.
+struct RotationRecordRejects {
   std::uint64_t bad_rate = 0;      ///< non-finite, or |rate| above plateau/max_rate
   std::uint64_t bad_angle = 0;     ///< non-finite, or a step from the last good angle beyond max_rate
   std::uint64_t bad_stamp = 0;     ///< zero or negative stamp
@@ -97,11 +98,13 @@ struct CalibrationOutcome {
   std::vector<GateResult> gates;
   std::vector<BinnedCurvePoint> binned;  ///< binned K and D (dual-rate) or step points
   std::vector<std::string> notes;
-  double quadrature_ratio = 0.0;           ///< mean |B/A| of the wave samples (F of the diagnosis)
-  std::uint64_t turntable_records = 0;     ///< turntable records received (all runs of the session)
-  TurntableRejects turntable_rejected;     ///< of them, dropped as glitches
-  std::uint64_t restarts = 0;              ///< times a stream went back for good and the run started over
-  std::vector<DefectDiagnosis> diagnosis;  ///< one per scale_factor fit with 2 and 4 theta terms
+  double quadrature_ratio = 0.0;  ///< mean |B/A| of the wave samples (F of the diagnosis)
+  /// Records of the rotation's stream received (all runs of the session): turntable states, or in a
+  /// field run precession states. The report keeps the keys turntable_records, turntable_rejected.
+  std::uint64_t rotation_records = 0;
+  RotationRecordRejects rotation_rejected;  ///< of them, dropped as glitches
+  std::uint64_t restarts = 0;               ///< times a stream went back for good and the run started over
+  std::vector<DefectDiagnosis> diagnosis;   ///< one per scale_factor fit with 2 and 4 theta terms
   /// dual-rate: the bias's trend fitted with K and D (order 0: none was fitted). The written D0 is
   /// the bias at bias_trend.reference_stamp, the mean time of the data.
   BiasTrendFit bias_trend;

@@ -1,10 +1,13 @@
-// One calibration run fed by the two live streams (or a bag): turntable states and wave angles.
+// One calibration run fed by two live streams (or a bag): wave angles, and the records of the
+// rotation they are measured against -- turntable states, or in a field run the precession loop's
+// states (the commanded virtual angle psi and rate in place of the table's; addRotationRecord takes
+// either). The generator method is fed generator pairs instead.
 //
-// The streams arrive independently, so a wave sample is held until the turntable stream has passed
-// its stamp; it is then classified by the turntable states on either side of it: both must belong
+// The streams arrive independently, so a wave sample is held until the rotation's stream has passed
+// its stamp; it is then classified by the rotation records on either side of it: both must belong
 // to the same settled plateau (a sample at a plateau boundary is skipped), and it is handed to the
-// method with that plateau, the interpolated table angle and the reported rate. Memory is bounded:
-// the wave queue and the turntable history are trimmed by age, the methods keep bins.
+// method with that plateau, the interpolated rotation angle and the reported rate. Memory is bounded:
+// the wave queue and the rotation history are trimmed by age, the methods keep bins.
 //
 // The turntable stream always carries an angle and a rate. A stream whose angle is NaN from its start
 // does not log the angle (rate-only): the table angle is then the integral of the reported rate. From
@@ -18,7 +21,7 @@
 // of rate is kept to measure the offset that is left (TableClockOffsetEstimator), reported with the
 // outcome and gated (table_clock/max_offset).
 //
-// A glitched turntable record (a non-finite or impossible rate, an infinite angle, a NaN angle or one
+// A glitched rotation record (a non-finite or impossible rate, an infinite angle, a NaN angle or one
 // the rate bound cannot reach in an angle-logging stream, a zero, duplicate or backward stamp, a
 // stamp that jumps back or ahead) is dropped and counted by reason before the plateau detector sees
 // it, so it cannot end a plateau; a wave sample whose stamp jumps is dropped and counted too. Both
@@ -45,27 +48,29 @@ namespace hrg_gyro {
 namespace core {
 
 struct SessionCounters {
-  std::uint64_t turntable = 0;        ///< turntable states received
-  std::uint64_t wave = 0;             ///< wave samples received
-  std::uint64_t used = 0;             ///< handed to the method
-  std::uint64_t unsettled = 0;        ///< not on a settled plateau (ramps, settling, boundaries)
-  std::uint64_t unsynchronized = 0;   ///< no turntable state around the stamp (or too far away)
-  std::uint64_t out_of_order = 0;     ///< wave samples dropped: zero, duplicate or slightly backward stamps
-  std::uint64_t wave_jumps = 0;       ///< wave samples dropped: the stamp jumped (a glitch), all runs
-  TurntableRejects rejected;          ///< turntable records dropped (glitches), all runs of the session
-  std::uint64_t restarts = 0;         ///< a stream went back for good: the run started over
-  std::uint64_t turntable_total = 0;  ///< turntable records received, all runs of the session
+  std::uint64_t rotation_records = 0;        ///< rotation records received (turntable or precession states)
+  std::uint64_t wave = 0;                    ///< wave samples received
+  std::uint64_t used = 0;                    ///< handed to the method
+  std::uint64_t unsettled = 0;               ///< not on a settled plateau (ramps, settling, boundaries)
+  std::uint64_t unsynchronized = 0;          ///< no rotation record around the stamp (or too far away)
+  std::uint64_t out_of_order = 0;            ///< wave samples dropped: zero, duplicate or slightly backward stamps
+  std::uint64_t wave_jumps = 0;              ///< wave samples dropped: the stamp jumped (a glitch), all runs
+  RotationRecordRejects rejected;            ///< rotation records dropped (glitches), all runs of the session
+  std::uint64_t restarts = 0;                ///< a stream went back for good: the run started over
+  std::uint64_t rotation_records_total = 0;  ///< rotation records received, all runs of the session
 };
 
 class CalibrationSession {
  public:
   CalibrationSession(const CalibrationSettings& settings, const GyroParameters& prior);
 
-  /// Returns false when the record was dropped (counted in counters().rejected). `sequence`: the
-  /// record's header sequence number (TableStampRegulariser::kNoSequence when there is none); the
-  /// stamps of a fixed-rate log are regularised with it (table_clock settings).
-  bool addTurntable(Nanoseconds stamp, double angle, double rate,
-                    std::uint64_t sequence = TableStampRegulariser::kNoSequence);
+  /// A record of the rotation: a turntable state (the table's angle, NaN if not logged, and rate), or
+  /// in a field run a precession state (the commanded virtual angle psi and rate). Returns false when
+  /// the record was dropped (counted in counters().rejected). `sequence`: the record's header
+  /// sequence number (TableStampRegulariser::kNoSequence when there is none); the stamps of a
+  /// fixed-rate table log are regularised with it (table_clock settings).
+  bool addRotationRecord(Nanoseconds stamp, double angle, double rate,
+                         std::uint64_t sequence = TableStampRegulariser::kNoSequence);
   /// quadrature_ratio: B/A of the wave (NaN if unknown), averaged for the defect diagnosis.
   void addWave(Nanoseconds stamp, double theta, double frequency, double quadrature_ratio = NAN);
   void addGeneratorPair(Nanoseconds stamp, const ChannelVector& raw, const ChannelVector& reference);
@@ -96,7 +101,7 @@ class CalibrationSession {
     double theta, frequency;
   };
   void drain();
-  /// Whether the values of a turntable record are possible; counts the reason when not.
+  /// Whether the values of a rotation record are possible; counts the reason when not.
   bool plausible(Nanoseconds stamp, double angle, double rate);
   /// The stream went back for good: drop what the run gathered, start over from the prior.
   void restart();
@@ -110,17 +115,17 @@ class CalibrationSession {
   GyroParameters prior_;
   std::unique_ptr<CalibrationMethod> method_;
   PlateauDetector detector_;
-  RingBuffer<PlateauRecord> turntable_;  // judged records
-  std::vector<PlateauRecord> judged_;    // scratch: records the detector has just judged
+  RingBuffer<PlateauRecord> rotation_;  // judged rotation records
+  std::vector<PlateauRecord> judged_;   // scratch: records the detector has just judged
   RingBuffer<WaveRecord> pending_;
   TableStampRegulariser regulariser_;
   TableClockOffsetEstimator clock_offset_;
   SessionCounters counters_;
-  StampTimeline turntable_timeline_;
+  StampTimeline rotation_timeline_;
   StampTimeline wave_timeline_;
   Nanoseconds last_wave_stamp_ = 0;
-  int bad_angle_run_ = 0;       // turntable records in a row whose angle the rate bound cannot reach
-  bool has_last_good_ = false;  // the last turntable record accepted, for the angle bound
+  int bad_angle_run_ = 0;       // rotation records in a row whose angle the rate bound cannot reach
+  bool has_last_good_ = false;  // the last rotation record accepted, for the angle bound
   Nanoseconds last_good_stamp_ = 0;
   double last_good_angle_ = NAN;
   Nanoseconds last_generator_stamp_ = 0;

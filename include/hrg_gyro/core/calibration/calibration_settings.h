@@ -15,7 +15,7 @@
 #include "hrg_gyro/core/model/frequency_interpolator.h"
 #include "hrg_gyro/core/resonator/control_loops.h"
 #include "hrg_gyro/core/resonator/drive_chain.h"
-#include "hrg_gyro/core/resonator/resonator_parameters.h"
+#include "hrg_gyro/core/resonator/shell_parameters.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -67,7 +67,7 @@ struct TableClockSettings {
 /// precessed wave (precessionLagDrift in resonator/first_order_model.h): from the gyro's maker, or
 /// a simulated gyro's scenario (its dynamics section's shell, loops and drive).
 struct FieldResonator {
-  ResonatorParameters shell;
+  ShellParameters shell;
   LoopSettings loops;
   DriveChainErrors drive;
 };
@@ -77,7 +77,7 @@ struct FieldResonator {
 /// (fieldCommandPlan); the rest are the estimator's orders and the method's own gates.
 struct FieldSettings {
   std::vector<int> gain_orders{2, 4};  ///< harmonic orders of the virtual rate's gain G_v(theta)
-  /// rad/s (electrical), |commanded virtual rate|, in [kMinRate, kMaxRate]. Faster, the loops' lag
+  /// rad/s (electrical), |commanded virtual rate|, in [kMinRate, kMaxPrecessionRate]. Faster, the loops' lag
   /// adds more drift (as the rate squared and faster): see `resonator` and the loop_lag gate.
   double rate = 0.2;
   double turns = 2.0;                         ///< full turns of theta (2 pi) per segment, at most kMaxTurns
@@ -99,7 +99,7 @@ struct FieldSettings {
 
   /// Bounds of the plan's keys (each refused by name beyond them); the whole plan is bounded by
   /// kMaxFieldPlanDuration (field_command_plan.h).
-  static constexpr double kMinRate = 0.01, kMaxRate = 10.0;  ///< rad/s
+  static constexpr double kMinRate = 0.01;  ///< rad/s (the largest: kMaxPrecessionRate, control_loops.h)
   static constexpr double kMaxTurns = 100.0;
   static constexpr double kMaxRest = 600.0;  ///< s
   static constexpr std::size_t kMaxDirections = 16;
@@ -135,6 +135,8 @@ struct CalibrationSettings {
   static CalibrationSettings parse(const YamlField& root, const std::vector<std::string>& extra_keys = {});
   /// Every key parse() reads, nested ones as "section/key" (the calibrator's parameter template lists them all).
   static std::vector<std::string> keyPaths();
+  /// Former names of keys that parse() still reads (backward_persist), not in keyPaths().
+  static std::vector<std::string> formerKeyPaths();
 };
 
 }  // namespace core

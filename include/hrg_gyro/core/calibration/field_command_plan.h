@@ -9,18 +9,22 @@
 // resonator the settings describe (field.resonator), fieldLoopLag predicts it.
 //
 // FieldPlanRun is the plan under way in a live run, on the stream time of the precession state (the
-// driver's stamps): which command is due, and whether what the driver reports is what this run
-// commanded. A run cannot go on when the precession loop executes a command this run did not send
+// driver's stamps): when it starts (the first state while the driver listens), which command is due,
+// whether what the driver reports is what this run commanded, and when a run that ends must command
+// the rate 0. A run cannot go on when the precession loop executes a command this run did not send
 // -- named by the driver as another node's, a rate this run did not command, or more commands than
 // it sent from a driver that names nobody -- and cannot complete once its plan is over without the
-// data it needed: both end it with a reason instead of leaving it waiting.
+// data it needed: both end it with a reason instead of leaving it waiting. FieldPlanRun::step does
+// all of it for one precession state; the live calibrator sends the commands and ends the run.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "hrg_gyro/core/calibration/calibration_outcome.h"
+#include "hrg_gyro/core/calibration/calibration_session.h"
 #include "hrg_gyro/core/calibration/calibration_settings.h"
 #include "hrg_gyro/core/common/units.h"
 
@@ -62,6 +66,16 @@ struct PrecessionReport {
   std::string source;          ///< who commanded the rate in force ("" when the driver does not say)
 };
 
+/// What one precession state asks of the calibrator running the plan.
+struct FieldPlanStep {
+  /// Not empty: the precession loop executed a command this run did not send; the run is aborted
+  /// for this reason (nothing else is due).
+  std::string foreign;
+  std::vector<PlannedPrecession> due;  ///< the commands due, in order: send them
+  /// Not empty: the plan is over and the data incomplete; the run is finished, refused for this reason.
+  std::string overdue;
+};
+
 class FieldPlanRun {
  public:
   /// s of stream time after the plan's last command within which incomplete data may still complete:
@@ -75,7 +89,9 @@ class FieldPlanRun {
   static constexpr double kRateTolerance = 1e-6;
 
   FieldPlanRun() = default;  ///< no plan
-  /// `self`: this calibrator's node name as a driver sees the publisher of its commands.
+  /// `self`: this calibrator's node name as a driver sees the publisher of its commands. Throws
+  /// std::invalid_argument for a plan that cannot run or cannot pass (checkFieldPlan): nothing is
+  /// commanded for it.
   FieldPlanRun(const CalibrationSettings& settings, std::string self);
 
   bool empty() const { return plan_.empty(); }
@@ -91,6 +107,19 @@ class FieldPlanRun {
   bool midway() const { return next_ > 0 && next_ < plan_.size(); }
   /// The run ends before its plan: the caller commands 0 (recorded as this run's); nothing more is due.
   void stop();
+  /// The run ends (finished, aborted, restarted): true when its plan had the wave turning (midway);
+  /// it is then stopped and the caller commands 0.
+  bool end();
+  /// The run started over (a stream went back for good): the plan starts again from the next
+  /// precession state, nothing sent yet.
+  void restart();
+
+  /// One precession state of the run: judged (check); the plan started on it if it waits and
+  /// `driver_listens()` (asked only then: commands sent before the driver listens would be lost);
+  /// the commands due; and, the session's data incomplete, whether the plan is overdue (`wave_now`:
+  /// the newest wave stamp, 0 none).
+  FieldPlanStep step(const PrecessionReport& report, const std::function<bool()>& driver_listens,
+                     const CalibrationSession& session, Nanoseconds wave_now);
 
   /// "" when the state is what this run commanded (or none of its commands has been executed yet);
   /// otherwise why the run cannot go on. Records at or before the last one checked are not judged

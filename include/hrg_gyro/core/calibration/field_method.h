@@ -4,8 +4,8 @@
 //   d theta/dt = G_v(theta) w_v + K(theta) Omega_s + D(theta)
 // with G_v the drive's realised gain of the command and Omega_s the Earth rate about the sensitive
 // axis. That is the dual-rate method's equation with the commanded virtual angle psi (the integral of
-// w_v, reported on precession/state) in place of the table angle and G_v in place of K: the same
-// increment regression (increment_regression.h) fits G_v(theta) and the still gyro's rate
+// w_v, reported on precession/state: PlateauSample::rotation_angle) in place of the table angle and
+// G_v in place of K: the same increment regression (increment_regression.h) fits G_v(theta) and the still gyro's rate
 // D(theta) + K(theta) Omega_s at once, exactly for any window, with the block-sandwich standard errors.
 // Both directions separate the two, as two table rates separate K and D.
 //
@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "hrg_gyro/core/calibration/calibration_method_interface.h"
+#include "hrg_gyro/core/calibration/increment_chains.h"
 #include "hrg_gyro/core/estimation/increment_regression.h"
 #include "hrg_gyro/core/estimation/rate_groups.h"
 
@@ -40,20 +41,26 @@ class FieldMethod : public CalibrationMethod {
   CalibrationOutcome finish(const GyroParameters& prior) const override;
 
  private:
-  /// The averaging window at this virtual rate: the wave sweeps at most window_span and the highest
-  /// order's phase at most 1 rad in it (as the dual-rate method's), `window` the upper bound.
-  double windowFor(double rate) const;
-  double minBinTime(double rate) const { return 0.25 * windowFor(rate); }
+  /// Swept time a theta bin needs at this virtual rate: a quarter of its chains' window.
+  double minBinTime(double rate) const { return chains_.minBinTime(rate); }
   /// The longest-running group of each sign of the commanded rate (-1: none).
   void directionGroups(int* positive, int* negative) const;
+  // The phases of finish(), in its order.
+  /// The two directions' rates, turns and times, and their coverage and turns gates; returns the
+  /// swept time a bin needs in both.
+  double gateDirections(const RateGroup& positive, const RateGroup& negative, CalibrationOutcome* o) const;
+  /// The fit into the report, and D: the still gyro's rate less K(theta) Omega_s.
+  HarmonicFitResult driftFromFit(const IncrementFit& e, const GyroParameters& prior, CalibrationOutcome* o) const;
+  /// The gates on the fit: condition, stillness, the realised gain, D's errors, the loops' lag, the trend.
+  void gateFit(const IncrementFit& e, const HarmonicFitResult& d, CalibrationOutcome* o) const;
+  /// The notes on what was kept, what D rests on, and the fit.
+  void noteResult(const IncrementFit& e, const GyroParameters& prior, CalibrationOutcome* o) const;
 
   CalibrationSettings settings_;
   RateGroups groups_;
   IncrementRegression regression_;
-  std::vector<double> group_rates_;  // commanded rate of each regression group
-  bool in_chain_ = false;
-  std::uint64_t chain_plateau_ = 0;
-  Nanoseconds last_stamp_ = 0;
+  // The wave turns at about the commanded rate: one radian of theta per radian of psi.
+  IncrementChains chains_;
   double frequency_sum_ = 0.0;  // of the samples' resonator frequency, for a frequency-dependent prior K
   std::uint64_t frequency_count_ = 0;
   std::uint64_t samples_ = 0;

@@ -18,6 +18,8 @@
 #include <utility>
 #include <vector>
 
+#include "hrg_gyro/core/model/harmonic_model.h"
+
 namespace hrg_gyro {
 namespace core {
 
@@ -56,6 +58,12 @@ HarmonicFitResult fitHarmonics(const std::vector<FitPoint>& points, const std::v
 /// The fit restricted to `orders`, in that order: their coefficients and standard errors (zeros for
 /// an order the fit lacks); the mean and the fit's statistics are kept.
 HarmonicFitResult selectOrders(const HarmonicFitResult& fit, const std::vector<int>& orders);
+
+/// The frequency-independent model of a fit (only the given orders, in that order).
+HarmonicModel toModel(const HarmonicFitResult& fit);
+
+/// Union of two order sets, sorted.
+std::vector<int> mergeOrders(const std::vector<int>& a, const std::vector<int>& b);
 
 }  // namespace core
 }  // namespace hrg_gyro

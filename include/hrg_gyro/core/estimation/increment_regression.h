@@ -46,7 +46,7 @@
 
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/common/weighted_least_squares.h"
-#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
+#include "hrg_gyro/core/estimation/binned_rate_fit.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/model/harmonic_basis.h"
 
@@ -146,6 +146,18 @@ class IncrementRegression {
     Eigen::MatrixXd sandwich, white;
   };
 
+  /// The fitted columns among the accumulated ones: the K block, T, the T harmonics of D's orders
+  /// (mean, cos..., sin...), then the trend's.
+  struct Columns {
+    std::vector<int> sel;
+    std::vector<int> without_trend;  ///< sel without the trend's columns
+    int trend_at = 0;                ///< index in sel of the trend's first coefficient
+  };
+  /// Each fitted coefficient with the basis-noise attenuation undone, and its total standard error.
+  struct Terms {
+    std::vector<double> value, total_std;
+  };
+
   void closeWindow();
   /// The chain's window means into increments, the table angle taken as the weighted sum of the
   /// logged angle and the rate integral (with the chain's slope from the angle).
@@ -155,6 +167,23 @@ class IncrementRegression {
   Eigen::MatrixXd regressorMap(double earth_rate, double reference_time) const;
   Solved solveColumns(const std::vector<int>& sel, const Eigen::MatrixXd& map, const std::vector<Block>& blocks,
                       const Eigen::MatrixXd& total, double angle_noise, double max_condition) const;
+  // The sections of solve().
+  Columns fittedColumns() const;
+  /// |change of each coefficient| when the Earth rate moves by its standard deviation.
+  Eigen::VectorXd earthRateShift(const std::vector<int>& sel, const Eigen::VectorXd& beta, const Eigen::MatrixXd& total,
+                                 double earth_rate, double earth_rate_std, double reference_time,
+                                 double max_condition) const;
+  /// The corrected terms; the error budgets of K and D into fit->budget and fit->drift_budget.
+  Terms correctedTerms(const Solved& solved, const Eigen::VectorXd& earth_shift, IncrementFit* fit) const;
+  /// One model's terms (mean, cos..., sin... from `offset`) as a fit.
+  void fillFit(const Terms& terms, const std::vector<int>& orders, int offset, double condition_number,
+               HarmonicFitResult* f) const;
+  void fitTrend(const Columns& columns, const Terms& terms, const LeastSquaresSolution& solution,
+                const Eigen::MatrixXd& map, const Eigen::MatrixXd& total, double reference_time,
+                BiasTrendFit* trend) const;
+  /// The binned K and D of the two groups with the most data, and the fits' residual rms about them.
+  void binCurves(const std::vector<int>& sel, const Eigen::VectorXd& beta, const Eigen::MatrixXd& map,
+                 double earth_rate, double min_bin_time, IncrementFit* fit) const;
 
   std::vector<int> k_orders_, d_orders_, all_orders_;
   int bins_;

@@ -28,6 +28,8 @@
 namespace hrg_gyro {
 namespace core {
 
+class ModelPairEvaluator;
+
 struct TableClockOffsetSettings {
   double window = 1.0;  ///< s of settled plateau on each side of a change
   /// s left out before the table's stamps show it leaving its plateau: with its stamps late by up to
@@ -93,6 +95,10 @@ class TableClockOffsetEstimator {
     std::vector<Sample> samples;
   };
   void keep(std::deque<Sample>* into, Nanoseconds origin, Nanoseconds stamp, double theta, double phi, int side);
+  /// One change of rate's offset from the model's integral along its path (K0 `k0` where the change
+  /// has no sample of its own); false when a side has fewer than 3 samples.
+  static bool measure(const Transition& tr, ModelPairEvaluator* models, double earth_rate, double frequency, double k0,
+                      TableClockTransition* out);
 
   TableClockOffsetSettings settings_;
   Nanoseconds last_kept_ = 0, last_added_ = 0;

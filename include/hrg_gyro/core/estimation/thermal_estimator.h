@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "hrg_gyro/core/estimation/dual_rate_estimator.h"
+#include "hrg_gyro/core/estimation/binned_rate_fit.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/estimation/rate_groups.h"
 #include "hrg_gyro/core/model/frequency_interpolator.h"

@@ -1,7 +1,8 @@
 // The triad's chain without ROS, for the core's tests and offline tools: a triad scenario simulated,
-// each axis through its own processor, into the triad calibration -- what `hrg_bag calibrate
-// --method triad` does with a bag of the same session, on the samples directly -- or into the
-// triad combiner, to check the body rates it publishes against the simulator's exact ones.
+// each axis through its own processor (TriadProcessor), into the triad calibration -- what `hrg_bag
+// calibrate --method triad` does with a bag of the same session, on the samples directly -- or on
+// into the triad combiner, as `hrg_bag process --triad` and the live nodes do, to check the body rates
+// it publishes against the simulator's exact ones.
 #pragma once
 
 #include <Eigen/Core>
@@ -10,9 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "hrg_gyro/core/calibration/triad_calibration.h"
-#include "hrg_gyro/core/processing/gyro_processor.h"
-#include "hrg_gyro/core/processing/triad_combiner.h"
+#include "hrg_gyro/core/calibration/triad/triad_calibration.h"
+#include "hrg_gyro/core/processing/triad_processor.h"
 #include "hrg_gyro/core/simulation/triad_simulator.h"
 
 namespace hrg_gyro {
@@ -65,11 +65,11 @@ struct TriadVerification {
   double worst_rest_error = 0.0;   ///< rad/s, the largest |mean_error| of the segments at rest
 };
 
-/// Runs `scenario` once through one processor per axis and a TriadCombiner for each set of files,
-/// and compares the combined body rates with the simulator's exact ones (TriadMotion) over every
-/// piece of constant table rate, `margin` s in from each end (the processors' delay, the settling
-/// after a rate change). The fixture's moves are no segment. Throws std::invalid_argument when a
-/// set's files do not make a triad (TriadCombiner's check).
+/// Runs `scenario` once through a TriadProcessor for each set of files (the nodes' default settings,
+/// `processor` the processors'), and compares the combined body rates with the simulator's exact ones
+/// (TriadMotion) over every piece of constant table rate, `margin` s in from each end (the
+/// processors' delay, the settling after a rate change). The fixture's moves are no segment. Throws
+/// std::invalid_argument when a set's files do not make a triad (TriadCombiner's check).
 std::vector<TriadVerification> verifyTriadOnSimulation(const TriadSimulationConfig& scenario,
                                                        const std::vector<TriadCalibrationFiles>& files,
                                                        const ProcessorConfig& processor = {}, double margin = 2.0);

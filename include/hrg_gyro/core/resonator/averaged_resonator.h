@@ -9,7 +9,7 @@
 //   x'' + 2 K0 Omega y' + (2/tau_d) x' + h (c_d x' + s_d y') + w0^2 x + w0 Dw (c_w x + s_w y) = f_x
 //   y'' - 2 K0 Omega x' + (2/tau_d) y' + h (s_d x' - c_d y') + w0^2 y + w0 Dw (s_w x - c_w y) = f_y
 // with the mean damping time tau_d, the damping anisotropy h = D(1/tau_d) along theta_d and the split
-// Dw along theta_omega (resonator_parameters.h), c_d, s_d = cos, sin 2 theta_d and c_w, s_w = cos, sin
+// Dw along theta_omega (shell_parameters.h), c_d, s_d = cos, sin 2 theta_d and c_w, s_w = cos, sin
 // 2 theta_omega.
 // Terms in Omega^2 and dOmega/dt (relative size Omega / w0) are left out. The gyroscopic term is
 // written with K0 = -2k, which makes an ideal shell's wave turn at d theta/dt = K0 Omega.
@@ -38,7 +38,7 @@
 #pragma once
 
 #include "hrg_gyro/core/model/wave_parameters.h"
-#include "hrg_gyro/core/resonator/resonator_parameters.h"
+#include "hrg_gyro/core/resonator/shell_parameters.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -79,9 +79,9 @@ ModalForce toModalForce(const WaveFrameForce& force, double cos_theta, double si
 class AveragedResonator {
  public:
   /// Throws std::invalid_argument if the parameters do not validate.
-  explicit AveragedResonator(const ResonatorParameters& parameters);
+  explicit AveragedResonator(const ShellParameters& parameters);
 
-  const ResonatorParameters& parameters() const { return parameters_; }
+  const ShellParameters& parameters() const { return parameters_; }
 
   /// The averaged equations at `wave`, for body rate `body_rate` (rad/s), a force fixed on the
   /// electrodes and the reference carrier's offset dw_r = w_r - w0 (rad/s). `angle_rate` (rad/s) is
@@ -94,7 +94,7 @@ class AveragedResonator {
                   const WaveFrameForce& force, double reference_offset, double angle_rate = 0.0) const;
 
  private:
-  ResonatorParameters parameters_;
+  ShellParameters parameters_;
   double w0_, inverse_damping_time_, half_h_, half_dw_, k0_;
   double cos_damping_axis_, sin_damping_axis_;      // of 2 theta_d
   double cos_frequency_axis_, sin_frequency_axis_;  // of 2 theta_omega

@@ -23,6 +23,10 @@
 namespace hrg_gyro {
 namespace core {
 
+/// rad/s, electrical: the largest |rate| a precession command may carry. The field method's
+/// field/rate, a scenario's dynamics.commands and driver_sim's command/precession are held to it.
+constexpr double kMaxPrecessionRate = 10.0;
+
 struct LoopSettings {
   double energy = 1.0;                        ///< E setpoint, amplitude units squared
   double energy_bandwidth = 5.0;              ///< Hz; 0 opens the loop

@@ -47,7 +47,7 @@
 #include "hrg_gyro/core/model/harmonic_model.h"
 #include "hrg_gyro/core/resonator/control_loops.h"
 #include "hrg_gyro/core/resonator/drive_chain.h"
-#include "hrg_gyro/core/resonator/resonator_parameters.h"
+#include "hrg_gyro/core/resonator/shell_parameters.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -61,13 +61,13 @@ struct ResonatorModel {
 
 /// Throws std::invalid_argument if a setting fails to validate, or if the quadrature loop is open
 /// while there is a frequency split (B then grows and no drift settles).
-ResonatorModel firstOrderModel(const ResonatorParameters& parameters, const LoopSettings& loops,
+ResonatorModel firstOrderModel(const ShellParameters& parameters, const LoopSettings& loops,
                                const DriveChainErrors& drive);
 
 /// D_lag(theta) above, rad/s, orders {2, 4} and no mean, for a wave precessed at `virtual_rate`
 /// (electrical rad/s, either sign: the result is even in it). Throws std::invalid_argument as
 /// firstOrderModel does, and for a rate that is not finite.
-HarmonicModel precessionLagDrift(const ResonatorParameters& parameters, const LoopSettings& loops,
+HarmonicModel precessionLagDrift(const ShellParameters& parameters, const LoopSettings& loops,
                                  const DriveChainErrors& drive, double virtual_rate);
 
 }  // namespace core

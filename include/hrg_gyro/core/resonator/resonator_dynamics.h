@@ -20,7 +20,7 @@
 #include "hrg_gyro/core/resonator/averaged_resonator.h"
 #include "hrg_gyro/core/resonator/control_loops.h"
 #include "hrg_gyro/core/resonator/drive_chain.h"
-#include "hrg_gyro/core/resonator/resonator_parameters.h"
+#include "hrg_gyro/core/resonator/shell_parameters.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -38,7 +38,7 @@ class ResonatorDynamics {
  public:
   /// Throws std::invalid_argument if any settings fail to validate or the initial wave does not
   /// stand (A^2 > B^2, all finite).
-  ResonatorDynamics(const ResonatorParameters& parameters, const LoopSettings& loops, const DriveChainErrors& drive,
+  ResonatorDynamics(const ShellParameters& parameters, const LoopSettings& loops, const DriveChainErrors& drive,
                     const WaveParameters& initial);
 
   /// Advances by dt > 0 s. Returns false, leaving the wave where the failing control period began,

@@ -17,7 +17,7 @@
 
 #include "hrg_gyro/core/resonator/control_loops.h"
 #include "hrg_gyro/core/resonator/drive_chain.h"
-#include "hrg_gyro/core/resonator/resonator_parameters.h"
+#include "hrg_gyro/core/resonator/shell_parameters.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -26,7 +26,7 @@ class SteadyStateResponse {
  public:
   /// Throws std::invalid_argument if a setting fails to validate, or if the quadrature loop is open
   /// (then B is not held and nothing settles).
-  SteadyStateResponse(const ResonatorParameters& parameters, const LoopSettings& loops, const DriveChainErrors& drive);
+  SteadyStateResponse(const ShellParameters& parameters, const LoopSettings& loops, const DriveChainErrors& drive);
 
   /// D(theta), rad/s: the settled wave's angle rate at zero body rate and no virtual rate.
   double drift(double theta) const;
@@ -39,7 +39,7 @@ class SteadyStateResponse {
   };
   Terms terms(double theta) const;
 
-  ResonatorParameters parameters_;
+  ShellParameters parameters_;
   DriveChainErrors drive_;
   bool energy_loop_;
   double c_, s_;

@@ -14,7 +14,7 @@
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/resonator/control_loops.h"
 #include "hrg_gyro/core/resonator/drive_chain.h"
-#include "hrg_gyro/core/resonator/resonator_parameters.h"
+#include "hrg_gyro/core/resonator/shell_parameters.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -33,8 +33,8 @@ struct ScheduledPrecession {
 
 struct DynamicsConfig {
   DynamicsModel model = DynamicsModel::kHarmonic;
-  ResonatorParameters shell;  ///< frequency: the resonator section's
-  LoopSettings loops;         ///< energy and phase setpoints: the resonator section's amplitude^2 and phase
+  ShellParameters shell;  ///< frequency: the resonator section's
+  LoopSettings loops;     ///< energy and phase setpoints: the resonator section's amplitude^2 and phase
   DriveChainErrors drive;
   /// s the loops run at rest before the first sample (not output): the session starts locked, as a
   /// gyro that has been running does.

@@ -171,6 +171,14 @@ class GyroSimulator {
   double generatorDuration() const;
   std::uint64_t generatorOutputsPerState() const;
   void stamp(double t_center, SimulationSample* out) const;
+  /// Advances t_ by one carrier period h.
+  void advanceTime(double h);
+  /// A window of `m` periods from t_start to t_: its mean channels (sum / m), frequency, temperature
+  /// and stamp; returns its centre, s.
+  double closeWindow(const ChannelVector& sum, int m, double t_start, SimulationSample* out) const;
+  /// The truth's wave (A, B, tau), frequency, temperature and injected bias at t_center.
+  void setTruthWave(double amplitude, double quadrature, double phase, double t_center, bool generator,
+                    TruthState* truth) const;
   /// The injected D0 at t s from the start, within the current window (TruthState::bias).
   double injectedBias(double t) const;
   /// Thermal scenarios: moves the gyro to the temperature at time t (s from the start).

@@ -34,6 +34,9 @@ struct BiasDriftConfig {
   double trendAt(double t) const { return rate * t; }
 };
 
+/// A scenario's `resonator` section: the simulated gyro's carrier and sampling, the wave it holds and
+/// its given K(theta) and D(theta). Not the shell's physics (resonator/shell_parameters.h, the
+/// `dynamics.shell` section), which the averaged dynamics use instead of the given K and D.
 struct ResonatorConfig {
   double frequency = 5000.0;          ///< Hz
   int samples_per_period = 32;        ///< N >= 8
@@ -101,6 +104,12 @@ ResonatorConfig parseResonatorSection(const YamlField& resonator);
 PickoffDefects parsePickoffSection(const YamlField& pickoff, double amplitude);
 TableRippleConfig parseRippleSection(const YamlField& ripple);
 DeliveryConfig parseChannelDeliverySection(const YamlField& channels);
+
+/// A scenario's top level, as the single gyro's and the triad's are read: a map of `keys` and
+/// `extra_keys` only (any other refused), its `seed` (>= 0, default 1) and `start_time` (> 0 s,
+/// default `*start_time`). Throws ConfigError naming the key.
+void parseScenarioTopLevel(const YamlField& root, std::vector<std::string> keys,
+                           const std::vector<std::string>& extra_keys, std::uint64_t* seed, double* start_time);
 
 /// A scenario file's YAML document: only a regular file of at most kMaxScenarioFileBytes (a FIFO, a
 /// device or a directory is refused at once), a syntax error reported with its line. Throws ConfigError.

@@ -1,0 +1,127 @@
+// The triad calibration against the exact injected triad, at angle level (core/testing/
+// angle_level_triad.h, written apart from the signal-level simulator): each axis's K(theta), the
+// axes' directions A (and M), the body bias; with fixture errors, the error they explain; and the
+// refusal of a session with too few positions.
+#include "hrg_gyro/core/calibration/triad/triad_calibration.h"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cstdio>
+
+#include "core/testing/angle_level_session.h"
+#include "core/testing/angle_level_triad.h"
+#include "hrg_gyro/core/model/triad_file.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+using testing::AngleLevelTriad;
+using testing::TriadPosition;
+
+double worstAngleMicroradians(const Eigen::Matrix3d& estimated, const Eigen::Matrix3d& truth) {
+  double worst = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (i != j) worst = std::max(worst, std::abs(estimated(i, j) - truth(i, j)));
+  return 1e6 * worst;
+}
+
+TEST(TriadCalibrationTest, TheAxesDirectionsEachAxisKAndTheBiasAgainstTheExactTriad) {
+  const AngleLevelTriad g = testing::misalignedTriad();
+  const std::vector<TriadPosition> positions = testing::sixPositions(0.4, 40.0, 2, 30.0);
+  const TriadOutcome o = testing::calibrateAngleLevelTriad(g, positions, testing::settingsFor(g));
+  ASSERT_TRUE(o.accepted) << o.reason;
+  const double worst = worstAngleMicroradians(o.body_to_axis, g.body_to_axis);
+  std::printf("triad, perfect fixture: worst misalignment error %.3f urad; A - truth (urad):\n", worst);
+  int within = 0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double error = o.body_to_axis(i, j) - g.body_to_axis(i, j);
+      std::printf("  %+8.3f (sigma %.3f)", 1e6 * error, 1e6 * o.body_to_axis_std(i, j));
+      if (std::abs(error) <= 3.0 * o.body_to_axis_std(i, j)) ++within;
+    }
+    std::printf("\n");
+  }
+  EXPECT_LE(worst, 5.0);
+  EXPECT_GE(within, 8);  // of 9: within 3 reported sigmas
+  // M is A's inverse, and each axis's K is as good as a single-axis calibration.
+  EXPECT_LT((o.triad.axis_to_body * g.body_to_axis - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 5e-6);
+  for (int i = 0; i < 3; ++i) {
+    const double peak = testing::peakErrorPpm(o.axes[i].parameters.scale_factor, g.k[i]);
+    std::printf("axis %d: peak K error %.2f ppm\n", i, peak);
+    EXPECT_LE(peak, 1.0) << i;
+  }
+  // The bias: the axes' D0 came from their own plateaus, so what is left is noise.
+  ASSERT_TRUE(o.bias_estimated);
+  EXPECT_EQ(o.rests.size(), 6u);
+  for (int j = 0; j < 3; ++j) EXPECT_LE(std::abs(o.triad.bias(j)), 3.0 * o.triad.bias_std(j) + 1e-9) << j;
+
+  // The report holds the same numbers (full precision), each axis's own report and the file to write.
+  const YAML::Node report = YAML::Load(emitTriadReport(o));
+  EXPECT_EQ(report["method"].as<std::string>(), "triad");
+  EXPECT_TRUE(report["accepted"].as<bool>());
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_EQ(report["axis_to_body"][i][j].as<double>(), o.triad.axis_to_body(i, j));
+      EXPECT_EQ(report["body_to_axis_std"][i][j].as<double>(), o.body_to_axis_std(i, j));
+    }
+    EXPECT_EQ(report["bias"][i].as<double>(), o.triad.bias(i));
+    const std::string axis = o.axis_names[i];
+    EXPECT_EQ(report["axis_reports"][axis]["nonlinearity_ppm"].as<double>(), o.axes[i].nonlinearity_ppm) << axis;
+  }
+  EXPECT_EQ(report["positions"].size(), o.positions.size());
+  EXPECT_EQ(report["rests"].size(), o.rests.size());
+  EXPECT_EQ(parseTriadParameters(YAML::Load(report["triad_file"].as<std::string>())), o.triad);
+}
+
+TEST(TriadCalibrationTest, AFixtureOffByMicroradiansGivesTheErrorItExplains) {
+  AngleLevelTriad g = testing::misalignedTriad();
+  std::vector<TriadPosition> positions = testing::sixPositions(0.4, 40.0, 2, 30.0);
+  const double e = 30e-6;
+  const Eigen::Vector3d errors[] = {{e, 0, 0}, {0, -e, 0}, {0, e, e}, {-e, 0, e}, {e, e, 0}, {0, 0, -e}};
+  for (std::size_t p = 0; p < positions.size(); ++p) positions[p].error = errors[p];
+  const TriadOutcome o = testing::calibrateAngleLevelTriad(g, positions, testing::settingsFor(g));
+  ASSERT_TRUE(o.accepted) << o.reason;
+  // What the errors predict: each position's true table axis u_true, fitted on the plan's u.
+  Eigen::Matrix3d predicted;
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for (const TriadPosition& p : positions) {
+      const Eigen::Vector3d u_plan = p.body_to_table.transpose() * Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d u_true = p.trueBodyToTable().transpose() * Eigen::Vector3d::UnitZ();
+      // The along axis's response is its own K's: 1 by construction, the cross responses the truth's.
+      normal += u_plan * u_plan.transpose();
+      rhs += u_plan * g.body_to_axis.row(i).dot(u_true);
+    }
+    predicted.row(i) = (normal.inverse() * rhs).transpose();
+  }
+  const double moved = worstAngleMicroradians(predicted, g.body_to_axis);
+  const double explained = worstAngleMicroradians(o.body_to_axis, predicted);
+  std::printf(
+      "fixture errors of %.0f urad: the truth moves by up to %.2f urad; estimate against the prediction "
+      "%.3f urad\n",
+      1e6 * e, moved, explained);
+  EXPECT_GT(moved, 10.0);
+  EXPECT_LE(explained, 5.0);
+}
+
+TEST(TriadCalibrationTest, TooFewPositionsAreRefusedWithTheMissingOnesNamed) {
+  const AngleLevelTriad g = testing::misalignedTriad();
+  std::vector<TriadPosition> positions = testing::sixPositions(0.4, 40.0, 2, 30.0);
+  positions.resize(4);  // +z, -z, +x, -x: y never along the table axis
+  const TriadOutcome o = testing::calibrateAngleLevelTriad(g, positions, testing::settingsFor(g));
+  EXPECT_FALSE(o.accepted);
+  std::printf("four positions: %s\n", o.reason.c_str());
+  EXPECT_NE(o.reason.find("axis y"), std::string::npos) << o.reason;
+  EXPECT_NE(o.reason.find("+y or -y"), std::string::npos) << o.reason;
+  bool positions_gate = false;
+  for (const GateResult& gate : o.gates) positions_gate = positions_gate || (gate.name == "positions" && !gate.passed);
+  EXPECT_TRUE(positions_gate);
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro
