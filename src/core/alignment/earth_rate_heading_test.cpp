@@ -1,6 +1,6 @@
 // The heading from an Earth's rate vector and a level: exact for the exact rate at any attitude; a bias
-// across the horizontal Earth rate moves it by b / (Omega cos lat); a tilt about East by tan(lat) times
-// the tilt, one about North not at all; the budget says so.
+// across the horizontal Earth rate moves it by b / (Omega cos lat); a tilt about North (the East axis
+// tipped) by tan(lat) times the tilt, one about East not at all; the budget says so.
 #include "hrg_gyro/core/alignment/earth_rate_heading.h"
 
 #include <gtest/gtest.h>
@@ -48,18 +48,19 @@ TEST(EarthRateHeadingTest, ErrorsEnterAsTheBudgetSays) {
   // Its variance in the budget: 1e-8 rad/s on each horizontal axis gives 1e-8 / h of yaw.
   m.residual_bias = Eigen::Vector3d(1e-16, 1e-16, 1e-16).asDiagonal();
   EXPECT_NEAR(solveHeading(m, level, latitude).budget.residual_bias, 1e-8 / h, 1e-12);
-  // A tilt about the East axis, by declaring the level 1 mrad off: tan(lat) mrad of yaw. The body's
-  // x points along yaw 0.4 from East, so East is roll and pitch mixed: rotate the 1 mrad into them.
+  // A tilt about the North axis, by declaring the level 1 mrad off: it tips the vertical Earth rate
+  // into the East component, tan(lat) mrad of yaw. The body's x points along yaw 0.4 from East, so
+  // North is roll and pitch mixed: rotate the 1 mrad into them.
   const double tilt = 1e-3;
-  const Eigen::Vector2d east_in_body(std::cos(a.yaw), -std::sin(a.yaw));  // East in the levelled body axes
-  level.roll = tilt * east_in_body.x();
-  level.pitch = tilt * east_in_body.y();
+  const Eigen::Vector2d north_in_body(std::sin(a.yaw), std::cos(a.yaw));  // North in the levelled body axes
+  level.roll = tilt * north_in_body.x();
+  level.pitch = tilt * north_in_body.y();
   const HeadingSolution tilted = solveHeading(exact(a, latitude), level, latitude);
   const double shift = std::abs(wrapToPi(tilted.attitude.yaw - a.yaw));
   EXPECT_NEAR(shift, std::tan(latitude) * tilt, 0.01 * std::tan(latitude) * tilt);
-  // About North: nothing to first order.
-  level.roll = tilt * std::sin(a.yaw);
-  level.pitch = tilt * std::cos(a.yaw);
+  // About East: it tips the vertical rate along the horizontal one, nothing to first order.
+  level.roll = tilt * std::cos(a.yaw);
+  level.pitch = -tilt * std::sin(a.yaw);
   EXPECT_LT(std::abs(wrapToPi(solveHeading(exact(a, latitude), level, latitude).attitude.yaw - a.yaw)), 1e-3 * tilt);
   // A level sigma of 1 mrad on roll and pitch: tan(lat) mrad of yaw in the budget.
   level.roll = level.pitch = 0.0;
@@ -68,7 +69,7 @@ TEST(EarthRateHeadingTest, ErrorsEnterAsTheBudgetSays) {
   EXPECT_NEAR(budgeted.budget.level, std::tan(latitude) * 1e-3, 1e-3 * std::tan(latitude) * 1e-3);
   EXPECT_NEAR(budgeted.budget.total, budgeted.budget.level, 1e-12);
   std::printf(
-      "[ measured ] lat 0.9 rad: 1e-8 rad/s across -> %.4f mrad (1/h = %.4f); 1 mrad East tilt -> %.4f mrad "
+      "[ measured ] lat 0.9 rad: 1e-8 rad/s across -> %.4f mrad (1/h = %.4f); 1 mrad tilt about North -> %.4f mrad "
       "(tan lat %.4f)\n",
       1e3 * moved, 1e3 * 1e-8 / h, 1e3 * shift, std::tan(latitude));
 }

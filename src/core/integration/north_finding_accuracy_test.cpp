@@ -295,7 +295,8 @@ TEST(NorthFindingAccuracy, ErrorAgainstWindowLengthFollowsThePredictedLaw) {
 }
 
 TEST(NorthFindingAccuracy, AMilliradianLevelErrorMovesTheHeadingByTanLatitude) {
-  // The same session twice, the level declared exact and then 1 mrad off about the East axis.
+  // The same session twice, the level declared exact and then 1 mrad off about the North axis (the
+  // East axis tipped: the vertical Earth rate leaks across the horizontal one).
   MountScenario s;
   s.latitude = kLatitude;
   s.mount = EulerAngles{0.0, 0.0, 0.3};
@@ -305,14 +306,14 @@ TEST(NorthFindingAccuracy, AMilliradianLevelErrorMovesTheHeadingByTanLatitude) {
   a.level.roll_sigma = a.level.pitch_sigma = 1e-3;
   const AlignmentResult exact = testing::alignScenario(a, s);
   const double tilt = 1e-3;
-  // East in the body's axes (a level body at yaw 0.3): a tilt about it is a roll and a pitch.
-  a.level.roll = tilt * std::cos(s.mount.yaw);
-  a.level.pitch = -tilt * std::sin(s.mount.yaw);
+  // North in the body's axes (a level body at yaw 0.3): a tilt about it is a roll and a pitch.
+  a.level.roll = tilt * std::sin(s.mount.yaw);
+  a.level.pitch = tilt * std::cos(s.mount.yaw);
   const AlignmentResult tilted = testing::alignScenario(a, s);
   ASSERT_TRUE(exact.accepted && tilted.accepted) << tilted.summary();
   const double shift = wrapToPi(tilted.attitude.yaw - exact.attitude.yaw);
   std::printf(
-      "[ measured ] a 1 mrad tilt about East moves the heading by %.4f mrad (tan(0.9) = %.4f); the budget's "
+      "[ measured ] a 1 mrad tilt about North moves the heading by %.4f mrad (tan(0.9) = %.4f); the budget's "
       "level term for 1 mrad on roll and pitch: %.4f mrad\n",
       1e3 * shift, std::tan(kLatitude), 1e3 * exact.budget.level);
   EXPECT_NEAR(std::abs(shift), std::tan(kLatitude) * tilt, 0.005 * std::tan(kLatitude) * tilt);
@@ -325,7 +326,7 @@ TEST(NorthFindingAccuracy, AMilliradianLevelErrorMovesTheHeadingByTanLatitude) {
   b.level.accelerometer_to_body = mounted.accelerometer_to_body;
   const AlignmentResult known = testing::alignScenario(b, mounted);
   ASSERT_TRUE(unknown.accepted && known.accepted);
-  const double predicted = std::tan(kLatitude) * tilt * std::sin(s.mount.yaw);  // the pitch's share of East
+  const double predicted = std::tan(kLatitude) * tilt * std::cos(s.mount.yaw);  // the pitch's share of North
   std::printf(
       "[ measured ] accelerometer mounted 1 mrad off in pitch: heading moves %.4f mrad unless its mounting is "
       "given (predicted %.4f), then %.4f mrad from the truth\n",

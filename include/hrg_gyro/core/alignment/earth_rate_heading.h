@@ -10,11 +10,12 @@
 //   d yaw = a^T (L dw + dL w),      a = (cos yaw, -sin yaw, 0) / h
 // so every error of w enters divided by the horizontal Earth rate: a rate error b across the
 // horizontal Earth rate costs b / (Omega cos(lat)) rad of heading (1e-8 rad/s at 0.9 rad: 0.22 mrad),
-// and a tilt error e about the East axis tips the vertical Earth rate Omega sin(lat) into the
-// north component: e tan(lat) rad of heading (tan(0.9) = 1.26). A tilt about North costs nothing to
-// first order. The latitude enters only through h (and the vertical rate v that the indexed mode
-// puts in for the component it does not measure); close to the poles h vanishes and the errors grow
-// as 1 / cos(lat): above max_latitude the alignment is refused.
+// and a tilt error e about the North axis (the East axis tipped up or down) tips the vertical Earth
+// rate Omega sin(lat) into the East component, across the horizontal Earth rate: e tan(lat) rad of
+// heading (tan(0.9) = 1.26). A tilt about East tips it into the North component, along the horizontal
+// rate: it changes the rate's length, not its direction, and costs nothing to first order. The latitude enters only
+// through h (and the vertical rate v that the indexed mode puts in for the component it does not measure); close to the
+// poles h vanishes and the errors grow as 1 / cos(lat): above max_latitude the alignment is refused.
 //
 // The covariance of (roll, pitch, yaw) is that of the level, propagated, beside the sum of the yaw
 // terms; the level and the gyros' errors are independent. No ROS.
@@ -57,7 +58,7 @@ struct HeadingErrorBudget {
   double residual_bias = 0.0;                 ///< the calibration's bias: a floor (static, sweep); cancels indexed
   double drift_harmonics = 0.0;               ///< D(theta) residual: in full at rest, averaged by a sweep
   double bias_random_walk = 0.0;              ///< grows as T^1/2
-  double level = 0.0;                         ///< the tilt about East, times tan(lat)
+  double level = 0.0;                         ///< the tilt about North, times tan(lat)
   double indexer = 0.0;                       ///< the indexer's angle errors
   double total = 0.0;                         ///< root sum of squares
   double horizontal_earth_rate = 0.0;         ///< rad/s, Omega cos(lat): every gyro error is divided by it
