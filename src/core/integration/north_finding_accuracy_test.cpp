@@ -68,7 +68,7 @@ MountScenario drawn(MountScenario s, std::uint64_t seed, double bias = kBias, do
 
 struct Coverage {
   int runs = 0, within2 = 0, refused = 0;
-  double z2 = 0.0, e2 = 0.0, sigma2 = 0.0, worst = 0.0;
+  double z2 = 0.0, e2 = 0.0, sigma2 = 0.0, worst = 0.0, worst_scatter = 0.0;
   void add(const AlignmentResult& r, const MountScenario& s) {
     if (!r.accepted) {
       ++refused;
@@ -82,6 +82,7 @@ struct Coverage {
     e2 += e * e;
     sigma2 += sigma * sigma;
     worst = std::max(worst, std::abs(e));
+    worst_scatter = std::max(worst_scatter, r.scatter);
   }
   double rmsZ() const { return std::sqrt(z2 / runs); }
   double rmsError() const { return std::sqrt(e2 / runs); }
@@ -89,8 +90,9 @@ struct Coverage {
   void print(const char* what) const {
     std::printf(
         "[ measured ] %s: %d runs, %d within 2 sigma (%.0f %%), rms z %.3f, rms error %.4f mrad, rms sigma "
-        "%.4f mrad, worst %.4f mrad\n",
-        what, runs, within2, 100.0 * within2 / runs, rmsZ(), 1e3 * rmsError(), 1e3 * rmsSigma(), 1e3 * worst);
+        "%.4f mrad, worst %.4f mrad; largest residual scatter %.3f\n",
+        what, runs, within2, 100.0 * within2 / runs, rmsZ(), 1e3 * rmsError(), 1e3 * rmsSigma(), 1e3 * worst,
+        worst_scatter);
   }
 };
 
@@ -362,11 +364,13 @@ TEST(NorthFindingAccuracy, TheSweepAveragesOutWhatTheStaticHeadingTakesFromD) {
         (std::cos(x.mount.yaw) * wl.x() - std::sin(x.mount.yaw) * wl.y()) / horizontalEarthRate(kLatitude);
     std::printf(
         "[ measured ] seed %llu, %.0f s: static error %+.4f mrad (the D residual's image %+.4f, budget "
-        "%.4f), swept %+.4f mrad (budget: noise %.4f, D %.4f)\n",
+        "%.4f, level %.4f), swept %+.4f mrad (budget: noise %.4f, D %.4f)\n",
         static_cast<unsigned long long>(seed), x.duration, 1e3 * testing::yawError(rs, x), 1e3 * predicted,
-        1e3 * rs.budget.drift_harmonics, 1e3 * testing::yawError(rw, sw), 1e3 * rw.budget.noise,
+        1e3 * rs.budget.drift_harmonics, 1e3 * rs.budget.level, 1e3 * testing::yawError(rw, sw), 1e3 * rw.budget.noise,
         1e3 * rw.budget.drift_harmonics);
-    EXPECT_LT(std::abs(testing::yawError(rs, x) - predicted), 4.0 * rs.budget.noise);
+    // Beside the D residual's image, the static heading carries the noise and the level error of the
+    // accelerometer's drawn bias (seed 5: 0.18 mrad off the image, against a noise of 0.03 mrad).
+    EXPECT_LT(std::abs(testing::yawError(rs, x) - predicted), 4.0 * std::hypot(rs.budget.noise, rs.budget.level));
     static_runs.add(rs, x);
     swept_runs.add(rw, sw);
     EXPECT_LT(rw.budget.drift_harmonics, 0.1 * rs.budget.drift_harmonics);
