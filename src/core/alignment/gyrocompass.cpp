@@ -697,8 +697,7 @@ bool GyrocompassSolver::level(LevelMeasurement* out) {
   return true;
 }
 
-bool GyrocompassSolver::measure(const IntegratedAngleFit& fit, const LevelMeasurement& level,
-                                EarthRateMeasurement* m) {
+bool GyrocompassSolver::measure(const IntegratedAngleFit& fit, const LevelMeasurement& level, EarthRateMeasurement* m) {
   const AngleFitResult& f = fit.result();
   const GyroNoiseModel& noise = s_.noise;
   const double bias2 = noise.residual_bias * noise.residual_bias;
