@@ -159,8 +159,8 @@ void TriadCalibration::addTurntable(Nanoseconds stamp, double angle, double rate
     for (int i = 0; i < 3; ++i) {
       const int sign = verticalSign(*fixture, i);
       if (sign == 0) continue;
-      sessions_[i]->addRotationRecord(stamp, sign * angle + (sign - 1) * vertical * t, sign * rate + (sign - 1) * vertical,
-                                 sequence);
+      sessions_[i]->addRotationRecord(stamp, sign * angle + (sign - 1) * vertical * t,
+                                      sign * rate + (sign - 1) * vertical, sequence);
     }
   }
   if (!std::isfinite(angle) || !std::isfinite(rate) || stamp <= 0) return;
