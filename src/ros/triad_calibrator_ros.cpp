@@ -239,6 +239,9 @@ void TriadCalibratorRos::serve(int queue_size, double heap_trim_period, bool aut
 }
 
 TriadCalibratorRos::~TriadCalibratorRos() {
+  // First: the timer runs the diagnostic tasks, some of them members destroyed before it (a
+  // FrequencyStatus called after its destruction aborted a test with "pure virtual method called").
+  diagnostics_timer_.stop();
   for (ros::Subscriber& s : wave_subs_) s.shutdown();
   turntable_sub_.shutdown();
   fixture_sub_.shutdown();
