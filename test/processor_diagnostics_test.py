@@ -100,7 +100,16 @@ class Diagnostics(unittest.TestCase):
 
         start = rospy.get_time()
         self.feed(3.0)
+        # The first good samples after the bad ones may be rejected (theta jumped); a busy host works
+        # them off late, and a report can still count them: good samples keep coming until a report
+        # covers them only (within 20 more s of feeding).
         level, message = self.status_after("wave", start + 1.5)[:2]
+        for _ in range(10):
+            if level == DiagnosticStatus.OK:
+                break
+            start = rospy.get_time()
+            self.feed(2.0)
+            level, message = self.status_after("wave", start + 1.5)[:2]
         self.assertEqual(level, DiagnosticStatus.OK, message)
         level, message = self.status_after("input", start + 1.5)[:2]
         self.assertNotEqual(level, DiagnosticStatus.ERROR, message)

@@ -145,6 +145,9 @@ void CalibratorRos::subscribe(int queue_size) {
 }
 
 CalibratorRos::~CalibratorRos() {
+  // First: the timer runs the diagnostic tasks, some of them members destroyed before it (a
+  // FrequencyStatus called after its destruction aborted a test with "pure virtual method called").
+  diagnostics_timer_.stop();
   stopVirtualRotation("the calibrator shut down");
   turntable_sub_.shutdown();
   wave_sub_.shutdown();

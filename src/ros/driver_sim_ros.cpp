@@ -20,6 +20,15 @@ namespace hrg_gyro {
 
 DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_process)
     : nh_(nh), pnh_(pnh), params_(pnh, "driver_sim"), owns_process_(owns_process) {
+  readScenario();
+  readNodeParameters();
+  advertise();
+  announce();
+  worker_ = std::thread(&DriverSimRos::run, this);
+}
+
+/// The scenario from the private parameters: a single gyro's, or a triad's.
+void DriverSimRos::readScenario() {
   const YAML::Node params = privateParameters(pnh_);
   if (core::isTriadScenario(params)) {
     triad_config_ = std::make_unique<core::TriadSimulationConfig>(
@@ -36,39 +45,16 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   params_.claim({"seed", "start_time", "resonator", "pickoff", "turntable", "generator", "thermal", "channels", "triad",
                  "dynamics"},
                 true);
+}
+
+/// The node's own parameters (pace, clock, topics' queues), checked; unknown keys warned about.
+void DriverSimRos::readNodeParameters() {
   time_scale_ = params_.get("time_scale", time_scale_);
-  // clock_period: "auto" (the template's value) or unset means: with every output sample, but no
-  // more often than kFinestAutoClockPeriod. A consumer's timer under sim time fires only when /clock
-  // passes its due time, so a clock coarser than the samples throttles it (a 50 Hz filter ran at
-  // 20 Hz behind a 20 Hz clock); at the 10 kHz a bench gyro may run, a clock per sample would cost
-  // every node of the graph a callback per sample for timers that no consumer runs that fast.
-  const double auto_clock_period = std::max(output_period_, kFinestAutoClockPeriod);
-  clock_period_ = auto_clock_period;
-  XmlRpc::XmlRpcValue clock_raw;
-  if (params_.getOptional("clock_period", &clock_raw)) {
-    if (clock_raw.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
-      clock_period_ = static_cast<double>(clock_raw);
-    } else if (clock_raw.getType() == XmlRpc::XmlRpcValue::TypeInt) {
-      clock_period_ = static_cast<int>(clock_raw);
-    } else if (clock_raw.getType() != XmlRpc::XmlRpcValue::TypeString ||
-               static_cast<std::string>(clock_raw) != "auto") {
-      throw std::invalid_argument("~clock_period must be a positive number of seconds or auto");
-    }
-  }
+  readClockPeriod();
   max_lag_ = params_.get("max_lag", max_lag_);
   frame_id_ = params_.get("frame_id", frame_id_);
   ros::param::param("/use_sim_time", use_sim_time_, false);
-  // publish_clock: "auto" (the template's value) or unset means: exactly when /use_sim_time is set.
-  std::string publish_clock = "auto";
-  XmlRpc::XmlRpcValue raw;
-  if (params_.getOptional("publish_clock", &raw)) {
-    if (raw.getType() == XmlRpc::XmlRpcValue::TypeBoolean) {
-      publish_clock = static_cast<bool>(raw) ? "true" : "false";
-    } else if (raw.getType() != XmlRpc::XmlRpcValue::TypeString || static_cast<std::string>(raw) != "auto") {
-      throw std::invalid_argument("~publish_clock must be true, false or auto");
-    }
-  }
-  publish_clock_ = publish_clock == "auto" ? use_sim_time_ : publish_clock == "true";
+  readPublishClock();
   shutdown_when_done_ = params_.get("shutdown_when_done", shutdown_when_done_);
   wait_channels_ = params_.get("wait_for_subscribers/channels", 0);
   wait_turntable_ = params_.get("wait_for_subscribers/turntable", 0);
@@ -77,7 +63,7 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   pace_topic_ = params_.get<std::string>("pace_topic", pace_topic_);
   max_lead_ = params_.get("max_lead", max_lead_);
   pace_timeout_ = params_.get("pace_timeout", pace_timeout_);
-  const int queue_size = params_.get("queue_size", 20000);
+  queue_size_ = params_.get("queue_size", 20000);
   params_.warnAboutUnknownKeys();
   if (!(clock_period_ > 0.0) || !std::isfinite(clock_period_)) {
     throw std::invalid_argument("~clock_period must be a positive number of seconds or auto");
@@ -97,20 +83,62 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
     ROS_WARN("driver_sim: ~time_scale = %g without /use_sim_time: stamps will run ahead of the wall clock",
              time_scale_);
   }
-  turntable_pub_ = nh_.advertise<TurntableState>("turntable/state", queue_size);
+}
+
+/// ~clock_period: a positive number of seconds, or auto.
+void DriverSimRos::readClockPeriod() {
+  // clock_period: "auto" (the template's value) or unset means: with every output sample, but no
+  // more often than kFinestAutoClockPeriod. A consumer's timer under sim time fires only when /clock
+  // passes its due time, so a clock coarser than the samples throttles it (a 50 Hz filter ran at
+  // 20 Hz behind a 20 Hz clock); at the 10 kHz a bench gyro may run, a clock per sample would cost
+  // every node of the graph a callback per sample for timers that no consumer runs that fast.
+  const double auto_clock_period = std::max(output_period_, kFinestAutoClockPeriod);
+  clock_period_ = auto_clock_period;
+  XmlRpc::XmlRpcValue clock_raw;
+  if (params_.getOptional("clock_period", &clock_raw)) {
+    if (clock_raw.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+      clock_period_ = static_cast<double>(clock_raw);
+    } else if (clock_raw.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+      clock_period_ = static_cast<int>(clock_raw);
+    } else if (clock_raw.getType() != XmlRpc::XmlRpcValue::TypeString ||
+               static_cast<std::string>(clock_raw) != "auto") {
+      throw std::invalid_argument("~clock_period must be a positive number of seconds or auto");
+    }
+  }
+}
+
+/// ~publish_clock: true, false or auto.
+void DriverSimRos::readPublishClock() {
+  // publish_clock: "auto" (the template's value) or unset means: exactly when /use_sim_time is set.
+  std::string publish_clock = "auto";
+  XmlRpc::XmlRpcValue raw;
+  if (params_.getOptional("publish_clock", &raw)) {
+    if (raw.getType() == XmlRpc::XmlRpcValue::TypeBoolean) {
+      publish_clock = static_cast<bool>(raw) ? "true" : "false";
+    } else if (raw.getType() != XmlRpc::XmlRpcValue::TypeString || static_cast<std::string>(raw) != "auto") {
+      throw std::invalid_argument("~publish_clock must be true, false or auto");
+    }
+  }
+  publish_clock_ = publish_clock == "auto" ? use_sim_time_ : publish_clock == "true";
+}
+
+/// The topics: the table, each gyro's channels and truth (or the triad's), the precession loop's state,
+/// the command and pace subscriptions, ~done and /clock.
+void DriverSimRos::advertise() {
+  turntable_pub_ = nh_.advertise<TurntableState>("turntable/state", queue_size_);
   if (triad_config_) {
     for (int i = 0; i < 3; ++i) {
       const std::string& axis = triad_config_->axes[i].name;
-      axis_channels_pub_[i] = nh_.advertise<ChannelAmplitudes>(triadAxisTopic(axis, "channels"), queue_size);
-      axis_truth_pub_[i] = nh_.advertise<GroundTruth>(triadAxisTopic(axis, "truth"), queue_size);
+      axis_channels_pub_[i] = nh_.advertise<ChannelAmplitudes>(triadAxisTopic(axis, "channels"), queue_size_);
+      axis_truth_pub_[i] = nh_.advertise<GroundTruth>(triadAxisTopic(axis, "truth"), queue_size_);
     }
-    fixture_pub_ = nh_.advertise<FixturePosition>("fixture/position", queue_size);
-    truth_pub_ = nh_.advertise<BodyTruth>("truth", queue_size);
+    fixture_pub_ = nh_.advertise<FixturePosition>("fixture/position", queue_size_);
+    truth_pub_ = nh_.advertise<BodyTruth>("truth", queue_size_);
   } else {
-    channels_pub_ = nh_.advertise<ChannelAmplitudes>("channels", queue_size);
-    truth_pub_ = nh_.advertise<GroundTruth>("truth", queue_size);
+    channels_pub_ = nh_.advertise<ChannelAmplitudes>("channels", queue_size_);
+    truth_pub_ = nh_.advertise<GroundTruth>("truth", queue_size_);
     has_precession_loop_ = config_->dynamics.averaged();
-    if (has_precession_loop_) precession_pub_ = nh_.advertise<PrecessionState>("precession/state", queue_size);
+    if (has_precession_loop_) precession_pub_ = nh_.advertise<PrecessionState>("precession/state", queue_size_);
   }
   // Subscribed either way: a command to a gyro without the loop is answered with a warning.
   command_sub_ = nh_.subscribe("command/precession", 10, &DriverSimRos::onPrecessionCommand, this);
@@ -128,6 +156,10 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
   std_msgs::Bool done;
   done.data = false;
   done_pub_.publish(done);
+}
+
+/// One line on what is simulated, at start-up.
+void DriverSimRos::announce() {
   if (triad_config_) {
     ROS_INFO("driver_sim: %.1f s triad session (%zu fixture positions) at %.0f Hz output, time scale %s",
              triad_config_->duration(), triad_config_->positions.size(), 1.0 / output_period_,
@@ -138,7 +170,6 @@ DriverSimRos::DriverSimRos(ros::NodeHandle nh, ros::NodeHandle pnh, bool owns_pr
              1.0 / output_period_, config_->generator.enabled ? "generator sweep first" : "turntable profile",
              time_scale_ > 0.0 ? std::to_string(time_scale_).c_str() : "as fast as possible");
   }
-  worker_ = std::thread(&DriverSimRos::run, this);
 }
 
 void DriverSimRos::onPrecessionCommand(const ros::MessageEvent<PrecessionCommand const>& event) {

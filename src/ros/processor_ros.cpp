@@ -147,6 +147,9 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 ProcessorRos::~ProcessorRos() {
+  // First: the timer runs the diagnostic tasks, some of them members destroyed before it (a
+  // FrequencyStatus called after its destruction aborted a test with "pure virtual method called").
+  diagnostics_timer_.stop();
   wait_timer_.stop();
   channels_sub_.shutdown();
   precession_sub_.shutdown();

@@ -234,21 +234,19 @@ void TriadCalibratorRos::serve(int queue_size, double heap_trim_period, bool aut
            axis_files_[1].c_str(), axis_files_[2].c_str(), triad_file_.c_str(),
            autostart ? "run started" : "waiting for ~start");
   // Threads last: a constructor that throws must not leave a joinable thread behind.
-  worker_ = std::thread(&TriadCalibratorRos::resultLoop, this);
+  result_worker_.start([this](Pending& p) { serveResult(p); });
   input_.start();
 }
 
 TriadCalibratorRos::~TriadCalibratorRos() {
+  // First: the timer runs the diagnostic tasks, some of them members destroyed before it (a
+  // FrequencyStatus called after its destruction aborted a test with "pure virtual method called").
+  diagnostics_timer_.stop();
   for (ros::Subscriber& s : wave_subs_) s.shutdown();
   turntable_sub_.shutdown();
   fixture_sub_.shutdown();
   input_.stop();
-  {
-    std::lock_guard<std::mutex> lock(worker_mutex_);
-    stopping_ = true;
-  }
-  worker_cv_.notify_all();
-  if (worker_.joinable()) worker_.join();
+  result_worker_.stop();
 }
 
 std::unique_ptr<core::TriadFeed> TriadCalibratorRos::newFeed() const {
@@ -415,11 +413,7 @@ bool TriadCalibratorRos::finishRun(std::string* message) {
     if (!g.passed) ROS_WARN("%s: gate %s failed: %s", kNode, g.name.c_str(), g.message.c_str());
   }
   for (const std::string& n : o.notes) ROS_INFO("%s: note: %s", kNode, n.c_str());
-  {
-    std::lock_guard<std::mutex> lock(worker_mutex_);
-    pending_.push_back({r, written});
-  }
-  worker_cv_.notify_one();
+  result_worker_.push({r, written});
   if (written) ++pending_reloads_;  // ~progress holds until the processors and the triad run the new files
   return written;
 }
@@ -440,40 +434,29 @@ void TriadCalibratorRos::publishProgress() {
   progress_pub_.publish(t);
 }
 
-void TriadCalibratorRos::resultLoop() {
-  for (;;) {
-    Pending p;
-    {
-      std::unique_lock<std::mutex> lock(worker_mutex_);
-      worker_cv_.wait(lock, [this] { return stopping_ || !pending_.empty(); });
-      if (stopping_) return;
-      p = std::move(pending_.front());
-      pending_.pop_front();
-    }
-    if (p.reload) {
-      for (const std::string& s : reload_services_) {
-        const std::string service = nh_.resolveName(s);
-        std_srvs::Trigger call;
-        if (ros::service::waitForService(service, ros::Duration(5.0)) && ros::service::call(service, call) &&
-            call.response.success) {
-          ROS_INFO("%s: %s: %s", kNode, service.c_str(), call.response.message.c_str());
-          p.result.reloaded.push_back(service);
-        } else {
-          ROS_ERROR("%s: %s %s%s", kNode, service.c_str(),
-                    call.response.message.empty() ? "could not be called" : "refused the new files: ",
-                    call.response.message.c_str());
-          p.result.reload_failed.push_back(service);
-        }
-        std::lock_guard<std::mutex> lock(worker_mutex_);
-        if (stopping_) return;
+void TriadCalibratorRos::serveResult(Pending& p) {
+  if (p.reload) {
+    for (const std::string& s : reload_services_) {
+      const std::string service = nh_.resolveName(s);
+      std_srvs::Trigger call;
+      if (ros::service::waitForService(service, ros::Duration(5.0)) && ros::service::call(service, call) &&
+          call.response.success) {
+        ROS_INFO("%s: %s: %s", kNode, service.c_str(), call.response.message.c_str());
+        p.result.reloaded.push_back(service);
+      } else {
+        ROS_ERROR("%s: %s %s%s", kNode, service.c_str(),
+                  call.response.message.empty() ? "could not be called" : "refused the new files: ",
+                  call.response.message.c_str());
+        p.result.reload_failed.push_back(service);
       }
+      if (result_worker_.stopping()) return;
     }
-    result_pub_.publish(p.result);
-    if (p.reload) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      --pending_reloads_;
-      publishProgress();  // the driver may be waiting for it with no data left in flight
-    }
+  }
+  result_pub_.publish(p.result);
+  if (p.reload) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    --pending_reloads_;
+    publishProgress();  // the driver may be waiting for it with no data left in flight
   }
 }
 

@@ -119,6 +119,9 @@ TriadRos::TriadRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 TriadRos::~TriadRos() {
+  // First: the timer runs the diagnostic tasks, some of them members destroyed before it (a
+  // FrequencyStatus called after its destruction aborted a test with "pure virtual method called").
+  diagnostics_timer_.stop();
   for (ros::Subscriber& s : subscribers_) s.shutdown();
   input_.stop();
 }

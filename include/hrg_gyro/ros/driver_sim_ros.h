@@ -53,6 +53,13 @@ class DriverSimRos {
   const ParameterReader& parameters() const { return params_; }
 
  private:
+  // The constructor's steps, in order.
+  void readScenario();
+  void readNodeParameters();
+  void readClockPeriod();
+  void readPublishClock();
+  void advertise();
+  void announce();
   void run();
   /// Plays `sim` (a GyroSimulator or a TriadSimulator) on the schedule; `publish(sample, stamp,
   /// origin)` publishes one sample's messages.
@@ -122,6 +129,7 @@ class DriverSimRos {
   bool publish_clock_ = true;
   bool shutdown_when_done_ = false;
   int wait_channels_ = 0, wait_turntable_ = 0, wait_truth_ = 0;
+  int queue_size_ = 20000;  // ~queue_size of every topic it publishes
   double wait_timeout_ = 10.0;
   std::atomic<bool> stop_{false};
   std::thread worker_;

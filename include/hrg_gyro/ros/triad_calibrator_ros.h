@@ -19,12 +19,9 @@
 #include <std_srvs/Trigger.h>
 
 #include <array>
-#include <condition_variable>
-#include <deque>
 #include <memory>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "hrg_gyro/FixturePosition.h"
@@ -34,6 +31,7 @@
 #include "hrg_gyro/WaveState.h"
 #include "hrg_gyro/core/calibration/triad/triad_feed.h"
 #include "hrg_gyro/ros/input_thread.h"
+#include "hrg_gyro/ros/job_worker.h"
 #include "hrg_gyro/ros/parameter_reader.h"
 
 namespace hrg_gyro {
@@ -80,7 +78,11 @@ class TriadCalibratorRos {
   /// Fits, reports, writes, hands the reloads and the result to the worker. Caller holds the mutex.
   bool finishRun(std::string* message);
   /// The worker: calls the reload services, then publishes the result, off the callback threads.
-  void resultLoop();
+  struct Pending {
+    TriadCalibrationResult result;
+    bool reload = false;
+  };
+  void serveResult(Pending& p);  // the reloads a written result asks for, then the result published
 
   ros::NodeHandle nh_, pnh_;
   ParameterReader params_;
@@ -121,15 +123,7 @@ class TriadCalibratorRos {
   diagnostic_updater::Updater updater_;
   ros::WallTimer diagnostics_timer_;
 
-  struct Pending {
-    TriadCalibrationResult result;
-    bool reload = false;
-  };
-  std::mutex worker_mutex_;
-  std::condition_variable worker_cv_;
-  std::deque<Pending> pending_;
-  bool stopping_ = false;
-  std::thread worker_;
+  JobWorker<Pending> result_worker_;  // reloads and publishes each result off the callback threads
 };
 
 }  // namespace hrg_gyro

@@ -28,7 +28,12 @@ void CalibrationFeed::forgetRun() {
   sweep_end_ = last_channels_ = 0;
   last_rotation_ = 0;
   waves_reached_rotation_ = true;
-  newest_wave_ = 0;
+  finish_pending_ = false;
+  newest_wave_ = last_taken_wave_ = 0;
+}
+
+std::uint64_t CalibrationFeed::droppedWaves() const {
+  return session_->counters().wave_jumps + session_->counters().out_of_order;
 }
 
 void CalibrationFeed::noteRestart(std::uint64_t restarts_before, FeedStep* step) {
@@ -69,12 +74,15 @@ FeedStep CalibrationFeed::addWaveRecord(Nanoseconds stamp, double theta, double 
   FeedStep step;
   if (stamp > newest_wave_) newest_wave_ = stamp;
   const std::uint64_t restarts = session_->counters().restarts;
+  const std::uint64_t dropped = droppedWaves();
   session_->addWave(stamp, theta, frequency, quadrature_ratio);
   noteRestart(restarts, &step);
+  if (!step.restarted && droppedWaves() != dropped) return step;  // a glitch says nothing of the waves' progress
+  last_taken_wave_ = stamp;
   // The auto-finish rule needs both streams: the rest seen in the rotation records and the data
-  // complete from the waves. Checked on a rotation record only, a run whose waves came later than the
-  // table's (a hop more through the processor, run late on a busy host) would never finish once the
-  // table had said its last; so it is checked again when the waves reach the latest record's stamp.
+  // complete from the waves. The waves come later than the records (a hop more through the processor,
+  // later still on a busy host), so the rule is checked again when they reach the latest record's
+  // stamp, and a run the rule ends on a record finishes only when the waves reach it.
   if (!watch_finish_ || waves_reached_rotation_ || stamp < last_rotation_) return step;
   waves_reached_rotation_ = true;
   step.should_finish = session_->shouldFinish();
@@ -100,16 +108,21 @@ FeedStep CalibrationFeed::addPrecessionState(Nanoseconds stamp, double angle, do
 
 FeedStep CalibrationFeed::addRotation(Nanoseconds stamp, double angle, double rate, std::uint64_t sequence) {
   FeedStep step;
+  // The rule ended the run on an earlier record, and the waves are on their way to it: the records
+  // after it are not the run's, so that it holds the same samples however far the waves trail.
+  if (watch_finish_ && finish_pending_) return step;
   const std::uint64_t restarts = session_->counters().restarts;
-  session_->addRotationRecord(stamp, angle, rate, sequence);
+  const bool taken = session_->addRotationRecord(stamp, angle, rate, sequence);
   noteRestart(restarts, &step);
-  if (!watch_finish_) return step;
-  if (session_->shouldFinish()) {
-    step.should_finish = true;
-    return step;
-  }
+  if (!watch_finish_ || !taken) return step;
   last_rotation_ = stamp;
-  waves_reached_rotation_ = false;
+  waves_reached_rotation_ = last_taken_wave_ >= stamp;
+  if (!session_->shouldFinish()) return step;
+  if (waves_reached_rotation_) {
+    step.should_finish = true;
+  } else {
+    finish_pending_ = true;  // finished by the wave that reaches this record
+  }
   return step;
 }
 

@@ -7,8 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <deque>
 #include <memory>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -211,6 +213,47 @@ TEST(CalibrationFeedTest, AWatchedRunMayFinishWhenTheWavesReachTheTablesLastStat
     EXPECT_EQ(finished_at, watch ? last_state : 0);
     EXPECT_EQ(session.shouldFinish(), true);
   }
+}
+
+// The waves trail the table by a hop through the processor, by more on a busy host: a watched run
+// finishes holding the same samples and records however far they trail (the host's pace).
+TEST(CalibrationFeedTest, AWatchedRunFinishesWithTheSameDataWhateverTheWavesLag) {
+  const testing::AngleLevelGyro g = testing::referenceGyro();
+  CalibrationSettings s = settingsFor(CalibrationMethodKind::kDualRate);
+  s.auto_finish_idle = 10.0;
+  std::vector<std::tuple<std::uint64_t, std::uint64_t, double>> finished;  // used, records, K0
+  for (const std::size_t lag : {std::size_t{0}, std::size_t{1}, std::size_t{90}, std::size_t{5000}}) {
+    SCOPED_TRACE("waves " + std::to_string(lag) + " samples behind");
+    CalibrationSession session(s, prior());
+    CalibrationFeed feed(&session, nullptr, true);
+    std::deque<std::tuple<Nanoseconds, double>> in_transit;
+    bool done = false;
+    auto note = [&](const FeedStep& step) {
+      if (!step.should_finish || done) return;
+      done = true;
+      const CalibrationOutcome o = session.finish();
+      ASSERT_TRUE(o.accepted) << o.reason;
+      finished.emplace_back(session.counters().used, session.counters().rotation_records_total,
+                            o.parameters.scale_factor.meanAt(NAN));
+    };
+    testing::runAngleLevel(g, testing::dualRateProfile(0.05, -0.05, 120.0),
+                           [&](Nanoseconds t, double angle, double rate, double theta, double) {
+                             if (done) return;
+                             in_transit.emplace_back(t, theta);
+                             while (!done && in_transit.size() > lag) {
+                               const auto [wt, wtheta] = in_transit.front();
+                               in_transit.pop_front();
+                               note(feed.addWave(wt, wtheta, NAN, NAN));
+                             }
+                             if (!done) note(feed.addTableState(t, angle, rate, 0));
+                           });
+    ASSERT_TRUE(done);
+  }
+  ASSERT_EQ(finished.size(), 4u);
+  for (std::size_t i = 1; i < finished.size(); ++i) EXPECT_EQ(finished[i], finished[0]) << i;
+  std::printf("[ measured ] finished with %llu samples used, %llu table records, whatever the lag\n",
+              static_cast<unsigned long long>(std::get<0>(finished[0])),
+              static_cast<unsigned long long>(std::get<1>(finished[0])));
 }
 
 }  // namespace

@@ -46,7 +46,9 @@ class CalibrationFeed {
 
   /// `session`: the run fed (nullptr: none yet, see startRun). `processor`: turns raw channels into
   /// wave samples; nullptr when the front end receives the waves. Neither is owned; both must outlive
-  /// their use here. `watch_finish`: say when the run may finish by itself (FeedStep::should_finish).
+  /// their use here. `watch_finish`: say when the run may finish by itself (FeedStep::should_finish): on
+  /// the wave that reaches the record on which the auto-finish rule first held (the records after it are
+  /// not the run's), so that the run holds the same samples however far the waves trail the records.
   explicit CalibrationFeed(CalibrationSession* session, GyroProcessor* processor = nullptr, bool watch_finish = false);
   // The pairing's sink points at this feed.
   CalibrationFeed(const CalibrationFeed&) = delete;
@@ -81,6 +83,7 @@ class CalibrationFeed {
   /// After a record went into the session: a restarted run starts the feed's own state over too.
   void noteRestart(std::uint64_t restarts_before, FeedStep* step);
   void forgetRun();
+  std::uint64_t droppedWaves() const;  // wave samples the session dropped (jumps, out of order)
   FeedStep endSweep();
 
   CalibrationSession* session_ = nullptr;
@@ -96,6 +99,8 @@ class CalibrationFeed {
   Nanoseconds last_rotation_ = 0;
   bool waves_reached_rotation_ = true;
   Nanoseconds newest_wave_ = 0;
+  Nanoseconds last_taken_wave_ = 0;  // the newest wave the session took (glitches left out)
+  bool finish_pending_ = false;      // the rule ended the run on a record the waves have not reached
 };
 
 }  // namespace core
