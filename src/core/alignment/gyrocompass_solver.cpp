@@ -1,0 +1,705 @@
+#include "hrg_gyro/core/alignment/gyrocompass_solver.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "hrg_gyro/core/common/units.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+constexpr double kMaxPitch = 1.4;  // rad: the body's x within 10 deg of vertical has no heading
+constexpr double kDegrees = 180.0 / kPi;
+
+Eigen::Matrix3d rotZ(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+
+// Linear interpolation of a value between records at stamps (seconds from the window's start); false
+// when `t` is not between two records at most `max_gap` apart.
+bool interpolate(const std::vector<double>& times, const std::vector<double>& values, double t, double max_gap,
+                 double* out) {
+  if (times.empty() || t < times.front() || t > times.back()) return false;
+  const auto it = std::lower_bound(times.begin(), times.end(), t);
+  const std::size_t k = static_cast<std::size_t>(it - times.begin());
+  if (times[k] == t) {
+    *out = values[k];
+    return true;
+  }
+  const double t0 = times[k - 1], t1 = times[k];
+  if (t1 - t0 > max_gap) return false;
+  *out = values[k - 1] + (values[k] - values[k - 1]) * (t - t0) / (t1 - t0);
+  return true;
+}
+
+// The integrals of cos(psi) and sin(psi) over an interval along which psi moves linearly from a to b.
+void integrateCosSin(double a, double b, double dt, double* c, double* s) {
+  const double middle = 0.5 * (a + b), k = dt * sinc(0.5 * (b - a));
+  *c = k * std::cos(middle);
+  *s = k * std::sin(middle);
+}
+
+}  // namespace
+
+std::string formatAlignmentMessage(const char* pattern, double a, double b, double c, double d) {
+  char buffer[512];
+  std::snprintf(buffer, sizeof buffer, pattern, a, b, c, d);
+  return buffer;
+}
+
+AlignmentResult Gyrocompass::finish() const { return GyrocompassSolver(*this).solve(); }
+
+bool GyrocompassSolver::buildStatic() {
+  const Gyrocompass::Stream& st = g_.streams_[0];
+  parameters_ = 3;
+  series_.assign(3, AngleSeries());
+  for (std::size_t c = 0; c < 3; ++c) {
+    series_[c].columns = {static_cast<int>(c)};
+    series_[c].regressors.assign(1, {});
+  }
+  Gyrocompass::BlockMotion motion;
+  std::array<double, 3> y{{0.0, 0.0, 0.0}};
+  int seg = -1;
+  double last_time = -INFINITY;
+  for (std::size_t k = 0; k < st.stamp.size(); ++k) {
+    const double t_end = seconds(st.stamp[k]), t_start = std::max(t_end - st.dt[k], last_time);
+    const double* inc = &st.increment[3 * k];
+    if (k == 0 || st.broken[k]) {
+      seg = static_cast<int>(segments_.size());
+      segments_.push_back(Segment());
+      segments_.back().start = t_start;
+      segments_.back().group = seg;
+      y = {{0.0, 0.0, 0.0}};
+      for (std::size_t c = 0; c < 3; ++c) series_[c].push(t_start, seg, 0.0, &t_start);
+      motion.restart();
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+      y[c] += inc[c];
+      series_[c].push(t_end, seg, y[c], &t_end);
+    }
+    segments_.back().end = t_end;
+    motion.add(st.dt[k], inc, s_.motion.block);
+    used_seconds_ += st.dt[k];
+    last_time = t_end;
+  }
+  samples_ = st.stamp.size();
+  worst_motion_ = motion.worst;
+  return true;
+}
+
+bool GyrocompassSolver::prepareIndexer() {
+  const auto& records = g_.indexer_;
+  if (records.size() < 2) return refuse("input", "no indexer records in the window (addIndexer)");
+  for (const IndexerRecord& r : records) {
+    indexer_time_.push_back(seconds(r.stamp));
+    indexer_angle_.push_back(r.angle);
+  }
+  const std::size_t n = records.size();
+  indexer_rate_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (std::isfinite(records[k].rate)) {
+      indexer_rate_[k] = records[k].rate;
+    } else {
+      const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 < n ? k + 1 : n - 1;
+      indexer_rate_[k] = (indexer_angle_[b] - indexer_angle_[a]) / (indexer_time_[b] - indexer_time_[a]);
+    }
+  }
+  if (s_.indexer.continuous) return true;
+  // Rests: runs of records at rest, no two further apart than max_record_gap.
+  const IndexerSettings& x = s_.indexer;
+  for (std::size_t k = 0; k < n;) {
+    if (std::abs(indexer_rate_[k]) >= x.rest_rate) {
+      ++k;
+      continue;
+    }
+    std::size_t e = k;
+    double low = indexer_angle_[k], high = low, sum = 0.0;
+    while (e < n && std::abs(indexer_rate_[e]) < x.rest_rate &&
+           (e == k || indexer_time_[e] - indexer_time_[e - 1] <= x.max_record_gap)) {
+      low = std::min(low, indexer_angle_[e]);
+      high = std::max(high, indexer_angle_[e]);
+      sum += indexer_angle_[e];
+      ++e;
+    }
+    Rest rest;
+    rest.from = indexer_time_[k] + x.settle;
+    rest.to = indexer_time_[e - 1];
+    rest.angle = sum / static_cast<double>(e - k);
+    if (rest.to > rest.from) {
+      if (high - low > x.position_tolerance) {
+        return refuse("motion",
+                      formatAlignmentMessage("the indexer's angle wandered by %.3g rad while at rest near %.2f deg "
+                                             "(position_tolerance %.3g rad)",
+                                             high - low, rest.angle * kDegrees, x.position_tolerance));
+      }
+      rests_.push_back(rest);
+    }
+    k = e;
+  }
+  if (rests_.empty()) return refuse("input", "the indexer never rested in the window (indexer/rest_rate, settle)");
+  return true;
+}
+
+bool GyrocompassSolver::indexerAt(double t, double* angle) const {
+  return interpolate(indexer_time_, indexer_angle_, t, s_.indexer.max_record_gap, angle);
+}
+
+bool GyrocompassSolver::buildIndexed() {
+  if (!prepareIndexer()) return false;
+  const Gyrocompass::Stream& st = g_.streams_[0];
+  const std::size_t channels = st.channels;
+  const IndexerSettings& x = s_.indexer;
+  std::vector<Eigen::Vector3d> direction(channels);
+  for (std::size_t c = 0; c < channels; ++c) {
+    direction[c] = s_.single_gyro ? x.gyro_axis : Eigen::Vector3d(x.body_to_platform.col(c));
+  }
+  parameters_ = 2 + channels;
+  series_.assign(channels, AngleSeries());
+  for (std::size_t c = 0; c < channels; ++c) {
+    series_[c].columns = {0, 1, static_cast<int>(2 + c)};
+    series_[c].regressors.assign(3, {});
+  }
+  // The horizontal information, per channel: the spread of its direction turned by the indexer.
+  std::vector<Eigen::Vector2d> s1(channels, Eigen::Vector2d::Zero());
+  std::vector<Eigen::Matrix2d> s2(channels, Eigen::Matrix2d::Zero());
+  double cos_integral = 0.0, sin_integral = 0.0, weight = 0.0;
+  std::array<double, 3> y{{0.0, 0.0, 0.0}};
+  Gyrocompass::BlockMotion motion;
+  motion.channels = channels;
+  int seg = -1, current_rest = -1;
+  bool continues = false;
+  double last_time = -INFINITY;
+  for (std::size_t k = 0; k < st.stamp.size(); ++k) {
+    const double t_b = seconds(st.stamp[k]), t_a = std::max(t_b - st.dt[k], last_time);
+    double psi_a, psi_b;
+    int rest = -1;
+    if (!indexerSpan(t_a, t_b, &rest, &psi_a, &psi_b)) {
+      continues = false;
+      continue;
+    }
+    const double* raw = &st.increment[channels * k];
+    double inc[3];
+    for (std::size_t c = 0; c < channels; ++c) {
+      inc[c] = raw[c] - (x.continuous ? direction[c].z() * (psi_b - psi_a) : 0.0);
+    }
+    double dc, ds;
+    integrateCosSin(psi_a, psi_b, t_b - t_a, &dc, &ds);
+    if (!continues || st.broken[k] || rest != current_rest) {
+      seg = static_cast<int>(segments_.size());
+      Segment g;
+      g.start = t_a;
+      g.group = x.continuous ? 0 : rest;
+      segments_.push_back(g);
+      y = {{0.0, 0.0, 0.0}};
+      for (std::size_t c = 0; c < channels; ++c) {
+        const Eigen::Vector3d& d = direction[c];
+        const double point[3] = {d.x() * cos_integral - d.y() * sin_integral,
+                                 d.x() * sin_integral + d.y() * cos_integral, t_a};
+        series_[c].push(t_a, seg, 0.0, point);
+      }
+      motion.restart();
+      current_rest = rest;
+    }
+    cos_integral += dc;
+    sin_integral += ds;
+    for (std::size_t c = 0; c < channels; ++c) {
+      const Eigen::Vector3d& d = direction[c];
+      y[c] += inc[c];
+      const double point[3] = {d.x() * cos_integral - d.y() * sin_integral, d.x() * sin_integral + d.y() * cos_integral,
+                               t_b};
+      series_[c].push(t_b, seg, y[c], point);
+      const Eigen::Vector2d u(d.x() * dc - d.y() * ds, d.x() * ds + d.y() * dc);  // integral of its turned direction
+      s1[c] += u;
+      s2[c] += u * u.transpose() / (t_b - t_a);
+    }
+    weight += t_b - t_a;
+    Segment& g = segments_.back();
+    g.end = t_b;
+    g.angle = std::isfinite(g.angle) ? g.angle : 0.5 * (psi_a + psi_b);
+    motion.add(t_b - t_a, inc, s_.motion.block);
+    used_seconds_ += t_b - t_a;
+    ++samples_;
+    last_time = t_b;
+    continues = true;
+  }
+  worst_motion_ = motion.worst;
+  if (samples_ < 10) {
+    return refuse("input", x.continuous ? "no gyro samples within the indexer's records"
+                                        : "no gyro samples while the indexer rested (indexer/settle, rest_rate)");
+  }
+  return indexedDesignResolvesHeading(s1, s2, weight);
+}
+
+bool GyrocompassSolver::indexerSpan(double t_a, double t_b, int* rest, double* psi_a, double* psi_b) const {
+  if (s_.indexer.continuous) return indexerAt(t_a, psi_a) && indexerAt(t_b, psi_b);
+  for (std::size_t r = 0; r < rests_.size() && *rest < 0; ++r) {
+    if (t_a >= rests_[r].from && t_b <= rests_[r].to) *rest = static_cast<int>(r);
+  }
+  if (*rest < 0) return false;
+  *psi_a = *psi_b = rests_[*rest].angle;
+  return true;
+}
+
+bool GyrocompassSolver::indexedDesignResolvesHeading(const std::vector<Eigen::Vector2d>& s1,
+                                                     const std::vector<Eigen::Matrix2d>& s2, double weight) {
+  const IndexerSettings& x = s_.indexer;
+  const std::size_t channels = s1.size();
+  Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+  for (std::size_t c = 0; c < channels; ++c) information += s2[c] - s1[c] * s1[c].transpose() / weight;
+  information /= weight;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(information);
+  const double small = eigen.eigenvalues()(0), large = eigen.eigenvalues()(1);
+  std::string angles;
+  for (const Rest& r : rests_)
+    angles += (angles.empty() ? "" : ", ") + formatAlignmentMessage("%.1f", r.angle * kDegrees);
+  if (!(large > 1e-6)) {
+    return refuse("design", x.continuous || rests_.size() > 1
+                                ? "the indexer's turning shows the gyros no horizontal component of the Earth's "
+                                  "rate: no sensitive axis is horizontal"
+                                : "one indexer position (" + angles +
+                                      " deg) cannot tell the gyros' biases from the Earth's rate: use two "
+                                      "positions or more, or the static mode");
+  }
+  if (small < 1e-3 * large) {
+    return refuse("design",
+                  std::string(s_.single_gyro ? "one gyro" : "the gyros") + " at the positions " + angles +
+                      " deg sense one horizontal component of the Earth's rate only: the heading is ambiguous "
+                      "(two mirror solutions); use four positions 90 deg apart, continuous rotation, or the "
+                      "triad's two horizontal axes");
+  }
+  return true;
+}
+
+bool GyrocompassSolver::buildSweep() {
+  const SweepSettings& sw = s_.sweep;
+  const std::size_t orders = sw.gain_orders.size(), per_axis = 2 + 2 * orders;
+  parameters_ = 3 * per_axis;
+  series_.assign(3, AngleSeries());
+  std::vector<double> x(per_axis);
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    const Gyrocompass::Stream& st = g_.streams_[axis];
+    const auto& records = g_.precession_[axis];
+    AngleSeries& out = series_[axis];
+    for (std::size_t k = 0; k < per_axis; ++k) out.columns.push_back(static_cast<int>(axis * per_axis + k));
+    out.regressors.assign(per_axis, {});
+    if (records.size() < 2) {
+      return refuse("input",
+                    formatAlignmentMessage("no precession state for axis %.0f in the window (addPrecession)", axis));
+    }
+    std::vector<double> times, psi, change_time, change_rate;
+    commandTrack(records, &times, &psi, &change_time, &change_rate);
+    Gyrocompass::BlockMotion motion;
+    motion.channels = 1;
+    double y = 0.0, turned_up = 0.0, turned_down = 0.0, last_time = -INFINITY;
+    int seg = -1, command = -1;
+    bool continues = false;
+    for (auto& probe : sweep_probes_[axis]) probe.clear();
+    std::array<double, 4> probe_sum{{0.0, 0.0, 0.0, 0.0}};
+    std::uint64_t used = 0;
+    for (std::size_t k = 0; k < st.stamp.size(); ++k) {
+      const double t_b = seconds(st.stamp[k]), t_a = std::max(t_b - st.dt[k], last_time);
+      double psi_a, psi_b;
+      const int m =
+          static_cast<int>(std::upper_bound(change_time.begin(), change_time.end(), t_b) - change_time.begin()) - 1;
+      const bool usable = m >= 0 && t_a >= change_time[m] + sw.settle &&
+                          interpolate(times, psi, t_a, s_.indexer.max_record_gap, &psi_a) &&
+                          interpolate(times, psi, t_b, s_.indexer.max_record_gap, &psi_b);
+      if (!usable) {
+        continues = false;
+        continue;
+      }
+      auto point = [&](double t, double angle) {
+        x[0] = t;
+        x[1] = angle;
+        for (std::size_t o = 0; o < orders; ++o) {
+          x[2 + 2 * o] = std::sin(sw.gain_orders[o] * angle);
+          x[3 + 2 * o] = std::cos(sw.gain_orders[o] * angle);
+        }
+        return x.data();
+      };
+      auto pushProbes = [&]() {
+        for (std::size_t p = 0; p < 4; ++p) sweep_probes_[axis][p].push_back(probe_sum[p]);
+      };
+      if (!continues || st.broken[k] || m != command) {
+        seg = static_cast<int>(segments_.size());
+        Segment g;
+        g.channel = static_cast<int>(axis);
+        g.start = t_a;
+        g.rate = change_rate[m];
+        g.group = seg;
+        segments_.push_back(g);
+        y = 0.0;
+        out.push(t_a, seg, 0.0, point(t_a, psi_a));
+        pushProbes();
+        motion.restart();
+        command = m;
+      }
+      y += st.increment[k];
+      out.push(t_b, seg, y, point(t_b, psi_b));
+      // The residual drift harmonics' rate integrals: orders 2 and 4 of the wave angle, which the
+      // commanded angle moves (the wave's own offset only turns the pair).
+      double c2, s2, c4, s4;
+      integrateCosSin(2.0 * psi_a, 2.0 * psi_b, t_b - t_a, &c2, &s2);
+      integrateCosSin(4.0 * psi_a, 4.0 * psi_b, t_b - t_a, &c4, &s4);
+      probe_sum[0] += c2;
+      probe_sum[1] += s2;
+      probe_sum[2] += c4;
+      probe_sum[3] += s4;
+      pushProbes();
+      (psi_b > psi_a ? turned_up : turned_down) += std::abs(psi_b - psi_a);
+      segments_.back().end = t_b;
+      motion.add(t_b - t_a, &st.increment[k], s_.motion.block);
+      if (axis == 0) used_seconds_ += t_b - t_a;
+      ++used;
+      last_time = t_b;
+      continues = true;
+    }
+    worst_motion_ = std::max(worst_motion_, motion.worst);
+    if (used < 10)
+      return refuse("input", formatAlignmentMessage("axis %.0f: no outputs within its precession state", axis));
+    if (axis == 0) samples_ = used;
+    if (!sweptBothWays(axis, turned_up, turned_down)) return false;
+  }
+  return true;
+}
+
+void GyrocompassSolver::commandTrack(const std::vector<PrecessionStateRecord>& records, std::vector<double>* times,
+                                     std::vector<double>* psi, std::vector<double>* change_time,
+                                     std::vector<double>* change_rate) const {
+  // The commanded angle at each record's stamp (the record carries it at its sample's centre and
+  // the rate in force at its end), and the times the commanded rate changed.
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    const double t = seconds(records[k].stamp);
+    const double half = k == 0 ? 0.0 : 0.5 * (t - times->back());
+    times->push_back(t);
+    psi->push_back(records[k].angle + records[k].rate * half);
+    if (k == 0 || records[k].rate != records[k - 1].rate) {
+      change_time->push_back(k == 0 ? t : (*times)[k - 1]);
+      change_rate->push_back(records[k].rate);
+    }
+  }
+}
+
+bool GyrocompassSolver::sweptBothWays(std::size_t axis, double turned_up, double turned_down) {
+  const SweepSettings& sw = s_.sweep;
+  if (std::min(turned_up, turned_down) < sw.min_turns * kTwoPi) {
+    return refuse("design", formatAlignmentMessage(
+                                "axis %.0f: the commanded angle turned %.2f turns up and %.2f down in the data "
+                                "used; the sweep needs at least %.2f each way (sweep/min_turns)",
+                                axis, turned_up / kTwoPi, turned_down / kTwoPi, sw.min_turns));
+  }
+  if (std::abs(turned_up - turned_down) > 0.05 * kTwoPi) {
+    result_.notes.push_back(
+        formatAlignmentMessage("axis %.0f: %.2f turns up, %.2f down: unequal sweeps leave part of D(theta)", axis,
+                               turned_up / kTwoPi, turned_down / kTwoPi));
+  }
+  return true;
+}
+
+bool GyrocompassSolver::level(LevelMeasurement* out) {
+  const LevelSettings& l = s_.level;
+  if (l.source == LevelSource::kDeclared) {
+    out->roll = l.roll;
+    out->pitch = l.pitch;
+    out->covariance = Eigen::Vector2d(l.roll_sigma * l.roll_sigma, l.pitch_sigma * l.pitch_sigma).asDiagonal();
+    return true;
+  }
+  const Eigen::Matrix3d mount = l.accelerometer_to_body.normalized().toRotationMatrix();
+  const bool indexed = s_.mode == AlignmentMode::kIndexed;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), previous = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d differences = Eigen::Matrix3d::Zero(), transfer = Eigen::Matrix3d::Zero();
+  std::size_t n = 0, pairs = 0;
+  int previous_group = -2;
+  for (const AccelerometerRecord& r : g_.accelerometer_) {
+    if (r.stamp < g_.start_ || r.stamp > g_.end_) continue;
+    const double t = seconds(r.stamp);
+    Eigen::Matrix3d to_frame = mount;
+    int group = 0;
+    if (indexed) {
+      double psi = NAN;
+      group = -1;
+      if (s_.indexer.continuous) {
+        if (indexerAt(t, &psi)) group = 0;
+      } else {
+        for (std::size_t k = 0; k < rests_.size() && group < 0; ++k) {
+          if (t >= rests_[k].from && t <= rests_[k].to) {
+            group = static_cast<int>(k);
+            psi = rests_[k].angle;
+          }
+        }
+      }
+      if (group < 0) continue;
+      to_frame = rotZ(psi) * s_.indexer.body_to_platform * mount;
+    }
+    const Eigen::Vector3d f = to_frame * r.specific_force;
+    if (group == previous_group) {
+      const Eigen::Vector3d d = f - previous;
+      differences += d * d.transpose();
+      ++pairs;
+    }
+    previous = f;
+    previous_group = group;
+    sum += f;
+    transfer += to_frame;
+    ++n;
+  }
+  if (n < 10 || pairs < 2) {
+    return refuse("level", indexed ? "too few accelerometer samples while the indexer rested (addAccelerometer)"
+                                   : "too few accelerometer samples in the window (addAccelerometer)");
+  }
+  const Eigen::Vector3d mean = sum / static_cast<double>(n);
+  transfer /= static_cast<double>(n);
+  result_.accelerometer_gravity = mean.norm();
+  if (std::abs(mean.norm() / kStandardGravity - 1.0) > l.max_gravity_error) {
+    return refuse("level",
+                  formatAlignmentMessage("the accelerometer's mean specific force is %.4g m/s^2, not gravity (%.5g, "
+                                         "level/max_gravity_error %.3g): a wrong unit, frame or a moving base",
+                                         mean.norm(), kStandardGravity, l.max_gravity_error));
+  }
+  // White noise from successive differences (blind to a slow change), the mean's; the bias through
+  // the rotations it was seen in (an indexer's positions average its horizontal part away).
+  const Eigen::Matrix3d noise = differences / (2.0 * static_cast<double>(pairs));
+  const Eigen::Matrix3d covariance = noise / static_cast<double>(n) + l.accelerometer_bias_sigma *
+                                                                          l.accelerometer_bias_sigma * transfer *
+                                                                          transfer.transpose();
+  const EulerAngles a = levelFromSpecificForce(mean);
+  const Eigen::Matrix<double, 2, 3> j = levelJacobian(mean);
+  out->roll = a.roll;
+  out->pitch = a.pitch;
+  out->covariance = j * covariance * j.transpose();
+  return true;
+}
+
+bool GyrocompassSolver::measure(const IntegratedAngleFit& fit, const LevelMeasurement& level, EarthRateMeasurement* m) {
+  const AngleFitResult& f = fit.result();
+  const GyroNoiseModel& noise = s_.noise;
+  const double bias2 = noise.residual_bias * noise.residual_bias;
+  const double harmonics2 = noise.residual_drift_harmonics * noise.residual_drift_harmonics;
+  // L: the parameters -> the Earth's rate in the frame (3 x q); the body-bias transfer.
+  Eigen::MatrixXd l = Eigen::MatrixXd::Zero(3, parameters_);
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d bias_transfer = Eigen::Matrix3d::Zero();
+  const std::size_t channels = fit.channels().size();
+  if (s_.mode == AlignmentMode::kStatic) {
+    l.setIdentity();
+  } else if (s_.mode == AlignmentMode::kIndexed) {
+    // The biases absorb the component along the platform's z; it is the one that makes the levelled
+    // vertical the Earth's, v: (L w)_z = v. (Taking v itself for it would leave tilt x tilt x h.)
+    const Eigen::Matrix3d level_rotation = levelRotation(level.roll, level.pitch);
+    l(0, 0) = l(1, 1) = 1.0;
+    l(2, 0) = -level_rotation(2, 0) / level_rotation(2, 2);
+    l(2, 1) = -level_rotation(2, 1) / level_rotation(2, 2);
+    offset.z() = kEarthRotationRate * std::sin(s_.latitude) / level_rotation(2, 2);
+  } else {
+    const std::size_t per_axis = parameters_ / 3;
+    for (int i = 0; i < 3; ++i) l.col(i * per_axis) = triad_matrix_.col(i);
+    offset = -g_.triad_.bias;
+  }
+  const Eigen::VectorXd beta = f.parameters;
+  m->rate = l * beta + offset;
+  m->white = l * f.white * l.transpose();
+  m->angle_random_walk = l * f.angle_random_walk * l.transpose();
+  m->rate_random_walk = l * f.rate_random_walk * l.transpose();
+  // A constant rate per channel: the calibration's bias (and D at a resting wave).
+  Eigen::MatrixXd per_channel(3, channels);
+  for (std::size_t c = 0; c < channels; ++c) per_channel.col(c) = l * f.constant_rate[c];
+  if (s_.mode == AlignmentMode::kSweep) {
+    // A body bias b reaches the axes as A b (A = M^-1), then the fit and M.
+    bias_transfer = per_channel * g_.triad_.bodyToAxis();
+  } else if (channels == 3) {
+    bias_transfer = per_channel;  // the channels are the body axes
+  }
+  const Eigen::MatrixXd constant = channels == 3 ? Eigen::MatrixXd(bias_transfer) : per_channel;
+  m->residual_bias = bias2 * constant * constant.transpose();
+  m->bias_transfer = bias_transfer;
+  if (s_.mode != AlignmentMode::kSweep) {
+    // At rest each wave's D(theta) residual is one more constant rate (indexed: cancelled with the bias).
+    m->drift_harmonics = harmonics2 * constant * constant.transpose();
+  } else {
+    // A harmonic of random phase and rms sigma_h: sigma_h^2 (J_c J_c^T + J_s J_s^T), the larger order.
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+      Eigen::Matrix3d best = Eigen::Matrix3d::Zero();
+      for (int order = 0; order < 2; ++order) {
+        const Eigen::Vector3d jc = l * fit.response(axis, sweep_probes_[axis][2 * order]);
+        const Eigen::Vector3d js = l * fit.response(axis, sweep_probes_[axis][2 * order + 1]);
+        const Eigen::Matrix3d p = harmonics2 * (jc * jc.transpose() + js * js.transpose());
+        if (p.trace() > best.trace()) best = p;
+      }
+      m->drift_harmonics += best;
+    }
+  }
+  // The indexer: each position's angle off by a small angle e moves that position's regressors by
+  // e (-X_y w_x + X_x w_y) (their angle, in the cumulative form the fit takes).
+  if (s_.mode == AlignmentMode::kIndexed && s_.indexer.angle_sigma > 0.0) {
+    int groups = 0;
+    for (const Segment& g : segments_) groups = std::max(groups, g.group + 1);
+    for (int group = 0; group < groups; ++group) {
+      Eigen::VectorXd response = Eigen::VectorXd::Zero(parameters_);
+      for (std::size_t c = 0; c < channels; ++c) {
+        const AngleSeries& series = fit.channels()[c];
+        std::vector<double> probe(series.size(), 0.0);
+        for (std::size_t i = 0; i < series.size(); ++i) {
+          if (segments_[series.segment[i]].group != group) continue;
+          probe[i] = -series.regressors[1][i] * beta(0) + series.regressors[0][i] * beta(1);
+        }
+        response += fit.response(c, probe);
+      }
+      const Eigen::Vector3d j = l * response;
+      m->indexer += s_.indexer.angle_sigma * s_.indexer.angle_sigma * j * j.transpose();
+    }
+  }
+  return true;
+}
+
+void GyrocompassSolver::summariseSegments(const AngleFitResult& f) {
+  for (std::size_t id = 0; id < segments_.size(); ++id) {
+    const Segment& g = segments_[id];
+    AlignmentSegment out;
+    out.channel = g.channel;
+    out.start = g.start;
+    out.end = g.end;
+    out.indexer_angle = s_.mode == AlignmentMode::kIndexed ? g.angle : NAN;
+    out.commanded_rate = g.rate;
+    for (const SegmentResidual& r : f.segments) {
+      if (r.segment != static_cast<std::int32_t>(id)) continue;
+      if (g.channel >= 0 && r.channel != static_cast<std::size_t>(g.channel)) continue;
+      out.residual_rate.push_back(r.residual_rate);
+      out.residual_rate_std.push_back(r.residual_rate_std);
+      out.rms.push_back(r.rms);
+      out.predicted_rms.push_back(r.predicted_rms);
+    }
+    result_.segments.push_back(out);
+  }
+}
+
+AlignmentResult GyrocompassSolver::solve() {
+  AlignmentResult& r = result_;
+  r.mode = s_.mode;
+  r.single_gyro = s_.single_gyro;
+  r.frame = s_.mode == AlignmentMode::kIndexed ? "indexer" : "body";
+  r.start = g_.start_;
+  r.end = g_.end_;
+  r.budget.latitude = s_.latitude;
+  r.budget.max_latitude = s_.max_latitude;
+  r.budget.horizontal_earth_rate = horizontalEarthRate(s_.latitude);
+  if (!g_.refused_gate_.empty()) {
+    refuse(g_.refused_gate_, g_.refused_reason_);
+    return r;
+  }
+  if (!g_.started_) {
+    refuse("input", "no gyro samples");
+    return r;
+  }
+  triad_matrix_ = g_.triad_.axis_to_body;
+  bool built = false;
+  switch (s_.mode) {
+    case AlignmentMode::kStatic:
+      built = buildStatic();
+      break;
+    case AlignmentMode::kIndexed:
+      built = buildIndexed();
+      break;
+    case AlignmentMode::kSweep:
+      built = buildSweep();
+      break;
+  }
+  if (!built) return r;
+  r.samples = samples_;
+  r.seconds = used_seconds_;
+  r.worst_motion = worst_motion_;
+  if (samples_ < 10) {
+    refuse("input", "too few gyro samples in the window");
+    return r;
+  }
+  if (worst_motion_ > s_.motion.max_motion) {
+    refuse("motion", formatAlignmentMessage(
+                         "the base moved during the window: block mean rates spread over %.3g rad/s (limit %.3g)",
+                         2.0 * worst_motion_, 2.0 * s_.motion.max_motion));
+    return r;
+  }
+  for (AngleSeries& series : series_) {
+    series.white_noise = s_.noise.angle_white_noise;
+    series.angle_random_walk = s_.noise.angle_random_walk;
+    series.rate_random_walk = s_.noise.rate_random_walk;
+  }
+  LevelMeasurement level_measured;
+  if (!level(&level_measured)) return r;
+  IntegratedAngleFit fit(parameters_, std::move(series_));
+  const AngleFitResult& f = fit.solve(s_.max_condition);
+  if (!f.ok) {
+    refuse("design", f.problem);
+    return r;
+  }
+  r.white_noise = f.white_noise;
+  r.scatter = *std::max_element(f.scatter.begin(), f.scatter.end());
+  summariseSegments(f);
+  EarthRateMeasurement m;
+  measure(fit, level_measured, &m);
+  const HeadingSolution h = solveHeading(m, level_measured, s_.latitude);
+  r.attitude = h.attitude;
+  r.orientation = h.orientation;
+  r.covariance_rpy = h.covariance_rpy;
+  r.covariance_enu = h.covariance_enu;
+  r.heading = trueHeadingDegrees(h.attitude.yaw);
+  r.heading_sigma = h.budget.total * kDegrees;
+  r.levelled_rate = h.levelled_rate;
+  r.horizontal_rate = h.horizontal_rate;
+  r.horizontal_rate_std = h.horizontal_rate_std;
+  r.budget = h.budget;
+  r.budget.max_latitude = s_.max_latitude;
+  describeHoldStart(h);
+  return applyGates(h);
+}
+
+void GyrocompassSolver::describeHoldStart(const HeadingSolution& h) {
+  AlignmentResult& r = result_;
+  // For a hold: the bias the triad carries at rest, and its covariance with the attitude error.
+  const double bias2 = s_.noise.residual_bias * s_.noise.residual_bias;
+  const double harmonics2 = s_.noise.residual_drift_harmonics * s_.noise.residual_drift_harmonics;
+  r.bias_variance = bias2 + harmonics2;
+  r.attitude_bias_covariance = h.bias_to_attitude * (s_.mode == AlignmentMode::kSweep ? bias2 : bias2 + harmonics2);
+  // Where the triad's body is at the window's end.
+  r.body_orientation = r.orientation;
+  if (s_.mode == AlignmentMode::kIndexed) {
+    double psi = indexer_angle_.back();
+    indexerAt(seconds(g_.streams_[0].last), &psi);
+    const Eigen::Matrix3d body = r.orientation.toRotationMatrix() * rotZ(psi) *
+                                 (s_.single_gyro ? Eigen::Matrix3d::Identity() : s_.indexer.body_to_platform);
+    r.body_orientation = Eigen::Quaterniond(body).normalized();
+    r.notes.push_back(formatAlignmentMessage("indexed: %.0f segments; the gyros' own bias cancels", segments_.size()));
+  }
+}
+
+AlignmentResult GyrocompassSolver::applyGates(const HeadingSolution& h) {
+  AlignmentResult& r = result_;
+  if (r.scatter > s_.motion.max_scatter) {
+    refuse("stillness",
+           formatAlignmentMessage("the residuals scatter %.2f times what the noise model predicts (motion/max_scatter "
+                                  "%.2f): a base that sways, a bias that jumps, or angle noise beyond the settings'",
+                                  r.scatter, s_.motion.max_scatter));
+    return r;
+  }
+  const double hh = r.budget.horizontal_earth_rate;
+  const double mismatch = std::abs(h.horizontal_rate - hh);
+  if (mismatch > std::max(s_.max_earth_rate_error * hh, 4.0 * h.horizontal_rate_std)) {
+    refuse("earth_rate",
+           formatAlignmentMessage("the horizontal rate measured, %.4g rad/s, is not the Earth's %.4g rad/s at "
+                                  "latitude %.3f deg (max_earth_rate_error %.2f): a bias far beyond the calibration's, "
+                                  "a wrong latitude or a turning base",
+                                  h.horizontal_rate, hh, s_.latitude * kDegrees, s_.max_earth_rate_error));
+    return r;
+  }
+  if (std::abs(h.attitude.pitch) > kMaxPitch) {
+    refuse("attitude", formatAlignmentMessage(
+                           "pitch %.1f deg: the frame's x axis is within %.0f deg of vertical and has no heading",
+                           h.attitude.pitch * kDegrees, 90.0 - kMaxPitch * kDegrees));
+    return r;
+  }
+  r.accepted = true;
+  r.reason = r.summary();
+  return r;
+}
+
+}  // namespace core
+}  // namespace hrg_gyro
