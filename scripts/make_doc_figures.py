@@ -15,6 +15,8 @@ through the calibrated parameters. Writes:
   nonlinearity_before_after.png  what the uncalibrated and the calibrated models leave of the
                                nonlinearity (against the binned data and the exact injected model)
   allan_deviation.png          Allan deviation of the compensated rate at rest
+  north_finding_accuracy.png   the heading's sigma against window length and latitude, by the error
+                               law the north-finding tests check (no run needed)
 
 `make figures` runs it with the workspace sourced. matplotlib with the Agg backend."""
 import argparse
@@ -238,6 +240,66 @@ def figure_allan(hrg_bag, params, seconds, path):
     save(fig, path)
 
 
+# North finding: the error law the core's tests check (src/core/integration/north_finding_accuracy_test.cpp),
+# with the shipped gyro's white angle noise seen in the body (4.9e-6 rad per sample at 200 Hz, K0 0.56).
+EARTH_RATE = 7.292115e-5  # rad/s
+NORTH_NOISE = 4.9e-6 / 0.56  # rad of body angle per sample
+NORTH_RATE_HZ = 200.0
+
+
+def north_noise_rate(seconds):
+    """rad/s, 1 sigma: a rate fitted on the integrated angle over `seconds` of white angle noise."""
+    return math.sqrt(12.0 * NORTH_NOISE ** 2 / (NORTH_RATE_HZ * seconds ** 3))
+
+
+def north_heading_sigma(seconds, latitude, bias=0.0, level=0.0, positions=1):
+    """rad: the heading's sigma. positions=1: static (the bias a floor); 2: two positions 180 deg apart
+    of seconds/2 each (the bias cancels; the rate difference of two half windows: twice the noise)."""
+    h = EARTH_RATE * math.cos(latitude)
+    noise = north_noise_rate(seconds) * (2.0 if positions == 2 else 1.0)
+    floor = bias if positions == 1 else 0.0
+    return math.sqrt((noise ** 2 + floor ** 2) / h ** 2 + (level * math.tan(latitude)) ** 2)
+
+
+def figure_north_finding(path):
+    windows = [10.0 * 1.1 ** k for k in range(60) if 10.0 * 1.1 ** k <= 1200.0]
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for bias, style in ((1e-8, "-"), (3e-9, "--")):
+        ax1.loglog(windows, [1e3 * north_heading_sigma(t, 0.9, bias) for t in windows], "C0" + style,
+                   label="static triad, residual bias %.0e rad/s" % bias)
+    ax1.loglog(windows, [1e3 * north_heading_sigma(t, 0.9, positions=2) for t in windows], "C1-",
+               label="indexed, two positions of T/2 (bias cancels)")
+    ax1.loglog(windows, [1e3 * north_noise_rate(t) / (EARTH_RATE * math.cos(0.9)) for t in windows], "k:",
+               label="white angle noise alone, T^-3/2")
+    ax1.set_xlabel("window length T (s)")
+    ax1.set_ylabel("heading sigma (mrad)")
+    ax1.set_title("latitude 0.9 rad (51.6 deg), exact level")
+    ax1.grid(True, which="both", alpha=0.3)
+    ax1.legend(fontsize=8)
+    latitudes = [math.radians(d) for d in range(0, 81)]
+    for seconds, bias, positions, colour, label in (
+        (120.0, 1e-8, 1, "C0", "static 120 s, bias 1e-8 rad/s"),
+        (120.0, 0.0, 2, "C1", "indexed 2 x 60 s"),
+        (600.0, 0.0, 2, "C2", "indexed 2 x 300 s"),
+    ):
+        ax2.semilogy([math.degrees(x) for x in latitudes],
+                     [1e3 * north_heading_sigma(seconds, x, bias, 0.0, positions) for x in latitudes],
+                     colour + "-", label=label)
+        ax2.semilogy([math.degrees(x) for x in latitudes],
+                     [1e3 * north_heading_sigma(seconds, x, bias, 1e-4, positions) for x in latitudes],
+                     colour + "--", label=label + ", level 0.1 mrad")
+    ax2.axvline(80.0, color="grey", lw=0.8)
+    ax2.text(79.0, ax2.get_ylim()[1] * 0.5, "refused above max_latitude", rotation=90, ha="right", va="top",
+             fontsize=8)
+    ax2.set_xlabel("latitude (deg)")
+    ax2.set_ylabel("heading sigma (mrad)")
+    ax2.set_title("against latitude")
+    ax2.grid(True, which="both", alpha=0.3)
+    ax2.legend(fontsize=7)
+    fig.tight_layout()
+    save(fig, path)
+
+
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--run-output", default=os.path.join(ROOT, "run_output"))
@@ -265,6 +327,7 @@ def main(argv):
         fail("no injected K(theta) table in %s" % os.path.join(args.run_output, "summary.txt"))
     figure_before_after(report, injected, summary, os.path.join(args.out, "nonlinearity_before_after.png"))
     figure_allan(hrg_bag, params, args.rest_seconds, os.path.join(args.out, "allan_deviation.png"))
+    figure_north_finding(os.path.join(args.out, "north_finding_accuracy.png"))
     return 0
 
 
