@@ -207,6 +207,22 @@ BodyTruth toBodyTruthMessage(const core::TriadSample& s, const ros::Time& stamp,
   return m;
 }
 
+sensor_msgs::Imu toAccelerometerMessage(const core::TriadSample& s, const ros::Time& stamp,
+                                        const core::TriadAccelerometerConfig& accelerometer) {
+  sensor_msgs::Imu m;
+  m.header.seq = static_cast<std::uint32_t>(s.index);
+  m.header.stamp = stamp;
+  m.header.frame_id = accelerometer.frame_id;
+  m.orientation_covariance[0] = -1.0;
+  m.angular_velocity_covariance[0] = -1.0;
+  m.linear_acceleration.x = s.accelerometer.specific_force.x();
+  m.linear_acceleration.y = s.accelerometer.specific_force.y();
+  m.linear_acceleration.z = s.accelerometer.specific_force.z();
+  const double variance = accelerometer.noise * accelerometer.noise;
+  for (int i = 0; i < 3; ++i) m.linear_acceleration_covariance[4 * i] = variance;
+  return m;
+}
+
 HarmonicEstimate toMessage(const core::HarmonicFitResult& fit, double frequency) {
   HarmonicEstimate m;
   m.orders.assign(fit.orders.begin(), fit.orders.end());

@@ -134,6 +134,9 @@ void DriverSimRos::advertise() {
     }
     fixture_pub_ = nh_.advertise<FixturePosition>("fixture/position", queue_size_);
     truth_pub_ = nh_.advertise<BodyTruth>("truth", queue_size_);
+    if (triad_config_->accelerometer.enabled) {
+      accelerometer_pub_ = nh_.advertise<sensor_msgs::Imu>("accel/data_raw", queue_size_);
+    }
   } else {
     channels_pub_ = nh_.advertise<ChannelAmplitudes>("channels", queue_size_);
     truth_pub_ = nh_.advertise<GroundTruth>("truth", queue_size_);
@@ -322,6 +325,9 @@ void DriverSimRos::publishTriad(const core::TriadSample& s, const ros::Time& sta
     fixture_pub_.publish(boost::make_shared<FixturePosition>(toFixtureMessage(s, stamp, c.frame_id)));
   if (truth_pub_.getNumSubscribers() > 0) {
     truth_pub_.publish(boost::make_shared<BodyTruth>(toBodyTruthMessage(s, stamp, c.frame_id)));
+  }
+  if (s.accelerometer.present) {
+    accelerometer_pub_.publish(boost::make_shared<sensor_msgs::Imu>(toAccelerometerMessage(s, stamp, c.accelerometer)));
   }
 }
 

@@ -91,6 +91,11 @@ PrecessionCommand toPrecessionCommandMessage(const core::AppliedPrecession& comm
 // frame_id the triad's body frame; header.seq the sample's index.
 FixturePosition toFixtureMessage(const core::TriadSample& s, const ros::Time& stamp, const std::string& frame_id);
 BodyTruth toBodyTruthMessage(const core::TriadSample& s, const ros::Time& stamp, const std::string& frame_id);
+/// The simulated accelerometer's sample (accel/data_raw): sensor_msgs/Imu with linear_acceleration
+/// (REP-145: +g up at rest) and its covariance (the white noise's variance on the diagonal),
+/// orientation and angular velocity not measured (covariance[0] = -1), frame_id the accelerometer's.
+sensor_msgs::Imu toAccelerometerMessage(const core::TriadSample& s, const ros::Time& stamp,
+                                        const core::TriadAccelerometerConfig& accelerometer);
 /// The topic (relative) of one axis's stream of a triad: "<axis>/<stream>", e.g. "x/channels".
 inline std::string triadAxisTopic(const std::string& axis, const std::string& stream) { return axis + "/" + stream; }
 

@@ -15,7 +15,9 @@
 // and publishes, per output sample, `<axis>/channels` and `<axis>/truth` for each of its three axes
 // (frame_id the axis's name), `turntable/state`, `fixture/position` (hrg_gyro/FixturePosition, on a
 // change of position or lock and every second) and `truth` (hrg_gyro/BodyTruth), the last two with
-// the triad's frame_id (its triad.frame_id; ~frame_id is the single gyro's).
+// the triad's frame_id (its triad.frame_id; ~frame_id is the single gyro's). With
+// `triad/accelerometer` enabled it also publishes `accel/data_raw` (sensor_msgs/Imu, REP-145: the
+// specific force of gravity, +g up at rest, with its covariance; its own frame_id) with every sample.
 //
 // A gyro with a precession loop (dynamics.model: averaged, core::DynamicsConfig) also takes commands
 // of its virtual rotation on `command/precession` (hrg_gyro/PrecessionCommand), executed from the
@@ -85,7 +87,8 @@ class DriverSimRos {
   ros::Publisher channels_pub_, turntable_pub_, truth_pub_, clock_pub_, done_pub_;
   std::array<ros::Publisher, 3> axis_channels_pub_, axis_truth_pub_;  // a triad's; truth_pub_ its body truth
   ros::Publisher fixture_pub_;
-  ros::Publisher precession_pub_;  // a gyro with a precession loop only
+  ros::Publisher accelerometer_pub_;  // a triad's accelerometer, when its scenario has one
+  ros::Publisher precession_pub_;     // a gyro with a precession loop only
   ros::Subscriber command_sub_;
   // ~pace_topic (sim time only): a consumer's std_msgs/Time saying up to which stamp it has taken
   // the data in; a sample more than ~max_lead past it waits (a calibrator fitting, or reloading the

@@ -11,6 +11,7 @@ namespace core {
 TriadMotion::TriadMotion(const TriadSimulationConfig& config)
     : profile_(config.table_profile),
       wobble_(config.turntable.wobble.platterToTable()),
+      table_zero_to_enu_(config.turntable.tableZeroToEnu()),
       earth_zero_(config.turntable.earthRateInTableZero()) {
   Eigen::Matrix3d previous =
       config.positions.empty() ? Eigen::Matrix3d::Identity() : config.positions[0].bodyToPlatter();
@@ -79,6 +80,7 @@ TriadBodyState TriadMotion::stateAt(double t) const {
     moving(span, t, &b.body_to_platter, &move_rate);
   }
   b.body_to_table = wobble_ * b.body_to_platter;
+  b.body_to_enu = table_zero_to_enu_ * Eigen::AngleAxisd(b.table_angle, Eigen::Vector3d::UnitZ()) * b.body_to_table;
   b.angular_velocity = b.body_to_table.transpose() * tableFrameRateAt(t) + move_rate;
   return b;
 }

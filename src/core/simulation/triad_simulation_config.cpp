@@ -13,11 +13,13 @@ namespace {
 
 // Limits of what the scenario calls small: beyond them the fixture is not the nominal one (and the
 // triad file, which refuses |M - I| > 0.1, could not hold the result).
-constexpr double kMaxMisalignment = 0.05;     // rad, and relative for the residual scale
-constexpr double kMaxFixtureError = 0.1;      // rad per component
-constexpr double kMaxFixtureErrorStd = 0.01;  // rad
-constexpr double kMaxWobble = 0.01;           // rad
-constexpr double kMaxMove = 3600.0;           // s
+constexpr double kMaxMisalignment = 0.05;       // rad, and relative for the residual scale
+constexpr double kMaxFixtureError = 0.1;        // rad per component
+constexpr double kMaxFixtureErrorStd = 0.01;    // rad
+constexpr double kMaxWobble = 0.01;             // rad
+constexpr double kMaxMove = 3600.0;             // s
+constexpr double kMaxAccelerometerBias = 1.0;   // m/s^2: an accelerometer off by 0.1 g is broken
+constexpr double kMaxAccelerometerNoise = 1.0;  // m/s^2 per sample
 
 /// The stream the drawn fixture errors come from: switching it on changes no other draw.
 constexpr std::uint64_t kFixtureErrorStream = 0x6a09e667f3bcc908ULL;
@@ -34,6 +36,12 @@ double finite(const YamlField& section, const char* key, double fallback, const 
   const double v = section.getDouble(key, fallback);
   if (!std::isfinite(v)) section[key].fail(std::string("must be finite (") + unit + ")");
   return v;
+}
+
+std::string frameId(const YamlField& section, const std::string& fallback) {
+  const std::string id = section.getString("frame_id", fallback);
+  if (!isValidFrameId(id)) section["frame_id"].fail("must be a frame id: not empty, no leading '/', no blanks");
+  return id;
 }
 
 TriadAxisConfig parseAxis(const YamlField& a) {
@@ -105,6 +113,41 @@ Eigen::Matrix3d parseOrientation(const YamlField& p) {
   b.rejectUnknownKeys({"roll", "pitch", "yaw"});
   return rotationFromRollPitchYaw(finite(b, "roll", 0.0, "rad"), finite(b, "pitch", 0.0, "rad"),
                                   finite(b, "yaw", 0.0, "rad"));
+}
+
+TriadAccelerometerConfig parseAccelerometer(const YamlField& a, double output_period) {
+  a.requireMap();
+  a.rejectUnknownKeys({"enabled", "frame_id", "bias", "noise", "noise_density", "mounting"});
+  TriadAccelerometerConfig c;
+  c.enabled = a.getBool("enabled", true);
+  c.frame_id = frameId(a, c.frame_id);
+  if (a.has("bias")) {
+    const std::vector<double> b = a["bias"].asDoubles(3);
+    for (std::size_t j = 0; j < 3; ++j) {
+      if (!(std::abs(b[j]) <= kMaxAccelerometerBias)) {
+        a["bias"].at(j).fail("must be at most " + formatDouble(kMaxAccelerometerBias) + " m/s^2 in magnitude");
+      }
+      c.bias[static_cast<Eigen::Index>(j)] = b[j];
+    }
+  }
+  if (a.has("noise") && a.has("noise_density")) {
+    a["noise_density"].fail("give noise (m/s^2 per sample) or noise_density (m/s^2/sqrt(Hz)), not both");
+  }
+  // A density N sampled every dt (each sample the mean over its interval): N / sqrt(dt) per sample.
+  const std::string noise_key = a.has("noise_density") ? "noise_density" : "noise";
+  const double given = a.getDouble(noise_key, 0.0);
+  c.noise = noise_key == "noise" ? given : given / std::sqrt(output_period);
+  if (!(given >= 0.0 && c.noise <= kMaxAccelerometerNoise)) {
+    a[noise_key].fail("must be >= 0 and at most " + formatDouble(kMaxAccelerometerNoise) + " m/s^2 per sample");
+  }
+  if (a.has("mounting")) {
+    const YamlField m = a["mounting"];
+    m.requireMap();
+    m.rejectUnknownKeys({"roll", "pitch", "yaw"});
+    c.accelerometer_to_body = rotationFromRollPitchYaw(finite(m, "roll", 0.0, "rad"), finite(m, "pitch", 0.0, "rad"),
+                                                       finite(m, "yaw", 0.0, "rad"));
+  }
+  return c;
 }
 
 std::vector<FixturePositionConfig> parsePositions(const YamlField& list, double acceleration) {
@@ -184,6 +227,10 @@ Eigen::Vector3d TriadTurntableConfig::earthRateInTableZero() const {
   return Eigen::Vector3d(horizontal * std::cos(azimuth), horizontal * std::sin(azimuth), verticalEarthRate(latitude));
 }
 
+Eigen::Matrix3d TriadTurntableConfig::tableZeroToEnu() const {
+  return Eigen::AngleAxisd(kPi / 2 - azimuth, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
 Eigen::Matrix3d FixturePositionConfig::bodyToPlatter() const { return rotationFromVector(error) * nominal; }
 
 Eigen::Matrix3d TriadSimulationConfig::bodyToAxis() const {
@@ -237,9 +284,8 @@ TriadSimulationConfig TriadSimulationConfig::parse(const YamlField& root, const 
 
   const YamlField t = root["triad"];
   t.requireMap();
-  t.rejectUnknownKeys({"frame_id", "axes", "turntable", "positions", "fixture_error_std"});
-  c.frame_id = t.getString("frame_id", c.frame_id);
-  if (!isValidFrameId(c.frame_id)) t["frame_id"].fail("must be a frame id: not empty, no leading '/', no blanks");
+  t.rejectUnknownKeys({"frame_id", "axes", "turntable", "positions", "fixture_error_std", "accelerometer"});
+  c.frame_id = frameId(t, c.frame_id);
 
   const YamlField axes = t["axes"];
   axes.requireSequence();
@@ -265,6 +311,7 @@ TriadSimulationConfig TriadSimulationConfig::parse(const YamlField& root, const 
   if (!(c.fixture_error_std >= 0.0 && c.fixture_error_std <= kMaxFixtureErrorStd)) {
     t["fixture_error_std"].fail("must be in [0, " + formatDouble(kMaxFixtureErrorStd) + "] rad");
   }
+  if (t.has("accelerometer")) c.accelerometer = parseAccelerometer(t["accelerometer"], c.outputPeriod());
   c.positions = parsePositions(t["positions"], c.turntable.acceleration);
   c.setSeed(c.seed);
 

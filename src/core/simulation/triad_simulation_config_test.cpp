@@ -202,6 +202,23 @@ TEST(TriadSimulationConfigTest, OnlyTriadDocumentsAreTriadScenarios) {
   EXPECT_FALSE(isTriadScenario(YAML::Load("[1, 2]")));
 }
 
+TEST(TriadSimulationConfigTest, AccelerometerIsOffUnlessGivenAndTakesItsNoiseAsGiven) {
+  EXPECT_FALSE(parseText(scenario()).accelerometer.enabled);
+  const TriadSimulationConfig c =
+      parseText(scenario("  accelerometer: {frame_id: acc, bias: [1.0e-3, -2.0e-3, 3.0e-3], noise: 2.0e-3,\n"
+                         "                  mounting: {roll: 0.1, pitch: -0.2, yaw: 0.3}}\n"));
+  EXPECT_TRUE(c.accelerometer.enabled);
+  EXPECT_EQ(c.accelerometer.frame_id, "acc");
+  EXPECT_EQ(c.accelerometer.bias, Eigen::Vector3d(1.0e-3, -2.0e-3, 3.0e-3));
+  EXPECT_EQ(c.accelerometer.noise, 2.0e-3);
+  EXPECT_TRUE(c.accelerometer.accelerometer_to_body.isApprox(rotationFromRollPitchYaw(0.1, -0.2, 0.3), 1e-15));
+  EXPECT_FALSE(parseText(scenario("  accelerometer: {enabled: false}\n")).accelerometer.enabled);
+  // A density N: per sample of the output period dt, N / sqrt(dt) (1 kHz here: N sqrt(1000 Hz)).
+  const TriadSimulationConfig d = parseText(scenario("  accelerometer: {noise_density: 1.0e-4}\n"));
+  EXPECT_NEAR(d.outputPeriod(), 1e-3, 1e-15);
+  EXPECT_NEAR(d.accelerometer.noise, 1.0e-4 * std::sqrt(1000.0), 1e-15);
+}
+
 TEST(TriadSimulationConfigTest, RejectsBadValuesByKey) {
   auto expectError = [](const std::string& yaml, const std::string& key) {
     try {
@@ -227,6 +244,18 @@ TEST(TriadSimulationConfigTest, RejectsBadValuesByKey) {
   expectError(replaced(good, "frame_id: fixture", "frame_id: fixture\n  wobble: 1"), "triad.wobble");
   expectError(good + "  fixture_error_std: 0.5\n", "triad.fixture_error_std");
   expectError(good + "  fixture_error_std: -1.0e-4\n", "triad.fixture_error_std");
+  // The accelerometer.
+  expectError(good + "  accelerometer: {gain: 1}\n", "triad.accelerometer.gain");
+  expectError(good + "  accelerometer: 1\n", "triad.accelerometer");
+  expectError(good + "  accelerometer: {bias: [0, 0]}\n", "triad.accelerometer.bias");
+  expectError(good + "  accelerometer: {bias: [0, 2.0, 0]}\n", "triad.accelerometer.bias[1]");
+  expectError(good + "  accelerometer: {noise: -1.0e-3}\n", "triad.accelerometer.noise");
+  expectError(good + "  accelerometer: {noise: 1.0e-3, noise_density: 1.0e-4}\n", "triad.accelerometer.noise_density");
+  expectError(good + "  accelerometer: {noise_density: 1.0}\n", "triad.accelerometer.noise_density");
+  expectError(good + "  accelerometer: {frame_id: ' '}\n", "triad.accelerometer.frame_id");
+  expectError(good + "  accelerometer: {mounting: {roll: .inf}}\n", "triad.accelerometer.mounting.roll");
+  expectError(good + "  accelerometer: {mounting: {heading: 1}}\n", "triad.accelerometer.mounting.heading");
+  expectError(good + "  accelerometer: {enabled: maybe}\n", "triad.accelerometer.enabled");
   // The axes.
   expectError(replaced(good, "    - {name: z, misalignment: [-2.5e-4, 0.5e-4], scale: -2.0e-4}\n", ""), "triad.axes");
   expectError(replaced(good, "{name: y,", "{name: x,"), "triad.axes[1].name");

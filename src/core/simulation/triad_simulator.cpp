@@ -1,7 +1,19 @@
 #include "hrg_gyro/core/simulation/triad_simulator.h"
 
+#include "hrg_gyro/core/alignment/local_level.h"
+
 namespace hrg_gyro {
 namespace core {
+namespace {
+
+/// The accelerometer's noise stream: switching it on changes no other draw.
+constexpr std::uint64_t kAccelerometerStream = 0xbb67ae8584caa73bULL;
+
+}  // namespace
+
+Eigen::Vector3d specificForceAtRest(const Eigen::Matrix3d& body_to_enu, const Eigen::Matrix3d& accelerometer_to_body) {
+  return (body_to_enu * accelerometer_to_body).transpose() * Eigen::Vector3d(0.0, 0.0, kStandardGravity);
+}
 
 /// Axis i's sensed rate A_i . omega_body. Its own copy of the motion: the motions' evaluation cursors
 /// then follow one axis's times each.
@@ -17,7 +29,10 @@ class TriadSimulator::AxisInput : public AxisRateInput {
 };
 
 TriadSimulator::TriadSimulator(const TriadSimulationConfig& config)
-    : config_(config), motion_(config_), logger_(config_.turntable.log, config_.seed) {
+    : config_(config),
+      motion_(config_),
+      logger_(config_.turntable.log, config_.seed),
+      accelerometer_noise_(config_.seed ^ kAccelerometerStream) {
   const Eigen::Matrix3d a = config_.bodyToAxis();
   for (int i = 0; i < 3; ++i) {
     inputs_[i] = std::make_unique<AxisInput>(config_, a.row(i));
@@ -60,6 +75,16 @@ void TriadSimulator::logFixture(double t_center, const TriadBodyState& state, Tr
   last_fixture_ = f;
 }
 
+void TriadSimulator::measureGravity(const TriadBodyState& state, TriadSample* out) {
+  const TriadAccelerometerConfig& a = config_.accelerometer;
+  out->accelerometer.present = a.enabled;
+  if (!a.enabled) return;
+  Eigen::Vector3d noise;
+  for (int j = 0; j < 3; ++j) noise[j] = accelerometer_noise_.next();  // in order
+  out->accelerometer.specific_force =
+      specificForceAtRest(state.body_to_enu, a.accelerometer_to_body) + a.bias + a.noise * noise;
+}
+
 bool TriadSimulator::next(TriadSample* out) {
   if (done()) return false;
   const double t_start = elapsed();
@@ -71,9 +96,11 @@ bool TriadSimulator::next(TriadSample* out) {
   const TriadBodyState state = motion_.stateAt(t_center);
   out->body.angular_velocity = state.angular_velocity;
   out->body.body_to_table = Eigen::Quaterniond(state.body_to_table).normalized();
+  out->body.body_to_enu = Eigen::Quaterniond(state.body_to_enu).normalized();
   out->body.position = static_cast<std::uint32_t>(state.position);
   logTurntable(t_center, out->stamp, state, out);
   logFixture(t_center, state, out);
+  measureGravity(state, out);
   return true;
 }
 

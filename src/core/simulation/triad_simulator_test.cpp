@@ -295,6 +295,74 @@ TEST(TriadSimulatorTest, SameSeedSameSessionAndEachAxisItsOwnNoise) {
   EXPECT_EQ(first.back().axes[2].truth.inertial_angle, clean.back().axes[2].truth.inertial_angle);
 }
 
+TEST(TriadSimulatorTest, TrueAttitudeAndAnExactAccelerometerFollowTheTableAndThePositions) {
+  const double az = 0.3;
+  const TriadSimulationConfig c =
+      parseText(scenario("{latitude: 0.9, azimuth: 0.3}\n  accelerometer: {bias: [0, 0, 0], noise: 0}"));
+  TriadSimulator sim(c);
+  const std::vector<TriadSample> samples = runAll(sim);
+  const double g = 9.80665;
+  const Eigen::Matrix3d tilted = rotationFromRollPitchYaw(0.7854, 0.6155, 0.2);
+  for (const TriadSample& s : samples) {
+    ASSERT_TRUE(s.accelerometer.present);
+    const Eigen::Vector3d f = s.accelerometer.specific_force;
+    EXPECT_NEAR(f.norm(), g, 1e-12);
+    const Eigen::Matrix3d c_true = s.body.body_to_enu.toRotationMatrix();
+    // The true up, (0, 0, 1) in ENU, seen in the body: what the accelerometer points along.
+    EXPECT_LT((f / g - c_true.transpose() * Eigen::Vector3d::UnitZ()).norm(), 1e-12);
+    const double phi = s.axes[0].truth.table_angle;
+    if (s.body.position == 0) {
+      // +z up on the platter: body z up, body x at the platter's x, az - phi from North towards East.
+      EXPECT_LT((f - Eigen::Vector3d(0, 0, g)).norm(), 1e-12);
+      EXPECT_LT((c_true.col(0) - Eigen::Vector3d(std::sin(az - phi), std::cos(az - phi), 0)).norm(), 1e-12);
+    } else if (s.fixture.locked && s.body.position == 1) {
+      // -x up: body x down, body y along the platter's x.
+      EXPECT_LT((f - Eigen::Vector3d(-g, 0, 0)).norm(), 1e-12);
+      EXPECT_LT((c_true.col(1) - Eigen::Vector3d(std::sin(az - phi), std::cos(az - phi), 0)).norm(), 1e-12);
+    } else if (s.fixture.locked && s.body.position == 2) {
+      EXPECT_LT((f - tilted.transpose() * Eigen::Vector3d(0, 0, g)).norm(), 1e-12);
+    }
+  }
+  // The heading a navigator reads in the first position at table angle 0: the azimuth.
+  const Eigen::Matrix3d first = samples.front().body.body_to_enu.toRotationMatrix();
+  EXPECT_NEAR(std::atan2(first(0, 0), first(1, 0)), az, 1e-12);
+}
+
+TEST(TriadSimulatorTest, AccelerometerAddsItsBiasAndNoiseInItsMountedFrameFromItsOwnStream) {
+  const std::string table =
+      "{latitude: 0.9, azimuth: 0.3}\n  accelerometer: {frame_id: acc, bias: [1.0e-3, -2.0e-3, 3.0e-3], noise: "
+      "2.0e-3, mounting: {roll: 0.1, pitch: -0.2, yaw: 0.3}}";
+  const TriadSimulationConfig c = parseText(scenario(table, "", ", pickoff: {noise: 2.0e-4}"));
+  const Eigen::Matrix3d mounting = rotationFromRollPitchYaw(0.1, -0.2, 0.3);
+  TriadSimulator sim(c);
+  const std::vector<TriadSample> samples = runAll(sim);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), sum2 = Eigen::Vector3d::Zero();
+  for (const TriadSample& s : samples) {
+    const Eigen::Vector3d exact =
+        mounting.transpose() * s.body.body_to_enu.toRotationMatrix().transpose() * Eigen::Vector3d(0.0, 0.0, 9.80665);
+    const Eigen::Vector3d e = s.accelerometer.specific_force - exact;
+    sum += e;
+    sum2 += e.cwiseProduct(e);
+  }
+  const double n = static_cast<double>(samples.size());
+  const Eigen::Vector3d mean = sum / n;
+  for (int j = 0; j < 3; ++j) {
+    EXPECT_NEAR(mean[j], c.accelerometer.bias[j], 5.0 * 2.0e-3 / std::sqrt(n)) << j;
+    const double sd = std::sqrt(sum2[j] / n - mean[j] * mean[j]);
+    EXPECT_NEAR(sd / 2.0e-3, 1.0, 0.03) << j;  // 5400 samples: the sd within 1 %, 1 sigma
+  }
+  // Its noise is its own stream: the gyros' channels are those of the scenario without it.
+  const TriadSimulationConfig without =
+      parseText(scenario("{latitude: 0.9, azimuth: 0.3}", "", ", pickoff: {noise: 2.0e-4}"));
+  TriadSimulator sim_without(without);
+  const std::vector<TriadSample> plain = runAll(sim_without);
+  ASSERT_EQ(plain.size(), samples.size());
+  for (std::size_t k = 0; k < plain.size(); ++k) {
+    EXPECT_FALSE(plain[k].accelerometer.present);
+    for (int i = 0; i < 3; ++i) ASSERT_EQ(plain[k].axes[i].z, samples[k].axes[i].z);
+  }
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace hrg_gyro

@@ -53,6 +53,8 @@ int runSimulateTriad(const SimulateOptions& o, const YAML::Node& document) {
     }
     if (s.fixture_logged) bag.write("/fixture/position", stamp, toFixtureMessage(s, stamp, config.frame_id));
     if (truth) bag.write("/truth", stamp, toBodyTruthMessage(s, stamp, config.frame_id));
+    if (s.accelerometer.present)
+      bag.write("/accel/data_raw", stamp, toAccelerometerMessage(s, stamp, config.accelerometer));
     progress.update(sim.elapsed(), ++seq);
   }
   bag.commit();
@@ -132,7 +134,8 @@ Command addSimulateCommand(CLI::App& root) {
       "loop (dynamics.model: averaged) adds /precession/state with every sample and its schedule's\n"
       "commands (dynamics.commands) on /command/precession, as sent to a live driver. A triad scenario (a\n"
       "`triad` section) writes /<axis>/channels and /<axis>/truth for each axis, /turntable/state,\n"
-      "/fixture/position and the body's /truth (hrg_gyro/BodyTruth). Chunks are LZ4-compressed\n"
+      "/fixture/position, the body's /truth (hrg_gyro/BodyTruth) and, with triad.accelerometer, its\n"
+      "/accel/data_raw (sensor_msgs/Imu). Chunks are LZ4-compressed\n"
       "by default (several times faster to read back; every rosbag reader handles it).\n"
       "The bag is written to a temporary and renamed over --out when complete.\n"
       "Exit 0 success, 2 bad usage or unreadable scenario (or --out is the scenario file), 3 the bag\n"

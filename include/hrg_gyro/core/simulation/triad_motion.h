@@ -6,7 +6,8 @@
 // with R the body's orientation on the platter (the position's Exp(error) R_nominal, or during a
 // move R_previous Exp(s(u) rho), rho the move's rotation vector in the body frame), W the platter's
 // wobble tilt, phi the table angle and omega_E0 the Earth's rate in the table-zero frame. The moves
-// turn about a fixed body axis, so the body sees their rate along rho alone.
+// turn about a fixed body axis, so the body sees their rate along rho alone. The body's attitude in
+// ENU is the one place the truth of heading and level comes from (the accelerometer, the tests).
 #pragma once
 
 #include <Eigen/Core>
@@ -24,6 +25,8 @@ struct TriadBodyState {
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();     ///< rad/s, inertial, in the body frame
   Eigen::Matrix3d body_to_table = Eigen::Matrix3d::Identity();    ///< true: fixture error and wobble included
   Eigen::Matrix3d body_to_platter = Eigen::Matrix3d::Identity();  ///< true, without the wobble
+  /// The true attitude, body -> ENU: Rz(pi/2 - azimuth) Rz(table_angle) body_to_table.
+  Eigen::Matrix3d body_to_enu = Eigen::Matrix3d::Identity();
   std::size_t position = 0;  ///< index of the position; during a move, the one being moved into
   bool locked = true;        ///< false while the fixture is being moved
 };
@@ -53,6 +56,7 @@ class TriadMotion {
 
   TurntableProfile profile_;
   Eigen::Matrix3d wobble_;
+  Eigen::Matrix3d table_zero_to_enu_;
   Eigen::Vector3d earth_zero_;
   std::vector<Span> spans_;
   mutable std::size_t cursor_ = 0;  // evaluation is nearly always monotonic in t

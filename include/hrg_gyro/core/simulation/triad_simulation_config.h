@@ -35,6 +35,12 @@
 // that turns with the platter (a coning of the platter's normal about the table's axis):
 // body_to_table = W body_to_platter, W that tilt. For the body it is one more small rotation of the
 // fixture, the same in the platter's frame in every position.
+//
+// The body's true orientation in ENU (REP-103, body -> ENU): Rz(pi/2 - azimuth) Rz(phi) body_to_table,
+// the table-zero frame's x axis at yaw pi/2 - azimuth (counter-clockwise from East). An accelerometer
+// (`accelerometer`, off by default) may ride on the fixture at the table's axis (no lever arm): it
+// measures the specific force of gravity at rest, f = C^T (0, 0, g) in its frame (REP-145: +g up),
+// C = body_to_enu accelerometer_to_body, plus its bias and white noise, at the axes' output stamps.
 #pragma once
 
 #include <Eigen/Core>
@@ -67,6 +73,16 @@ struct TableWobbleConfig {
   Eigen::Matrix3d platterToTable() const;
 };
 
+/// An accelerometer on the fixture (`triad/accelerometer`): what a gravity reference for the level sees.
+struct TriadAccelerometerConfig {
+  bool enabled = false;
+  std::string frame_id = "accel_link";
+  Eigen::Vector3d bias = Eigen::Vector3d::Zero();  ///< m/s^2, in its own frame
+  double noise = 0.0;                              ///< m/s^2, white, 1 sigma per sample
+  /// v_body = accelerometer_to_body v_accelerometer (`mounting: {roll, pitch, yaw}`).
+  Eigen::Matrix3d accelerometer_to_body = Eigen::Matrix3d::Identity();
+};
+
 struct TriadTurntableConfig {
   double latitude = 0.0;      ///< rad, geodetic
   double azimuth = 0.0;       ///< rad: the platter's x axis at table angle 0, from North towards East
@@ -77,6 +93,8 @@ struct TriadTurntableConfig {
 
   /// The Earth's rate in the table-zero frame, rad/s.
   Eigen::Vector3d earthRateInTableZero() const;
+  /// The table-zero frame in ENU: Rz(pi/2 - azimuth).
+  Eigen::Matrix3d tableZeroToEnu() const;
 };
 
 struct FixturePositionConfig {
@@ -103,6 +121,7 @@ struct TriadSimulationConfig {
   TriadTurntableConfig turntable;
   std::vector<FixturePositionConfig> positions;
   double fixture_error_std = 0.0;  ///< rad: the errors of the positions that give none, drawn
+  TriadAccelerometerConfig accelerometer;
   /// The whole session's table motion: each position's profile in turn, the table at rest during the
   /// moves, ripple included; labels "<position>/<segment>" and "<position>/move" (set by the parser).
   TurntableProfile table_profile;

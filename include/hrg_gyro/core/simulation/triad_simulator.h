@@ -12,7 +12,9 @@
 //              locked), `fixture_logged` when it is to be published: at the first sample, whenever the
 //              position or the lock changed since the previous sample, and otherwise every second
 //   body       the body's truth at the sample: omega_body, the true body_to_table (fixture error and
-//              wobble included), the position index
+//              wobble included) and body_to_enu, the position index
+//   accelerometer  with `triad/accelerometer` enabled: its specific force at the sample (true attitude,
+//              standard gravity, its bias and white noise, drawn from a stream of its own)
 #pragma once
 
 #include <Eigen/Core>
@@ -43,8 +45,18 @@ struct FixtureState {
 struct TriadBodyTruth {
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();         ///< rad/s, inertial, body frame
   Eigen::Quaterniond body_to_table = Eigen::Quaterniond::Identity();  ///< true
+  Eigen::Quaterniond body_to_enu = Eigen::Quaterniond::Identity();    ///< true attitude (REP-103)
   std::uint32_t position = 0;
 };
+
+struct AccelerometerSample {
+  bool present = false;                                      ///< the scenario has an accelerometer
+  Eigen::Vector3d specific_force = Eigen::Vector3d::Zero();  ///< m/s^2, its frame (REP-145: +g up at rest)
+};
+
+/// The specific force an accelerometer mounted by `accelerometer_to_body` on a body at `body_to_enu`
+/// measures at rest, without bias or noise: (body_to_enu accelerometer_to_body)^T (0, 0, g), m/s^2.
+Eigen::Vector3d specificForceAtRest(const Eigen::Matrix3d& body_to_enu, const Eigen::Matrix3d& accelerometer_to_body);
 
 struct TriadSample {
   std::uint64_t index = 0;
@@ -54,6 +66,7 @@ struct TriadSample {
   FixtureState fixture;
   bool fixture_logged = false;
   TriadBodyTruth body;
+  AccelerometerSample accelerometer;
 };
 
 class TriadSimulator {
@@ -82,12 +95,14 @@ class TriadSimulator {
   class AxisInput;
   void logTurntable(double t_center, Nanoseconds stamp, const TriadBodyState& state, TriadSample* out);
   void logFixture(double t_center, const TriadBodyState& state, TriadSample* out);
+  void measureGravity(const TriadBodyState& state, TriadSample* out);
 
   TriadSimulationConfig config_;
   TriadMotion motion_;
   std::array<std::unique_ptr<AxisInput>, 3> inputs_;
   std::array<std::unique_ptr<GyroSimulator>, 3> axes_;
   TurntableLogger logger_;
+  GaussianNoise accelerometer_noise_;
   std::uint64_t next_log_ = 0;  // index of the next record at the table's log rate
   std::vector<Eigen::Quaterniond> nominal_;
   bool fixture_logged_once_ = false;
