@@ -15,24 +15,6 @@ namespace hrg_gyro {
 namespace bag_tools {
 namespace {
 
-/// A YAML number: 12 significant digits, .nan for what is not finite.
-std::string yamlNumber(double value) {
-  if (!std::isfinite(value)) return ".nan";
-  char text[40];
-  std::snprintf(text, sizeof text, "%.12g", value);
-  return text;
-}
-
-/// A YAML double-quoted string.
-std::string yamlQuoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += (c == '\n' || c == '\r') ? ' ' : c;
-  }
-  return out + '"';
-}
-
 /// Whether a number read back is the one written (12 significant digits, NaN for NaN).
 bool sameNumber(double written, double read) {
   if (std::isnan(written) || std::isnan(read)) return std::isnan(written) && std::isnan(read);
@@ -174,21 +156,28 @@ std::vector<WindowResult> AlignmentRun::finishWindows() const {
 
 std::string emitAlignmentRun(const core::AlignmentResult& result, const std::vector<WindowResult>& windows,
                              const std::string& bag, const std::string& settings) {
-  std::ostringstream y;
-  y << core::emitAlignmentResult(result);
-  y << "input: {bag: " << yamlQuoted(bag) << ", settings: " << yamlQuoted(settings) << "}\n";
-  y << "# The window's first window_s seconds solved alone (--windows): the heading against window length;\n"
-    << "# heading deg and its 1 sigma, the budget's noise (falls with the window) and total, rad.\n"
-    << "windows:\n";
+  // The inputs and the windows after the result's own document, through yaml-cpp's emitter (quoting,
+  // .nan, every double to the digits that read back the same).
+  YAML::Emitter e;
+  e << YAML::BeginMap << YAML::Key << "input" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "bag"
+    << YAML::Value << YAML::DoubleQuoted << bag << YAML::Key << "settings" << YAML::Value << YAML::DoubleQuoted
+    << settings << YAML::EndMap;
+  e << YAML::Key << "windows" << YAML::Value << YAML::BeginSeq;
   for (const WindowResult& w : windows) {
     const core::AlignmentResult& r = w.result;
-    y << "  - {window_s: " << yamlNumber(w.seconds) << ", accepted: " << (r.accepted ? "true" : "false")
-      << ", gate: " << yamlQuoted(r.gate) << ", seconds: " << yamlNumber(r.seconds)
-      << ", heading_deg: " << yamlNumber(r.heading) << ", heading_sigma_deg: " << yamlNumber(r.heading_sigma)
-      << ", noise_rad: " << yamlNumber(r.budget.noise) << ", total_rad: " << yamlNumber(r.budget.total) << "}\n";
+    e << YAML::Flow << YAML::BeginMap << YAML::Key << "window_s" << YAML::Value << w.seconds << YAML::Key << "accepted"
+      << YAML::Value << r.accepted << YAML::Key << "gate" << YAML::Value << YAML::DoubleQuoted << r.gate << YAML::Key
+      << "seconds" << YAML::Value << r.seconds << YAML::Key << "heading_deg" << YAML::Value << r.heading << YAML::Key
+      << "heading_sigma_deg" << YAML::Value << r.heading_sigma << YAML::Key << "noise_rad" << YAML::Value
+      << r.budget.noise << YAML::Key << "total_rad" << YAML::Value << r.budget.total << YAML::EndMap;
   }
-  if (windows.empty()) y << "  []\n";
-  return y.str();
+  e << YAML::EndSeq << YAML::EndMap;
+  if (!e.good()) throw std::runtime_error("YAML emitter error: " + e.GetLastError());
+  return core::emitAlignmentResult(result) +
+         "# input: the bag and settings aligned. windows: the window's first window_s seconds solved alone\n"
+         "# (--windows), the heading against window length: heading deg with its 1 sigma, the budget's noise\n"
+         "# (falls with the window) and total, rad.\n" +
+         e.c_str() + "\n";
 }
 
 void writeAlignmentFile(const std::string& path, const std::string& text, const core::AlignmentResult& result,
