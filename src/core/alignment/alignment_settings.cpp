@@ -1,8 +1,12 @@
 #include "hrg_gyro/core/alignment/alignment_settings.h"
 
+#include <algorithm>
 #include <cmath>
 
+#include "hrg_gyro/core/alignment/local_level.h"
+#include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -17,7 +21,179 @@ void requirePositive(double value, const std::string& key, const char* unit) {
   if (!std::isfinite(value) || !(value > 0.0)) throw ConfigError(key, std::string("must be positive (") + unit + ")");
 }
 
+// The keys, listed once: parse() refuses any other, keyPaths() lists them.
+const std::vector<std::string> kScalarKeys = {
+    "mode", "latitude", "max_latitude", "duration", "single_gyro", "max_earth_rate_error", "max_condition"};
+const std::vector<std::string> kNoiseKeys = {"angle_white_noise", "angle_random_walk", "rate_random_walk",
+                                             "residual_bias", "residual_drift_harmonics"};
+const std::vector<std::string> kLevelKeys = {"source",
+                                             "roll",
+                                             "pitch",
+                                             "roll_sigma",
+                                             "pitch_sigma",
+                                             "accelerometer_to_body",
+                                             "accelerometer_bias_sigma",
+                                             "max_gravity_error"};
+const std::vector<std::string> kIndexerKeys = {"continuous", "body_to_platform",   "gyro_axis",      "rest_rate",
+                                               "settle",     "position_tolerance", "max_record_gap", "angle_sigma"};
+const std::vector<std::string> kSweepKeys = {"settle", "gain_orders", "min_turns"};
+const std::vector<std::string> kMotionKeys = {"block", "max_motion", "max_scatter"};
+const std::vector<std::string> kSections = {"noise", "level", "indexer", "sweep", "motion"};
+const std::vector<std::string> kNodeKeys = {"align_at_startup", "triad_file", "hold", "queue_size",
+                                            "diagnostic_period"};
+
+// {roll, pitch, yaw} in rad: Rz(yaw) Ry(pitch) Rx(roll).
+Eigen::Quaterniond parseRotation(const YamlField& f) {
+  f.requireMap();
+  f.rejectUnknownKeys({"roll", "pitch", "yaw"});
+  EulerAngles a;
+  a.roll = f.getDouble("roll", 0.0);
+  a.pitch = f.getDouble("pitch", 0.0);
+  a.yaw = f.getDouble("yaw", 0.0);
+  return orientationFromEuler(a);
+}
+
+void parseNoise(const YamlField& f, GyroNoiseModel* n) {
+  f.requireMap();
+  f.rejectUnknownKeys(kNoiseKeys);
+  n->angle_white_noise = f.getDouble("angle_white_noise", n->angle_white_noise);
+  n->angle_random_walk = f.getDouble("angle_random_walk", n->angle_random_walk);
+  n->rate_random_walk = f.getDouble("rate_random_walk", n->rate_random_walk);
+  n->residual_bias = f.getDouble("residual_bias", n->residual_bias);
+  n->residual_drift_harmonics = f.getDouble("residual_drift_harmonics", n->residual_drift_harmonics);
+}
+
+void parseLevel(const YamlField& f, LevelSettings* l) {
+  f.requireMap();
+  f.rejectUnknownKeys(kLevelKeys);
+  if (f.has("source")) {
+    const std::string source = f["source"].asString();
+    if (source == "accelerometer") {
+      l->source = LevelSource::kAccelerometer;
+    } else if (source == "declared") {
+      l->source = LevelSource::kDeclared;
+    } else {
+      f["source"].fail("'" + source + "' is not a level source: accelerometer or declared");
+    }
+  }
+  l->roll = f.getDouble("roll", l->roll);
+  l->pitch = f.getDouble("pitch", l->pitch);
+  l->roll_sigma = f.getDouble("roll_sigma", l->roll_sigma);
+  l->pitch_sigma = f.getDouble("pitch_sigma", l->pitch_sigma);
+  if (f.has("accelerometer_to_body")) l->accelerometer_to_body = parseRotation(f["accelerometer_to_body"]);
+  l->accelerometer_bias_sigma = f.getDouble("accelerometer_bias_sigma", l->accelerometer_bias_sigma);
+  l->max_gravity_error = f.getDouble("max_gravity_error", l->max_gravity_error);
+}
+
+void parseIndexer(const YamlField& f, IndexerSettings* x) {
+  f.requireMap();
+  f.rejectUnknownKeys(kIndexerKeys);
+  x->continuous = f.getBool("continuous", x->continuous);
+  if (f.has("body_to_platform")) x->body_to_platform = parseRotation(f["body_to_platform"]).toRotationMatrix();
+  if (f.has("gyro_axis")) {
+    const std::vector<double> axis = f["gyro_axis"].asDoubles(3);
+    x->gyro_axis = Eigen::Vector3d(axis[0], axis[1], axis[2]);
+  }
+  x->rest_rate = f.getDouble("rest_rate", x->rest_rate);
+  x->settle = f.getDouble("settle", x->settle);
+  x->position_tolerance = f.getDouble("position_tolerance", x->position_tolerance);
+  x->max_record_gap = f.getDouble("max_record_gap", x->max_record_gap);
+  x->angle_sigma = f.getDouble("angle_sigma", x->angle_sigma);
+}
+
+void parseSweep(const YamlField& f, SweepSettings* w) {
+  f.requireMap();
+  f.rejectUnknownKeys(kSweepKeys);
+  w->settle = f.getDouble("settle", w->settle);
+  if (f.has("gain_orders")) {
+    w->gain_orders.clear();
+    for (long order : f["gain_orders"].asIntegers()) {
+      w->gain_orders.push_back(static_cast<int>(std::clamp<long>(order, -1, 1000)));  // validate() judges it
+    }
+  }
+  w->min_turns = f.getDouble("min_turns", w->min_turns);
+}
+
+void parseMotion(const YamlField& f, MotionSettings* m) {
+  f.requireMap();
+  f.rejectUnknownKeys(kMotionKeys);
+  m->block = f.getDouble("block", m->block);
+  m->max_motion = f.getDouble("max_motion", m->max_motion);
+  m->max_scatter = f.getDouble("max_scatter", m->max_scatter);
+}
+
+// validate() names nested keys as the node's parameters ("level/roll"); a file's errors name them
+// as YamlField does ("level.roll").
+std::string dotted(std::string key) {
+  std::replace(key.begin(), key.end(), '/', '.');
+  return key;
+}
+
 }  // namespace
+
+const std::vector<std::string>& AlignmentSettings::nodeKeys() { return kNodeKeys; }
+
+std::vector<std::string> AlignmentSettings::keyPaths() {
+  std::vector<std::string> keys = kScalarKeys;
+  const std::vector<std::pair<const char*, const std::vector<std::string>*>> sections = {{"noise", &kNoiseKeys},
+                                                                                         {"level", &kLevelKeys},
+                                                                                         {"indexer", &kIndexerKeys},
+                                                                                         {"sweep", &kSweepKeys},
+                                                                                         {"motion", &kMotionKeys}};
+  for (const auto& section : sections) {
+    for (const std::string& k : *section.second) keys.push_back(std::string(section.first) + "/" + k);
+  }
+  return keys;
+}
+
+AlignmentSettings AlignmentSettings::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
+  root.requireMap();
+  std::vector<std::string> allowed = kScalarKeys;
+  allowed.insert(allowed.end(), kSections.begin(), kSections.end());
+  allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
+  root.rejectUnknownKeys(allowed);
+  AlignmentSettings s;
+  if (root.has("mode")) s.mode = parseAlignmentMode(root["mode"].asString(), root["mode"].path());
+  s.latitude = root.getDouble("latitude", s.latitude);
+  s.max_latitude = root.getDouble("max_latitude", s.max_latitude);
+  s.duration = root.getDouble("duration", s.duration);
+  s.single_gyro = root.getBool("single_gyro", s.single_gyro);
+  s.max_earth_rate_error = root.getDouble("max_earth_rate_error", s.max_earth_rate_error);
+  s.max_condition = root.getDouble("max_condition", s.max_condition);
+  if (root.has("noise")) parseNoise(root["noise"], &s.noise);
+  if (root.has("level")) parseLevel(root["level"], &s.level);
+  if (root.has("indexer")) parseIndexer(root["indexer"], &s.indexer);
+  if (root.has("sweep")) parseSweep(root["sweep"], &s.sweep);
+  if (root.has("motion")) parseMotion(root["motion"], &s.motion);
+  try {
+    s.validate();
+  } catch (const ConfigError& e) {
+    const std::string key = root.path().empty() ? dotted(e.key()) : root.path() + "." + dotted(e.key());
+    throw ConfigError(key, e.problem());
+  }
+  return s;
+}
+
+AlignmentSettings AlignmentSettings::load(const std::string& path) {
+  std::string text;
+  try {
+    text = readBoundedRegularFile(path, kMaxParameterFileBytes, "alignment settings file");
+  } catch (const std::runtime_error& e) {
+    throw ConfigError("", e.what());
+  }
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError("",
+                      "YAML syntax error in '" + path + "' at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  try {
+    return parse(YamlField(root, ""), kNodeKeys);
+  } catch (const ConfigError& e) {
+    throw ConfigError(e.key(), e.problem() + " (in '" + path + "')");
+  }
+}
 
 const char* toString(AlignmentMode mode) {
   switch (mode) {

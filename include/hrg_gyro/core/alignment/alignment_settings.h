@@ -18,7 +18,12 @@
 //
 // The noise model (per gyro axis, in body rate units: rad, rad/s) comes from the Allan deviation the
 // package computes (estimation/allan_deviation.h, noiseFromAllan) or from the settings; the white
-// angle noise is measured from the window itself unless given. No ROS.
+// angle noise is measured from the window itself unless given.
+//
+// As YAML (the gyrocompass node's private parameters, `hrg_bag align --settings`): the fields below
+// by name, each section a map (`level: {source: declared, roll: 0.0, ...}`), `mode` and
+// `level/source` as text, rotations as {roll, pitch, yaw} in rad (R = Rz(yaw) Ry(pitch) Rx(roll)),
+// `indexer/gyro_axis` as [x, y, z]; an absent key keeps its default. No ROS.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/estimation/allan_deviation.h"
 
 namespace hrg_gyro {
@@ -127,6 +133,19 @@ struct AlignmentSettings {
   MotionSettings motion;
   /// Throws ConfigError naming the key.
   void validate() const;
+
+  /// Reads the settings map (the top level of a settings file or of the node's parameters) and
+  /// validates it. Unknown keys are refused by name; `extra_keys` are also allowed at the top level,
+  /// unread (someone else's). Throws ConfigError naming the key as the file writes it ("level.roll").
+  static AlignmentSettings parse(const YamlField& root, const std::vector<std::string>& extra_keys = {});
+  /// A settings file: the settings at its top level, beside them (unread) the gyrocompass node's own
+  /// keys (nodeKeys()), so the node's parameter file config/gyrocompass.yaml is one too. Throws
+  /// ConfigError (an unreadable file, a YAML syntax error with its line, a bad key).
+  static AlignmentSettings load(const std::string& path);
+  /// The gyrocompass node's keys that are not the alignment's (align_at_startup, triad_file, ...).
+  static const std::vector<std::string>& nodeKeys();
+  /// Every key parse() reads, nested ones as "section/key".
+  static std::vector<std::string> keyPaths();
 };
 
 }  // namespace core
