@@ -53,6 +53,8 @@ Command addReportCommand(CLI::App& root);
 Command addBatchCommand(CLI::App& root);
 Command addImportCommand(CLI::App& root);
 Command addExportCommand(CLI::App& root);
+/// align: north-finding from a recorded session (the gyrocompass offline).
+Command addAlignCommand(CLI::App& root);
 
 /// Opens a bag for reading; missing, unindexed, truncated or corrupt files become UsageErrors
 /// that say which.

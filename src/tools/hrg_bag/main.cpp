@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
       {"simulate", addSimulateCommand(app)},   {"info", addInfoCommand(app)},     {"process", addProcessCommand(app)},
       {"calibrate", addCalibrateCommand(app)}, {"allan", addAllanCommand(app)},   {"report", addReportCommand(app)},
       {"batch", addBatchCommand(app)},         {"import", addImportCommand(app)}, {"export", addExportCommand(app)},
+      {"align", addAlignCommand(app)},
   };
   if (argc < 2) {
     std::cerr << app.help();

@@ -22,34 +22,6 @@ namespace hrg_gyro {
 namespace bag_tools {
 namespace {
 
-/// One axis of the triad and where the bag holds it.
-struct AxisInput {
-  std::string name, parameter_file, topic;
-  std::string frame_id;  // of its outputs, as triad.launch names it
-};
-
-/// The chain's settings from the options, each refusal naming its option.
-core::TriadProcessorSettings checkedSettings(const core::ProcessorConfig& processor, const TriadOptions& o) {
-  checkProcessorConfig(processor);
-  core::TriadProcessorSettings s;
-  s.processor = processor;
-  s.noise = o.noise;
-  s.combiner = o.combiner;
-  s.combiner.initial_rate_variance = o.noise.initial_variance;  // the nodes' defaults agree
-  try {
-    o.noise.validate();
-    s.combiner.validate();
-  } catch (const core::ConfigError& e) {
-    std::string option = e.key();
-    if (option == "max_rate" || option == "backward_reset" || option == "forward_jump" || option == "jump_persist") {
-      option = "triad_" + option;  // the processors' options have these names
-    }
-    std::replace(option.begin(), option.end(), '_', '-');
-    throw UsageError("--" + option + ": " + e.problem());
-  }
-  return s;
-}
-
 /// The axis's channels: `chosen` (--axis-channels), or /AXIS/channels, or the one ChannelAmplitudes
 /// topic ending in /AXIS/channels (a triad recorded inside a namespace).
 std::string axisTopic(const rosbag::Bag& bag, const std::string& axis, const std::string& chosen) {
@@ -80,35 +52,6 @@ std::string axisTopic(const rosbag::Bag& bag, const std::string& axis, const std
                      "' in the bag; it holds:" + (listing.empty() ? " nothing" : listing));
   }
   throw UsageError("several " + type + " topics end in " + suffix + " in the bag: one triad per bag");
-}
-
-/// The axes in the triad's order: names, parameter files (--axis-params), topics in `bag`.
-std::array<AxisInput, 3> axisInputs(const TriadOptions& o, const core::TriadParameters& triad) {
-  const std::map<std::string, std::string> given = perAxis(o.axis_params, "axis-params");
-  checkAxisNames(given, triad.axes, "axis-params");
-  std::array<AxisInput, 3> axes;
-  for (std::size_t a = 0; a < 3; ++a) {
-    const auto it = given.find(triad.axes[a]);
-    if (it == given.end()) {
-      throw UsageError("--axis-params " + triad.axes[a] + "=FILE missing: each axis's parameter file is needed");
-    }
-    axes[a].name = triad.axes[a];
-    axes[a].parameter_file = it->second;
-    axes[a].frame_id = axes[a].name + "_gyro_link";
-  }
-  return axes;
-}
-
-/// Each axis's channels topic in `bag`, --axis-channels NAME=TOPIC choosing it.
-void findAxisTopics(const rosbag::Bag& bag, const TriadOptions& o, std::array<AxisInput, 3>* axes) {
-  const std::array<std::string, 3> names{{(*axes)[0].name, (*axes)[1].name, (*axes)[2].name}};
-  const std::map<std::string, std::string> channels = perAxis(o.axis_channels, "axis-channels");
-  checkAxisNames(channels, names, "axis-channels");
-  for (AxisInput& a : *axes) {
-    const auto chosen = channels.find(a.name);
-    a.topic = axisTopic(bag, a.name, chosen == channels.end() ? std::string() : chosen->second);
-  }
-  checkDistinctAxisTopics(names, {{(*axes)[0].topic, (*axes)[1].topic, (*axes)[2].topic}});
 }
 
 const char* kCsvHeader =
@@ -269,6 +212,54 @@ int summarize(const core::TriadProcessor& triad, const std::array<AxisInput, 3>&
 }
 
 }  // namespace
+
+core::TriadProcessorSettings checkedSettings(const core::ProcessorConfig& processor, const TriadOptions& o) {
+  checkProcessorConfig(processor);
+  core::TriadProcessorSettings s;
+  s.processor = processor;
+  s.noise = o.noise;
+  s.combiner = o.combiner;
+  s.combiner.initial_rate_variance = o.noise.initial_variance;  // the nodes' defaults agree
+  try {
+    o.noise.validate();
+    s.combiner.validate();
+  } catch (const core::ConfigError& e) {
+    std::string option = e.key();
+    if (option == "max_rate" || option == "backward_reset" || option == "forward_jump" || option == "jump_persist") {
+      option = "triad_" + option;  // the processors' options have these names
+    }
+    std::replace(option.begin(), option.end(), '_', '-');
+    throw UsageError("--" + option + ": " + e.problem());
+  }
+  return s;
+}
+
+std::array<AxisInput, 3> axisInputs(const TriadOptions& o, const core::TriadParameters& triad) {
+  const std::map<std::string, std::string> given = perAxis(o.axis_params, "axis-params");
+  checkAxisNames(given, triad.axes, "axis-params");
+  std::array<AxisInput, 3> axes;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const auto it = given.find(triad.axes[a]);
+    if (it == given.end()) {
+      throw UsageError("--axis-params " + triad.axes[a] + "=FILE missing: each axis's parameter file is needed");
+    }
+    axes[a].name = triad.axes[a];
+    axes[a].parameter_file = it->second;
+    axes[a].frame_id = axes[a].name + "_gyro_link";
+  }
+  return axes;
+}
+
+void findAxisTopics(const rosbag::Bag& bag, const TriadOptions& o, std::array<AxisInput, 3>* axes) {
+  const std::array<std::string, 3> names{{(*axes)[0].name, (*axes)[1].name, (*axes)[2].name}};
+  const std::map<std::string, std::string> channels = perAxis(o.axis_channels, "axis-channels");
+  checkAxisNames(channels, names, "axis-channels");
+  for (AxisInput& a : *axes) {
+    const auto chosen = channels.find(a.name);
+    a.topic = axisTopic(bag, a.name, chosen == channels.end() ? std::string() : chosen->second);
+  }
+  checkDistinctAxisTopics(names, {{(*axes)[0].topic, (*axes)[1].topic, (*axes)[2].topic}});
+}
 
 CLI::Option* addTriadOptions(CLI::App& command, TriadOptions* o) {
   const std::string group = "Triad (the triad node's parameters; same rules)";

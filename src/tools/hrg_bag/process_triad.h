@@ -5,7 +5,10 @@
 // same channels.
 #pragma once
 
+#include <rosbag/bag.h>
+
 #include <CLI/CLI.hpp>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -22,6 +25,20 @@ struct TriadOptions {
   core::RateNoiseSettings noise;           ///< each axis's, as its processor node's
   core::TriadCombinerSettings combiner;    ///< as the triad node's
 };
+
+/// One axis of the triad and where the bag holds it.
+struct AxisInput {
+  std::string name, parameter_file, topic;
+  std::string frame_id;  ///< of its outputs, as triad.launch names it
+};
+
+/// The chain's settings from the options, each refusal naming its option (a UsageError).
+core::TriadProcessorSettings checkedSettings(const core::ProcessorConfig& processor, const TriadOptions& options);
+/// The axes in the triad's order: names and parameter files (--axis-params, each axis's needed).
+std::array<AxisInput, 3> axisInputs(const TriadOptions& options, const core::TriadParameters& triad);
+/// Each axis's channels topic in `bag`: --axis-channels NAME=TOPIC, or /NAME/channels, or the one
+/// ChannelAmplitudes topic ending in /NAME/channels; two axes on one topic refused.
+void findAxisTopics(const rosbag::Bag& bag, const TriadOptions& options, std::array<AxisInput, 3>* axes);
 
 /// --triad, --axis-params, --axis-channels (the forms of hrg_bag calibrate --method triad) and the
 /// triad node's settings as options (--stamp-tolerance, --max-wait, --max-pending,

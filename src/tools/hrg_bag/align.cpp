@@ -1,0 +1,310 @@
+// hrg_bag align: north-finding from a recorded session. The bag's records feed one core::Gyrocompass
+// as the gyrocompass node feeds it: the triad's body samples (its triad/output, or its axes' channels
+// through core::TriadProcessor as the processors and the triad node run them), one gyro's outputs
+// (single_gyro), the indexer's state (turntable/state) and the accelerometer (accel/data_raw), each in
+// record order. Prints the heading with its uncertainty and writes the result's YAML.
+#include <rosbag/view.h>
+#include <sensor_msgs/Imu.h>
+
+#include <algorithm>
+#include <iostream>
+#include <map>
+#include <memory>
+
+#include "align_run.h"
+#include "bag_tools.h"
+#include "hrg_gyro/GyroOutput.h"
+#include "hrg_gyro/TriadOutput.h"
+#include "hrg_gyro/TurntableState.h"
+#include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/core/model/triad_file.h"
+#include "hrg_gyro/ros/conversions.h"
+#include "process_triad.h"
+#include "reused_message_reader.h"
+
+namespace hrg_gyro {
+namespace bag_tools {
+namespace {
+
+struct AlignCommand {
+  AlignOptions align;
+  TriadOptions triad;  // --triad: the axes' channels through the triad's chain
+  core::ProcessorConfig processor;
+  CLI::Option* triad_option = nullptr;
+};
+
+/// The settings file, --duration in place of its duration; refusals name the file and the key.
+core::AlignmentSettings loadSettings(const AlignOptions& o) {
+  core::AlignmentSettings s;
+  try {
+    s = core::AlignmentSettings::load(o.settings);
+  } catch (const std::exception& e) {  // ConfigError (the key), unreadable, not YAML
+    throw UsageError("--settings " + o.settings + ": " + e.what());
+  }
+  if (o.duration > 0.0) {
+    s.duration = o.duration;
+    try {
+      s.validate();
+    } catch (const core::ConfigError& e) {
+      throw UsageError("--duration: " + e.problem());
+    }
+  }
+  if (s.mode == core::AlignmentMode::kSweep) {
+    throw UsageError("--settings " + o.settings +
+                     ": mode sweep is aligned live only (the gyrocompass node); hrg_bag align reads the static and "
+                     "indexed modes");
+  }
+  return s;
+}
+
+/// Where the bag holds each stream the mode needs.
+struct AlignInputs {
+  std::string triad, gyro, turntable, accelerometer;
+  bool channels = false;  // the triad from its axes' channels (--triad)
+  std::array<AxisInput, 3> axes;
+};
+
+/// The accelerometer: --accelerometer-topic, or the bag's one sensor_msgs/Imu topic ending in
+/// accel/data_raw (the bag may hold the triad's imu/data_raw too).
+std::string accelerometerTopic(const rosbag::Bag& bag, const std::string& chosen) {
+  const std::string type = ros::message_traits::datatype<sensor_msgs::Imu>();
+  const std::string hint =
+      " for level/source accelerometer (or declare the level in the settings: level/source declared)";
+  if (!chosen.empty()) return findTopic(bag, chosen, type, "accelerometer-topic", true, hint);
+  const std::string suffix = "accel/data_raw";
+  std::vector<std::string> found;
+  rosbag::View all(bag);
+  for (const rosbag::ConnectionInfo* c : all.getConnections()) {
+    const bool ends = c->topic.size() >= suffix.size() &&
+                      c->topic.compare(c->topic.size() - suffix.size(), suffix.size(), suffix) == 0;
+    if (c->datatype == type && ends && std::find(found.begin(), found.end(), c->topic) == found.end()) {
+      found.push_back(c->topic);
+    }
+  }
+  if (found.size() == 1) return found.front();
+  if (found.size() > 1)
+    throw UsageError("several " + type + " topics end in " + suffix + ": choose one with --accelerometer-topic");
+  throw UsageError("no " + type + " topic ending in " + suffix + " in the bag" + hint +
+                   "; name another with --accelerometer-topic");
+}
+
+AlignInputs findInputs(const rosbag::Bag& bag, const AlignCommand& c, const core::AlignmentSettings& s,
+                       const std::array<AxisInput, 3>& axes) {
+  AlignInputs in;
+  const AlignOptions& o = c.align;
+  if (s.single_gyro) {
+    in.gyro = findTopic(bag, o.gyro_topic, ros::message_traits::datatype<GyroOutput>(), "gyro-topic", true,
+                        " (single_gyro: the gyro's outputs)");
+  } else if (*c.triad_option) {
+    in.channels = true;
+    in.axes = axes;
+    findAxisTopics(bag, c.triad, &in.axes);
+  } else {
+    in.triad = findTopic(bag, o.triad_topic, ros::message_traits::datatype<TriadOutput>(), "triad-topic", true,
+                         " (or give the axes' channels: --triad FILE --axis-params NAME=FILE for each axis)");
+  }
+  if (s.mode == core::AlignmentMode::kIndexed) {
+    in.turntable = findTopic(bag, o.turntable_topic, ros::message_traits::datatype<TurntableState>(), "turntable-topic",
+                             true, " (mode indexed: the indexer's angle)");
+  }
+  if (s.level.source == core::LevelSource::kAccelerometer)
+    in.accelerometer = accelerometerTopic(bag, o.accelerometer_topic);
+  return in;
+}
+
+/// A recorded triad sample as the triad node published it.
+core::TriadBodySample fromTriadOutput(const TriadOutput& m) {
+  core::TriadBodySample s;
+  s.stamp = toNanoseconds(m.header.stamp);
+  s.dt = m.dt;
+  s.delta_angle = Eigen::Vector3d(m.delta_angle.x, m.delta_angle.y, m.delta_angle.z);
+  s.angular_velocity = Eigen::Vector3d(m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z);
+  for (int i = 0; i < 9; ++i) s.covariance(i / 3, i % 3) = m.angular_velocity_covariance[i];
+  s.flags = m.flags;
+  return s;
+}
+
+/// Feeds the run with the bag's records in record order until its window is full. Gyro samples
+/// stamped before the first one plus --start are skipped.
+class BagFeed {
+ public:
+  BagFeed(const AlignInputs& in, double start, AlignmentRun* run)
+      : in_(in), start_(core::toNanoseconds(start)), run_(run) {}
+
+  void setChain(core::TriadProcessor* chain) { chain_ = chain; }
+
+  void read(const rosbag::Bag& bag) {
+    std::vector<std::string> topics;
+    for (const std::string& t : {in_.triad, in_.gyro, in_.turntable, in_.accelerometer}) {
+      if (!t.empty()) topics.push_back(t);
+    }
+    std::map<std::string, std::size_t> axis_of_topic;
+    for (std::size_t a = 0; in_.channels && a < 3; ++a) {
+      topics.push_back(in_.axes[a].topic);
+      axis_of_topic[in_.axes[a].topic] = a;
+    }
+    rosbag::View view(bag, rosbag::TopicQuery(topics));
+    Progress progress("align", view.size());
+    try {
+      for (const rosbag::MessageInstance& m : view) {
+        const std::string& topic = m.getTopic();
+        const auto axis = axis_of_topic.find(topic);
+        if (axis != axis_of_topic.end()) {
+          channels(m, axis->second);
+        } else if (topic == in_.triad) {
+          if (triad_reader_.read(m, &triad_) && admit(toNanoseconds(triad_.header.stamp)))
+            run_->addTriad(fromTriadOutput(triad_));
+        } else if (topic == in_.gyro) {
+          if (gyro_reader_.read(m, &gyro_) && admit(toNanoseconds(gyro_.header.stamp)))
+            run_->addAxis(toAxisOutput(gyro_));
+        } else if (topic == in_.turntable) {
+          if (table_reader_.read(m, &table_))
+            run_->addIndexer({toNanoseconds(table_.header.stamp), table_.angle, table_.rate});
+        } else if (accelerometer_reader_.read(m, &imu_)) {
+          const geometry_msgs::Vector3& f = imu_.linear_acceleration;
+          run_->addAccelerometer({toNanoseconds(imu_.header.stamp), Eigen::Vector3d(f.x, f.y, f.z)});
+        }
+        if (++records_ % 4096 == 0) progress.update(static_cast<double>(records_), records_);
+        if (run_->complete()) break;
+      }
+    } catch (...) {
+      rethrowBagReadError(records_);
+    }
+    progress.finish(records_);
+    if (chain_ && !run_->complete()) {
+      std::vector<core::TriadAxisOutput> decided;
+      std::vector<core::TriadBodySample> completed;
+      chain_->finish(&decided, &completed);
+      for (const core::TriadBodySample& s : completed) {
+        if (admit(s.stamp)) run_->addTriad(s);
+      }
+    }
+    if (!run_->complete()) run_->inputEnded("the bag");
+  }
+
+ private:
+  /// A gyro sample at or after the first one plus --start.
+  bool admit(core::Nanoseconds ns) {
+    if (first_ == 0) first_ = ns;
+    return ns >= first_ + start_;
+  }
+
+  /// One axis's channels through the triad's chain; the samples it completes go to the run.
+  void channels(const rosbag::MessageInstance& m, std::size_t axis) {
+    if (!channel_reader_.read(m, &channels_)) return;
+    chain_->process(axis, fromMessage(channels_), &result_);
+    if (!result_.has_output) return;
+    decided_.clear();
+    completed_.clear();
+    chain_->release(&decided_, &completed_);
+    for (const core::TriadBodySample& s : completed_) {
+      if (admit(s.stamp)) run_->addTriad(s);
+    }
+  }
+
+  const AlignInputs& in_;
+  core::Nanoseconds start_ = 0, first_ = 0;
+  AlignmentRun* run_;
+  core::TriadProcessor* chain_ = nullptr;
+  std::uint64_t records_ = 0;
+  ReusedMessageReader<TriadOutput> triad_reader_;
+  ReusedMessageReader<GyroOutput> gyro_reader_;
+  ReusedMessageReader<TurntableState> table_reader_;
+  ReusedMessageReader<sensor_msgs::Imu> accelerometer_reader_;
+  ReusedMessageReader<ChannelAmplitudes> channel_reader_;
+  TriadOutput triad_;
+  GyroOutput gyro_;
+  TurntableState table_;
+  sensor_msgs::Imu imu_;
+  ChannelAmplitudes channels_;
+  core::ProcessorResult result_;
+  std::vector<core::TriadAxisOutput> decided_;
+  std::vector<core::TriadBodySample> completed_;
+};
+
+void printResult(const AlignmentRun& run, const core::AlignmentResult& r, const std::vector<WindowResult>& windows) {
+  const core::AlignmentProgress p = run.window().progress();
+  std::cerr << "align: " << p.samples << " gyro samples, " << p.gaps << " gaps, " << p.indexer << " indexer records, "
+            << p.accelerometer << " accelerometer records, " << p.dropped << " records dropped\n";
+  std::cout << r.summary() << "\n";
+  for (const WindowResult& w : windows) {
+    char line[256];
+    if (w.result.accepted) {
+      std::snprintf(line, sizeof line, "  first %8.1f s: heading %.4f deg +- %.4f deg (noise %.4f mrad)\n", w.seconds,
+                    w.result.heading, w.result.heading_sigma, 1e3 * w.result.budget.noise);
+    } else {
+      std::snprintf(line, sizeof line, "  first %8.1f s: refused (%s)\n", w.seconds, w.result.gate.c_str());
+    }
+    std::cout << line;
+  }
+}
+
+int runAlign(const AlignCommand& c) {
+  const AlignOptions& o = c.align;
+  core::AlignmentSettings settings = loadSettings(o);
+  std::vector<double> windows;
+  try {
+    windows = parseWindows(o.windows, settings.duration);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--windows: ") + e.what());
+  }
+  std::vector<std::string> inputs{o.bag, o.settings};
+  std::shared_ptr<const core::TriadParameters> triad;
+  std::array<AxisInput, 3> axes;
+  std::unique_ptr<core::TriadProcessor> chain;
+  if (*c.triad_option) {
+    if (settings.single_gyro) throw UsageError("--triad: single_gyro aligns on one gyro's outputs, not a triad");
+    const core::TriadProcessorSettings chain_settings = checkedSettings(c.processor, c.triad);
+    triad = std::make_shared<const core::TriadParameters>(core::loadTriadFile(c.triad.triad_file));
+    axes = axisInputs(c.triad, *triad);
+    inputs.push_back(c.triad.triad_file);
+    for (const AxisInput& a : axes) inputs.push_back(a.parameter_file);
+    std::array<core::GyroParameters, 3> parameters;
+    for (std::size_t a = 0; a < 3; ++a) parameters[a] = core::loadParameterFile(axes[a].parameter_file);
+    chain = std::make_unique<core::TriadProcessor>(chain_settings, parameters, triad);
+  }
+  checkOutputPaths(inputs, {o.output});
+  const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
+  const AlignInputs in = findInputs(*bag, c, settings, axes);
+
+  AlignmentRun run(settings, windows);
+  BagFeed feed(in, o.start, &run);
+  feed.setChain(chain.get());
+  feed.read(*bag);
+  const core::AlignmentResult result = run.finish();
+  const std::vector<WindowResult> window_results = run.finishWindows();
+  printResult(run, result, window_results);
+  if (!o.output.empty()) {
+    try {
+      writeAlignmentFile(o.output, emitAlignmentRun(result, window_results, o.bag, o.settings), result, window_results);
+    } catch (const std::exception& e) {
+      throw OutputError("--output " + o.output + " not written: " + e.what());
+    }
+  }
+  return result.accepted ? 0 : 1;
+}
+
+constexpr const char* kAlignFooter =
+    "North-finding from the Earth's rate (docs/recorded_sessions.md): the settings' mode (static, indexed; one\n"
+    "gyro with single_gyro), site and gates, as the gyrocompass node's parameters. The triad's body samples\n"
+    "come from its triad/output, or from its axes' channels through the processors and the triad's combiner\n"
+    "(--triad FILE --axis-params NAME=FILE for each axis, as process --triad); mode indexed reads the indexer's\n"
+    "turntable/state; level/source accelerometer reads the sensor_msgs/Imu topic ending in accel/data_raw.\n"
+    "Prints the true heading (deg clockwise from North) +- 1 sigma and the error budget; --output writes the\n"
+    "whole result. Exit 0 accepted, 1 refused by a gate (named) or the bag ended before the window was full,\n"
+    "2 bad usage or unreadable input, 3 the result could not be written (nothing left at its path).";
+
+}  // namespace
+
+Command addAlignCommand(CLI::App& root) {
+  auto c = std::make_shared<AlignCommand>();
+  CLI::App* cmd = root.add_subcommand("align", "north-finding: true heading from the Earth's rate, with its budget");
+  addAlignOptions(*cmd, &c->align);
+  c->triad_option = addTriadOptions(*cmd, &c->triad);
+  addProcessorOptions(*cmd, &c->processor);
+  cmd->footer(kAlignFooter);
+  return [c] { return runAlign(*c); };
+}
+
+}  // namespace bag_tools
+}  // namespace hrg_gyro

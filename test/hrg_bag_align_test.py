@@ -1,0 +1,183 @@
+#!/usr/bin/env python3
+"""hrg_bag align, as a test engineer runs it on a recorded session: `hrg_bag simulate` of
+test/scenarios/north_align.yaml (a triad at rest on an indexer at latitude 0.9 rad, the platter's x axis
+at azimuth 2.0 rad = 114.59 deg true at table angle 0; 65 s there, a half turn, 65 s at pi), its axes'
+channels through the processors and the triad's combiner (--triad, --axis-params with the gyros' exact
+model). The static mode on the first 60 s and the indexed mode on both positions find the heading
+within 3 reported sigmas of the truth; the result file reads back; the window's first 15, 30, 60 s give
+sigmas that fall with the window; a moving table and a latitude beyond max_latitude are refused (exit 1)
+naming their gate; bad settings and options exit 2 naming the key or option. Needs no master; run as a
+rostest for the package environment."""
+import math
+import os
+import shutil
+import subprocess
+import unittest
+
+import rospy
+import rostest
+import yaml
+
+HRG_BAG = subprocess.check_output(["catkin_find", "--first-only", "--libexec", "hrg_gyro", "hrg_bag"],
+                                  universal_newlines=True).strip()
+AZIMUTH = 2.0  # rad, test/scenarios/north_align.yaml: the platter's x axis at table angle 0, from North to East
+
+STATIC = """# The static triad levelled by a declared (exact) level, the first 60 s of the session.
+mode: static                 # the triad at rest
+latitude: 0.9                # rad, the scenario's
+duration: 60.0               # s
+noise:
+  residual_bias: 1.0e-8      # rad/s, what a table calibration leaves (here the model is exact)
+level:
+  source: declared           # no accelerometer in the session
+  roll: 0.0                  # rad: the body on the platter, level
+  pitch: 0.0                 # rad
+"""
+
+INDEXED = """# The triad on the indexer, two positions 180 deg apart (the whole session).
+mode: indexed                # the gyros' own bias cancels
+latitude: 0.9                # rad
+duration: 137.0              # s: both rests and the half turn between
+level:
+  source: declared           # the indexer's zero frame is level
+indexer:
+  settle: 1.0                # s after the half turn before samples count
+"""
+
+
+def run(*args, timeout=600):
+    p = subprocess.run([HRG_BAG] + list(args), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       universal_newlines=True, timeout=timeout)
+    return p.returncode, p.stdout, p.stderr
+
+
+def heading_error_deg(heading, truth_deg):
+    return (heading - truth_deg + 180.0) % 360.0 - 180.0
+
+
+class HrgBagAlign(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.work = os.path.join(rospy.get_param("~work_dir"), "hrg_bag_align")
+        shutil.rmtree(cls.work, ignore_errors=True)
+        os.makedirs(cls.work)
+        cls.pkg = rospy.get_param("~package_dir")
+        cls.bag = cls.path("north_align.bag")
+        code, _, err = run("simulate", "--scenario", os.path.join(cls.pkg, "test/scenarios/north_align.yaml"),
+                           "--out", cls.bag, "--no-truth")
+        assert code == 0, err
+        axis = os.path.join(cls.pkg, "test/scenarios/north_align_axis.yaml")
+        cls.chain = ["--triad", os.path.join(cls.pkg, "config/triad.yaml")]
+        for name in "xyz":
+            cls.chain += ["--axis-params", "%s=%s" % (name, axis)]
+        cls.settings = {}
+        for name, text in (("static", STATIC), ("indexed", INDEXED)):
+            cls.settings[name] = cls.path(name + ".yaml")
+            with open(cls.settings[name], "w") as f:
+                f.write(text)
+
+    @classmethod
+    def path(cls, name):
+        return os.path.join(cls.work, name)
+
+    def align(self, settings, *extra):
+        return run("align", self.bag, "--settings", settings, *(self.chain + list(extra)))
+
+    def read(self, path):
+        with open(path) as f:
+            return yaml.safe_load(f)
+
+    def check_heading(self, result, what):
+        truth = math.degrees(AZIMUTH)
+        error = heading_error_deg(result["heading_deg"], truth)
+        sigma = result["heading_sigma_deg"]
+        print("[ measured ] %s: heading %.5f deg +- %.5f deg (truth %.5f deg): error %.4f mrad, sigma %.4f mrad, "
+              "%.2f sigma" % (what, result["heading_deg"], sigma, truth, 1e3 * math.radians(error),
+                              1e3 * math.radians(sigma), abs(error) / sigma))
+        self.assertLess(abs(error), 3.0 * sigma, what)
+
+    def test_the_static_triad_finds_the_heading_and_its_sigma_falls_with_the_window(self):
+        out = self.path("static.result.yaml")
+        code, stdout, err = self.align(self.settings["static"], "--output", out, "--windows", "15,30,60")
+        self.assertEqual(code, 0, stdout + err)
+        self.assertRegex(stdout, r"true heading [0-9.]+ deg \+- [0-9.]+ deg \(1 sigma\)")
+        r = self.read(out)
+        self.assertTrue(r["accepted"])
+        self.assertEqual(r["mode"], "static")
+        self.assertEqual(r["frame"], "body")
+        self.assertAlmostEqual(r["window"]["seconds"], 60.0, delta=0.01)
+        self.check_heading(r, "static, 60 s")
+        self.assertEqual(r["input"]["bag"], self.bag)
+        windows = r["windows"]
+        self.assertEqual([w["window_s"] for w in windows], [15.0, 30.0, 60.0])
+        self.assertTrue(all(w["accepted"] for w in windows), windows)
+        sigmas = [w["heading_sigma_deg"] for w in windows]
+        noise = [w["noise_rad"] for w in windows]
+        print("[ measured ] static, first 15, 30, 60 s: sigma %s deg, noise %s mrad" %
+              (", ".join("%.5f" % s for s in sigmas), ", ".join("%.4f" % (1e3 * n) for n in noise)))
+        self.assertTrue(sigmas[0] > sigmas[1] > sigmas[2], sigmas)
+        self.assertTrue(noise[0] > noise[1] > noise[2], noise)
+        # The whole window solved again (the result file carries its heading to 12 digits, the windows to 17).
+        self.assertAlmostEqual(windows[-1]["heading_deg"], r["heading_deg"], delta=1e-8)
+        for w in windows:
+            self.assertLess(abs(heading_error_deg(w["heading_deg"], math.degrees(AZIMUTH))),
+                            3.0 * w["heading_sigma_deg"], w)
+
+    def test_the_indexed_triad_finds_the_heading_of_the_indexers_zero(self):
+        out = self.path("indexed.result.yaml")
+        code, stdout, err = self.align(self.settings["indexed"], "--output", out)
+        self.assertEqual(code, 0, stdout + err)
+        r = self.read(out)
+        self.assertTrue(r["accepted"], r["reason"])
+        self.assertEqual((r["mode"], r["frame"]), ("indexed", "indexer"))
+        self.check_heading(r, "indexed, two positions of about 64 s")
+        angles = sorted(s["indexer_angle_rad"] for s in r["segments"])
+        self.assertEqual(len(angles), 2, r["segments"])
+        self.assertAlmostEqual(angles[0], 0.0, delta=1e-6)
+        self.assertAlmostEqual(angles[1], math.pi, delta=1e-6)
+        self.assertEqual(r["windows"], [])
+
+    def test_a_moving_table_and_a_latitude_beyond_the_limit_are_refused_naming_the_gate(self):
+        out = self.path("moving.result.yaml")
+        # The static mode over the half turn (65 s to 72 s): the motion gate, as the samples come.
+        code, stdout, err = self.align(self.settings["static"], "--duration", "100", "--output", out)
+        self.assertEqual(code, 1, stdout + err)
+        self.assertIn("alignment refused (motion)", stdout)
+        r = self.read(out)
+        self.assertEqual((r["accepted"], r["gate"]), (False, "motion"))
+        far_north = self.path("far_north.yaml")
+        with open(far_north, "w") as f:
+            f.write(STATIC + "max_latitude: 0.5          # rad: below the site's 0.9\n")
+        code, stdout, err = self.align(far_north)
+        self.assertEqual(code, 1, stdout + err)
+        self.assertIn("alignment refused (latitude)", stdout)
+        # The bag ends before the window is full: refused, saying how far it got.
+        code, stdout, err = self.align(self.settings["indexed"], "--duration", "500")
+        self.assertEqual(code, 1, stdout + err)
+        self.assertIn("the bag ended after", stdout)
+
+    def test_bad_settings_and_options_are_refused_by_name(self):
+        bad = self.path("bad.yaml")
+        with open(bad, "w") as f:
+            f.write(STATIC.replace("  roll: 0.0 ", "  rol: 0.0  "))
+        cases = [
+            (["--settings", bad], "rol"),
+            (["--settings", self.settings["static"], "--windows", "30,90"], "--windows"),
+            (["--settings", self.settings["static"], "--windows", "30,15"], "--windows"),
+            (["--settings", self.settings["static"], "--duration", "-1"], "--duration"),
+            (["--settings", self.settings["static"], "--output", self.bag], "refused"),
+            (["--settings", self.settings["static"], "--triad-topic", "/triad/output"], "triad-topic"),
+        ]
+        for extra, fragment in cases:
+            args = ["align", self.bag] + extra
+            if "--triad-topic" not in extra:
+                args += self.chain
+            code, stdout, err = run(*args)
+            self.assertEqual(code, 2, (args, stdout, err))
+            self.assertIn(fragment, err, args)
+        self.assertTrue(os.path.getsize(self.bag) > 0)
+
+
+if __name__ == "__main__":
+    rospy.init_node("hrg_bag_align_test")
+    rostest.rosrun("hrg_gyro", "hrg_bag_align", HrgBagAlign)
