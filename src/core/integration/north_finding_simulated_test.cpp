@@ -151,6 +151,9 @@ TEST_F(NorthFindingSimulated, StaticTriadWithAnExactLevelAfter120sAndWithTheAcce
   const SimulatedAlignment a = align(c, files_, exact);
   print("static 120 s, exact level", a);
   ASSERT_TRUE(a.result.accepted) << a.result.summary();
+  // 0.43 mrad. The scenario's residual puts the floor at the bound (its image below, 0.51 mrad): over
+  // the noise seeds 1 to 16 the error was 0.41 to 0.55 mrad, within 0.5 mrad for 10 of them; without
+  // noise and without the residual the chain's error was below 1e-4 mrad.
   EXPECT_LT(std::abs(a.error), 0.5e-3);
   EXPECT_LT(std::abs(a.error), 3.0 * a.result.budget.total);
   expectShippedNoise(a.result);
