@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -218,6 +219,10 @@ TEST(Scenarios, ShippedScenariosParseAndDescribeTheSameGyro) {
   files.erase("diagnosis.yaml");
   files.erase("triad.yaml");
   files.erase("triad_verification.yaml");
+  for (const std::string& name :
+       {"north_static.yaml", "north_indexed_two.yaml", "north_indexed_four.yaml", "north_continuous.yaml"}) {
+    files.erase(name);  // the triad's north-finding sessions (NorthScenarios...)
+  }
   for (const std::string& name : resonatorScenarios()) files.erase(name);
   EXPECT_EQ(files, shipped);
   std::string reference_gyro;
@@ -411,6 +416,77 @@ TEST(Scenarios, TriadShortScenarioIsTheCalibrationInTenMinutes) {
     for (const Plateau& q : plateaus) EXPECT_GE(0.56 * std::abs(q.rate) * (q.end - q.start), kTwoPi);
   }
   EXPECT_LT(brief.duration(), 600.0);
+}
+
+/// The rests (pieces at rate 0, not accelerating) of a profile: their angle and length.
+std::vector<std::pair<double, double>> restsOf(const TurntableProfile& p) {
+  std::vector<std::pair<double, double>> rests;
+  for (const TurntableProfile::Piece& piece : p.pieces()) {
+    if (piece.accel == 0.0 && piece.rate0 == 0.0 && piece.duration > 0.0)
+      rests.push_back({piece.angle0, piece.duration});
+  }
+  return rests;
+}
+
+// config/scenarios/north_*.yaml: the triad of triad.yaml, its D(theta) replaced by the residual a table
+// calibration leaves, at latitude 0.9 rad and a true heading of 0.4137 rad, with an accelerometer;
+// one session for each alignment mode.
+TEST(Scenarios, NorthScenariosAreTheCalibratedTriadInEachAlignmentMode) {
+  const TriadSimulationConfig cal = loadTriadScenario(kScenarioDir + "triad.yaml");
+  std::map<std::string, TriadSimulationConfig> north;
+  for (const char* name :
+       {"north_static.yaml", "north_indexed_two.yaml", "north_indexed_four.yaml", "north_continuous.yaml"}) {
+    SCOPED_TRACE(name);
+    const TriadSimulationConfig c = loadTriadScenario(kScenarioDir + name);
+    EXPECT_EQ(c.turntable.latitude, 0.9);
+    EXPECT_EQ(c.turntable.azimuth, 0.4137);
+    EXPECT_TRUE(c.accelerometer.enabled);
+    EXPECT_LE(c.accelerometer.bias.cwiseAbs().maxCoeff(), 5e-4);
+    for (int i = 0; i < 3; ++i) {
+      const TriadAxisConfig &a = c.axes[i], &b = cal.axes[i];
+      EXPECT_EQ(a.misalignment, b.misalignment);
+      EXPECT_EQ(a.resonator.scale_factor, b.resonator.scale_factor);
+      EXPECT_EQ(a.resonator.frequency, b.resonator.frequency);
+      EXPECT_EQ(a.resonator.initial_theta, b.resonator.initial_theta);
+      EXPECT_EQ(a.pickoff.noise, b.pickoff.noise);
+      EXPECT_EQ(a.pickoff.misplacement, b.pickoff.misplacement);
+      // The residual: 1e-8 rad/s of body rate, an order-2 term of 8e-9 rad/s.
+      const HarmonicModel& d = a.resonator.drift;
+      EXPECT_NEAR(std::abs(d.meanAt(NAN) / a.resonator.scale_factor.meanAt(NAN)), 1e-8, 1e-10);
+      ASSERT_EQ(d.orders(), std::vector<int>{2});
+      double coefficients[3];
+      d.coefficientsAt(NAN, coefficients);  // mean, cos 2, sin 2
+      EXPECT_NEAR(std::hypot(coefficients[1], coefficients[2]), 8e-9, 1e-10);
+    }
+    north.emplace(name, c);
+  }
+  // Static: one position, tilted by milliradians, the table at rest 125 s.
+  const TriadSimulationConfig& st = north.at("north_static.yaml");
+  ASSERT_EQ(st.positions.size(), 1u);
+  EXPECT_EQ(restsOf(st.table_profile).size(), 1u);
+  EXPECT_GE(st.duration(), 121.0);
+  const Eigen::Vector3d up = st.positions[0].bodyToPlatter().transpose() * Eigen::Vector3d::UnitZ();
+  EXPECT_GT(std::hypot(up.x(), up.y()), 1e-3);
+  EXPECT_LT(std::hypot(up.x(), up.y()), 5e-3);
+  // Indexed: rests of 61 s (60 s after the alignment's settle) 180 and 90 deg apart; continuous: two
+  // whole turns.
+  const double steps[2] = {kPi, kPi / 2};
+  const std::size_t counts[2] = {2, 4};
+  const char* indexed[2] = {"north_indexed_two.yaml", "north_indexed_four.yaml"};
+  for (int k = 0; k < 2; ++k) {
+    SCOPED_TRACE(indexed[k]);
+    const std::vector<std::pair<double, double>> rests = restsOf(north.at(indexed[k]).table_profile);
+    ASSERT_EQ(rests.size(), counts[k]);
+    for (std::size_t n = 0; n < rests.size(); ++n) {
+      EXPECT_NEAR(rests[n].first, n * steps[k], 1e-12);
+      EXPECT_GE(rests[n].second, 61.0);
+    }
+  }
+  const TriadSimulationConfig& turning = north.at("north_continuous.yaml");
+  double angle, rate;
+  turning.table_profile.evaluate(turning.duration() - 1.0, &angle, &rate);
+  EXPECT_NEAR(rate, kTwoPi / 120.0, 1e-12);
+  EXPECT_GE(angle, 2.0 * kTwoPi);
 }
 
 TEST(Scenarios, RejectsBadValuesByKey) {

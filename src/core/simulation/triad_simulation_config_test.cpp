@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/triad_file.h"
@@ -244,18 +247,22 @@ TEST(TriadSimulationConfigTest, RejectsBadValuesByKey) {
   expectError(replaced(good, "frame_id: fixture", "frame_id: fixture\n  wobble: 1"), "triad.wobble");
   expectError(good + "  fixture_error_std: 0.5\n", "triad.fixture_error_std");
   expectError(good + "  fixture_error_std: -1.0e-4\n", "triad.fixture_error_std");
-  // The accelerometer.
-  expectError(good + "  accelerometer: {gain: 1}\n", "triad.accelerometer.gain");
-  expectError(good + "  accelerometer: 1\n", "triad.accelerometer");
-  expectError(good + "  accelerometer: {bias: [0, 0]}\n", "triad.accelerometer.bias");
-  expectError(good + "  accelerometer: {bias: [0, 2.0, 0]}\n", "triad.accelerometer.bias[1]");
-  expectError(good + "  accelerometer: {noise: -1.0e-3}\n", "triad.accelerometer.noise");
-  expectError(good + "  accelerometer: {noise: 1.0e-3, noise_density: 1.0e-4}\n", "triad.accelerometer.noise_density");
-  expectError(good + "  accelerometer: {noise_density: 1.0}\n", "triad.accelerometer.noise_density");
-  expectError(good + "  accelerometer: {frame_id: ' '}\n", "triad.accelerometer.frame_id");
-  expectError(good + "  accelerometer: {mounting: {roll: .inf}}\n", "triad.accelerometer.mounting.roll");
-  expectError(good + "  accelerometer: {mounting: {heading: 1}}\n", "triad.accelerometer.mounting.heading");
-  expectError(good + "  accelerometer: {enabled: maybe}\n", "triad.accelerometer.enabled");
+  // The accelerometer: each section after the good scenario, and the key it is refused by.
+  const std::vector<std::pair<std::string, std::string>> accelerometer = {
+      {"{gain: 1}", "gain"},
+      {"1", ""},
+      {"{bias: [0, 0]}", "bias"},
+      {"{bias: [0, 2.0, 0]}", "bias[1]"},
+      {"{noise: -1.0e-3}", "noise"},
+      {"{noise: 1.0e-3, noise_density: 1.0e-4}", "noise_density"},
+      {"{noise_density: 1.0}", "noise_density"},
+      {"{frame_id: ' '}", "frame_id"},
+      {"{mounting: {roll: .inf}}", "mounting.roll"},
+      {"{mounting: {heading: 1}}", "mounting.heading"},
+      {"{enabled: maybe}", "enabled"}};
+  for (const auto& [section, key] : accelerometer) {
+    expectError(good + "  accelerometer: " + section + "\n", "triad.accelerometer" + (key.empty() ? "" : "." + key));
+  }
   // The axes.
   expectError(replaced(good, "    - {name: z, misalignment: [-2.5e-4, 0.5e-4], scale: -2.0e-4}\n", ""), "triad.axes");
   expectError(replaced(good, "{name: y,", "{name: x,"), "triad.axes[1].name");

@@ -10,6 +10,9 @@ namespace core {
 
 namespace {
 
+/// Largest angle error of a rest: an indexer off by more than 0.1 rad is not at its position.
+constexpr double kMaxRestAngleError = 0.1;  // rad
+
 const char* const kGlitchKeys[kTurntableGlitchKinds] = {"nan_rate", "absurd_rate", "infinite_angle", "zero_stamp",
                                                         "backward_stamp"};
 
@@ -53,7 +56,7 @@ double TurntableGlitchRates::total() const { return std::accumulate(per_record.b
 TurntableLogConfig TurntableLogConfig::parse(const YamlField& log) {
   log.requireMap();
   log.rejectUnknownKeys({"rate", "angle_noise", "angle_resolution", "logged_rate", "drop_probability", "gaps",
-                         "stamp_glitches", "glitches", "clock"});
+                         "stamp_glitches", "glitches", "clock", "rest_angle_errors", "rest_angle_error_std"});
   TurntableLogConfig c;
   c.rate = log.getDouble("rate", 0.0);
   if (!(std::isfinite(c.rate) && c.rate >= 0.0)) {
@@ -86,6 +89,19 @@ TurntableLogConfig TurntableLogConfig::parse(const YamlField& log) {
     if (!(c.glitches.total() <= 1.0)) g.fail("the glitch rates add up to more than 1 per record");
   }
   if (log.has("clock")) c.clock = TableClockConfig::parse(log["clock"]);
+  if (log.has("rest_angle_errors")) {
+    c.rest_errors.errors = log["rest_angle_errors"].asDoubles();
+    for (std::size_t k = 0; k < c.rest_errors.errors.size(); ++k) {
+      if (!(std::abs(c.rest_errors.errors[k]) <= kMaxRestAngleError)) {
+        log["rest_angle_errors"].at(k).fail("must be at most " + formatDouble(kMaxRestAngleError) +
+                                            " rad in magnitude (an indexer's position error)");
+      }
+    }
+  }
+  c.rest_errors.sigma = log.getDouble("rest_angle_error_std", 0.0);
+  if (!(c.rest_errors.sigma >= 0.0 && c.rest_errors.sigma <= kMaxRestAngleError)) {
+    log["rest_angle_error_std"].fail("must be in [0, " + formatDouble(kMaxRestAngleError) + "] rad");
+  }
   return c;
 }
 
@@ -94,6 +110,7 @@ TurntableLogger::TurntableLogger(const TurntableLogConfig& config, std::uint64_t
       encoder_noise_(seed ^ 0x3c6ef372fe94f82bULL),
       glitch_draws_(seed ^ 0xa54ff53a5f1d36f1ULL),
       clock_jitter_(seed ^ 0xcbbb9d5dc1059ed8ULL),
+      rest_draws_(seed ^ 0x1f83d9abfb41bd6bULL),
       delivery_(config.delivery, seed ^ 0x510e527fade682d1ULL) {}
 
 void TurntableLogger::log(double t, Nanoseconds stamp, double angle, double rate,
@@ -109,6 +126,16 @@ void TurntableLogger::log(double t, Nanoseconds stamp, double angle, double rate
     r.stamp = std::max<Nanoseconds>(1, stamp + toNanoseconds(error));
   }
   r.angle = angle;
+  if (config_.rest_errors.enabled()) {
+    if (rate == 0.0 && !at_rest_) {
+      const double drawn = rest_draws_.next();
+      const std::vector<double>& given = config_.rest_errors.errors;
+      rest_error_ = rests_ < given.size() ? given[rests_] : config_.rest_errors.sigma * drawn;
+      ++rests_;
+    }
+    at_rest_ = rate == 0.0;
+    if (at_rest_) r.angle += rest_error_;
+  }
   if (config_.angle_noise > 0.0) r.angle += config_.angle_noise * encoder_noise_.next();
   if (config_.angle_resolution > 0.0)
     r.angle = config_.angle_resolution * std::round(r.angle / config_.angle_resolution);

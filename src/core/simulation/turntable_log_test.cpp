@@ -557,9 +557,56 @@ TEST(TurntableLogTest, ScenarioKeysAreParsedAndBadOnesNamed) {
   EXPECT_EQ(key("  log: {clock: {ofset: 0.1}}\n"), "turntable.log.clock.ofset");
   EXPECT_EQ(key("  log: {clock: 0.1}\n"), "turntable.log.clock");
   EXPECT_EQ(key("  log: {clock: {offset: -0.05, steps: []}}\n"), "accepted");
+  EXPECT_EQ(key("  log: {rest_angle_errors: [1.0e-4, 0.2]}\n"), "turntable.log.rest_angle_errors[1]");
+  EXPECT_EQ(key("  log: {rest_angle_errors: 1.0e-4}\n"), "turntable.log.rest_angle_errors");
+  EXPECT_EQ(key("  log: {rest_angle_error_std: -1.0e-5}\n"), "turntable.log.rest_angle_error_std");
+  EXPECT_EQ(key("  log: {rest_angle_errors: [1.0e-4, -2.0e-4], rest_angle_error_std: 3.0e-5}\n"), "accepted");
   EXPECT_EQ(key("channels: {drop_probability: -0.1}\n"), "channels.drop_probability");
   EXPECT_EQ(key("channels: {gaps: [[-1, 1]]}\n"), "channels.gaps[0]");
   EXPECT_EQ(key("channels: {gap: []}\n"), "channels.gap");
+}
+
+TEST(TurntableLogTest, EachRestStopsOffByItsGivenOrDrawnAngleError) {
+  // Rests at 0, 0.6 and 1.2 rad joined by moves at 0.1 rad/s; one record a second.
+  struct Record {
+    double angle, rate;
+  };
+  std::vector<Record> motion;
+  for (int k = 0; k < 40; ++k) {
+    const int in = k % 15;
+    const double base = 0.6 * (k / 15);
+    motion.push_back(in < 10 ? Record{base, 0.0} : Record{base + 0.1 * (in - 9), 0.1});
+  }
+  auto logged = [&](const RestAngleErrorConfig& errors) {
+    TurntableLogConfig c;
+    c.rest_errors = errors;
+    TurntableLogger logger(c, 7);
+    std::vector<TurntableLogRecord> out;
+    for (std::size_t k = 0; k < motion.size(); ++k)
+      logger.log(static_cast<double>(k), toNanoseconds(1.0 + k), motion[k].angle, motion[k].rate, &out);
+    return out;
+  };
+  const std::vector<TurntableLogRecord> a = logged({{1e-4, -2e-4}, 3e-5});
+  ASSERT_EQ(a.size(), motion.size());
+  const double drawn = a[30].angle - motion[30].angle;
+  EXPECT_NE(drawn, 0.0);
+  EXPECT_LT(std::abs(drawn), 6.0 * 3e-5);
+  for (std::size_t k = 0; k < motion.size(); ++k) {
+    const double error = a[k].angle - motion[k].angle;
+    if (motion[k].rate != 0.0) {
+      EXPECT_EQ(error, 0.0) << k;  // turning: the encoder's angle
+    } else {
+      EXPECT_NEAR(error, k < 15 ? 1e-4 : k < 30 ? -2e-4 : drawn, 1e-15) << k;
+    }
+  }
+  // Giving one rest's error changes no other's draw.
+  const std::vector<TurntableLogRecord> b = logged({{5e-4}, 3e-5});
+  EXPECT_NEAR(b[0].angle - motion[0].angle, 5e-4, 1e-15);
+  EXPECT_NEAR(b[30].angle - motion[30].angle, drawn, 1e-15);
+  EXPECT_NE(b[15].angle - motion[15].angle, -2e-4);
+  // None asked: the exact angle.
+  const std::vector<TurntableLogRecord> exact = logged({});
+  for (std::size_t k = 0; k < motion.size(); ++k) EXPECT_EQ(exact[k].angle, motion[k].angle);
 }
 
 }  // namespace

@@ -3,13 +3,13 @@
 // angle read through an encoder (white noise, quantisation to whole counts), the rate either the
 // drive's (true) rate or the logged angle differenced at the log rate, lost records (StreamDelivery),
 // and glitched records (a NaN or absurd rate, an infinite angle, a zero or backward stamp) at a
-// given rate per record. The controller may stamp on its own computer's clock (TableClockConfig):
-// an offset from the gyro's clock, a rate error, steps and white jitter; the records are still
-// taken at their true times, only their stamps move (out of order when the jitter exceeds the
-// spacing: they are left so, as a real log would hold them). Each random effect draws from its own
-// seeded stream, so a scenario gives the same log run after run and switching one effect on leaves
-// the others' draws unchanged. Defaults: the exact table state and stamps, nothing lost, nothing
-// glitched.
+// given rate per record, and an error of the angle each rest stops at (an indexer's position error:
+// the logged angle of rest k is the true one plus e_k, given or drawn). The controller may stamp on its own computer's
+// clock (TableClockConfig): an offset from the gyro's clock, a rate error, steps and white jitter; the records are
+// still taken at their true times, only their stamps move (out of order when the jitter exceeds the spacing: they are
+// left so, as a real log would hold them). Each random effect draws from its own seeded stream, so a scenario gives the
+// same log run after run and switching one effect on leaves the others' draws unchanged. Defaults: the exact table
+// state and stamps, nothing lost, nothing glitched.
 #pragma once
 
 #include <array>
@@ -68,10 +68,22 @@ struct TableClockConfig {
   static TableClockConfig parse(const YamlField& clock);
 };
 
+/// Each rest's angle error: while the table is at rest (its true rate exactly 0), the logged angle is
+/// the true one plus e_k, k counting the rests from 0 in the order the table comes to them (a fixture
+/// move of a triad session is a rest too). e_k is errors[k] when given, else drawn N(0, sigma) from a
+/// stream of its own; every rest takes one draw whether given or not, so giving one rest's error
+/// changes no other's. The logged angle steps by e_k when the table stops and back when it starts.
+struct RestAngleErrorConfig {
+  std::vector<double> errors;  ///< rad, given, rest by rest
+  double sigma = 0.0;          ///< rad, 1 sigma of the rests beyond `errors`
+  bool enabled() const { return !errors.empty() || sigma > 0.0; }
+};
+
 struct TurntableLogConfig {
   double rate = 0.0;              ///< Hz; 0: one record with every output sample, at its stamp
   double angle_noise = 0.0;       ///< rad, white noise of the logged angle
   double angle_resolution = 0.0;  ///< rad per encoder count; 0: not quantised
+  RestAngleErrorConfig rest_errors;
   LoggedRate logged_rate = LoggedRate::kTable;
   DeliveryConfig delivery;  ///< lost records
   TurntableGlitchRates glitches;
@@ -113,7 +125,11 @@ class TurntableLogger {
   GaussianNoise encoder_noise_;
   GaussianNoise glitch_draws_;
   GaussianNoise clock_jitter_;
+  GaussianNoise rest_draws_;
   StreamDelivery delivery_;
+  bool at_rest_ = false;
+  std::size_t rests_ = 0;    // rests begun so far
+  double rest_error_ = 0.0;  // rad, the current rest's
   bool has_previous_ = false;
   double previous_time_ = 0.0;
   double previous_angle_ = 0.0;  // as logged, before any glitch
