@@ -190,6 +190,43 @@ class HrgBagAlign(unittest.TestCase):
         self.assertEqual(code, 2, err)
         self.assertIn("accel/data_raw", err)
 
+    def test_one_gyro_on_the_indexer_finds_the_heading_from_four_positions(self):
+        # The session's x gyro alone (horizontal, along the platter's x), its outputs as its processor
+        # node publishes them (hrg_bag process --triad --out), on four positions 90 deg apart of 30 s.
+        with open(os.path.join(self.pkg, "test/scenarios/north_align.yaml")) as f:
+            text = f.read()
+        step = "{type: steps, angle: 3.141592653589793, rate: 0.5, dwell: 65.0, count: 1, label: index}"
+        self.assertIn(step, text)
+        scenario, bag = self.path("four.yaml"), self.path("four.bag")
+        with open(scenario, "w") as f:
+            f.write(text.replace(step, step.replace("3.141592653589793", "1.5707963267948966")
+                                 .replace("65.0", "30.0").replace("count: 1", "count: 3")))
+        self.assertEqual(run("simulate", "--scenario", scenario, "--out", bag, "--no-truth")[0], 0)
+        processed, gyro = self.path("four_processed.bag"), self.path("four_gyro.bag")
+        code, _, err = run("process", bag, "--out", processed, *self.chain)
+        self.assertEqual(code, 0, err)
+        with rosbag.Bag(processed) as a, rosbag.Bag(bag) as b, rosbag.Bag(gyro, "w") as out:
+            for topic, message, t in a.read_messages(topics=["/x/output"]):
+                out.write(topic, message, t)
+            for topic, message, t in b.read_messages(topics=["/turntable/state"]):
+                out.write(topic, message, t)
+        settings = self.path("single.yaml")
+        with open(settings, "w") as f:
+            f.write(INDEXED.replace("duration: 137.0              # s: both rests and the half turn between",
+                                    "duration: 132.0              # s: four rests and three quarter turns")
+                    + "single_gyro: true            # the x gyro alone\n")
+        result = self.path("single.result.yaml")
+        code, stdout, err = run("align", gyro, "--settings", settings, "--output", result)
+        self.assertEqual(code, 0, stdout + err)
+        self.assertIn("(one gyro)", stdout)
+        r = self.read(result)
+        self.assertEqual((r["mode"], r["single_gyro"], r["frame"], len(r["segments"])), ("indexed", True, "indexer", 4))
+        self.check_heading(r, "one gyro, indexed, four positions of about 29 s")
+        # Two of the gyro's outputs in the bag: the one to align names itself.
+        code, _, err = run("align", processed, "--settings", settings)
+        self.assertEqual(code, 2, err)
+        self.assertIn("gyro-topic", err)
+
     def test_a_moving_table_and_a_latitude_beyond_the_limit_are_refused_naming_the_gate(self):
         out = self.path("moving.result.yaml")
         # The static mode over the half turn (65 s to 72 s): the motion gate, as the samples come.
