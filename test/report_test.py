@@ -414,6 +414,19 @@ class ReportTest(unittest.TestCase):
         code, _, err = run(HRG_BAG, "report", results[0], self.prior, "--out", self.path("mix.html"))
         self.assertEqual(code, 2, err)
         self.assertIn("an alignment result and a calibration report do not share a page", err)
+        # A damaged result is refused naming the key, nothing written.
+        with open(results[0]) as f:
+            good = f.read()
+        for bad, message in ((re.sub(r"\nheading_deg: [^\n]*", "\nheading_deg: abc", good), "heading_deg: must be a number"),
+                             (good.replace("{window_s: 5, ", "{"), "windows[0].window_s: missing"),
+                             (re.sub(r"\n  total: [^\n]*", "", good), "budget_rad.total: missing")):
+            path = self.path("damaged.alignment.yaml")
+            with open(path, "w") as f:
+                f.write(bad)
+            code, _, err = run(HRG_BAG, "report", path, "--out", self.path("damaged.html"))
+            self.assertEqual(code, 2, err)
+            self.assertIn(message, err)
+            self.assertFalse(os.path.exists(self.path("damaged.html")))
         self.assertFalse(os.path.exists(self.path("mix.html")))
 
     def test_hrg_bag_runs_the_scripts_with_their_own_help(self):
