@@ -1,4 +1,4 @@
-// The five wrappers as nodelets (the calibrator's: one of two, by ~method), for zero-copy pipelines in one manager.
+// The six wrappers as nodelets (the calibrator's: one of two, by ~method), for zero-copy pipelines in one manager.
 // Each owns the same wrapper class as its node. The driver never shuts the manager down when its scenario ends; the
 // session monitor does when ~shutdown_when_done asks for it (demos and tests).
 #include <nodelet/nodelet.h>
@@ -10,6 +10,7 @@
 
 #include "hrg_gyro/ros/calibrator_ros.h"
 #include "hrg_gyro/ros/driver_sim_ros.h"
+#include "hrg_gyro/ros/gyrocompass_ros.h"
 #include "hrg_gyro/ros/processor_ros.h"
 #include "hrg_gyro/ros/session_monitor_ros.h"
 #include "hrg_gyro/ros/triad_calibrator_ros.h"
@@ -76,6 +77,10 @@ class TriadNodelet : public WrapperNodelet<TriadRos> {
   void onInit() override { create(getNodeHandle(), getPrivateNodeHandle()); }
 };
 
+class GyrocompassNodelet : public WrapperNodelet<GyrocompassRos> {
+  void onInit() override { create(getNodeHandle(), getPrivateNodeHandle()); }
+};
+
 }  // namespace hrg_gyro
 
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::DriverSimNodelet, nodelet::Nodelet)
@@ -83,3 +88,4 @@ PLUGINLIB_EXPORT_CLASS(hrg_gyro::ProcessorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::CalibratorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::SessionMonitorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(hrg_gyro::TriadNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(hrg_gyro::GyrocompassNodelet, nodelet::Nodelet)

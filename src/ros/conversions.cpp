@@ -1,5 +1,6 @@
 #include "hrg_gyro/ros/conversions.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hrg_gyro {
@@ -380,6 +381,125 @@ core::FixtureRecord fromMessage(const FixturePosition& msg) {
       Eigen::Quaterniond(msg.body_to_table.w, msg.body_to_table.x, msg.body_to_table.y, msg.body_to_table.z);
   r.locked = msg.locked;
   return r;
+}
+
+core::TriadBodySample fromMessage(const TriadOutput& m) {
+  core::TriadBodySample s;
+  s.stamp = toNanoseconds(m.header.stamp);
+  s.dt = m.dt;
+  s.delta_angle = Eigen::Vector3d(m.delta_angle.x, m.delta_angle.y, m.delta_angle.z);
+  s.angular_velocity = Eigen::Vector3d(m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) s.covariance(i, j) = m.angular_velocity_covariance[3 * i + j];
+  }
+  s.flags = m.flags;
+  return s;
+}
+
+core::IndexerRecord fromMessage(const TurntableState& m) {
+  core::IndexerRecord r;
+  r.stamp = toNanoseconds(m.header.stamp);
+  r.angle = m.angle;
+  r.rate = m.rate;
+  return r;
+}
+
+core::AccelerometerRecord fromAccelerometerMessage(const sensor_msgs::Imu& m) {
+  core::AccelerometerRecord r;
+  r.stamp = toNanoseconds(m.header.stamp);
+  r.specific_force = Eigen::Vector3d(m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z);
+  return r;
+}
+
+core::PrecessionStateRecord fromMessage(const PrecessionState& m) {
+  core::PrecessionStateRecord r;
+  r.stamp = toNanoseconds(m.header.stamp);
+  r.rate = m.rate;
+  r.angle = m.angle;
+  return r;
+}
+
+namespace {
+
+template <class Array>
+void copyMatrix(const Eigen::Matrix3d& matrix, Array* out) {
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) (*out)[3 * i + j] = matrix(i, j);
+  }
+}
+
+}  // namespace
+
+AlignmentResult toMessage(const core::AlignmentResult& r, const std::string& frame_id) {
+  AlignmentResult m;
+  m.header.stamp = toRosTime(r.end);
+  m.header.frame_id = frame_id;
+  m.accepted = r.accepted;
+  m.gate = r.gate;
+  m.reason = r.reason;
+  m.mode = core::toString(r.mode);
+  m.single_gyro = r.single_gyro;
+  m.frame = r.frame;
+  m.heading_deg = r.heading;
+  m.heading_sigma_deg = r.heading_sigma;
+  m.roll = r.attitude.roll;
+  m.pitch = r.attitude.pitch;
+  m.yaw = r.attitude.yaw;
+  m.orientation = toQuaternionMessage(r.orientation);
+  copyMatrix(r.covariance_enu, &m.orientation_covariance);
+  copyMatrix(r.covariance_rpy, &m.euler_covariance);
+  m.body_orientation = toQuaternionMessage(r.body_orientation);
+  m.window_start = toRosTime(r.start);
+  m.window_end = toRosTime(r.end);
+  m.seconds = r.seconds;
+  m.samples = r.samples;
+  const core::HeadingErrorBudget& b = r.budget;
+  m.budget_white_angle_noise = b.white_angle_noise;
+  m.budget_angle_random_walk = b.angle_random_walk;
+  m.budget_noise = b.noise;
+  m.budget_residual_bias = b.residual_bias;
+  m.budget_drift_harmonics = b.drift_harmonics;
+  m.budget_bias_random_walk = b.bias_random_walk;
+  m.budget_level = b.level;
+  m.budget_indexer = b.indexer;
+  m.budget_total = b.total;
+  m.horizontal_rate = r.horizontal_rate;
+  m.horizontal_rate_std = r.horizontal_rate_std;
+  m.expected_horizontal_rate = b.horizontal_earth_rate;
+  m.latitude = b.latitude;
+  m.scatter = r.scatter;
+  m.worst_motion = r.worst_motion;
+  for (const core::AlignmentSegment& g : r.segments) {
+    m.segment_start.push_back(g.start);
+    m.segment_end.push_back(g.end);
+    m.segment_indexer_angle.push_back(g.indexer_angle);
+    m.segment_commanded_rate.push_back(g.commanded_rate);
+    double worst = 0.0;
+    for (std::size_t c = 0; c < g.rms.size() && c < g.predicted_rms.size(); ++c) {
+      if (g.predicted_rms[c] > 0.0) worst = std::max(worst, g.rms[c] / g.predicted_rms[c]);
+    }
+    m.segment_rms_ratio.push_back(worst);
+  }
+  return m;
+}
+
+sensor_msgs::Imu toAlignmentImuMessage(const core::AlignmentResult& r, const std::string& frame_id) {
+  sensor_msgs::Imu m;
+  m.header.stamp = toRosTime(r.end);
+  m.header.frame_id = frame_id;
+  m.orientation = toQuaternionMessage(r.body_orientation);
+  copyMatrix(r.covariance_enu, &m.orientation_covariance);
+  m.angular_velocity_covariance[0] = -1.0;
+  m.linear_acceleration_covariance[0] = -1.0;
+  return m;
+}
+
+sensor_msgs::Imu toHeldImuMessage(const core::AttitudeHold& hold, const core::TriadBodySample& sample,
+                                  const std::string& frame_id) {
+  sensor_msgs::Imu m = toImuMessage(sample, frame_id);
+  m.orientation = toQuaternionMessage(hold.orientation());
+  copyMatrix(hold.covariance(), &m.orientation_covariance);
+  return m;
 }
 
 }  // namespace hrg_gyro

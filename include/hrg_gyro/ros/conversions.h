@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "hrg_gyro/AlignmentResult.h"
 #include "hrg_gyro/BodyTruth.h"
 #include "hrg_gyro/CalibrationResult.h"
 #include "hrg_gyro/ChannelAmplitudes.h"
@@ -19,6 +20,8 @@
 #include "hrg_gyro/TriadOutput.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
+#include "hrg_gyro/core/alignment/attitude_hold.h"
+#include "hrg_gyro/core/alignment/gyrocompass.h"
 #include "hrg_gyro/core/calibration/calibration_outcome.h"
 #include "hrg_gyro/core/calibration/triad/triad_calibration.h"
 #include "hrg_gyro/core/common/units.h"
@@ -111,5 +114,27 @@ TriadCalibrationResult toMessage(const core::TriadOutcome& outcome);
 /// The fixture's position as logged, its quaternion as is: core::acceptFixtureOrientation decides
 /// whether it is a rotation (the live calibrator and `hrg_bag calibrate --method triad` alike).
 core::FixtureRecord fromMessage(const FixturePosition& msg);
+
+// North-finding: the records the gyrocompass node (and `hrg_bag align`) feed core::Gyrocompass with,
+// and its outputs. Frames and signs: core/alignment/local_level.h.
+/// A triad sample as the combiner made it (missing_axes, which the message does not carry, left 0).
+core::TriadBodySample fromMessage(const TriadOutput& msg);
+/// The indexer's (or rate table's) state.
+core::IndexerRecord fromMessage(const TurntableState& msg);
+/// An accelerometer's specific force (linear_acceleration, REP-145: +g up at rest), in its own frame.
+core::AccelerometerRecord fromAccelerometerMessage(const sensor_msgs::Imu& msg);
+/// The driver's precession state.
+core::PrecessionStateRecord fromMessage(const PrecessionState& msg);
+/// The result as a message: stamped with the window's end; frame_id the frame its triad or gyro
+/// publishes in.
+AlignmentResult toMessage(const core::AlignmentResult& result, const std::string& frame_id);
+/// An accepted result as an absolute attitude for a navigation filter: the body's orientation
+/// (body -> ENU at the window's end) with its ENU covariance; angular velocity and acceleration not
+/// measured (covariance[0] = -1). Stamped with the window's end.
+sensor_msgs::Imu toAlignmentImuMessage(const core::AlignmentResult& result, const std::string& frame_id);
+/// The held attitude at a triad sample: the hold's orientation and covariance, the sample's angular
+/// velocity and covariance (as toImuMessage gives them), acceleration not measured.
+sensor_msgs::Imu toHeldImuMessage(const core::AttitudeHold& hold, const core::TriadBodySample& sample,
+                                  const std::string& frame_id);
 
 }  // namespace hrg_gyro

@@ -1,0 +1,290 @@
+#include "hrg_gyro/ros/gyrocompass_ros.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "hrg_gyro/AlignmentResult.h"
+#include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/model/triad_file.h"
+#include "hrg_gyro/ros/conversions.h"
+#include "hrg_gyro/ros/diagnostics_timer.h"
+#include "hrg_gyro/ros/param_tree.h"
+
+namespace hrg_gyro {
+namespace {
+
+using diagnostic_msgs::DiagnosticStatus;
+
+std::invalid_argument startupError(const std::string& what) { return std::invalid_argument("gyrocompass: " + what); }
+
+std::string format(const char* fmt, double a, double b) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, fmt, a, b);
+  return buf;
+}
+
+}  // namespace
+
+GyrocompassRos::GyrocompassRos(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh),
+      pnh_(pnh),
+      params_(pnh, "gyrocompass"),
+      updater_(nh, params_.checkDiagnosticPeriod(), pnh.getNamespace()) {
+  // The alignment's settings, by the parser `hrg_bag align --settings` uses.
+  try {
+    settings_ = core::AlignmentSettings::parse(core::YamlField(privateParameters(pnh_), ""),
+                                               core::AlignmentSettings::nodeKeys());
+  } catch (const core::ConfigError& e) {
+    throw startupError(std::string("~") + e.what());
+  }
+  params_.claim(core::AlignmentSettings::keyPaths());
+  const std::string triad_file = params_.get<std::string>("triad_file", "");
+  if (!triad_file.empty()) {
+    try {
+      triad_ = core::loadTriadFile(triad_file);
+    } catch (const core::ConfigError& e) {
+      throw startupError(std::string("~triad_file: ") + e.what());
+    }
+    have_triad_file_ = true;
+  }
+  if (settings_.mode == core::AlignmentMode::kSweep && !have_triad_file_) {
+    throw startupError("~mode sweep needs ~triad_file (the axes' names, M and the body bias)");
+  }
+  hold_enabled_ = params_.get("hold/enabled", hold_enabled_);
+  hold_settings_.latitude = settings_.latitude;
+  hold_settings_.noise = settings_.noise;
+  hold_settings_.covariance_interval =
+      params_.getPositive("hold/covariance_interval", hold_settings_.covariance_interval, "s");
+  const bool align_at_startup = params_.get("align_at_startup", false);
+  const int queue_size = params_.getAtLeast("queue_size", 50000, 1, "messages");
+  const std::vector<std::string> unknown = params_.unknownKeys();
+  if (!unknown.empty()) throw startupError("~" + unknown.front() + ": unknown parameter (see config/gyrocompass.yaml)");
+  try {
+    hold_settings_.validate();
+  } catch (const core::ConfigError& e) {
+    throw startupError("~hold: " + std::string(e.what()));
+  }
+
+  result_pub_ = nh_.advertise<AlignmentResult>("alignment/result", 1, true);
+  alignment_imu_pub_ = nh_.advertise<sensor_msgs::Imu>("alignment/imu", 1, true);
+  if (hold_enabled_) imu_pub_ = nh_.advertise<sensor_msgs::Imu>("imu/data", queue_size);
+  align_srv_ = pnh_.advertiseService("align", &GyrocompassRos::onAlign, this);
+
+  updater_.setHardwareID("hrg_gyro_gyrocompass");
+  updater_.add("gyrocompass", this, &GyrocompassRos::diagnoseAlignment);
+  if (hold_enabled_) updater_.add("attitude hold", this, &GyrocompassRos::diagnoseHold);
+
+  // What the configured mode needs; triad/output also for the hold.
+  const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
+  subscribers_.push_back(nh_.subscribe("triad/output", queue_size, &GyrocompassRos::onTriad, this, hints));
+  if (settings_.single_gyro) {
+    subscribers_.push_back(nh_.subscribe("output", queue_size, &GyrocompassRos::onGyro, this, hints));
+  }
+  if (settings_.mode == core::AlignmentMode::kIndexed) {
+    subscribers_.push_back(nh_.subscribe("turntable/state", queue_size, &GyrocompassRos::onIndexer, this, hints));
+  }
+  if (settings_.level.source == core::LevelSource::kAccelerometer) {
+    subscribers_.push_back(nh_.subscribe("accel/data_raw", queue_size, &GyrocompassRos::onAccelerometer, this, hints));
+  }
+  if (have_triad_file_) {
+    for (std::size_t a = 0; a < 3; ++a) {
+      const std::string& axis = triad_.axes[a];
+      subscribers_.push_back(nh_.subscribe<GyroOutput>(
+          triadAxisTopic(axis, "output"), queue_size, [this, a](const GyroOutput::ConstPtr& m) { onSweepAxis(a, m); },
+          ros::VoidConstPtr(), hints));
+      subscribers_.push_back(nh_.subscribe<PrecessionState>(
+          triadAxisTopic(axis, "precession/state"), queue_size,
+          [this, a](const PrecessionState::ConstPtr& m) { onPrecession(a, m); }, ros::VoidConstPtr(), hints));
+    }
+  }
+  diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
+  ROS_INFO("gyrocompass: mode %s%s, latitude %.6f rad, window %.1f s, level %s; ~align starts one",
+           toString(settings_.mode), settings_.single_gyro ? " (one gyro)" : "", settings_.latitude, settings_.duration,
+           settings_.level.source == core::LevelSource::kDeclared ? "declared" : "accel/data_raw");
+  if (align_at_startup) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const std::string refused = start(0.0, "");
+    if (!refused.empty()) ROS_ERROR("gyrocompass: the alignment at start-up was refused: %s", refused.c_str());
+  }
+}
+
+GyrocompassRos::~GyrocompassRos() {
+  // First: the timer runs the diagnostic tasks, which read the members below.
+  diagnostics_timer_.stop();
+  for (ros::Subscriber& s : subscribers_) s.shutdown();
+}
+
+std::string GyrocompassRos::start(double duration, const std::string& mode) {
+  if (running_) {
+    const core::AlignmentProgress p = running_->progress();
+    return format("an alignment runs (%.1f of %.1f s): wait for its result", p.seconds, p.duration);
+  }
+  if (!std::isfinite(duration) || duration < 0.0) return "duration must be 0 (the configured) or positive, s";
+  core::AlignmentSettings s = settings_;
+  if (duration > 0.0) s.duration = duration;
+  try {
+    if (!mode.empty()) s.mode = core::parseAlignmentMode(mode);
+    s.validate();
+  } catch (const core::ConfigError& e) {
+    return e.what();
+  }
+  if (s.mode == core::AlignmentMode::kSweep && !have_triad_file_) {
+    return "mode sweep needs ~triad_file (its axes' topics are not subscribed)";
+  }
+  if (s.mode == core::AlignmentMode::kIndexed && settings_.mode != core::AlignmentMode::kIndexed) {
+    return "mode indexed needs ~mode indexed at start-up (turntable/state is not subscribed)";
+  }
+  running_ = std::make_unique<core::Gyrocompass>(s, triad_);
+  running_frame_.clear();
+  ++alignments_;
+  ROS_INFO("gyrocompass: alignment %llu started: mode %s, %.1f s of gyro stamps",
+           static_cast<unsigned long long>(alignments_), toString(s.mode), s.duration);
+  finishIfComplete();  // a latitude beyond max_latitude refuses it at once
+  if (!running_ && last_ && !last_->accepted) return "refused (" + last_->gate + "): " + last_->reason;
+  return "";
+}
+
+void GyrocompassRos::finishIfComplete() {
+  if (!running_ || !running_->complete()) return;
+  core::AlignmentResult r = running_->finish();
+  const bool triad = !r.single_gyro;
+  running_.reset();
+  const std::string frame = running_frame_;
+  result_pub_.publish(toMessage(r, frame));
+  if (r.accepted) {
+    alignment_imu_pub_.publish(toAlignmentImuMessage(r, frame));
+    ROS_INFO("gyrocompass: %s", r.summary().c_str());
+    if (hold_enabled_ && triad) {
+      hold_ = std::make_unique<core::AttitudeHold>(hold_settings_, core::holdStartFrom(r));
+      hold_frame_ = frame;
+    }
+  } else {
+    ROS_ERROR("gyrocompass: alignment refused (%s): %s", r.gate.c_str(), r.reason.c_str());
+  }
+  last_ = std::move(r);
+}
+
+void GyrocompassRos::onTriad(const TriadOutput::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const core::TriadBodySample sample = fromMessage(*msg);
+  if (hold_ && hold_->holding()) {
+    if (hold_->add(sample)) {
+      imu_pub_.publish(toHeldImuMessage(*hold_, sample, hold_frame_));
+    } else if (!hold_->holding()) {
+      ROS_WARN("gyrocompass: attitude hold lost: %s; align again", hold_->lostReason().c_str());
+    }
+  }
+  if (!running_ || running_->settings().single_gyro || running_->settings().mode == core::AlignmentMode::kSweep) {
+    return;
+  }
+  running_frame_ = msg->header.frame_id;
+  running_->addTriad(sample);
+  finishIfComplete();
+}
+
+void GyrocompassRos::onGyro(const GyroOutput::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!running_ || !running_->settings().single_gyro) return;
+  running_frame_ = msg->header.frame_id;
+  running_->addAxis(toAxisOutput(*msg));
+  finishIfComplete();
+}
+
+void GyrocompassRos::onSweepAxis(std::size_t axis, const GyroOutput::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!running_ || running_->settings().mode != core::AlignmentMode::kSweep) return;
+  running_frame_ = triad_.frame_id;
+  running_->addSweepAxis(axis, toAxisOutput(*msg));
+  finishIfComplete();
+}
+
+void GyrocompassRos::onPrecession(std::size_t axis, const PrecessionState::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (running_ && running_->settings().mode == core::AlignmentMode::kSweep)
+    running_->addPrecession(axis, fromMessage(*msg));
+}
+
+void GyrocompassRos::onIndexer(const TurntableState::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (running_) running_->addIndexer(fromMessage(*msg));
+}
+
+void GyrocompassRos::onAccelerometer(const sensor_msgs::Imu::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (running_) running_->addAccelerometer(fromAccelerometerMessage(*msg));
+}
+
+bool GyrocompassRos::onAlign(StartAlignment::Request& req, StartAlignment::Response& res) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::string refused = start(req.duration, req.mode);
+  res.success = refused.empty();
+  res.message = refused.empty() ? "aligning: " + core::formatDouble(running_->settings().duration) +
+                                      " s of gyro stamps, mode " + toString(running_->settings().mode)
+                                : refused;
+  if (!refused.empty()) ROS_WARN("gyrocompass: ~align refused: %s", refused.c_str());
+  return true;
+}
+
+void GyrocompassRos::diagnoseAlignment(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (running_) {
+    const core::AlignmentProgress p = running_->progress();
+    stat.summaryf(DiagnosticStatus::WARN, "aligning: %.1f of %.1f s (%s)", p.seconds, p.duration,
+                  toString(running_->settings().mode));
+    stat.add("window seconds", p.seconds);
+    stat.add("window duration", p.duration);
+    stat.add("samples", p.samples);
+    stat.add("gaps", p.gaps);
+    stat.add("dropped records", p.dropped);
+    stat.add("indexer records", p.indexer);
+    stat.add("accelerometer records", p.accelerometer);
+  } else if (!last_) {
+    stat.summary(DiagnosticStatus::WARN, "no alignment yet: call ~align");
+  } else if (last_->accepted) {
+    stat.summaryf(DiagnosticStatus::OK, "heading %.4f +- %.4f deg (true, clockwise from North; %s, %.1f s)",
+                  last_->heading, last_->heading_sigma, toString(last_->mode), last_->seconds);
+  } else {
+    stat.summaryf(DiagnosticStatus::ERROR, "alignment refused (%s): %s", last_->gate.c_str(), last_->reason.c_str());
+  }
+  stat.add("alignments started", alignments_);
+  if (!last_) return;
+  const core::AlignmentResult& r = *last_;
+  stat.add("last accepted", r.accepted ? "true" : "false");
+  stat.add("last gate", r.gate);
+  stat.add("last heading deg", r.heading);
+  stat.add("last heading sigma deg", r.heading_sigma);
+  stat.add("last roll rad", r.attitude.roll);
+  stat.add("last pitch rad", r.attitude.pitch);
+  stat.add("budget noise rad", r.budget.noise);
+  stat.add("budget residual bias rad", r.budget.residual_bias);
+  stat.add("budget drift harmonics rad", r.budget.drift_harmonics);
+  stat.add("budget bias random walk rad", r.budget.bias_random_walk);
+  stat.add("budget level rad", r.budget.level);
+  stat.add("budget indexer rad", r.budget.indexer);
+  stat.add("budget total rad", r.budget.total);
+  stat.add("horizontal earth rate rad/s", r.horizontal_rate);
+  stat.add("expected horizontal earth rate rad/s", r.budget.horizontal_earth_rate);
+  stat.add("scatter", r.scatter);
+}
+
+void GyrocompassRos::diagnoseHold(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!hold_) {
+    stat.summary(DiagnosticStatus::WARN, "not holding: no accepted alignment of the triad yet");
+    return;
+  }
+  if (hold_->holding()) {
+    stat.summaryf(DiagnosticStatus::OK, "holding %.1f s: heading %.4f +- %.4f deg", hold_->elapsed(), hold_->heading(),
+                  hold_->headingSigma());
+  } else {
+    stat.summaryf(DiagnosticStatus::ERROR, "attitude lost after %.1f s: %s; align again", hold_->elapsed(),
+                  hold_->lostReason().c_str());
+  }
+  stat.add("elapsed s", hold_->elapsed());
+  stat.add("heading deg", hold_->heading());
+  stat.add("heading sigma deg", hold_->headingSigma());
+  stat.add("dropped samples", hold_->dropped());
+  stat.add("lost reason", hold_->lostReason());
+}
+
+}  // namespace hrg_gyro
