@@ -3,6 +3,7 @@
 
   hrg_report.py REPORT.yaml --out OUT.html [--bag BAG] [--params CALIBRATED.yaml] [--spec LIMITS.yaml]
                 [--verification SUMMARY.yaml] [--rest FROM TO] [--title TEXT]
+  hrg_report.py ALIGNMENT.yaml [ALIGNMENT.yaml ...] --out OUT.html [--title TEXT]
 
 REPORT.yaml is the calibration report (`hrg_bag calibrate --report`, or the calibrator node's
 <parameter file>.<method>.report.yaml). A triad's report (method triad) gets a page of its own: the
@@ -16,6 +17,10 @@ processor with the calibrated parameters (--params, else the parameters in the r
 nominal model). --verification adds the before/after nonlinearity measured on a verification
 profile against ground truth (session_monitor's summary YAML, as `make run` writes it). --spec
 checks the figures against the gyro's specification (see SPEC_KEYS).
+
+ALIGNMENT.yaml, one or more results of `hrg_bag align --output` (north-finding), give the alignment page
+instead (hrg_report_alignment.py): per result the heading against window length with its 1-sigma band
+and the law of its budget, the residuals per segment and the error budget, from the YAML alone.
 
 Everything the page shows is embedded (PNG figures as data URIs, styles inline): it opens offline
 and prints on A4. The page is written as the package's C++ tools write their outputs
@@ -50,6 +55,7 @@ import hrg_output_file  # noqa: E402
 from hrg_models import one_line  # noqa: E402
 from hrg_report_figures import (allan_figure, allan_terms, fmt, longest_rest, model_figure,  # noqa: E402
                                 profile_figure, read_session, run_allan, temperature_figure, triad_axis_figures)
+from hrg_report_alignment import build_alignment, is_alignment_result  # noqa: E402
 from hrg_report_validation import (RAD_S_TO_DEG_H, SPEC_KEYS, SPEC_OTHER_KEYS, TRIAD_SPEC_KEYS,  # noqa: E402
                                    ReportError, load_report, load_spec, load_verification)
 
@@ -164,6 +170,15 @@ def triad_spec_rows(spec, report, ctx):
 
 
 def build(args):
+    alignments = [is_alignment_result(path) for path in args.report]
+    if any(alignments):
+        if not all(alignments):
+            raise ReportError("%s: an alignment result and a calibration report do not share a page" %
+                              args.report[alignments.index(False)])
+        return build_alignment(args, args.report)
+    if len(args.report) != 1:
+        raise ReportError("one calibration report per page (several files are for alignment results)")
+    args.report = args.report[0]
     report = load_report(args.report)
     if report["method"] == "triad":
         return build_triad(args, report)
@@ -296,7 +311,8 @@ def main(argv):
                                      "report). Unknown keys are refused. Exit 0 the "
                                      "page was written, 2 bad usage or input (nothing written), 3 the page could "
                                      "not be written." % ", ".join(sorted(list(SPEC_KEYS) + list(TRIAD_SPEC_KEYS) + list(SPEC_OTHER_KEYS))))
-    parser.add_argument("report", help="calibration report YAML")
+    parser.add_argument("report", nargs="+",
+                        help="calibration report YAML, or one or more alignment results (hrg_bag align --output)")
     parser.add_argument("--out", required=True, help="HTML file to write")
     parser.add_argument("--bag", help="the session's bag: profile, temperature, Allan deviation at rest")
     parser.add_argument("--params", help="calibrated parameter file for the Allan deviation")
@@ -321,8 +337,9 @@ def main(argv):
 
 def run(args):
     inputs = []
-    for name in ("report", "bag", "params", "spec", "verification"):
-        path = getattr(args, name)
+    named = [("report", p) for p in args.report] + [(n, getattr(args, n)) for n in ("bag", "params", "spec",
+                                                                                    "verification")]
+    for name, path in named:
         if not path:
             continue
         what = path if name == "report" else "--%s %s" % (name, path)
@@ -345,7 +362,10 @@ def run(args):
         return 2
     try:
         ctx = build(args)
-        html = render("triad_report.html.j2" if ctx["r"]["method"] == "triad" else "report.html.j2", **ctx)
+        if "results" in ctx:
+            html = render("alignment_report.html.j2", **ctx)
+        else:
+            html = render("triad_report.html.j2" if ctx["r"]["method"] == "triad" else "report.html.j2", **ctx)
     except ReportError as e:
         sys.stderr.write("hrg_report: %s\n" % e)
         return 2
@@ -354,6 +374,11 @@ def run(args):
     except hrg_output_file.OutputWriteError as e:
         sys.stderr.write("hrg_report: report %s not written: %s\n" % (args.out, e))
         return 3
+    if "results" in ctx:
+        print("hrg_report: wrote %s (alignment: %s)" % (args.out, ", ".join(
+            "%s %s" % (x["name"], "ACCEPTED" if x["r"]["accepted"] else "REFUSED (%s)" % x["r"]["gate"])
+            for x in ctx["results"])))
+        return 0
     verdict = "" if ctx["overall"] is None else (" spec PASS" if ctx["overall"] else " spec FAIL")
     print("hrg_report: wrote %s (calibration %s%s)" % (args.out, "ACCEPTED" if ctx["r"]["accepted"] else "REFUSED",
                                                        verdict))

@@ -10,13 +10,16 @@ naming their gate; bad settings and options exit 2 naming the key or option. Nee
 rostest for the package environment."""
 import math
 import os
+import random
 import shutil
 import subprocess
 import unittest
 
+import rosbag
 import rospy
 import rostest
 import yaml
+from sensor_msgs.msg import Imu
 
 HRG_BAG = subprocess.check_output(["catkin_find", "--first-only", "--libexec", "hrg_gyro", "hrg_bag"],
                                   universal_newlines=True).strip()
@@ -136,6 +139,93 @@ class HrgBagAlign(unittest.TestCase):
         self.assertAlmostEqual(angles[0], 0.0, delta=1e-6)
         self.assertAlmostEqual(angles[1], math.pi, delta=1e-6)
         self.assertEqual(r["windows"], [])
+
+    def test_the_triads_recorded_output_gives_the_same_heading_and_an_accelerometer_levels_it(self):
+        # The triad's output as the live triad node records it (hrg_bag process --triad --out): the same
+        # records, so the same heading, bit for bit in the result file, as from the channels.
+        processed = self.path("processed.bag")
+        code, _, err = run("process", self.bag, "--out", processed, *self.chain)
+        self.assertEqual(code, 0, err)
+        from_channels, from_output = self.path("channels.result.yaml"), self.path("output.result.yaml")
+        self.assertEqual(self.align(self.settings["static"], "--output", from_channels)[0], 0)
+        code, stdout, err = run("align", processed, "--settings", self.settings["static"], "--output", from_output)
+        self.assertEqual(code, 0, stdout + err)
+        a, b = self.read(from_channels), self.read(from_output)
+        for key in ("heading_deg", "heading_sigma_deg", "orientation", "covariance_enu_rad2", "segments"):
+            self.assertEqual(a[key], b[key], key)
+        # An accelerometer on the mount, level (+g up, 1e-3 m/s^2 of white noise at 100 Hz), on
+        # accel/data_raw beside the triad's output: level/source accelerometer takes it.
+        levelled = self.path("levelled.bag")
+        noise = random.Random(7)
+        with rosbag.Bag(processed) as source, rosbag.Bag(levelled, "w") as out:
+            start = None
+            for topic, message, t in source.read_messages(topics=["/triad/output"]):
+                out.write(topic, message, t)
+                start = start or message.header.stamp
+            stamp = start
+            while stamp < t:
+                imu = Imu()
+                imu.header.stamp = stamp
+                imu.header.frame_id = "imu_link"
+                f = imu.linear_acceleration
+                f.x, f.y, f.z = noise.gauss(0.0, 1e-3), noise.gauss(0.0, 1e-3), 9.80665 + noise.gauss(0.0, 1e-3)
+                out.write("/accel/data_raw", imu, stamp)
+                stamp += rospy.Duration(0.01)
+        accelerometer = self.path("accelerometer.yaml")
+        with open(accelerometer, "w") as f:
+            f.write(STATIC.replace("  source: declared           # no accelerometer in the session",
+                                   "  source: accelerometer      # accel/data_raw")
+                    .replace("  roll: 0.0                  # rad: the body on the platter, level\n", "")
+                    .replace("  pitch: 0.0                 # rad\n", ""))
+        result = self.path("accelerometer.result.yaml")
+        code, stdout, err = run("align", levelled, "--settings", accelerometer, "--output", result)
+        self.assertEqual(code, 0, stdout + err)
+        self.assertRegex(err, r" [1-9][0-9]{3} accelerometer records")
+        r = self.read(result)
+        self.assertAlmostEqual(r["accelerometer_gravity_m_s2"], 9.80665, delta=1e-3)
+        self.assertLess(abs(r["attitude_rad"]["roll"]), 1e-5)
+        self.check_heading(r, "static, 60 s, levelled by the accelerometer")
+        # Asked for and absent: refused naming the topic it looked for.
+        code, _, err = run("align", processed, "--settings", accelerometer)
+        self.assertEqual(code, 2, err)
+        self.assertIn("accel/data_raw", err)
+
+    def test_one_gyro_on_the_indexer_finds_the_heading_from_four_positions(self):
+        # The session's x gyro alone (horizontal, along the platter's x), its outputs as its processor
+        # node publishes them (hrg_bag process --triad --out), on four positions 90 deg apart of 30 s.
+        with open(os.path.join(self.pkg, "test/scenarios/north_align.yaml")) as f:
+            text = f.read()
+        step = "{type: steps, angle: 3.141592653589793, rate: 0.5, dwell: 65.0, count: 1, label: index}"
+        self.assertIn(step, text)
+        scenario, bag = self.path("four.yaml"), self.path("four.bag")
+        with open(scenario, "w") as f:
+            f.write(text.replace(step, step.replace("3.141592653589793", "1.5707963267948966")
+                                 .replace("65.0", "30.0").replace("count: 1", "count: 3")))
+        self.assertEqual(run("simulate", "--scenario", scenario, "--out", bag, "--no-truth")[0], 0)
+        processed, gyro = self.path("four_processed.bag"), self.path("four_gyro.bag")
+        code, _, err = run("process", bag, "--out", processed, *self.chain)
+        self.assertEqual(code, 0, err)
+        with rosbag.Bag(processed) as a, rosbag.Bag(bag) as b, rosbag.Bag(gyro, "w") as out:
+            for topic, message, t in a.read_messages(topics=["/x/output"]):
+                out.write(topic, message, t)
+            for topic, message, t in b.read_messages(topics=["/turntable/state"]):
+                out.write(topic, message, t)
+        settings = self.path("single.yaml")
+        with open(settings, "w") as f:
+            f.write(INDEXED.replace("duration: 137.0              # s: both rests and the half turn between",
+                                    "duration: 132.0              # s: four rests and three quarter turns")
+                    + "single_gyro: true            # the x gyro alone\n")
+        result = self.path("single.result.yaml")
+        code, stdout, err = run("align", gyro, "--settings", settings, "--output", result)
+        self.assertEqual(code, 0, stdout + err)
+        self.assertIn("(one gyro)", stdout)
+        r = self.read(result)
+        self.assertEqual((r["mode"], r["single_gyro"], r["frame"], len(r["segments"])), ("indexed", True, "indexer", 4))
+        self.check_heading(r, "one gyro, indexed, four positions of about 29 s")
+        # Two of the gyro's outputs in the bag: the one to align names itself.
+        code, _, err = run("align", processed, "--settings", settings)
+        self.assertEqual(code, 2, err)
+        self.assertIn("gyro-topic", err)
 
     def test_a_moving_table_and_a_latitude_beyond_the_limit_are_refused_naming_the_gate(self):
         out = self.path("moving.result.yaml")

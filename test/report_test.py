@@ -8,6 +8,7 @@ modes are kept, a full disk leaves nothing behind, malformed inputs are refused 
 Needs no master; run as a rostest for the package environment."""
 import errno
 import html.parser
+import math
 import os
 import re
 import shutil
@@ -78,11 +79,14 @@ class Page(html.parser.HTMLParser):
     def __init__(self):
         super().__init__()
         self.stack, self.by_q, self.by_id, self.body, self.links = [], {}, {}, {}, []
+        self.scale = {}  # data-q -> the factor the page applied (data-scale)
 
     def handle_starttag(self, tag, attrs):
         a = dict(attrs)
         if tag == "body":
             self.body = a
+        if a.get("data-q") and a.get("data-scale"):
+            self.scale[a["data-q"]] = float(a["data-scale"])
         for name in ("src", "href"):
             if a.get(name):
                 self.links.append(a[name])
@@ -337,6 +341,93 @@ class ReportTest(unittest.TestCase):
         # 200 s at rest cannot show a bias instability or a rate random walk: bounded, not read.
         self.assertTrue(page.by_id["allan-rate_random_walk"].startswith("\u2264"), page.by_id["allan-rate_random_walk"])
         self.assertTrue(page.by_id["allan-bias_instability"].startswith("\u2264"))
+
+    def test_the_alignment_page_shows_the_numbers_of_the_align_results(self):
+        # test/scenarios/north_align.yaml with rests of 25 s: the static mode on the first 20 s (its first 5,
+        # 10, 20 s alone), the indexed mode on both rests, and one refused by the latitude gate.
+        with open(os.path.join(self.pkg, "test", "scenarios", "north_align.yaml")) as f:
+            text = f.read()
+        self.assertIn("dwell: 65.0", text)
+        scenario, bag = self.path("north_short.yaml"), self.path("north_short.bag")
+        with open(scenario, "w") as f:
+            f.write(text.replace("dwell: 65.0", "dwell: 25.0"))
+        code, _, err = run(HRG_BAG, "simulate", "--scenario", scenario, "--out", bag, "--no-truth")
+        self.assertEqual(code, 0, err)
+        chain = ["--triad", os.path.join(self.pkg, "config", "triad.yaml")]
+        for axis in "xyz":
+            chain += ["--axis-params", axis + "=" + os.path.join(self.pkg, "test", "scenarios", "north_align_axis.yaml")]
+        level = "level: {source: declared}  # the body on the platter is level\n"
+        settings = {"static": "mode: static  # the triad at rest\nlatitude: 0.9  # rad\n" + level,
+                    "indexed": "mode: indexed  # two positions\nlatitude: 0.9  # rad\n" + level,
+                    "refused": "mode: static  # the triad at rest\nlatitude: 0.9  # rad\nmax_latitude: 0.5  # rad\n" +
+                    level}
+        results, codes = [], {"static": 0, "indexed": 0, "refused": 1}
+        for name, extra in (("static", ["--duration", "20", "--windows", "5,10,20"]), ("indexed", ["--duration", "56"]),
+                            ("refused", [])):
+            path, result = self.path(name + ".settings.yaml"), self.path(name + ".alignment.yaml")
+            with open(path, "w") as f:
+                f.write(settings[name])
+            code, out, err = run(HRG_BAG, "align", bag, "--settings", path, "--output", result, *(chain + extra))
+            self.assertEqual(code, codes[name], out + err)
+            results.append(result)
+        out = self.path("alignment.html")
+        code, stdout, err = run(HRG_BAG, "report", *results, "--out", out)
+        self.assertEqual(code, 0, err)
+        self.assertIn("static.alignment.yaml ACCEPTED", stdout)
+        self.assertIn("refused.alignment.yaml REFUSED (latitude)", stdout)
+        code, page, err = render(out, self.work)
+        self.assertEqual(code, 0, err[-2000:])
+        console = [line for line in err.splitlines() if "CONSOLE" in line or "net::ERR" in line]
+        self.assertEqual(console, [], "the page logged errors")
+        # Per result the heading against window length; the residuals per segment of the two accepted.
+        self.assertEqual(page.body.get("data-images"), "5/5")
+        loaded = []
+        for path in results:
+            with open(path) as f:
+                loaded.append(yaml.load(f, Loader=self.models_module.Loader))
+        checked = 0
+        for q, shown in page.by_q.items():
+            index, where = q.split(":", 1)
+            expected = lookup(loaded[int(index)], where)
+            if isinstance(expected, str):
+                self.assertEqual(shown, expected, q)
+            elif isinstance(expected, int) and not isinstance(expected, bool):
+                self.assertEqual(int(shown), expected, q)
+            elif math.isnan(expected):  # a refused result's budget terms
+                self.assertEqual(shown, "nan", q)
+            else:
+                expected = expected * page.scale.get(q, 1.0)
+                digits = len(re.sub(r"[^0-9]", "", re.split(r"e", shown.lstrip("-"))[0]).lstrip("0")) or 1
+                self.assertEqual(float(shown), float("%.*g" % (digits, expected)), "%s: page %s, YAML %r" %
+                                 (q, shown, expected))
+            checked += 1
+        for key in ("0:heading_deg", "0:heading_sigma_deg", "0:budget_rad.total", "0:budget_rad.white_angle_noise",
+                    "0:windows.0.heading_sigma_deg", "0:windows.2.heading_deg", "1:heading_deg",
+                    "1:segments.1.residual_rate_rad_s.2", "1:segments.0.predicted_rms_rad.0", "2:gate"):
+            self.assertIn(key, page.by_q)
+        self.assertEqual(page.by_q["2:gate"], "latitude")
+        self.assertEqual([page.by_id["status-%d" % i] for i in range(3)], ["ACCEPTED", "ACCEPTED", "REFUSED"])
+        print("report test: alignment page, %d numbers checked; static %s +- %s deg, indexed %s +- %s deg" %
+              (checked, page.by_q["0:heading_deg"], page.by_q["0:heading_sigma_deg"], page.by_q["1:heading_deg"],
+               page.by_q["1:heading_sigma_deg"]))
+        # An alignment result and a calibration report do not share a page.
+        code, _, err = run(HRG_BAG, "report", results[0], self.prior, "--out", self.path("mix.html"))
+        self.assertEqual(code, 2, err)
+        self.assertIn("an alignment result and a calibration report do not share a page", err)
+        # A damaged result is refused naming the key, nothing written.
+        with open(results[0]) as f:
+            good = f.read()
+        for bad, message in ((re.sub(r"\nheading_deg: [^\n]*", "\nheading_deg: abc", good), "heading_deg: must be a number"),
+                             (good.replace("{window_s: 5, ", "{"), "windows[0].window_s: missing"),
+                             (re.sub(r"\n  total: [^\n]*", "", good), "budget_rad.total: missing")):
+            path = self.path("damaged.alignment.yaml")
+            with open(path, "w") as f:
+                f.write(bad)
+            code, _, err = run(HRG_BAG, "report", path, "--out", self.path("damaged.html"))
+            self.assertEqual(code, 2, err)
+            self.assertIn(message, err)
+            self.assertFalse(os.path.exists(self.path("damaged.html")))
+        self.assertFalse(os.path.exists(self.path("mix.html")))
 
     def test_hrg_bag_runs_the_scripts_with_their_own_help(self):
         for command, script in (("report", "hrg_report.py"), ("batch", "hrg_batch.py")):

@@ -112,18 +112,6 @@ AlignInputs findInputs(const rosbag::Bag& bag, const AlignCommand& c, const core
   return in;
 }
 
-/// A recorded triad sample as the triad node published it.
-core::TriadBodySample fromTriadOutput(const TriadOutput& m) {
-  core::TriadBodySample s;
-  s.stamp = toNanoseconds(m.header.stamp);
-  s.dt = m.dt;
-  s.delta_angle = Eigen::Vector3d(m.delta_angle.x, m.delta_angle.y, m.delta_angle.z);
-  s.angular_velocity = Eigen::Vector3d(m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z);
-  for (int i = 0; i < 9; ++i) s.covariance(i / 3, i % 3) = m.angular_velocity_covariance[i];
-  s.flags = m.flags;
-  return s;
-}
-
 /// Feeds the run with the bag's records in record order until its window is full. Gyro samples
 /// stamped before the first one plus --start are skipped.
 class BagFeed {
@@ -152,17 +140,17 @@ class BagFeed {
         if (axis != axis_of_topic.end()) {
           channels(m, axis->second);
         } else if (topic == in_.triad) {
-          if (triad_reader_.read(m, &triad_) && admit(toNanoseconds(triad_.header.stamp)))
-            run_->addTriad(fromTriadOutput(triad_));
+          if (triad_reader_.read(m, &triad_) && admit(toNanoseconds(triad_.header.stamp))) {
+            run_->addTriad(fromMessage(triad_));
+          }
         } else if (topic == in_.gyro) {
-          if (gyro_reader_.read(m, &gyro_) && admit(toNanoseconds(gyro_.header.stamp)))
+          if (gyro_reader_.read(m, &gyro_) && admit(toNanoseconds(gyro_.header.stamp))) {
             run_->addAxis(toAxisOutput(gyro_));
+          }
         } else if (topic == in_.turntable) {
-          if (table_reader_.read(m, &table_))
-            run_->addIndexer({toNanoseconds(table_.header.stamp), table_.angle, table_.rate});
+          if (table_reader_.read(m, &table_)) run_->addIndexer(fromMessage(table_));
         } else if (accelerometer_reader_.read(m, &imu_)) {
-          const geometry_msgs::Vector3& f = imu_.linear_acceleration;
-          run_->addAccelerometer({toNanoseconds(imu_.header.stamp), Eigen::Vector3d(f.x, f.y, f.z)});
+          run_->addAccelerometer(fromAccelerometerMessage(imu_));
         }
         if (++records_ % 4096 == 0) progress.update(static_cast<double>(records_), records_);
         if (run_->complete()) break;

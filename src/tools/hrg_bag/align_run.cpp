@@ -135,6 +135,10 @@ void AlignmentRun::addAccelerometer(const core::AccelerometerRecord& record) {
   for (core::Gyrocompass& g : compasses_) g.addAccelerometer(record);
 }
 
+bool AlignmentRun::complete() const {
+  return std::all_of(compasses_.begin(), compasses_.end(), [](const core::Gyrocompass& g) { return g.complete(); });
+}
+
 void AlignmentRun::inputEnded(const std::string& input) {
   for (core::Gyrocompass& g : compasses_) {
     if (g.complete()) continue;

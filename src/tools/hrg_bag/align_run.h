@@ -49,8 +49,8 @@ class AlignmentRun {
   void addIndexer(const core::IndexerRecord& record);
   void addAccelerometer(const core::AccelerometerRecord& record);
 
-  /// The window is full or refused (every shorter window is then too).
-  bool complete() const { return compasses_.front().complete(); }
+  /// Every window is full or refused (a window refused early leaves the shorter ones to fill).
+  bool complete() const;
   const core::Gyrocompass& window() const { return compasses_.front(); }
   /// The input ended: every alignment whose window is not full is aborted, saying how far it got.
   void inputEnded(const std::string& input);
