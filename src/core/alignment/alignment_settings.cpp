@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "hrg_gyro/core/alignment/local_level.h"
-#include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/common/yaml_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
@@ -175,19 +175,7 @@ AlignmentSettings AlignmentSettings::parse(const YamlField& root, const std::vec
 }
 
 AlignmentSettings AlignmentSettings::load(const std::string& path) {
-  std::string text;
-  try {
-    text = readBoundedRegularFile(path, kMaxParameterFileBytes, "alignment settings file");
-  } catch (const std::runtime_error& e) {
-    throw ConfigError("", e.what());
-  }
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError("",
-                      "YAML syntax error in '" + path + "' at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+  const YAML::Node root = loadYamlFile(path, kMaxParameterFileBytes, "alignment settings file");
   try {
     return parse(YamlField(root, ""), kNodeKeys);
   } catch (const ConfigError& e) {

@@ -10,6 +10,7 @@
 
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/common/yaml_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
@@ -115,19 +116,7 @@ TriadParameters parseTriadParameters(const YAML::Node& root) {
 }
 
 TriadParameters loadTriadFile(const std::string& path) {
-  std::string text;
-  try {
-    text = readBoundedRegularFile(path, kMaxParameterFileBytes, "triad file");
-  } catch (const std::runtime_error& e) {
-    throw ConfigError("", e.what());
-  }
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(
-        "", "YAML syntax error at line " + std::to_string(e.mark.line + 1) + " (in '" + path + "'): " + e.msg);
-  }
+  const YAML::Node root = loadYamlFile(path, kMaxParameterFileBytes, "triad file");
   try {
     return parseTriadParameters(root);
   } catch (const ConfigError& e) {

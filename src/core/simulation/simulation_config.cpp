@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "hrg_gyro/core/common/atomic_file.h"
+#include "hrg_gyro/core/common/yaml_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
@@ -159,18 +159,7 @@ DeliveryConfig parseChannelDeliverySection(const YamlField& ch) {
 }
 
 YAML::Node loadScenarioDocument(const std::string& path) {
-  std::string text;
-  try {
-    text = readBoundedRegularFile(path, kMaxScenarioFileBytes, "scenario file");
-  } catch (const std::runtime_error& e) {
-    throw ConfigError("", e.what());
-  }
-  try {
-    return YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError("",
-                      "YAML syntax error in '" + path + "' at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+  return loadYamlFile(path, kMaxScenarioFileBytes, "scenario file");
 }
 
 void parseScenarioTopLevel(const YamlField& root, std::vector<std::string> keys,
