@@ -37,7 +37,8 @@ class InstallSpace(unittest.TestCase):
         self.assertEqual(p.stdout.strip(), os.path.join(PREFIX, "share", "hrg_gyro"))
 
     def test_everything_a_user_runs_is_installed(self):
-        for exe in ("driver_sim", "processor", "triad", "calibrator", "session_monitor", "hrg_bag", "hrg_session",
+        for exe in ("driver_sim", "processor", "triad", "calibrator", "session_monitor", "gyrocompass", "hrg_bag",
+                    "hrg_session",
                     "plot_calibration.py", "hrg_report.py", "hrg_batch.py", "hrg_gyro_core_bench",
                     "hrg_gyro_calibration_bench"):
             path = os.path.join(PREFIX, "lib", "hrg_gyro", exe)
@@ -51,7 +52,11 @@ class InstallSpace(unittest.TestCase):
                     "include/hrg_gyro/core/processing/triad_combiner.h", "include/hrg_gyro/ros/triad_ros.h",
                     "include/hrg_gyro/TriadOutput.h", "share/hrg_gyro/launch/triad.launch",
                     "share/hrg_gyro/launch/example_triad_stack.launch", "share/hrg_gyro/config/triad_node.yaml",
-                    "share/hrg_gyro/config/triad.yaml",
+                    "share/hrg_gyro/config/triad.yaml", "include/hrg_gyro/core/alignment/gyrocompass.h",
+                    "include/hrg_gyro/ros/gyrocompass_ros.h", "include/hrg_gyro/AlignmentResult.h",
+                    "include/hrg_gyro/StartAlignment.h", "share/hrg_gyro/launch/gyrocompass.launch",
+                    "share/hrg_gyro/config/gyrocompass.yaml", "share/hrg_gyro/config/scenarios/north_static.yaml",
+                    "share/hrg_gyro/templates/alignment_report.html.j2",
                     "share/hrg_gyro/config/calibrator.yaml", "share/hrg_gyro/config/driver_sim.yaml",
                     "share/hrg_gyro/config/params_uncalibrated.yaml", "share/hrg_gyro/config/scenarios/dual_rate.yaml",
                     "share/hrg_gyro/config/report_spec.yaml", "share/hrg_gyro/templates/report.html.j2",
@@ -74,9 +79,10 @@ class InstallSpace(unittest.TestCase):
     def test_report_scripts_find_their_templates_and_hrg_bag_in_the_install_space(self):
         lib = os.path.join(PREFIX, "lib", "hrg_gyro")
         # The modules the scripts import from beside themselves.
-        for module in ("hrg_output_file.py", "hrg_models.py", "hrg_report_validation.py", "hrg_report_figures.py"):
+        for module in ("hrg_output_file.py", "hrg_models.py", "hrg_report_validation.py", "hrg_report_figures.py",
+                       "hrg_report_alignment.py"):
             self.assertTrue(os.path.isfile(os.path.join(lib, module)), module)
-        p = run("/usr/bin/python3", "-c", "import sys; sys.path.insert(0, %r); import hrg_report, hrg_report_figures; "
+        p = run("/usr/bin/python3", "-c", "import sys; sys.path.insert(0, %r); import hrg_report, hrg_report_figures, hrg_report_alignment; "
                 "print(hrg_report.find_template_dir()); print(hrg_report_figures.hrg_bag_executable())" % lib)
         self.assertEqual(p.stdout.split(), [os.path.join(PREFIX, "share", "hrg_gyro", "templates"),
                                             os.path.join(lib, "hrg_bag")], p.stdout)
