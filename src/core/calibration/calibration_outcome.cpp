@@ -239,6 +239,21 @@ void emitBiasTrend(YAML::Emitter& out, const CalibrationOutcome& o) {
   out << YAML::EndMap;
 }
 
+/// The bias's random walk estimated with the dual-rate fit, if it shows.
+void emitBiasWalk(YAML::Emitter& out, const CalibrationOutcome& o) {
+  const BiasWalkFit& w = o.bias_walk;
+  if (!(w.rate_random_walk > 0.0)) return;
+  out << YAML::Key << "bias_random_walk" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "rate_random_walk" << YAML::Value << formatDouble(w.rate_random_walk)
+      << YAML::Comment("rad/s/sqrt(s), from the blocks' mean residual rates");
+  out << YAML::Key << "rate_random_walk_std" << YAML::Value << formatDouble(w.rate_random_walk_std);
+  out << YAML::Key << "angle_random_walk" << YAML::Value << formatDouble(w.angle_random_walk)
+      << YAML::Comment("rad/sqrt(s), fitted with it");
+  out << YAML::Key << "carried" << YAML::Value << w.carried
+      << YAML::Comment("the standard errors include what it predicts");
+  out << YAML::EndMap;
+}
+
 /// The defect diagnosis, one per K fit.
 void emitDiagnosis(YAML::Emitter& out, const CalibrationOutcome& o) {
   // Root causes read from the K harmonics (first order, docs/math.md 'Pickoff defects to first
@@ -332,6 +347,7 @@ std::string emitCalibrationReport(const CalibrationOutcome& o) {
   emitTableClock(out, o);
   emitFieldReport(out, o);
   emitBiasTrend(out, o);
+  emitBiasWalk(out, o);
   emitDiagnosis(out, o);
   emitPlateaus(out, o);
   emitGatesAndNotes(out, o.gates, o.notes);

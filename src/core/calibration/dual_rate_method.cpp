@@ -72,8 +72,9 @@ void DualRateMethod::noteErrorBudget(const IncrementFit& e, CalibrationOutcome* 
   o->notes.push_back(
       "K harmonic standard errors, ppm of |K0| (largest of each kind): statistical " + largest(e.budget.statistical) +
       " (white wave-angle noise alone " + largest(e.budget.angle_noise) + ", beyond it " +
-      largest(e.budget.beyond_noise) + "), Earth rate " + largest(e.budget.earth_rate) + ", basis-noise correction " +
-      largest(e.budget.basis_noise) + "; phi from the " +
+      largest(e.budget.beyond_noise) + (e.walk.carried ? ", bias random walk " + largest(e.budget.bias_walk) : "") +
+      "), Earth rate " + largest(e.budget.earth_rate) + ", basis-noise correction " + largest(e.budget.basis_noise) +
+      "; phi from the " +
       (angle_logged_ ? (e.angle_weight >= 1.0 ? std::string("logged table angle")
                                               : "logged table angle weighted " + formatShort(e.angle_weight, 2) +
                                                     " against the logged rate's integral")
@@ -160,6 +161,7 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
     return o;
   }
   o.binned = e.binned;
+  o.bias_walk = e.walk;
   noteErrorBudget(e, &o);    // stated in the report
   o.smoothing_factor = 1.0;  // nothing is smoothed: the increments are fitted through their exact integrals
   if (e.trend.order > 0) gateBiasTrend(e, &o);

@@ -74,6 +74,9 @@ IncrementRegression::IncrementRegression(const std::vector<int>& k_orders, const
   sum_.w = Eigen::VectorXd::Zero(raw_y_ + 1);
   previous_mean_.w = Eigen::VectorXd::Zero(m_ + 1);
   open_block_.products = Eigen::MatrixXd::Zero(m_ + 1, m_ + 1);
+  open_block_.sum = open_block_.sum_dt = open_block_.prefix_v = open_block_.prefix_p = Eigen::VectorXd::Zero(m_ + 1);
+  walk_prefix_ = walk_prefix_integral_ = walk_prefix_v_ = Eigen::VectorXd::Zero(m_ + 1);
+  walk_products_ = arw_products_ = Eigen::MatrixXd::Zero(m_ + 1, m_ + 1);
   white_lag0_ = white_lag1_ = Eigen::MatrixXd::Zero(m_, m_);
 }
 
@@ -276,17 +279,49 @@ void IncrementRegression::closeWindow() {
 void IncrementRegression::addIncrement(const WindowMean& a, const WindowMean& b) {
   const Eigen::VectorXd dw = b.w - a.w;
   const double dt = b.t - a.t;
+  const double t_mid = 0.5 * (a.t_session + b.t_session);
   open_block_.products.noalias() += dw * dw.transpose();
+  // A bias walk b(t) leaves this increment dt b(t_mid): the prefix sums of its covariances.
+  if (walk_started_) {
+    const double ds = t_mid - walk_time_;
+    walk_prefix_integral_ += ds * walk_prefix_;
+    walk_products_.noalias() += ds * walk_prefix_ * walk_prefix_.transpose();
+  }
+  walk_started_ = true;
+  walk_time_ = t_mid;
+  walk_prefix_ += dt * dw;
+  walk_prefix_v_ += dt * t_mid * dw;
+  arw_products_.noalias() += dt * dw * dw.transpose();
+  open_block_.self += 2.0 * dt * open_block_.moment + dt * dt * t_mid;  // the earlier increments are older
+  open_block_.sum += dw;
+  open_block_.sum_dt += dt * dw;
+  open_block_.prefix_v += dt * walk_prefix_v_;
+  open_block_.prefix_p += dt * t_mid * walk_prefix_;
+  open_block_.time += dt;
+  open_block_.moment += dt * t_mid;
   if (++open_block_.count >= block_size_) {
     blocks_.push_back(open_block_);
     open_block_.products.setZero();
+    open_block_.sum.setZero();
+    open_block_.sum_dt.setZero();
+    open_block_.prefix_v.setZero();
+    open_block_.prefix_p.setZero();
+    open_block_.time = open_block_.moment = open_block_.self = 0.0;
     open_block_.count = 0;
     if (blocks_.size() >= kMaxBlocks) {
       // Merge neighbours: the sums add, so this is the same data in half as many, longer blocks.
       std::vector<Block> merged;
       for (std::size_t i = 0; i + 1 < blocks_.size(); i += 2) {
         Block m = blocks_[i];
-        m.products += blocks_[i + 1].products;
+        const Block& next = blocks_[i + 1];
+        m.products += next.products;
+        m.self += next.self + 2.0 * next.time * m.moment;  // every increment of m is older
+        m.sum += next.sum;
+        m.sum_dt += next.sum_dt;
+        m.prefix_v += next.prefix_v;
+        m.prefix_p += next.prefix_p;
+        m.time += next.time;
+        m.moment += next.moment;
         m.count += blocks_[i + 1].count;
         merged.push_back(m);
       }
@@ -383,6 +418,119 @@ IncrementRegression::Solved IncrementRegression::solveColumns(const std::vector<
   return out;
 }
 
+BiasWalkFit IncrementRegression::estimateWalk(const std::vector<Block>& blocks, const std::vector<int>& sel,
+                                              const Eigen::MatrixXd& map, const LeastSquaresSolution& solution) const {
+  // The blocks' residual sums r = s - X_b beta, s the sums of the increments' errors and X_b the
+  // blocks' regressor sums. Their covariance for a unit bias walk and for a unit angle random walk,
+  // exactly through the fit (which takes much of a walk into K, D and the trend):
+  //   Cov(r) = C_ss - X_b inv C_xs - (X_b inv C_xs)^T + X_b inv C_xx inv X_b^T.
+  std::vector<const Block*> used;
+  for (const Block& b : blocks)
+    if (b.time > 0.0) used.push_back(&b);
+  const int g = static_cast<int>(used.size()), p = static_cast<int>(sel.size());
+  BiasWalkFit walk;
+  if (g < 8) return walk;
+  const Eigen::MatrixXd& inverse = solution.normal_inverse;
+  const Eigen::VectorXd& beta = solution.coefficients;
+  auto selected = [&](const Eigen::VectorXd& raw) {
+    const Eigen::VectorXd w = map * raw;
+    Eigen::VectorXd out(p);
+    for (int i = 0; i < p; ++i) out(i) = w(sel[i]);
+    return out;
+  };
+  Eigen::MatrixXd xb(g, p), cxs_walk(p, g), cxs_arw(p, g);
+  Eigen::MatrixXd css_walk = Eigen::MatrixXd::Zero(g, g), css_arw = Eigen::MatrixXd::Zero(g, g);
+  Eigen::VectorXd r(g);
+  for (int k = 0; k < g; ++k) {
+    const Block& b = *used[k];
+    const Eigen::VectorXd w = map * b.sum;
+    xb.row(k) = selected(b.sum).transpose();
+    r(k) = w(m_) - xb.row(k).dot(beta);
+    cxs_walk.col(k) = selected(b.prefix_v - b.prefix_p + walk_prefix_ * b.moment);
+    cxs_arw.col(k) = selected(b.sum_dt);
+    css_walk(k, k) = b.self;
+    css_arw(k, k) = b.time;
+    for (int j = 0; j < k; ++j) css_walk(j, k) = css_walk(k, j) = used[j]->moment * b.time;
+  }
+  const Eigen::MatrixXd full_walk = map * walkScoreCovariance() * map.transpose();
+  const Eigen::MatrixXd full_arw = map * arw_products_ * map.transpose();
+  auto residualCovariance = [&](const Eigen::MatrixXd& css, const Eigen::MatrixXd& cxs, const Eigen::MatrixXd& full) {
+    const Eigen::MatrixXd projected = xb * inverse;
+    const Eigen::MatrixXd cross = projected * cxs;
+    return Eigen::MatrixXd(css - cross - cross.transpose() +
+                           projected * submatrix(full, sel, sel) * projected.transpose());
+  };
+  const Eigen::MatrixXd cov_walk = residualCovariance(css_walk, cxs_walk, full_walk);
+  const Eigen::MatrixXd cov_arw = residualCovariance(css_arw, cxs_arw, full_arw);
+  // Moment equations: the difference of the mean residual rates of neighbouring groups of 1, 2 and
+  // 4 blocks, E[d^2] = q^2 v^T Cov_walk v + N^2 v^T Cov_arw v (v the difference's weights).
+  std::vector<double> d2, a, c;
+  for (int scale = 1; scale <= 4; scale *= 2) {
+    for (int first = 0; first + 2 * scale <= g; first += scale) {
+      Eigen::VectorXd v = Eigen::VectorXd::Zero(g);
+      double t1 = 0.0, t2 = 0.0;
+      for (int k = first; k < first + scale; ++k) t1 += used[k]->time;
+      for (int k = first + scale; k < first + 2 * scale; ++k) t2 += used[k]->time;
+      for (int k = first; k < first + scale; ++k) v(k) = -1.0 / t1;
+      for (int k = first + scale; k < first + 2 * scale; ++k) v(k) = 1.0 / t2;
+      const double d = v.dot(r);
+      d2.push_back(d * d);
+      a.push_back(std::max(0.0, v.dot(cov_walk * v)));
+      c.push_back(std::max(0.0, v.dot(cov_arw * v)));
+    }
+  }
+  const std::size_t n = d2.size();
+  // Weighted least squares, the weights 1 / (2 E^2) of a chi-square of one degree from the previous
+  // pass's prediction E (first pass: the mean square); N^2 dropped where it comes out negative.
+  double q2 = 0.0, n2 = 0.0, q2_var = 0.0;
+  double mean_square = 0.0;
+  for (double v : d2) mean_square += v / n;
+  if (!(mean_square > 0.0)) return walk;
+  for (int pass = 0; pass < 4; ++pass) {
+    Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
+    for (std::size_t i = 0; i < n; ++i) {
+      const double e = pass == 0 ? mean_square : std::max(q2 * a[i] + n2 * c[i], 1e-3 * mean_square);
+      const double weight = 1.0 / (2.0 * e * e);
+      const Eigen::Vector2d row(a[i], c[i]);
+      normal.noalias() += weight * row * row.transpose();
+      rhs += weight * d2[i] * row;
+    }
+    const Eigen::Vector2d both = normal.ldlt().solve(rhs);
+    if (both(1) >= 0.0 && normal.determinant() > 0.0) {
+      q2 = both(0);
+      n2 = both(1);
+      q2_var = normal.inverse()(0, 0);
+    } else {
+      q2 = normal(0, 0) > 0.0 ? rhs(0) / normal(0, 0) : 0.0;
+      n2 = 0.0;
+      q2_var = normal(0, 0) > 0.0 ? 1.0 / normal(0, 0) : 0.0;
+    }
+    q2 = std::max(q2, 0.0);
+  }
+  if (!(q2 > 0.0) || !std::isfinite(q2)) return walk;
+  walk.rate_random_walk = std::sqrt(q2);
+  walk.rate_random_walk_std = std::sqrt(q2_var) / (2.0 * walk.rate_random_walk);
+  walk.angle_random_walk = std::sqrt(n2);
+  walk.carried = true;
+  return walk;
+}
+
+Eigen::MatrixXd IncrementRegression::walkScoreCovariance() const {
+  // integral over [0, last] of (U - P)(U - P)^T ds, U the whole sum (P = 0 before the first increment).
+  const Eigen::VectorXd& u = walk_prefix_;
+  const Eigen::VectorXd& integral = walk_prefix_integral_;
+  return u * u.transpose() * walk_time_ - u * integral.transpose() - integral * u.transpose() + walk_products_;
+}
+
+Eigen::MatrixXd IncrementRegression::walkCovariance(const BiasWalkFit& walk, const std::vector<int>& sel,
+                                                    const Eigen::MatrixXd& map, const Eigen::MatrixXd& inverse) const {
+  const double q2 = walk.rate_random_walk * walk.rate_random_walk;
+  const double n2 = walk.angle_random_walk * walk.angle_random_walk;
+  const Eigen::MatrixXd meat = map * (q2 * walkScoreCovariance() + n2 * arw_products_) * map.transpose();
+  return inverse * submatrix(meat, sel, sel) * inverse;
+}
+
 IncrementRegression::Columns IncrementRegression::fittedColumns() const {
   const int n_k = static_cast<int>(k_orders_.size()), n_all = static_cast<int>(all_orders_.size());
   const int t0 = 1 + 2 * n_k, n_kterms = 1 + 2 * n_k, trend0 = t0 + 1 + 2 * n_all;
@@ -423,6 +571,7 @@ IncrementRegression::Terms IncrementRegression::correctedTerms(const Solved& sol
   const Eigen::VectorXd& beta = solved.solution.coefficients;
   const Eigen::MatrixXd& sandwich = solved.sandwich;
   const Eigen::MatrixXd& white = solved.white;
+  const Eigen::MatrixXd& walk = solved.walk;
   const int p = static_cast<int>(beta.size());
   // Noise of theta inside the basis attenuates order k by exp(-k^2 s^2 / 2); undo it. A tenth of the
   // correction is taken as its uncertainty: the noise is estimated well (0.05 % at 0.2 rad), but
@@ -437,7 +586,7 @@ IncrementRegression::Terms IncrementRegression::correctedTerms(const Solved& sol
   terms.total_std.resize(p);
   for (int i = 0; i < p; ++i) {
     terms.value[i] = beta(i) * scale[i];
-    const double statistical = std::sqrt(std::max(sandwich(i, i), white(i, i))) * scale[i];
+    const double statistical = std::sqrt(std::max(sandwich(i, i), white(i, i) + walk(i, i))) * scale[i];
     const double noise = std::sqrt(std::max(0.0, white(i, i))) * scale[i];
     const double beyond = std::sqrt(std::max(0.0, sandwich(i, i) - white(i, i))) * scale[i];
     const double earth = earth_shift(i);
@@ -451,6 +600,7 @@ IncrementRegression::Terms IncrementRegression::correctedTerms(const Solved& sol
       part->beyond_noise.push_back(beyond);
       part->earth_rate.push_back(earth);
       part->basis_noise.push_back(basis);
+      part->bias_walk.push_back(std::sqrt(std::max(0.0, walk(i, i))) * scale[i]);
     }
   }
   return terms;
@@ -572,7 +722,7 @@ IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std
   // The trend is centred on the mean time of the increments: D0 is then the session's mean bias.
   const double reference_time = increment_time_ > 0.0 ? increment_time_moment_ / increment_time_ : 0.0;
   const Eigen::MatrixXd map = regressorMap(earth_rate, reference_time);
-  const Solved solved = solveColumns(sel, map, blocks, total, fit.angle_noise, max_condition);
+  Solved solved = solveColumns(sel, map, blocks, total, fit.angle_noise, max_condition);
   if (!solved.solution.ok) {
     fit.reason = "increment regression condition number " + std::to_string(solved.solution.condition_number) +
                  " above " + std::to_string(max_condition);
@@ -580,6 +730,9 @@ IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std
   }
   const LeastSquaresSolution& solution = solved.solution;
   const Eigen::VectorXd& beta = solution.coefficients;
+  fit.walk = estimateWalk(blocks, sel, map, solution);
+  solved.walk =
+      fit.walk.carried ? walkCovariance(fit.walk, sel, map, solution.normal_inverse) : Eigen::MatrixXd::Zero(p, p);
   // Earth-rate uncertainty: refit with the rate moved by its standard deviation.
   const Eigen::VectorXd earth_shift =
       earthRateShift(sel, beta, total, earth_rate, earth_rate_std, reference_time, max_condition);

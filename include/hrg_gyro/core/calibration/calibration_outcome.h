@@ -108,6 +108,9 @@ struct CalibrationOutcome {
   /// dual-rate: the bias's trend fitted with K and D (order 0: none was fitted). The written D0 is
   /// the bias at bias_trend.reference_stamp, the mean time of the data.
   BiasTrendFit bias_trend;
+  /// dual-rate: the bias's random walk estimated from the fit's residuals; when carried, the
+  /// standard errors include what it predicts.
+  BiasWalkFit bias_walk;
   TableClockReport table_clock;
   FieldReport field;  ///< method field only
 

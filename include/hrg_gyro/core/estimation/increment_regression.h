@@ -36,6 +36,18 @@
 // separated from K by its time signature (the order of the plateau rates and the curvature it gives
 // the wave angle within each plateau). How well the session separates it is measured: the trend's
 // inflation of the K0 standard error, and their correlation.
+//
+// A bias that follows a random walk (rate random walk q, rad/s/sqrt(s)) is what no polynomial
+// follows: it leaves each increment an error dt_i b(t_i), correlated over the whole session, which
+// the block sandwich (blocks share nothing beyond their neighbours) does not see. The walk is
+// estimated from the residuals: the mean residual rates of consecutive blocks (and of pairs and
+// fours of them) differ by a variance q^2 a + N^2 c (N the angle random walk), a and c computed
+// exactly through the fit, which takes much of a walk into K, D and the trend (a would be
+// T1/3 + T2/3 + gap without it); a moment fit of q^2 and N^2 weighted by its own prediction. Where
+// q^2 comes out positive, the fit's covariance carries the walk exactly:
+//   Cov(X'e) = q^2 integral S(s) S(s)^T ds + N^2 sum x_i x_i^T dt_i,  S(s) = sum_{t_i > s} x_i dt_i,
+// summed as the increments arrive (S from prefix sums, so memory stays fixed), and each coefficient's
+// statistical variance is the larger of the sandwich and that model (with the white angle noise).
 #pragma once
 
 #include <Eigen/Core>
@@ -60,6 +72,15 @@ struct IncrementErrorBudget {
   std::vector<double> beyond_noise;  ///< statistical beyond that: table angle/rate errors, rate noise, drift
   std::vector<double> earth_rate;    ///< from the Earth-rate uncertainty
   std::vector<double> basis_noise;   ///< from the uncertainty of the basis-noise correction
+  std::vector<double> bias_walk;     ///< predicted by the estimated bias random walk (0: none carried)
+};
+
+/// The bias random walk estimated from the residuals of the increment fit.
+struct BiasWalkFit {
+  double rate_random_walk = 0.0;      ///< q, rad/s/sqrt(s) (0 where the estimate is negative)
+  double rate_random_walk_std = 0.0;  ///< standard error of q
+  double angle_random_walk = 0.0;     ///< N, rad/sqrt(s), fitted with it
+  bool carried = false;               ///< q^2 > 0: the covariance carries the walk
 };
 
 /// The bias trend fitted with K and D (bias_trend_order > 0).
@@ -89,6 +110,7 @@ struct IncrementFit {
   std::size_t increments = 0;
   std::size_t blocks = 0;  ///< blocks of the sandwich covariance
   BiasTrendFit trend;      ///< order 0: none fitted
+  BiasWalkFit walk;        ///< the bias's random walk, estimated whatever the trend order
   /// Weight of the logged table angle against the integral of the logged rate (with the angle's
   /// slope per chain), time-weighted over the chains: 1 the angle alone, 0 the rate's shape alone.
   double angle_weight = 1.0;
@@ -123,6 +145,14 @@ class IncrementRegression {
  private:
   struct Block {
     Eigen::MatrixXd products;  // sum w w^T of its increments, w = (dz, dy)
+    Eigen::VectorXd sum;       // sum w: the block's residual at the solution
+    double time = 0.0;         // s: sum of the increments' dt
+    double moment = 0.0;       // sum of dt t (t the increment's mid time from the session's first sample)
+    // For the walk's covariances (t_i, dt_i, w_i the increments; P and V the session's prefix sums of
+    // w dt and w dt t up to and including each): sum w dt, sum dt V(t), sum dt t P(t), and
+    // sum_{i,j in the block} dt_i dt_j min(t_i, t_j).
+    Eigen::VectorXd sum_dt, prefix_v, prefix_p;
+    double self = 0.0;
     std::size_t count = 0;
   };
   struct BinSums {
@@ -144,6 +174,7 @@ class IncrementRegression {
   struct Solved {
     LeastSquaresSolution solution;
     Eigen::MatrixXd sandwich, white;
+    Eigen::MatrixXd walk;  // what the estimated bias random walk (and angle random walk) predict; zero if none
   };
 
   /// The fitted columns among the accumulated ones: the K block, T, the T harmonics of D's orders
@@ -173,6 +204,15 @@ class IncrementRegression {
   Eigen::VectorXd earthRateShift(const std::vector<int>& sel, const Eigen::VectorXd& beta, const Eigen::MatrixXd& total,
                                  double earth_rate, double earth_rate_std, double reference_time,
                                  double max_condition) const;
+  /// q and N from the blocks' mean residual rates at the solution.
+  BiasWalkFit estimateWalk(const std::vector<Block>& blocks, const std::vector<int>& sel, const Eigen::MatrixXd& map,
+                           const LeastSquaresSolution& solution) const;
+  /// Cov(X^T e) for a unit bias walk from the session's start: integral of S S^T ds, S(s) the sum of
+  /// w dt over the increments after s (raw columns).
+  Eigen::MatrixXd walkScoreCovariance() const;
+  /// The covariance of the coefficients that the walk predicts.
+  Eigen::MatrixXd walkCovariance(const BiasWalkFit& walk, const std::vector<int>& sel, const Eigen::MatrixXd& map,
+                                 const Eigen::MatrixXd& inverse) const;
   /// The corrected terms; the error budgets of K and D into fit->budget and fit->drift_budget.
   Terms correctedTerms(const Solved& solved, const Eigen::VectorXd& earth_shift, IncrementFit* fit) const;
   /// One model's terms (mean, cos..., sin... from `offset`) as a fit.
@@ -223,6 +263,13 @@ class IncrementRegression {
   Block open_block_;
   std::size_t block_size_ = 8;
   Eigen::MatrixXd white_lag0_, white_lag1_;  // predicted white-noise products, per unit variance
+  // The bias walk's covariance: P the prefix sum of w dt over the increments so far, A = integral of
+  // P ds and B = integral of P P^T ds over their mid times, V the prefix sum of w dt t; the angle
+  // random walk's sum of w w^T dt.
+  Eigen::VectorXd walk_prefix_, walk_prefix_integral_, walk_prefix_v_;
+  Eigen::MatrixXd walk_products_, arw_products_;
+  bool walk_started_ = false;
+  double walk_time_ = 0.0;
   std::map<int, std::vector<BinSums>> bins_by_group_;
   std::map<int, double> group_time_;
   std::size_t increments_ = 0;

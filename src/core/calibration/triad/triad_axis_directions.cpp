@@ -12,7 +12,8 @@ namespace {
 struct WindowIncrements {
   std::array<std::vector<Eigen::Vector4d>, 3> x;
   std::array<std::vector<double>, 3> y;
-  double moving_time = 0.0;  ///< s of moving plateau data
+  std::vector<std::size_t> chain_starts;  ///< index of each plateau's first increment
+  double moving_time = 0.0;               ///< s of moving plateau data
 };
 
 /// Window means along one moving plateau (samples [begin, end)) of alpha, phi, t and the Earth terms'
@@ -47,6 +48,7 @@ void addPlateauIncrements(const std::vector<TriadPositionSample>& points, std::s
     sum.s += s_int;
     sum.n += 1.0;
   }
+  w->chain_starts.push_back(w->y[0].size());
   for (std::size_t m = 1; m < means.size(); ++m) {
     const Mean& a = means[m - 1];
     const Mean& b = means[m];
@@ -60,13 +62,19 @@ void addPlateauIncrements(const std::vector<TriadPositionSample>& points, std::s
 }
 
 /// Least squares of y on the columns of x for one axis and position: the response to the table
-/// angle with its standard error (from the residuals, widened for their lag-one correlation).
+/// angle with its standard error. The increments' errors are the window means' own noise (each
+/// increment has two window means; neighbours share one, with opposite signs) plus noise white from
+/// increment to increment (angle random walk, table errors): Cov = a D D^T + b I, a and b read from
+/// the residuals' lag-one and lag-zero covariances within the plateaus, and the standard error is
+/// the sandwich (X^T X)^-1 X^T Cov X (X^T X)^-1. Treating the increments as independent instead
+/// would count the window means' noise once per increment, where along a plateau it telescopes.
 struct ResponseFit {
   bool ok = false;
   double value = 0.0, std = 0.0;
 };
 
-ResponseFit fitResponse(const std::vector<Eigen::Vector4d>& x, const std::vector<double>& y) {
+ResponseFit fitResponse(const std::vector<Eigen::Vector4d>& x, const std::vector<double>& y,
+                        const std::vector<std::size_t>& chain_starts) {
   ResponseFit r;
   const std::size_t n = y.size();
   if (n < 12) return r;
@@ -87,20 +95,35 @@ ResponseFit fitResponse(const std::vector<Eigen::Vector4d>& x, const std::vector
   if (!lu.isInvertible()) return r;
   const Eigen::Matrix4d inverse = lu.inverse();
   const Eigen::Vector4d beta = inverse * rhs;
+  // Neighbours: consecutive increments of one plateau.
+  std::vector<bool> follows(n, true);
+  for (std::size_t start : chain_starts)
+    if (start < n) follows[start] = false;
+  follows[0] = false;
   double squares = 0.0, lag = 0.0, previous = 0.0;
+  std::size_t pairs = 0;
+  Eigen::Matrix4d products = Eigen::Matrix4d::Zero(), neighbours = Eigen::Matrix4d::Zero();
   for (std::size_t k = 0; k < n; ++k) {
-    const double e = y[k] - x[k].cwiseQuotient(scale).dot(beta);
+    const Eigen::Vector4d xs = x[k].cwiseQuotient(scale);
+    const double e = y[k] - xs.dot(beta);
     squares += e * e;
-    if (k > 0) lag += e * previous;
+    products.noalias() += xs * xs.transpose();
+    if (follows[k]) {
+      lag += e * previous;
+      ++pairs;
+      const Eigen::Vector4d before = x[k - 1].cwiseQuotient(scale);
+      neighbours.noalias() += xs * before.transpose() + before * xs.transpose();
+    }
     previous = e;
   }
-  const double variance = squares / (n - 4);
-  // Increments of window means share the window between them: white noise makes neighbours
-  // anti-correlated (rho = -1/2), which the plain formula would overstate; anything positive widens.
-  const double rho = std::clamp(lag / squares, -0.5, 0.9);
-  const double inflation = std::max(0.0, 1.0 + 2.0 * rho);
+  const double variance = squares / (n - 4), covariance = pairs > 0 ? lag / pairs : 0.0;
+  // lag zero: 2a + b, lag one: -a. A positive lag one (a wander) is charged to b, widened by it.
+  const double a = std::max(0.0, -covariance);
+  const double b = std::max(0.0, variance - 2.0 * a) * (covariance > 0.0 ? 1.0 + 2.0 * covariance / variance : 1.0);
+  const Eigen::Matrix4d meat = a * (2.0 * products - neighbours) + b * products;
+  const double beta_variance = (inverse * meat * inverse)(0, 0);
   r.value = beta(0) / scale(0);
-  r.std = std::sqrt(variance * inverse(0, 0) * std::max(inflation, 0.25)) / scale(0);
+  r.std = std::sqrt(std::max(0.0, beta_variance)) / scale(0);
   r.ok = std::isfinite(r.value) && std::isfinite(r.std);
   return r;
 }
@@ -150,7 +173,7 @@ void measureResponses(const TriadLockedPosition& position, const TriadCalibratio
   response.increments = w.y[0].size();
   bool fitted = w.moving_time >= settings.min_position_time;
   for (int i = 0; i < 3 && fitted; ++i) {
-    const ResponseFit f = fitResponse(w.x[i], w.y[i]);
+    const ResponseFit f = fitResponse(w.x[i], w.y[i], w.chain_starts);
     fitted = f.ok;
     response.response(i) = f.value;
     response.response_std(i) = f.std;

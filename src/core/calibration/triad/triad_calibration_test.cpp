@@ -84,17 +84,26 @@ TEST(TriadCalibrationTest, AFixtureOffByMicroradiansGivesTheErrorItExplains) {
   for (std::size_t p = 0; p < positions.size(); ++p) positions[p].error = errors[p];
   const TriadOutcome o = testing::calibrateAngleLevelTriad(g, positions, testing::settingsFor(g));
   ASSERT_TRUE(o.accepted) << o.reason;
-  // What the errors predict: each position's true table axis u_true, fitted on the plan's u.
+  // What the errors predict: each position's true table axis u_true, fitted on the plan's u with the
+  // weights the calibration gave each position's response (its standard error).
+  ASSERT_EQ(o.positions.size(), positions.size());
   Eigen::Matrix3d predicted;
   for (int i = 0; i < 3; ++i) {
     Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
     Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-    for (const TriadPosition& p : positions) {
+    for (std::size_t k = 0; k < positions.size(); ++k) {
+      const TriadPosition& p = positions[k];
       const Eigen::Vector3d u_plan = p.body_to_table.transpose() * Eigen::Vector3d::UnitZ();
       const Eigen::Vector3d u_true = p.trueBodyToTable().transpose() * Eigen::Vector3d::UnitZ();
+      const double weight = 1.0 / std::pow(o.positions[k].response_std(i), 2);
+      if (i == 0) {
+        std::printf("position %s: response sigmas (%.3f %.3f %.3f) urad\n", o.positions[k].name.c_str(),
+                    1e6 * o.positions[k].response_std(0), 1e6 * o.positions[k].response_std(1),
+                    1e6 * o.positions[k].response_std(2));
+      }
       // The along axis's response is its own K's: 1 by construction, the cross responses the truth's.
-      normal += u_plan * u_plan.transpose();
-      rhs += u_plan * g.body_to_axis.row(i).dot(u_true);
+      normal += weight * u_plan * u_plan.transpose();
+      rhs += weight * u_plan * (std::abs(u_plan(i)) > 0.5 ? u_plan(i) : g.body_to_axis.row(i).dot(u_true));
     }
     predicted.row(i) = (normal.inverse() * rhs).transpose();
   }
@@ -106,6 +115,35 @@ TEST(TriadCalibrationTest, AFixtureOffByMicroradiansGivesTheErrorItExplains) {
       1e6 * e, moved, explained);
   EXPECT_GT(moved, 10.0);
   EXPECT_LE(explained, 5.0);
+}
+
+TEST(TriadCalibrationTest, TheAxisMatrixSigmasCoverItsErrorsOverSeeds) {
+  // The responses' standard errors follow the increments' correlation (window means shared by
+  // neighbours telescope along a plateau): over seeds, A's errors lie within 2 reported sigmas as
+  // often as a normal error does, and the sigmas are not wider than the errors' scatter says.
+  AngleLevelTriad g = testing::misalignedTriad();
+  const std::vector<TriadPosition> positions = testing::sixPositions(0.4, 40.0, 2, 30.0);
+  int within = 0, total = 0;
+  double squares = 0.0, largest = 0.0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    g.seed = 300 + seed;
+    const TriadOutcome o = testing::calibrateAngleLevelTriad(g, positions, testing::settingsFor(g));
+    ASSERT_TRUE(o.accepted) << o.reason;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        const double ratio = (o.body_to_axis(i, j) - g.body_to_axis(i, j)) / o.body_to_axis_std(i, j);
+        ++total;
+        if (std::abs(ratio) <= 2.0) ++within;
+        squares += ratio * ratio;
+        largest = std::max(largest, std::abs(ratio));
+      }
+    }
+  }
+  const double rms = std::sqrt(squares / total), share = static_cast<double>(within) / total;
+  std::printf("A over 20 seeds: %d of %d within 2 sigma (%.1f %%), rms error/sigma %.2f, largest %.2f\n", within, total,
+              100.0 * share, rms, largest);
+  EXPECT_GE(share, 0.9);
+  EXPECT_GT(rms, 0.5);  // sigmas about the errors' size, not an order of magnitude wider
 }
 
 TEST(TriadCalibrationTest, TooFewPositionsAreRefusedWithTheMissingOnesNamed) {

@@ -5,8 +5,10 @@
 // moving plateaus, window means (triad/window s) of the axes' compensated angles alpha_i, the table
 // angle phi, the time and the integrals C, S of cos phi and sin phi; their increments fitted by least
 // squares as alpha_i = c_i phi + b_i t + e_c C + e_s S (b_i: the axis's residual bias; e_c, e_s: the
-// Earth's horizontal rate, which turns with the table). The standard error of c_i comes from the
-// residuals, widened for their lag-one correlation. A position with less than
+// Earth's horizontal rate, which turns with the table). The standard error of c_i is the sandwich
+// over the increments' covariance a D D^T + b I: a the window means' own noise (neighbouring
+// increments share a window mean, so along a plateau it telescopes), b noise white from increment to
+// increment, both read from the residuals' lag-zero and lag-one covariances. A position with less than
 // triad/min_position_time s of moving plateaus gives no response (a note says so).
 //
 // A_i is then the weighted least-squares solution over the positions' responses: at least three
