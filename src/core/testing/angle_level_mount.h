@@ -176,6 +176,42 @@ inline void commandedPrecession(const MountScenario& s, double t, double* rate, 
   }
 }
 
+/// The sweep's records of one sample: each axis's output (flagged while a rate is commanded) and its
+/// driver's precession state (the commanded angle at the sample's centre, the rate at its end).
+inline void emitSweepSample(const MountScenario& s, const MountSinks& sinks, const TriadBodySample& triad, double t_b,
+                            double cmd_rate) {
+  const double h = 1.0 / s.rate_hz;
+  for (std::size_t i = 0; i < 3; ++i) {
+    AxisOutput out;
+    out.stamp = triad.stamp;
+    out.dt = h;
+    out.dalpha = triad.delta_angle(static_cast<int>(i));
+    out.flags = cmd_rate != 0.0 ? kFlagPrecessing : 0;
+    PrecessionStateRecord state;
+    state.stamp = triad.stamp;
+    state.rate = cmd_rate;
+    double centre_rate, centre_angle;
+    commandedPrecession(s, t_b - 0.5 * h, &centre_rate, &centre_angle);
+    state.angle = centre_angle;
+    if (sinks.precession) sinks.precession(i, state);
+    if (sinks.sweep_axis) sinks.sweep_axis(i, out);
+  }
+}
+
+/// The accelerometer's record at platform angle `psi`: gravity (`g0`, in the mount frame) seen through
+/// the platform and the body, then its mounting, bias and noise.
+inline AccelerometerRecord accelerometerSample(const MountScenario& s, Nanoseconds stamp, double psi,
+                                               const Eigen::Vector3d& g0, GaussianNoise* noise) {
+  const Eigen::Matrix3d body_to_mount =
+      Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()).toRotationMatrix() * s.body_to_platform;
+  AccelerometerRecord r;
+  r.stamp = stamp;
+  r.specific_force =
+      s.accelerometer_to_body.toRotationMatrix().transpose() * (body_to_mount.transpose() * g0) + s.accelerometer_bias;
+  for (int i = 0; i < 3; ++i) r.specific_force(i) += s.accelerometer_noise * noise->next();
+  return r;
+}
+
 /// Runs the session into the sinks, sample by sample in stamp order.
 inline void runMountScenario(const MountScenario& s, const MountSinks& sinks) {
   GaussianNoise noise(s.seed);
@@ -183,7 +219,7 @@ inline void runMountScenario(const MountScenario& s, const MountSinks& sinks) {
   const Eigen::Matrix3d mount = orientationFromEuler(s.mount).toRotationMatrix();
   const Eigen::Vector3d w0 = mount.transpose() * earthRateEnu(s.latitude);  // in the mount (platform zero) frame
   const Eigen::Vector3d g0 = mount.transpose() * Eigen::Vector3d(0.0, 0.0, kStandardGravity);
-  const Eigen::Matrix3d b = s.body_to_platform, accel = s.accelerometer_to_body.toRotationMatrix();
+  const Eigen::Matrix3d& b = s.body_to_platform;
   const long samples = static_cast<long>(std::llround(s.length() * s.rate_hz));
   std::array<double, 3> truth{{0.0, 0.0, 0.0}}, measured_previous{{0.0, 0.0, 0.0}}, walk{{0.0, 0.0, 0.0}};
   std::array<double, 3> bias_walk{{0.0, 0.0, 0.0}}, theta = s.wave_angle, psi_cmd_previous{{0.0, 0.0, 0.0}};
@@ -234,21 +270,7 @@ inline void runMountScenario(const MountScenario& s, const MountSinks& sinks) {
     }
     triad.angular_velocity = triad.delta_angle / h;
     if (s.sweep) {
-      for (std::size_t i = 0; i < 3; ++i) {
-        AxisOutput out;
-        out.stamp = stamp;
-        out.dt = h;
-        out.dalpha = triad.delta_angle(static_cast<int>(i));
-        out.flags = cmd_rate != 0.0 ? kFlagPrecessing : 0;
-        PrecessionStateRecord state;
-        state.stamp = stamp;
-        state.rate = cmd_rate;
-        double centre_rate, centre_angle;
-        commandedPrecession(s, t_b - 0.5 * h, &centre_rate, &centre_angle);
-        state.angle = centre_angle;
-        if (sinks.precession) sinks.precession(i, state);
-        if (sinks.sweep_axis) sinks.sweep_axis(i, out);
-      }
+      emitSweepSample(s, sinks, triad, t_b, cmd_rate);
     } else if (s.single_gyro) {
       const Eigen::Vector3d& d = s.gyro_axis;
       single_truth += d.dot(platform_increment) + s.residual_bias.x() * h;
@@ -269,14 +291,7 @@ inline void runMountScenario(const MountScenario& s, const MountSinks& sinks) {
       r.rate = rate_b;
       sinks.indexer(r);
     }
-    if (s.accelerometer && sinks.accelerometer) {
-      const Eigen::Matrix3d body_to_mount = Eigen::AngleAxisd(psi_b, Eigen::Vector3d::UnitZ()).toRotationMatrix() * b;
-      AccelerometerRecord r;
-      r.stamp = stamp;
-      r.specific_force = accel.transpose() * (body_to_mount.transpose() * g0) + s.accelerometer_bias;
-      for (int i = 0; i < 3; ++i) r.specific_force(i) += s.accelerometer_noise * noise.next();
-      sinks.accelerometer(r);
-    }
+    if (s.accelerometer && sinks.accelerometer) sinks.accelerometer(accelerometerSample(s, stamp, psi_b, g0, &noise));
     psi_a = psi_b;
   }
 }

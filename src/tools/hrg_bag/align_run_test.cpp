@@ -1,16 +1,17 @@
 #include "align_run.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "core/testing/angle_level_mount.h"
+#include "core/testing/output_directory_test_base.h"
 
 namespace hrg_gyro {
 namespace bag_tools {
@@ -176,16 +177,16 @@ TEST(AlignmentRun, AnInputShortOfTheWindowIsRefusedSayingHowFarItGot) {
   EXPECT_EQ(windows[1].result.gate, "aborted");
 }
 
-TEST(AlignmentRun, TheResultFileReadsBackWithItsWindows) {
+class AlignmentRunFile : public core::OutputDirectoryTestBase {};
+
+TEST_F(AlignmentRunFile, TheResultFileReadsBackWithItsWindows) {
   MountScenario s;
   s.duration = 60.0;
   AlignmentRun run(staticSettings(s), {20.0, 40.0});
   core::testing::runMountScenario(s, runSinks(&run));
   const core::AlignmentResult r = run.finish();
   const std::vector<WindowResult> windows = run.finishWindows();
-  std::string dir = ::testing::TempDir() + "align_run_XXXXXX";
-  ASSERT_NE(::mkdtemp(&dir[0]), nullptr);
-  const std::string path = dir + "/result.yaml";
+  const std::string path = at("result.yaml");
   writeAlignmentFile(path, emitAlignmentRun(r, windows, "a \"bag\".bag", "s.yaml"), r, windows);
   const YAML::Node doc = YAML::LoadFile(path);
   EXPECT_TRUE(doc["accepted"].as<bool>());
@@ -199,9 +200,9 @@ TEST(AlignmentRun, TheResultFileReadsBackWithItsWindows) {
   EXPECT_THROW(writeAlignmentFile(path, "accepted: false\n", r, windows), std::runtime_error);
   EXPECT_TRUE(YAML::LoadFile(path)["accepted"].as<bool>());
   // Over a directory: refused, nothing written.
-  EXPECT_THROW(writeAlignmentFile(dir, emitAlignmentRun(r, windows, "b", "s"), r, windows), std::runtime_error);
-  std::remove(path.c_str());
-  ::rmdir(dir.c_str());
+  EXPECT_THROW(writeAlignmentFile(dir_, emitAlignmentRun(r, windows, "b", "s"), r, windows), std::runtime_error);
+  // Neither refusal left a temporary file beside the result.
+  EXPECT_EQ(listing(), std::set<std::string>{"result.yaml"});
 }
 
 }  // namespace
