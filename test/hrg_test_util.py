@@ -26,6 +26,10 @@ from diagnostic_msgs.msg import DiagnosticArray
 # the machine at load 8 to 15 (docs/testing.md).
 STALL = float(os.environ.get("HRG_TEST_STALL", "120"))
 
+# Seconds this test node sleeps before it starts (0 unless set): run a live test with, say, 15 to
+# check that its verdict does not hang on the test node starting before the session does.
+time.sleep(float(os.environ.get("HRG_TEST_START_DELAY", "0")))
+
 _sources = []
 _latest = []
 
