@@ -42,7 +42,8 @@ test: build
 	@# Every C++ file formatted as .clang-format says; the fuzz build finds every core source.
 	ROS_TEST_RESULTS_DIR=$(WS)/build/test_results /usr/bin/python3 $(ROOT)/test/source_format_test.py
 	ROS_TEST_RESULTS_DIR=$(WS)/build/test_results /usr/bin/python3 $(ROOT)/test/fuzz/fuzz_sources_test.py
-	cd $(WS) && catkin_test_results build/test_results
+	@# --verbose: a failed test's whole result file (its assertion and output) ends the log.
+	cd $(WS) && catkin_test_results --verbose build/test_results
 
 run: build
 	cd $(WS) && source devel/setup.bash && bash $(ROOT)/scripts/run_main_job.sh
