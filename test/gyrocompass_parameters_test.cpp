@@ -65,6 +65,7 @@ TEST(GyrocompassParameters, BadAndUnknownKeysAreRefusedByName) {
   expectRefused("hold/covariance_interval", 0.0, "hold/covariance_interval");
   expectRefused("hold/enable", true, "hold/enable");
   expectRefused("queue_size", 0, "queue_size");
+  expectRefused("stall_timeout", 0.0, "stall_timeout");
   expectRefused("triad_file", std::string("/nonexistent/triad.yaml"), "triad_file");
   expectRefused("mode", std::string("sweep"), "mode sweep needs ~triad_file");
 }

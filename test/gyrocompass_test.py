@@ -89,6 +89,7 @@ class Gyrocompass(unittest.TestCase):
         cls.result = util.Latest("/alignment/result", AlignmentResult)
         cls.imu = util.Latest("/alignment/imu", Imu)
         cls.polar_result = util.Latest("/polar/alignment/result", AlignmentResult)
+        cls.levelled = util.Latest("/levelled/alignment/result", AlignmentResult)
         cls.truth = util.Latest("/truth", BodyTruth)  # the driver starts once this listens
         util.wait_for_service("/gyrocompass/align")
         util.wait_for_service("/polar/gyrocompass/align")
@@ -103,6 +104,7 @@ class Gyrocompass(unittest.TestCase):
         util.wait_for(lambda: cls.held.all and cls.held.all[-1].header.stamp.to_sec() > end + HOLD,
                       "%.0f s of imu/data after the window's end" % HOLD)
         util.wait_for(lambda: cls.polar_result.msg is not None, "polar/alignment/result")
+        util.wait_for(lambda: cls.levelled.msg is not None, "levelled/alignment/result")
 
     def test_the_service_starts_one_and_refuses_a_second_while_it_runs(self):
         self.assertTrue(self.started.success, self.started.message)
@@ -158,6 +160,32 @@ class Gyrocompass(unittest.TestCase):
         self.assertEqual(r.latitude, self.latitude)
         self.assertLess(abs(r.horizontal_rate - h), 4.0 * r.horizontal_rate_std + 1e-3 * h)
         self.assertTrue(r.segment_start and len(r.segment_start) == len(r.segment_end) == len(r.segment_rms_ratio))
+
+    def test_an_accelerometer_levels_the_alignment_at_startup(self):
+        # The second gyrocompass: ~align_at_startup, level from accel/data_raw (bias 4.9e-4, -3.2e-4
+        # m/s^2, declared ~level/accelerometer_bias_sigma 5e-4): its window is the session's first 30 s.
+        r = self.levelled.msg
+        self.assertTrue(r.accepted, "%s: %s" % (r.gate, r.reason))
+        self.assertEqual(r.mode, "static")
+        first = self.triad.all[0].header.stamp
+        self.assertLess(abs((r.window_start - first).to_sec()), 0.006, "the window starts with the first sample")
+        self.assertAlmostEqual(r.seconds, WINDOW, delta=0.01)
+        truth = math.degrees(self.azimuth)
+        error = wrap_deg(r.heading_deg - truth)
+        e = np.array(r.euler_covariance).reshape(3, 3)
+        roll_sigma, pitch_sigma = math.sqrt(e[0, 0]), math.sqrt(e[1, 1])
+        rospy.loginfo("levelled gyrocompass: heading error %.5f deg = %.2f sigma (sigma %.5f deg, level %.2e rad); "
+                      "roll %.2e +- %.1e, pitch %.2e +- %.1e rad (truth 0)", error, error / r.heading_sigma_deg,
+                      r.heading_sigma_deg, r.budget_level, r.roll, roll_sigma, r.pitch, pitch_sigma)
+        self.assertLess(abs(error), 3.0 * r.heading_sigma_deg)
+        # The level is measured (the accelerometer's bias tilts it by about bias / g) within its sigma,
+        # and its error enters the heading's budget times tan(latitude).
+        self.assertNotEqual(r.roll, 0.0)
+        self.assertNotEqual(r.pitch, 0.0)
+        self.assertLess(abs(r.roll), 3.0 * roll_sigma)
+        self.assertLess(abs(r.pitch), 3.0 * pitch_sigma)
+        self.assertGreater(roll_sigma, 0.9 * 5e-4 / 9.80665)
+        self.assertGreater(r.budget_level, 0.0)
 
     def test_the_sigma_is_what_the_triads_noise_predicts(self):
         r = self.result.msg

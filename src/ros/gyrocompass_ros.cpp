@@ -55,6 +55,7 @@ GyrocompassRos::GyrocompassRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   hold_settings_.noise = settings_.noise;
   hold_settings_.covariance_interval =
       params_.getPositive("hold/covariance_interval", hold_settings_.covariance_interval, "s");
+  stall_timeout_ = params_.getPositive("stall_timeout", stall_timeout_, "s");
   const bool align_at_startup = params_.get("align_at_startup", false);
   const int queue_size = params_.getAtLeast("queue_size", 50000, 1, "messages");
   const std::vector<std::string> unknown = params_.unknownKeys();
@@ -115,7 +116,7 @@ GyrocompassRos::~GyrocompassRos() {
 }
 
 std::string GyrocompassRos::start(double duration, const std::string& mode) {
-  if (running_) {
+  if (running_ && !alignmentStalled()) {
     const core::AlignmentProgress p = running_->progress();
     return format("an alignment runs (%.1f of %.1f s): wait for its result", p.seconds, p.duration);
   }
@@ -134,8 +135,18 @@ std::string GyrocompassRos::start(double duration, const std::string& mode) {
   if (s.mode == core::AlignmentMode::kIndexed && settings_.mode != core::AlignmentMode::kIndexed) {
     return "mode indexed needs ~mode indexed at start-up (turntable/state is not subscribed)";
   }
+  if (running_) {
+    const core::AlignmentProgress p = running_->progress();
+    ROS_WARN("gyrocompass: the stalled alignment (%.1f of %.1f s, no %s for %.1f s) replaced by a new one", p.seconds,
+             p.duration, running_topic_.c_str(), quietFor(alignment_input_));
+  }
   running_ = std::make_unique<core::Gyrocompass>(s, triad_);
   running_frame_.clear();
+  running_topic_ = s.single_gyro ? nh_.resolveName("output")
+                   : s.mode == core::AlignmentMode::kSweep
+                       ? nh_.resolveName(triadAxisTopic(triad_.axes[0], "output")) + " (or another axis's)"
+                       : nh_.resolveName("triad/output");
+  alignment_input_ = ros::WallTime::now();
   ++alignments_;
   ROS_INFO("gyrocompass: alignment %llu started: mode %s, %.1f s of gyro stamps",
            static_cast<unsigned long long>(alignments_), toString(s.mode), s.duration);
@@ -157,6 +168,7 @@ void GyrocompassRos::finishIfComplete() {
     if (hold_enabled_ && triad) {
       hold_ = std::make_unique<core::AttitudeHold>(hold_settings_, core::holdStartFrom(r));
       hold_frame_ = frame;
+      hold_input_ = ros::WallTime::now();
     }
   } else {
     ROS_ERROR("gyrocompass: alignment refused (%s): %s", r.gate.c_str(), r.reason.c_str());
@@ -168,6 +180,7 @@ void GyrocompassRos::onTriad(const TriadOutput::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   const core::TriadBodySample sample = fromMessage(*msg);
   if (hold_ && hold_->holding()) {
+    hold_input_ = ros::WallTime::now();
     if (hold_->add(sample)) {
       imu_pub_.publish(toHeldImuMessage(*hold_, sample, hold_frame_));
     } else if (!hold_->holding()) {
@@ -178,6 +191,7 @@ void GyrocompassRos::onTriad(const TriadOutput::ConstPtr& msg) {
     return;
   }
   running_frame_ = msg->header.frame_id;
+  alignment_input_ = ros::WallTime::now();
   running_->addTriad(sample);
   finishIfComplete();
 }
@@ -186,6 +200,7 @@ void GyrocompassRos::onGyro(const GyroOutput::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_ || !running_->settings().single_gyro) return;
   running_frame_ = msg->header.frame_id;
+  alignment_input_ = ros::WallTime::now();
   running_->addAxis(toAxisOutput(*msg));
   finishIfComplete();
 }
@@ -194,6 +209,7 @@ void GyrocompassRos::onSweepAxis(std::size_t axis, const GyroOutput::ConstPtr& m
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_ || running_->settings().mode != core::AlignmentMode::kSweep) return;
   running_frame_ = triad_.frame_id;
+  alignment_input_ = ros::WallTime::now();
   running_->addSweepAxis(axis, toAxisOutput(*msg));
   finishIfComplete();
 }
@@ -229,8 +245,16 @@ void GyrocompassRos::diagnoseAlignment(diagnostic_updater::DiagnosticStatusWrapp
   std::lock_guard<std::mutex> lock(mutex_);
   if (running_) {
     const core::AlignmentProgress p = running_->progress();
-    stat.summaryf(DiagnosticStatus::WARN, "aligning: %.1f of %.1f s (%s)", p.seconds, p.duration,
-                  toString(running_->settings().mode));
+    const double quiet = quietFor(alignment_input_);
+    if (quiet > stall_timeout_) {
+      stat.summaryf(DiagnosticStatus::ERROR,
+                    "aligning, input stalled: no %s for %.1f s (%.1f of %.1f s); ~align restarts it",
+                    running_topic_.c_str(), quiet, p.seconds, p.duration);
+    } else {
+      stat.summaryf(DiagnosticStatus::WARN, "aligning: %.1f of %.1f s (%s)", p.seconds, p.duration,
+                    toString(running_->settings().mode));
+    }
+    stat.add("seconds without gyro input", quiet);
     stat.add("window seconds", p.seconds);
     stat.add("window duration", p.duration);
     stat.add("samples", p.samples);
@@ -273,13 +297,18 @@ void GyrocompassRos::diagnoseHold(diagnostic_updater::DiagnosticStatusWrapper& s
     stat.summary(DiagnosticStatus::WARN, "not holding: no accepted alignment of the triad yet");
     return;
   }
-  if (hold_->holding()) {
+  const double quiet = quietFor(hold_input_);
+  if (hold_->holding() && quiet > stall_timeout_) {
+    stat.summaryf(DiagnosticStatus::ERROR, "holding, input stalled: no %s for %.1f s; the attitude is not updated",
+                  nh_.resolveName("triad/output").c_str(), quiet);
+  } else if (hold_->holding()) {
     stat.summaryf(DiagnosticStatus::OK, "holding %.1f s: heading %.4f +- %.4f deg", hold_->elapsed(), hold_->heading(),
                   hold_->headingSigma());
   } else {
     stat.summaryf(DiagnosticStatus::ERROR, "attitude lost after %.1f s: %s; align again", hold_->elapsed(),
                   hold_->lostReason().c_str());
   }
+  stat.add("seconds without triad input", quiet);
   stat.add("elapsed s", hold_->elapsed());
   stat.add("heading deg", hold_->heading());
   stat.add("heading sigma deg", hold_->headingSigma());

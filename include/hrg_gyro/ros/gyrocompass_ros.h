@@ -15,7 +15,9 @@
 // the triad, a core::AttitudeHold integrates `triad/output` from the aligned attitude and `imu/data`
 // carries the held orientation with its growing covariance and the triad's angular velocity. The
 // vehicle's own travel over the Earth is out of scope: the hold is for a base at or near its site.
-// Diagnostics: `gyrocompass` (progress, the last result and its budget) and `attitude hold`.
+// Diagnostics: `gyrocompass` (progress, the last result and its budget) and `attitude hold`; either
+// turns ERROR "input stalled" when its gyro stream has been quiet for `~stall_timeout` s of wall time
+// (a stalled alignment is replaced by the next `~align`).
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -62,6 +64,9 @@ class GyrocompassRos {
   /// Ends the running alignment when its window is full (or it was refused): publishes the result,
   /// starts the hold when accepted.
   void finishIfComplete();
+  /// Seconds of wall time since `since`.
+  static double quietFor(const ros::WallTime& since) { return (ros::WallTime::now() - since).toSec(); }
+  bool alignmentStalled() const { return running_ && quietFor(alignment_input_) > stall_timeout_; }
   void diagnoseAlignment(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseHold(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
@@ -74,7 +79,11 @@ class GyrocompassRos {
   bool hold_enabled_ = true;
   core::AttitudeHoldSettings hold_settings_;
   std::unique_ptr<core::Gyrocompass> running_;
-  std::string running_frame_;  // the frame_id of the gyro messages fed to it
+  std::string running_frame_;      // the frame_id of the gyro messages fed to it
+  std::string running_topic_;      // the gyro stream it reads (for the stall diagnostic)
+  double stall_timeout_ = 1.0;     // s of wall time
+  ros::WallTime alignment_input_;  // the running alignment's last gyro message (or its start)
+  ros::WallTime hold_input_;       // the hold's last triad message (or its start)
   std::optional<core::AlignmentResult> last_;
   std::unique_ptr<core::AttitudeHold> hold_;
   std::string hold_frame_;

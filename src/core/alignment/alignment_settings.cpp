@@ -39,8 +39,8 @@ const std::vector<std::string> kIndexerKeys = {"continuous", "body_to_platform",
 const std::vector<std::string> kSweepKeys = {"settle", "gain_orders", "min_turns"};
 const std::vector<std::string> kMotionKeys = {"block", "max_motion", "max_scatter"};
 const std::vector<std::string> kSections = {"noise", "level", "indexer", "sweep", "motion"};
-const std::vector<std::string> kNodeKeys = {"align_at_startup", "triad_file", "hold", "queue_size",
-                                            "diagnostic_period"};
+const std::vector<std::string> kNodeKeys = {"align_at_startup", "triad_file",    "hold",
+                                            "queue_size",       "stall_timeout", "diagnostic_period"};
 
 // {roll, pitch, yaw} in rad: Rz(yaw) Ry(pitch) Rx(roll).
 Eigen::Quaterniond parseRotation(const YamlField& f) {
