@@ -508,10 +508,10 @@ class HrgBagCli(unittest.TestCase):
         self.assertEqual(sorted(os.listdir(d)), ["link.yaml", "prior.yaml", "steps.bag"])
 
     def test_allan_reads_the_angle_random_walk(self):
-        bag, out_csv = self.path("static.bag"), self.path("allan.csv")
+        bag, out_csv, out_yaml = self.path("static.bag"), self.path("allan.csv"), self.path("allan.yaml")
         self.assertEqual(hrg_bag("simulate", "--scenario", os.path.join(self.pkg, "test/scenarios/static_noise.yaml"),
                                  "--out", bag)[0], 0)
-        code, stdout, err = hrg_bag("allan", bag, "--params", self.params, "--csv", out_csv)
+        code, stdout, err = hrg_bag("allan", bag, "--params", self.params, "--csv", out_csv, "--yaml", out_yaml)
         self.assertEqual(code, 0, err)
         self.assertIn("angle random walk", stdout)
         line = [l for l in stdout.splitlines() if "angle random walk" in l][0]
@@ -523,6 +523,12 @@ class HrgBagCli(unittest.TestCase):
         near = min(rows, key=lambda r: abs(math.log(float(r["tau"]))))
         self.assertAlmostEqual(float(near["tau"]), 1.0, delta=0.2)
         self.assertAlmostEqual(float(near["deviation"]), 1e-4, delta=0.15e-4)
+        # The readings file (the alignment's noise/allan_file reads it): N identified, in SI.
+        with open(out_yaml) as f:
+            readings = yaml.safe_load(f)
+        self.assertTrue(readings["angle_random_walk"]["identified"])
+        self.assertAlmostEqual(readings["angle_random_walk"]["value"], 1e-4, delta=0.15e-4)
+        self.assertEqual(readings["samples"] * readings["tau0"], readings["record_length"])
 
     def test_the_documented_chain_on_the_dual_rate_scenario(self):
         bag, out, report = self.path("dual_rate.bag"), self.path("calibrated.yaml"), self.path("report.yaml")

@@ -6,6 +6,7 @@
 #include "hrg_gyro/core/alignment/local_level.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/common/yaml_file.h"
+#include "hrg_gyro/core/estimation/allan_readings_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
@@ -24,8 +25,8 @@ void requirePositive(double value, const std::string& key, const char* unit) {
 // The keys, listed once: parse() refuses any other, keyPaths() lists them.
 const std::vector<std::string> kScalarKeys = {
     "mode", "latitude", "max_latitude", "duration", "single_gyro", "max_earth_rate_error", "max_condition"};
-const std::vector<std::string> kNoiseKeys = {"angle_white_noise", "angle_random_walk", "rate_random_walk",
-                                             "residual_bias", "residual_drift_harmonics"};
+const std::vector<std::string> kNoiseKeys = {"angle_white_noise", "angle_random_walk",        "rate_random_walk",
+                                             "residual_bias",     "residual_drift_harmonics", "allan_file"};
 const std::vector<std::string> kLevelKeys = {"source",
                                              "roll",
                                              "pitch",
@@ -53,7 +54,16 @@ Eigen::Quaterniond parseRotation(const YamlField& f) {
   return orientationFromEuler(a);
 }
 
-void parseNoise(const YamlField& f, GyroNoiseModel* n) {
+/// noise/allan_file's path as read: relative to `base_directory` (a settings file's), absolute only
+/// when there is none (a node's working directory is nobody's choice).
+std::string allanFilePath(const YamlField& f, const std::string& base_directory) {
+  const std::string path = f.asString();
+  if (!path.empty() && path.front() == '/') return path;
+  if (base_directory.empty()) f.fail("must be an absolute path here (or \"\": none)");
+  return base_directory + "/" + path;
+}
+
+void parseNoise(const YamlField& f, GyroNoiseModel* n, const std::string& base_directory) {
   f.requireMap();
   f.rejectUnknownKeys(kNoiseKeys);
   n->angle_white_noise = f.getDouble("angle_white_noise", n->angle_white_noise);
@@ -61,6 +71,15 @@ void parseNoise(const YamlField& f, GyroNoiseModel* n) {
   n->rate_random_walk = f.getDouble("rate_random_walk", n->rate_random_walk);
   n->residual_bias = f.getDouble("residual_bias", n->residual_bias);
   n->residual_drift_harmonics = f.getDouble("residual_drift_harmonics", n->residual_drift_harmonics);
+  // The measured readings replace the keys above; one the record did not identify keeps its key.
+  if (f.getString("allan_file", "").empty()) return;
+  const YamlField file = f["allan_file"];
+  try {
+    *n = noiseFromAllan(loadAllanReadings(allanFilePath(file, base_directory)).result, *n);
+  } catch (const ConfigError& e) {
+    if (e.key() == file.path()) throw;
+    file.fail(e.what());
+  }
 }
 
 void parseLevel(const YamlField& f, LevelSettings* l) {
@@ -146,7 +165,8 @@ std::vector<std::string> AlignmentSettings::keyPaths() {
   return keys;
 }
 
-AlignmentSettings AlignmentSettings::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
+AlignmentSettings AlignmentSettings::parse(const YamlField& root, const std::vector<std::string>& extra_keys,
+                                           const std::string& base_directory) {
   root.requireMap();
   std::vector<std::string> allowed = kScalarKeys;
   allowed.insert(allowed.end(), kSections.begin(), kSections.end());
@@ -160,7 +180,7 @@ AlignmentSettings AlignmentSettings::parse(const YamlField& root, const std::vec
   s.single_gyro = root.getBool("single_gyro", s.single_gyro);
   s.max_earth_rate_error = root.getDouble("max_earth_rate_error", s.max_earth_rate_error);
   s.max_condition = root.getDouble("max_condition", s.max_condition);
-  if (root.has("noise")) parseNoise(root["noise"], &s.noise);
+  if (root.has("noise")) parseNoise(root["noise"], &s.noise, base_directory);
   if (root.has("level")) parseLevel(root["level"], &s.level);
   if (root.has("indexer")) parseIndexer(root["indexer"], &s.indexer);
   if (root.has("sweep")) parseSweep(root["sweep"], &s.sweep);
@@ -177,7 +197,8 @@ AlignmentSettings AlignmentSettings::parse(const YamlField& root, const std::vec
 AlignmentSettings AlignmentSettings::load(const std::string& path) {
   const YAML::Node root = loadYamlFile(path, kMaxParameterFileBytes, "alignment settings file");
   try {
-    return parse(YamlField(root, ""), kNodeKeys);
+    const std::size_t slash = path.find_last_of('/');
+    return parse(YamlField(root, ""), kNodeKeys, slash == std::string::npos ? "." : path.substr(0, slash));
   } catch (const ConfigError& e) {
     throw ConfigError(e.key(), e.problem() + " (in '" + path + "')");
   }

@@ -1,5 +1,6 @@
 // The alignment's settings: every bad value refused naming its key; the mode's names; the noise terms
-// an Allan deviation identified replace the defaults; the YAML form: every key read from a file, an
+// an Allan deviation identified replace the defaults, also read from `hrg_bag allan --yaml`'s file
+// (noise/allan_file); the YAML form: every key read from a file, an
 // unknown key and a bad value refused by name, the shipped node template a settings file too.
 #include "hrg_gyro/core/alignment/alignment_settings.h"
 
@@ -15,6 +16,7 @@
 #include "core/testing/refusal.h"
 #include "hrg_gyro/core/alignment/local_level.h"
 #include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/estimation/allan_readings_file.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -192,7 +194,7 @@ TEST(AlignmentSettingsTest, EveryKeyIsReadFromAFile) {
   EXPECT_EQ(s.motion.max_scatter, 2.0);
   // keyPaths() names every key the file gives (the node's own aside).
   const std::vector<std::string> paths = AlignmentSettings::keyPaths();
-  EXPECT_EQ(paths.size(), 7u + 5u + 8u + 8u + 3u + 3u);
+  EXPECT_EQ(paths.size(), 7u + 6u + 8u + 8u + 3u + 3u);
   for (const char* key : {"mode", "noise/residual_drift_harmonics", "level/accelerometer_to_body", "indexer/gyro_axis",
                           "sweep/gain_orders", "motion/max_scatter"}) {
     EXPECT_NE(std::find(paths.begin(), paths.end(), key), paths.end()) << key;
@@ -231,6 +233,38 @@ TEST(AlignmentSettingsTest, UnknownKeysAndBadValuesAreRefusedByName) {
   }
   const SettingsFile broken("hrg_alignment_settings_broken", "latitude: [0.9\n");
   EXPECT_EQ(refusedKey([&] { AlignmentSettings::load(broken.path()); }), "");
+}
+
+// noise/allan_file: the readings a record's Allan deviation identified (Q and K here) replace their
+// keys, one it did not (N) keeps its key; a relative path is the settings file's neighbour, and is
+// refused where there is no settings file (the node's parameters); a missing file names the key.
+TEST(AlignmentSettingsTest, TheNoiseComesFromAnAllanReadingsFile) {
+  AllanReadings readings;
+  readings.samples = 72000;
+  readings.tau0 = 0.005;
+  readings.result.angle_white_noise = {true, 4.9e-6, 0.005, 0.05};
+  readings.result.angle_random_walk = {false, 0.0, 0.0, 0.0};
+  readings.result.bias_instability = {true, 3e-9, 20.0, 60.0};
+  readings.result.rate_random_walk = {true, 5e-10, 100.0, 300.0};
+  const SettingsFile allan("hrg_alignment_allan", allanReadingsYaml(readings));
+  const std::string name = std::filesystem::path(allan.path()).filename().string();
+  const SettingsFile file("hrg_alignment_settings_allan",
+                          "latitude: 0.9\nnoise:\n  allan_file: " + name +
+                              "\n  angle_random_walk: 1.5e-7\n  rate_random_walk: 1e-9\n"
+                              "  residual_bias: 1e-8\n");
+  const AlignmentSettings s = AlignmentSettings::load(file.path());
+  EXPECT_EQ(s.noise.angle_white_noise, 4.9e-6);
+  EXPECT_EQ(s.noise.angle_random_walk, 1.5e-7);  // not identified: the key's
+  EXPECT_EQ(s.noise.rate_random_walk, 5e-10);    // the file's, not the key's
+  EXPECT_EQ(s.noise.residual_bias, 1e-8);
+  const std::string base = "latitude: 0.9\n";
+  EXPECT_EQ(refusedKey([&] { parseText(base + "noise: {allan_file: " + name + "}\n"); }), "noise.allan_file");
+  EXPECT_EQ(parseText(base + "noise: {allan_file: " + allan.path() + "}\n").noise.rate_random_walk, 5e-10);
+  EXPECT_EQ(parseText(base + "noise: {allan_file: ''}\n").noise.rate_random_walk, 0.0);  // "": none
+  EXPECT_EQ(refusedKey([&] { parseText(base + "noise: {allan_file: /nonexistent/allan.yaml}\n"); }),
+            "noise.allan_file");
+  const SettingsFile bad("hrg_alignment_allan_bad", "samples: 10\ntau0: 0.005\n");
+  EXPECT_EQ(refusedKey([&] { parseText(base + "noise: {allan_file: " + bad.path() + "}\n"); }), "noise.allan_file");
 }
 
 // The node's parameter template is a settings file too: every key in it is valid, and its one

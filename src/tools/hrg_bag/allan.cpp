@@ -1,6 +1,4 @@
 // hrg_bag allan: overlapping Allan deviation of the compensated rate (IEEE 952 readings).
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -11,6 +9,7 @@
 #include "../cli_checks.h"
 #include "bag_tools.h"
 #include "hrg_gyro/core/estimation/allan_deviation.h"
+#include "hrg_gyro/core/estimation/allan_readings_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
@@ -77,28 +76,9 @@ int runAllan(const AllanOptions& o) {
   reading("bias instability B", a.bias_instability, kDegPerHour, "deg/h", 1.0, "rad/s");
   reading("rate random walk K", a.rate_random_walk, kDegPerHour * 60.0, "deg/h/sqrt(h)", 1.0, "rad/s/sqrt(s)");
   if (!o.yaml.empty()) {
-    // The readings in SI for reports: what was read, from which tau range, and the record they came from.
-    YAML::Emitter y;
-    y << YAML::BeginMap;
-    y << YAML::Key << "samples" << YAML::Value << best.size();
-    y << YAML::Key << "tau0" << YAML::Value << tau0;
-    y << YAML::Key << "record_length" << YAML::Value << tau0 * static_cast<double>(best.size());
-    auto emit = [&y](const char* key, const core::NoiseReading& r) {
-      y << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap;
-      y << YAML::Key << "identified" << YAML::Value << r.identified;
-      y << YAML::Key << "value" << YAML::Value << r.value;
-      y << YAML::Key << "tau_min" << YAML::Value << r.tau_min;
-      y << YAML::Key << "tau_max" << YAML::Value << r.tau_max;
-      y << YAML::EndMap;
-    };
-    emit("angle_white_noise", a.angle_white_noise);  // rad
-    emit("angle_random_walk", a.angle_random_walk);  // rad/sqrt(s)
-    emit("bias_instability", a.bias_instability);    // rad/s
-    emit("rate_random_walk", a.rate_random_walk);    // rad/s/sqrt(s)
-    y << YAML::EndMap;
+    // The readings in SI for reports and for settings that read them (the alignment's noise/allan_file).
     OutputText yaml_file(o.yaml);
-    yaml_file.stream() << "# hrg_bag allan readings, SI: Q rad, N rad/sqrt(s), B rad/s, K rad/s/sqrt(s); tau in s.\n"
-                       << y.c_str() << "\n";
+    yaml_file.stream() << core::allanReadingsYaml({best.size(), tau0, a});
     yaml_file.commit();
   }
   if (!o.csv.empty()) {

@@ -16,9 +16,10 @@
 //           +rate then -rate: D(theta)'s harmonics average out instead of entering the heading, and
 //           the commanded virtual rate, executed with an unknown gain G_v near 1, is fitted out.
 //
-// The noise model (per gyro axis, in body rate units: rad, rad/s) comes from the Allan deviation the
-// package computes (estimation/allan_deviation.h, noiseFromAllan) or from the settings; the white
-// angle noise is measured from the window itself unless given.
+// The noise model (per gyro axis, in body rate units: rad, rad/s) comes from the settings, or from the
+// Allan deviation the package computes (`noise/allan_file`: the readings `hrg_bag allan --yaml` wrote,
+// whose identified Q, N and K replace the keys; noiseFromAllan); the white angle noise is measured
+// from the window itself unless given.
 //
 // As YAML (the gyrocompass node's private parameters, `hrg_bag align --settings`): the fields below
 // by name, each section a map (`level: {source: declared, roll: 0.0, ...}`), `mode` and
@@ -136,8 +137,11 @@ struct AlignmentSettings {
 
   /// Reads the settings map (the top level of a settings file or of the node's parameters) and
   /// validates it. Unknown keys are refused by name; `extra_keys` are also allowed at the top level,
-  /// unread (someone else's). Throws ConfigError naming the key as the file writes it ("level.roll").
-  static AlignmentSettings parse(const YamlField& root, const std::vector<std::string>& extra_keys = {});
+  /// unread (someone else's). A relative `noise/allan_file` is read from `base_directory` (the settings
+  /// file's); without one it must be absolute. Throws ConfigError naming the key as the file writes it
+  /// ("level.roll").
+  static AlignmentSettings parse(const YamlField& root, const std::vector<std::string>& extra_keys = {},
+                                 const std::string& base_directory = "");
   /// A settings file: the settings at its top level, beside them (unread) the gyrocompass node's own
   /// keys (nodeKeys()), so the node's parameter file config/gyrocompass.yaml is one too. Throws
   /// ConfigError (an unreadable file, a YAML syntax error with its line, a bad key).

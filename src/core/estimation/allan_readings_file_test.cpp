@@ -1,0 +1,101 @@
+// The Allan readings file: what allanReadingsYaml writes, loadAllanReadings reads back bit for bit;
+// a missing or mistyped entry, an unknown key, a negative value, a positive-less identified reading
+// and a bad tau0 are refused naming the key and the file.
+#include "hrg_gyro/core/estimation/allan_readings_file.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "core/testing/refusal.h"
+#include "hrg_gyro/core/common/yaml_field.h"
+
+namespace hrg_gyro {
+namespace core {
+namespace {
+
+// A file of its own per test process and name, removed when the test ends.
+class ReadingsFile {
+ public:
+  ReadingsFile(const std::string& name, const std::string& text)
+      : path_(std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".yaml")) {
+    std::ofstream(path_) << text;
+  }
+  ~ReadingsFile() { std::remove(path_.c_str()); }
+  std::string path() const { return path_.string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+AllanReadings example() {
+  AllanReadings r;
+  r.samples = 120001;
+  r.tau0 = 0.005000000000000001;
+  r.result.angle_white_noise = {true, 4.912345678901234e-6, 0.005, 0.0631};
+  r.result.angle_random_walk = {false, 0.0, 0.0, 0.0};
+  r.result.bias_instability = {true, 3.1e-9, 20.0, 63.1};
+  r.result.rate_random_walk = {true, 5.123456789e-10, 100.0, 316.2};
+  return r;
+}
+
+TEST(AllanReadingsFileTest, WhatIsWrittenIsReadBackExactly) {
+  const AllanReadings w = example();
+  const ReadingsFile file("hrg_allan_readings", allanReadingsYaml(w));
+  const AllanReadings r = loadAllanReadings(file.path());
+  EXPECT_EQ(r.samples, w.samples);
+  EXPECT_EQ(r.tau0, w.tau0);
+  EXPECT_TRUE(r.result.curve.empty());
+  const NoiseReading AllanResult::*terms[] = {&AllanResult::angle_white_noise, &AllanResult::angle_random_walk,
+                                              &AllanResult::bias_instability, &AllanResult::rate_random_walk};
+  for (const auto term : terms) {
+    EXPECT_EQ((r.result.*term).identified, (w.result.*term).identified);
+    EXPECT_EQ((r.result.*term).value, (w.result.*term).value);
+    EXPECT_EQ((r.result.*term).tau_min, (w.result.*term).tau_min);
+    EXPECT_EQ((r.result.*term).tau_max, (w.result.*term).tau_max);
+  }
+  EXPECT_EQ(allanReadingsYaml(w).rfind("# hrg_bag allan readings, SI", 0), 0u);
+}
+
+TEST(AllanReadingsFileTest, ABadEntryIsRefusedNamingTheKeyAndTheFile) {
+  const std::string good = allanReadingsYaml(example());
+  auto refused = [](const std::string& text) {
+    const ReadingsFile file("hrg_allan_readings_bad", text);
+    try {
+      loadAllanReadings(file.path());
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(file.path()), std::string::npos) << e.what();
+      return e.key();
+    }
+    return std::string("(accepted)");
+  };
+  EXPECT_EQ(refused(good), "(accepted)");
+  EXPECT_EQ(refused("samples: 10\ntau0: 0.005\n"), "angle_white_noise");
+  EXPECT_EQ(refused(good + "extra: 1\n"), "extra");
+  std::string negative = good;
+  negative.replace(negative.find("value: 5.123456789"), 9, "value: -5.");
+  EXPECT_EQ(refused(negative), "rate_random_walk.value");
+  std::string zero = "samples: 10\ntau0: 0.005\n";
+  for (const char* k : {"angle_white_noise", "angle_random_walk", "bias_instability"}) {
+    zero += std::string(k) + ": {identified: false, value: 0, tau_min: 0, tau_max: 0}\n";
+  }
+  EXPECT_EQ(refused(zero + "rate_random_walk: {identified: true, value: 0, tau_min: 1, tau_max: 2}\n"),
+            "rate_random_walk.value");
+  std::string tau = good;
+  tau.replace(tau.find("tau0: "), 6, "tau0: -");
+  EXPECT_EQ(refused(tau), "tau0");
+  try {
+    loadAllanReadings("/nonexistent/allan.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/allan.yaml"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace hrg_gyro
