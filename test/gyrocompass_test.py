@@ -42,8 +42,14 @@ def quaternion(q):
 
 
 def angle_between(a, b):
-    """rad between two unit quaternions (x, y, z, w)."""
-    return 2.0 * math.acos(min(1.0, abs(float(np.dot(a, b)))))
+    """rad between two unit quaternions (x, y, z, w): 2 atan2(|v|, |w|) of a^-1 b, exact for small angles
+    (2 acos(a . b) cannot resolve less than 3e-8 rad: a . b rounds to 1 or to 1 - 1.1e-16)."""
+    ax, ay, az, aw = -a[0], -a[1], -a[2], a[3]  # the conjugate
+    bx, by, bz, bw = b
+    v = np.array([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+                  aw * bz + ax * by - ay * bx + az * bw])
+    w = aw * bw - ax * bx - ay * by - az * bz
+    return 2.0 * math.atan2(float(np.linalg.norm(v)), abs(w))
 
 
 def rpy_quaternion(roll, pitch, yaw):
