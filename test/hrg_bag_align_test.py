@@ -6,8 +6,9 @@ channels through the processors and the triad's combiner (--triad, --axis-params
 model). The static mode on the first 60 s and the indexed mode on both positions find the heading
 within 3 reported sigmas of the truth; the result file reads back; the window's first 15, 30, 60 s give
 sigmas that fall with the window; a moving table and a latitude beyond max_latitude are refused (exit 1)
-naming their gate; bad settings and options exit 2 naming the key or option. Needs no master; run as a
-rostest for the package environment."""
+naming their gate; bad settings and options exit 2 naming the key or option. The sweep of config/scenarios/north_sweep.yaml (its pickoffs' defects left
+out; each axis's channels and precession state) finds the heading within 2 reported sigmas. Needs no master; run as a rostest for the
+package environment."""
 import math
 import os
 import random
@@ -15,6 +16,7 @@ import shutil
 import subprocess
 import unittest
 
+import numpy
 import rosbag
 import rospy
 import rostest
@@ -45,6 +47,36 @@ level:
   source: declared           # the indexer's zero frame is level
 indexer:
   settle: 1.0                # s after the half turn before samples count
+"""
+
+SWEEP = """# The sweep of config/scenarios/north_sweep.yaml, levelled by its accelerometer.
+mode: sweep                  # each axis's wave turned through whole turns both ways
+latitude: 0.9                # rad, the scenario's
+duration: 270.0              # s: the field calibration's plan
+noise:
+  residual_drift_harmonics: 1.0e-8  # rad/s: the scenario's order-2 residual of D over |K0|, rms
+level:
+  source: accelerometer      # accel/data_raw
+  accelerometer_to_body: {roll: 0.0, pitch: 0.0, yaw: 1.5707963267948966}  # rad: the scenario's mounting
+  accelerometer_bias_sigma: 5.0e-4  # m/s^2: the scenario's bias is within it per axis
+"""
+
+SWEEP_AXIS = """# A gyro of config/scenarios/north_sweep.yaml: its K0; D = 0 (the scenario's D is the residual).
+schema_version: 1
+scale_factor: {orders: [], mean: %r, cos: [], sin: []}
+drift: {orders: [], mean: 0.0, cos: [], sin: []}
+correction_matrix: {p: [0.0, 0.0, 0.0, 0.0]}
+earth_rate: {enabled: false, latitude: 0.9}
+calibration: {method: manual, time: "", source: "%s", notes: "K0 of the simulated gyro"}
+"""
+
+SWEEP_TRIAD = """# The triad of config/scenarios/north_sweep.yaml as a perfect calibration finds it: M = A^-1.
+frame_id: imu_link
+axes: [x, y, z]
+axis_to_body:
+  %s
+bias: [0.0, 0.0, 0.0]
+calibration: {method: manual, time: "", source: "", notes: "M = A^-1 of the scenario"}
 """
 
 
@@ -226,6 +258,59 @@ class HrgBagAlign(unittest.TestCase):
         code, _, err = run("align", processed, "--settings", settings)
         self.assertEqual(code, 2, err)
         self.assertIn("gyro-topic", err)
+
+    def test_the_sweep_of_config_north_sweep_finds_the_heading_from_each_axis_and_its_precession(self):
+        # config/scenarios/north_sweep.yaml: each axis's wave turned + - - + by its precession loop, its
+        # /<axis>/precession/state recorded beside its channels. Its pickoffs without their defects here,
+        # so that the processors' files (each axis's K0, D = 0: the scenario's D is the residual the sweep
+        # averages out; the correction matrix none) are the gyros' exact model; the triad file M = A^-1.
+        shipped = os.path.join(self.pkg, "config/scenarios/north_sweep.yaml")
+        document = yaml.safe_load(open(shipped))
+        for axis in document["triad"]["axes"]:
+            axis["pickoff"] = {"noise": axis["pickoff"]["noise"]}
+        scenario_path = self.path("north_sweep.yaml")
+        with open(scenario_path, "w") as f:
+            yaml.safe_dump(document, f)
+        bag = self.path("north_sweep.bag")
+        code, _, err = run("simulate", "--scenario", scenario_path, "--out", bag, "--no-truth")
+        self.assertEqual(code, 0, err)
+        with rosbag.Bag(bag) as b:
+            topics = b.get_type_and_topic_info().topics
+        for name in "xyz":
+            state = topics["/%s/precession/state" % name]
+            self.assertEqual(state.msg_type, "hrg_gyro/PrecessionState")
+            self.assertEqual(state.message_count, topics["/%s/channels" % name].message_count)
+        scenario = document["triad"]
+        chain = ["--triad", self.path("north_sweep_triad.yaml")]
+        a = numpy.identity(3)
+        for i, axis in enumerate(scenario["axes"]):
+            others = [j for j in range(3) if j != i]
+            a[i, others[0]], a[i, others[1]] = axis["misalignment"]
+            k0 = -2.0 * axis["dynamics"]["shell"]["bryan_factor"]
+            params = self.path("north_sweep_%s.yaml" % axis["name"])
+            with open(params, "w") as f:
+                f.write(SWEEP_AXIS % (k0, scenario_path))
+            chain += ["--axis-params", "%s=%s" % (axis["name"], params)]
+        with open(chain[1], "w") as f:
+            f.write(SWEEP_TRIAD % yaml.safe_dump(numpy.linalg.inv(a).tolist(), default_flow_style=None).strip()
+                    .replace("\n", "\n  "))
+        settings, out = self.path("sweep.yaml"), self.path("sweep.result.yaml")
+        with open(settings, "w") as f:
+            f.write(SWEEP)
+        code, stdout, err = run("align", bag, "--settings", settings, "--output", out, *chain)
+        self.assertEqual(code, 0, stdout + err)
+        r = self.read(out)
+        self.assertEqual(r["mode"], "sweep")
+        truth = math.degrees(scenario["turntable"]["azimuth"] - scenario["positions"][0]["body_to_table"]["yaw"])
+        error, sigma = heading_error_deg(r["heading_deg"], truth), r["heading_sigma_deg"]
+        print("[ measured ] sweep, 270 s from the axes' channels: heading %.5f deg +- %.5f deg (truth %.5f deg): "
+              "error %.4f mrad, sigma %.4f mrad" % (r["heading_deg"], sigma, truth, 1e3 * math.radians(error),
+                                                    1e3 * math.radians(sigma)))
+        self.assertLess(abs(error), 2.0 * sigma)
+        # Without the triad's chain there are no axis outputs to sweep: refused naming the option.
+        code, _, err = run("align", bag, "--settings", settings)
+        self.assertEqual(code, 2, err)
+        self.assertIn("--triad", err)
 
     def test_a_moving_table_and_a_latitude_beyond_the_limit_are_refused_naming_the_gate(self):
         out = self.path("moving.result.yaml")

@@ -4,7 +4,10 @@ nodelet: in its namespace it publishes <axis>/channels and <axis>/truth for x, y
 axis), turntable/state, fixture/position and the body's truth (frame_id the triad's imu_link), the
 three axes at the same stamps, each axis's truth rate its row of A times the body's rate; and the
 accelerometer the launch file adds to the scenario, accel/data_raw: gravity through the true body
-orientation and the mounting, plus the bias, with its noise's covariance."""
+orientation and the mounting, plus the bias, with its noise's covariance. On
+config/scenarios/north_sweep.yaml (each axis run by the averaged resonator on its schedule) each axis
+also publishes <axis>/precession/state with each of its channel samples: the schedule's rate in force,
+the commanded angle, source "schedule"."""
 import math
 import os
 import sys
@@ -15,7 +18,7 @@ import rostest
 
 from sensor_msgs.msg import Imu
 
-from hrg_gyro.msg import BodyTruth, ChannelAmplitudes, FixturePosition, GroundTruth, TurntableState
+from hrg_gyro.msg import BodyTruth, ChannelAmplitudes, FixturePosition, GroundTruth, PrecessionState, TurntableState
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hrg_test_util as util  # noqa: E402
@@ -115,6 +118,33 @@ class TriadDriverSim(unittest.TestCase):
 
     def test_node(self):
         self.check("triad_node")
+
+    def test_axes_that_precess_publish_their_precession_state(self):
+        # north_sweep.yaml: rest (its first command, rate 0) until 5 s, then +0.2 rad/s (electrical).
+        channels = {a: util.Latest("/triad_sweep/%s/channels" % a, ChannelAmplitudes, keep_all=True) for a in AXES}
+        states = {a: util.Latest("/triad_sweep/%s/precession/state" % a, PrecessionState, keep_all=True)
+                  for a in AXES}
+        util.wait_for(lambda: all(any(m.rate != 0.0 for m in s.all) and s.count > 1200 for s in states.values()),
+                      "each axis's precession state past the first command")
+        for s in list(channels.values()) + list(states.values()):
+            s.sub.unregister()
+        for a in AXES:
+            received = states[a].all
+            self.assertEqual({m.header.frame_id for m in received}, {a})
+            self.assertEqual({m.source for m in received}, {"schedule"})
+            # One state with each channel sample, at its stamp.
+            stamps = set(m.header.stamp for m in channels[a].all)
+            self.assertGreater(len(stamps & set(m.header.stamp for m in received)), 0.9 * len(received))
+            # Live, the stamps start at the wall clock: the angle dates the second command instead.
+            resting = [m for m in received if m.rate == 0.0]
+            turning = [m for m in received if m.rate != 0.0]
+            self.assertEqual({(m.angle, m.commands) for m in resting}, {(0.0, 1)})
+            self.assertEqual({(m.rate, m.commands) for m in turning}, {(0.2, 2)})
+            switch = [m.header.stamp.to_sec() - m.angle / 0.2 for m in turning]
+            self.assertLess(max(switch) - min(switch), 1e-6)  # one start: the angle grows at 0.2 rad/s
+            if resting:
+                self.assertLess(resting[-1].header.stamp.to_sec(), min(switch))
+                self.assertLess(min(switch), turning[0].header.stamp.to_sec())
 
     def test_nodelet(self):
         self.check("triad_nodelet")

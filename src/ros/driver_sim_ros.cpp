@@ -131,6 +131,9 @@ void DriverSimRos::advertise() {
       const std::string& axis = triad_config_->axes[i].name;
       axis_channels_pub_[i] = nh_.advertise<ChannelAmplitudes>(triadAxisTopic(axis, "channels"), queue_size_);
       axis_truth_pub_[i] = nh_.advertise<GroundTruth>(triadAxisTopic(axis, "truth"), queue_size_);
+      if (triad_config_->axes[i].dynamics.averaged()) {
+        axis_precession_pub_[i] = nh_.advertise<PrecessionState>(triadAxisTopic(axis, "precession/state"), queue_size_);
+      }
     }
     fixture_pub_ = nh_.advertise<FixturePosition>("fixture/position", queue_size_);
     truth_pub_ = nh_.advertise<BodyTruth>("truth", queue_size_);
@@ -316,6 +319,11 @@ void DriverSimRos::publishTriad(const core::TriadSample& s, const ros::Time& sta
     if (axis_truth_pub_[i].getNumSubscribers() > 0) {
       axis_truth_pub_[i].publish(
           boost::make_shared<GroundTruth>(toTruthMessage(axis, trueHeader(channels->header, stamp))));
+    }
+    if (c.axes[i].dynamics.averaged()) {
+      // Its schedule's commands only: the state's source is the schedule's.
+      axis_precession_pub_[i].publish(boost::make_shared<PrecessionState>(
+          toPrecessionStateMessage(axis, trueHeader(channels->header, stamp), kScheduledPrecessionSource)));
     }
   }
   for (const core::TurntableLogRecord& r : s.turntable) {

@@ -18,6 +18,9 @@
 // the triad's frame_id (its triad.frame_id; ~frame_id is the single gyro's). With
 // `triad/accelerometer` enabled it also publishes `accel/data_raw` (sensor_msgs/Imu, REP-145: the
 // specific force of gravity, +g up at rest, with its covariance; its own frame_id) with every sample.
+// An axis run by the averaged resonator (triad/axes[i]/dynamics, model: averaged) follows its
+// schedule (dynamics/commands) and publishes `<axis>/precession/state` with every sample, `source`
+// "schedule" (a triad's axes take no commands on a topic).
 //
 // A gyro with a precession loop (dynamics.model: averaged, core::DynamicsConfig) also takes commands
 // of its virtual rotation on `command/precession` (hrg_gyro/PrecessionCommand), executed from the
@@ -87,8 +90,9 @@ class DriverSimRos {
   ros::Publisher channels_pub_, turntable_pub_, truth_pub_, clock_pub_, done_pub_;
   std::array<ros::Publisher, 3> axis_channels_pub_, axis_truth_pub_;  // a triad's; truth_pub_ its body truth
   ros::Publisher fixture_pub_;
-  ros::Publisher accelerometer_pub_;  // a triad's accelerometer, when its scenario has one
-  ros::Publisher precession_pub_;     // a gyro with a precession loop only
+  ros::Publisher accelerometer_pub_;                   // a triad's accelerometer, when its scenario has one
+  ros::Publisher precession_pub_;                      // a gyro with a precession loop only
+  std::array<ros::Publisher, 3> axis_precession_pub_;  // a triad's axes with a precession loop only
   ros::Subscriber command_sub_;
   // ~pace_topic (sim time only): a consumer's std_msgs/Time saying up to which stamp it has taken
   // the data in; a sample more than ~max_lead past it waits (a calibrator fitting, or reloading the

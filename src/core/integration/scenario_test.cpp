@@ -8,6 +8,8 @@
 #include <set>
 #include <sstream>
 
+#include "hrg_gyro/core/calibration/calibration_settings.h"
+#include "hrg_gyro/core/calibration/field_command_plan.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/simulation/injected_model.h"
 #include "hrg_gyro/core/simulation/simulation_config.h"
@@ -219,8 +221,8 @@ TEST(Scenarios, ShippedScenariosParseAndDescribeTheSameGyro) {
   files.erase("diagnosis.yaml");
   files.erase("triad.yaml");
   files.erase("triad_verification.yaml");
-  for (const std::string& name :
-       {"north_static.yaml", "north_indexed_two.yaml", "north_indexed_four.yaml", "north_continuous.yaml"}) {
+  for (const std::string& name : {"north_static.yaml", "north_indexed_two.yaml", "north_indexed_four.yaml",
+                                  "north_continuous.yaml", "north_sweep.yaml"}) {
     files.erase(name);  // the triad's north-finding sessions (NorthScenarios...)
   }
   for (const std::string& name : resonatorScenarios()) files.erase(name);
@@ -487,6 +489,50 @@ TEST(Scenarios, NorthScenariosAreTheCalibratedTriadInEachAlignmentMode) {
   turning.table_profile.evaluate(turning.duration() - 1.0, &angle, &rate);
   EXPECT_NEAR(rate, kTwoPi / 120.0, 1e-12);
   EXPECT_GE(angle, 2.0 * kTwoPi);
+}
+
+// config/scenarios/north_sweep.yaml: north_static.yaml's triad, level and site, its axes run by the
+// averaged resonator (triad.yaml's K0, the shell and drive calibrated but for the precession gain), D's
+// order-2 residual of 8e-9 rad/s without the bias, each wave turned on the field calibration's plan.
+TEST(Scenarios, NorthSweepScenarioTurnsTheCalibratedTriadOnTheFieldPlan) {
+  const TriadSimulationConfig cal = loadTriadScenario(kScenarioDir + "triad.yaml");
+  const TriadSimulationConfig st = loadTriadScenario(kScenarioDir + "north_static.yaml");
+  const TriadSimulationConfig c = loadTriadScenario(kScenarioDir + "north_sweep.yaml");
+  YAML::Node settings;
+  settings["field"] = YAML::LoadFile(std::string(HRG_GYRO_SOURCE_DIR) + "/config/calibrator.yaml")["field"];
+  const std::vector<PlannedPrecession> plan = fieldCommandPlan(CalibrationSettings::parse(YamlField(settings, "")));
+  EXPECT_EQ(c.turntable.latitude, st.turntable.latitude);
+  EXPECT_EQ(c.turntable.azimuth, st.turntable.azimuth);
+  EXPECT_EQ(c.accelerometer.bias, st.accelerometer.bias);
+  EXPECT_EQ(c.accelerometer.noise, st.accelerometer.noise);
+  ASSERT_EQ(c.positions.size(), 1u);
+  EXPECT_EQ(c.positions[0].bodyToPlatter(), st.positions[0].bodyToPlatter());
+  EXPECT_EQ(restsOf(c.table_profile).size(), 1u);
+  ASSERT_FALSE(plan.empty());
+  EXPECT_GE(c.duration(), plan.back().time + 1.0);
+  for (int i = 0; i < 3; ++i) {
+    SCOPED_TRACE(i);
+    const TriadAxisConfig &a = c.axes[i], &b = cal.axes[i];
+    EXPECT_EQ(a.misalignment, b.misalignment);
+    EXPECT_EQ(a.resonator.initial_theta, b.resonator.initial_theta);
+    EXPECT_EQ(a.pickoff.noise, b.pickoff.noise);
+    EXPECT_EQ(a.pickoff.misplacement, b.pickoff.misplacement);
+    ASSERT_TRUE(a.dynamics.averaged());
+    EXPECT_NEAR(a.resonator.scale_factor.meanAt(NAN), b.resonator.scale_factor.meanAt(NAN), 1e-12);
+    EXPECT_EQ(a.dynamics.shell.damping_anisotropy, 0.0);
+    EXPECT_EQ(a.dynamics.shell.frequency_split, 0.0);
+    const HarmonicModel& d = a.resonator.drift;
+    ASSERT_EQ(d.orders(), std::vector<int>{2});
+    double coefficients[3];
+    d.coefficientsAt(NAN, coefficients);  // mean, cos 2, sin 2
+    EXPECT_EQ(coefficients[0], 0.0);
+    EXPECT_NEAR(std::hypot(coefficients[1], coefficients[2]), 8e-9, 1e-10);
+    ASSERT_EQ(a.dynamics.commands.size(), plan.size());
+    for (std::size_t k = 0; k < plan.size(); ++k) {
+      EXPECT_NEAR(a.dynamics.commands[k].time, plan[k].time, 1e-6) << k;
+      EXPECT_EQ(a.dynamics.commands[k].rate, plan[k].rate) << k;
+    }
+  }
 }
 
 TEST(Scenarios, RejectsBadValuesByKey) {

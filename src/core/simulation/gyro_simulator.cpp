@@ -29,7 +29,6 @@ GyroSimulator::GyroSimulator(const SimulationConfig& config, const AxisRateInput
   if (config_.thermal.enabled) updateTemperature(0.0);
   const DynamicsConfig& d = config_.dynamics;
   if (d.averaged()) {
-    if (input_) throw std::invalid_argument("the averaged resonator is a single gyro's dynamics, not a triad axis's");
     const ResonatorConfig& rc = config_.resonator;
     const IntrinsicModel intrinsic(config_);
     shell_bias_ = intrinsic.meanDrift() - rc.drift.meanAt(rc.frequency);
@@ -193,6 +192,25 @@ bool GyroSimulator::next(SimulationSample* out) {
   return true;
 }
 
+void GyroSimulator::integrateInputAngle(double h, double rate_start, double rate_middle, double rate_end) {
+  // Kahan-compensated like the time: hours of small increments stay exact to the last bits.
+  const double y = h / 6 * (rate_start + 4 * rate_middle + rate_end) - input_angle_compensation_;
+  const double sum = input_angle_ + y;
+  input_angle_compensation_ = (sum - input_angle_) - y;
+  input_angle_ = sum;
+}
+
+void GyroSimulator::setInputTruth(double t_lo, double angle_lo, double t_center, TruthState* truth) const {
+  // The input's rate at the centre and its angle: Simpson from the period boundary before it.
+  truth->inertial_rate = input_->rateAt(t_center);
+  truth->inertial_angle = angle_lo;
+  if (t_center > t_lo) {
+    truth->inertial_angle +=
+        (t_center - t_lo) / 6 *
+        (input_->rateAt(t_lo) + 4 * input_->rateAt(0.5 * (t_lo + t_center)) + truth->inertial_rate);
+  }
+}
+
 void GyroSimulator::nextDynamic(SimulationSample* out) {
   if (dynamics_) {
     nextResonator(out);
@@ -219,13 +237,7 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
     const double k4 = thetaRate(t + h, theta_ + h * k3, sensed1);
     double theta_end = theta_ + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
     // The input's angle by Simpson's rule on the same stages (RK4 of a function of time alone).
-    if (input_) {
-      // Kahan-compensated like the time: hours of small increments stay exact to the last bits.
-      const double y = h / 6 * (sensed0 + 4 * sensed_mid + sensed1) - input_angle_compensation_;
-      const double sum = input_angle_ + y;
-      input_angle_compensation_ = (sum - input_angle_) - y;
-      input_angle_ = sum;
-    }
+    if (input_) integrateInputAngle(h, sensed0, sensed_mid, sensed1);
     if (rc.rate_noise > 0.0) {
       // A white body-rate noise, seen through the scale factor like any rotation.
       double k, d;
@@ -248,15 +260,7 @@ void GyroSimulator::nextDynamic(SimulationSample* out) {
   truth.theta = boundary_theta[lo] + frac * (boundary_theta[lo + 1] - boundary_theta[lo]);
   config_.profile.evaluate(t_center - generatorDuration(), &truth.table_angle, &truth.table_rate, &truth.segment);
   if (input_) {
-    // The input's rate at the centre and its angle: Simpson from the period boundary before it.
-    const double t_lo = t_start + lo * period;
-    truth.inertial_rate = input_->rateAt(t_center);
-    truth.inertial_angle = boundary_input_angle[lo];
-    if (t_center > t_lo) {
-      truth.inertial_angle +=
-          (t_center - t_lo) / 6 *
-          (input_->rateAt(t_lo) + 4 * input_->rateAt(0.5 * (t_lo + t_center)) + truth.inertial_rate);
-    }
+    setInputTruth(t_start + lo * period, boundary_input_angle[lo], t_center, &truth);
   } else {
     truth.inertial_rate = truth.table_rate + earth_rate_;
     truth.inertial_angle = truth.table_angle + earth_rate_ * t_center;
@@ -269,7 +273,7 @@ void GyroSimulator::nextResonator(SimulationSample* out) {
   const ResonatorConfig& rc = config_.resonator;
   const int m = rc.periods_per_output;
   const double period = 1.0 / rc.frequency;
-  double boundary_theta[2] = {0.0, 0.0}, boundary_psi[2] = {0.0, 0.0};
+  double boundary_theta[2] = {0.0, 0.0}, boundary_psi[2] = {0.0, 0.0}, input_angle_lo = 0.0;
   const int lo = std::min(m / 2, m - 1);  // the period holding the window's centre
   const double frac = 0.5 * m - lo;
   const double t_start = t_;
@@ -278,9 +282,10 @@ void GyroSimulator::nextResonator(SimulationSample* out) {
   ResonatorInputs in;
   for (int p = 0; p < m; ++p) {
     applyPrecessionCommands(out);
-    const double h = period, t = t_;
+    const double h = period, t = t_, input_angle_before = input_angle_;
     in.body_rate_start = sensedRate(t);
     in.body_rate_end = sensedRate(t + h);
+    if (input_) integrateInputAngle(h, in.body_rate_start, input_->rateAt(t + 0.5 * h), in.body_rate_end);
     if (rc.rate_noise > 0.0) {
       // A white body-rate noise held over the period: the angle random walk of the harmonic path.
       const double noise = rc.rate_noise / std::sqrt(h) * rate_noise_.next();
@@ -296,6 +301,7 @@ void GyroSimulator::nextResonator(SimulationSample* out) {
     const double theta_end = dynamics_->wave().theta;
     sum += synth_.period(start, theta_end);
     if (p == lo) {
+      input_angle_lo = input_angle_before;
       boundary_theta[0] = theta_, boundary_psi[0] = virtual_angle_;
       boundary_theta[1] = theta_end, boundary_psi[1] = virtual_angle_ + virtual_rate_ * h;
     }
@@ -309,8 +315,12 @@ void GyroSimulator::nextResonator(SimulationSample* out) {
   TruthState& truth = out->truth;
   truth.theta = boundary_theta[0] + frac * (boundary_theta[1] - boundary_theta[0]);
   config_.profile.evaluate(t_center - generatorDuration(), &truth.table_angle, &truth.table_rate, &truth.segment);
-  truth.inertial_rate = truth.table_rate + earth_rate_;
-  truth.inertial_angle = truth.table_angle + earth_rate_ * t_center;
+  if (input_) {
+    setInputTruth(t_start + lo * period, input_angle_lo, t_center, &truth);
+  } else {
+    truth.inertial_rate = truth.table_rate + earth_rate_;
+    truth.inertial_angle = truth.table_angle + earth_rate_ * t_center;
+  }
   setTruthWave(wave.amplitude, wave.quadrature, wave.phase, t_center, false, &truth);
   out->precession.rate = virtual_rate_;
   out->precession.angle = boundary_psi[0] + frac * (boundary_psi[1] - boundary_psi[0]);

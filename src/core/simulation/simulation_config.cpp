@@ -174,6 +174,23 @@ void parseScenarioTopLevel(const YamlField& root, std::vector<std::string> keys,
   if (!(*start_time > 0.0)) root["start_time"].fail("must be positive (time 0 means 'unset' in ROS)");
 }
 
+DynamicsConfig parseDynamicsOf(const YamlField& parent, ResonatorConfig* resonator) {
+  if (!parent.has("dynamics")) return DynamicsConfig();
+  const DynamicsConfig d =
+      parseDynamicsSection(parent["dynamics"], resonator->frequency, resonator->amplitude, resonator->phase);
+  if (!d.averaged()) return d;
+  // One description of each quantity: the shell's K and the loops' B = 0 replace the given ones.
+  if (parent.has("resonator") && parent["resonator"].has("scale_factor")) {
+    parent["resonator"]["scale_factor"].fail("the averaged resonator's K follows from dynamics.shell.bryan_factor");
+  }
+  if (parent.has("resonator") && parent["resonator"].has("quadrature")) {
+    parent["resonator"]["quadrature"].fail("the averaged resonator's quadrature loop holds B at 0");
+  }
+  resonator->scale_factor = HarmonicModel(d.shell.scaleFactor());
+  resonator->quadrature = 0.0;
+  return d;
+}
+
 SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vector<std::string>& extra_keys) {
   SimulationConfig c;
   parseScenarioTopLevel(
@@ -214,22 +231,8 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
     c.thermal = ThermalConfig::parse(root["thermal"]);
     checkThermalLimits(c, root["thermal"]);
   }
-  if (root.has("dynamics")) {
-    const ResonatorConfig& rc = c.resonator;
-    c.dynamics = parseDynamicsSection(root["dynamics"], rc.frequency, rc.amplitude, rc.phase);
-  }
-  if (c.dynamics.averaged()) {
-    // One description of each quantity: the shell's K and the loops' B = 0 replace the given ones.
-    if (root.has("resonator") && root["resonator"].has("scale_factor")) {
-      root["resonator"]["scale_factor"].fail("the averaged resonator's K follows from dynamics.shell.bryan_factor");
-    }
-    if (root.has("resonator") && root["resonator"].has("quadrature")) {
-      root["resonator"]["quadrature"].fail("the averaged resonator's quadrature loop holds B at 0");
-    }
-    if (c.thermal.enabled) root["thermal"].fail("not available with dynamics.model: averaged");
-    c.resonator.scale_factor = HarmonicModel(c.dynamics.shell.scaleFactor());
-    c.resonator.quadrature = 0.0;
-  }
+  c.dynamics = parseDynamicsOf(root, &c.resonator);
+  if (c.dynamics.averaged() && c.thermal.enabled) root["thermal"].fail("not available with dynamics.model: averaged");
   if (!c.generator.enabled && c.profile.pieces().empty()) {
     throw ConfigError("turntable.profile", "missing: give a turntable profile (or enable the generator)");
   }

@@ -46,13 +46,14 @@ std::string frameId(const YamlField& section, const std::string& fallback) {
 
 TriadAxisConfig parseAxis(const YamlField& a) {
   a.requireMap();
-  a.rejectUnknownKeys({"name", "resonator", "pickoff", "channels", "misalignment", "scale"});
+  a.rejectUnknownKeys({"name", "resonator", "pickoff", "channels", "misalignment", "scale", "dynamics"});
   TriadAxisConfig c;
   c.name = a["name"].asString();
   if (!isValidAxisName(c.name)) {
     a["name"].fail("'" + c.name + "' is not a namespace: a letter, then letters, digits or '_'");
   }
   if (a.has("resonator")) c.resonator = parseResonatorSection(a["resonator"]);
+  c.dynamics = parseDynamicsOf(a, &c.resonator);
   if (a.has("pickoff")) c.pickoff = parsePickoffSection(a["pickoff"], c.resonator.amplitude);
   if (a.has("channels")) c.channels = parseChannelDeliverySection(a["channels"]);
   if (a.has("misalignment")) {
@@ -272,6 +273,7 @@ SimulationConfig TriadSimulationConfig::axisScenario(int axis) const {
   c.resonator = a.resonator;
   c.pickoff = a.pickoff;
   c.channels = a.channels;
+  c.dynamics = a.dynamics;
   c.latitude = turntable.latitude;
   c.acceleration = turntable.acceleration;
   c.profile = table_profile;  // the ripple already in it: the simulator must not add it again

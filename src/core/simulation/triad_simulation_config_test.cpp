@@ -222,6 +222,27 @@ TEST(TriadSimulationConfigTest, AccelerometerIsOffUnlessGivenAndTakesItsNoiseAsG
   EXPECT_NEAR(d.accelerometer.noise, 1.0e-4 * std::sqrt(1000.0), 1e-15);
 }
 
+// An axis's `dynamics` section is a single gyro's: the averaged resonator's K replaces the resonator's,
+// its schedule reaches the axis's scenario, and the other axes keep the given K and D.
+TEST(TriadSimulationConfigTest, AnAxisMayRunTheAveragedResonatorOnItsSchedule) {
+  std::string text = scenario();
+  text.replace(text.find("{name: y,"), 9,
+               "{name: y, dynamics: {model: averaged, shell: {bryan_factor: 0.3}, commands: [{time: 1.0, rate: 0.2}, "
+               "{time: 2.0, rate: -0.2}]},");
+  const TriadSimulationConfig c = parseText(text);
+  EXPECT_FALSE(c.axes[0].dynamics.averaged());
+  ASSERT_TRUE(c.axes[1].dynamics.averaged());
+  EXPECT_FALSE(c.axes[2].dynamics.averaged());
+  EXPECT_EQ(c.axes[1].resonator.scale_factor, HarmonicModel(-0.6));
+  EXPECT_EQ(c.axes[1].resonator.quadrature, 0.0);
+  const SimulationConfig y = c.axisScenario(1);
+  ASSERT_TRUE(y.dynamics.averaged());
+  ASSERT_EQ(y.dynamics.commands.size(), 2u);
+  EXPECT_EQ(y.dynamics.commands[1].time, 2.0);
+  EXPECT_EQ(y.dynamics.commands[1].rate, -0.2);
+  EXPECT_FALSE(c.axisScenario(0).dynamics.averaged());
+}
+
 TEST(TriadSimulationConfigTest, RejectsBadValuesByKey) {
   auto expectError = [](const std::string& yaml, const std::string& key) {
     try {
@@ -281,6 +302,17 @@ TEST(TriadSimulationConfigTest, RejectsBadValuesByKey) {
               "triad.axes[1].pickoff.amplitude_to_gap");
   expectError(replaced(good, "{name: y,", "{name: y, channels: {drop_probability: 2},"),
               "triad.axes[1].channels.drop_probability");
+  expectError(replaced(good, "{name: y,", "{name: y, dynamics: {model: averaged, shel: {}},"),
+              "triad.axes[1].dynamics.shel");
+  expectError(replaced(good, "{name: y,", "{name: y, dynamics: {commands: [{time: 1.0, rate: 0.2}]},"),
+              "triad.axes[1].dynamics");
+  expectError(
+      replaced(good, "{name: y,",
+               "{name: y, dynamics: {model: averaged}, resonator: {scale_factor: {orders: [2], mean: -0.5, cos: [0.0], "
+               "sin: [0.0]}},"),
+      "triad.axes[1].resonator.scale_factor");
+  expectError(replaced(good, "{name: y,", "{name: y, dynamics: {model: averaged}, resonator: {quadrature: 0.01},"),
+              "triad.axes[1].resonator.quadrature");
   // The turntable.
   const std::string table = "turntable: {latitude: 0.9, azimuth: 0.3}";
   expectError(replaced(good, table, "turntable: {latitude: 2.0}"), "triad.turntable.latitude");

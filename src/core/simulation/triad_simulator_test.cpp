@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <cstdio>
 #include <functional>
+#include <string>
 
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
@@ -361,6 +363,53 @@ TEST(TriadSimulatorTest, AccelerometerAddsItsBiasAndNoiseInItsMountedFrameFromIt
     EXPECT_FALSE(plain[k].accelerometer.present);
     for (int i = 0; i < 3; ++i) ASSERT_EQ(plain[k].axes[i].z, samples[k].axes[i].z);
   }
+}
+
+// An axis may run the averaged resonator: it senses the same A_x . omega_body as the harmonic axis
+// (its truth bit for bit the same), its wave turns at K0 r + D(theta) plus the commanded rate of its
+// schedule, and the other axes are those of the scenario without it, bit for bit.
+TEST(TriadSimulatorTest, AnAveragedAxisSensesItsRowOfAAndTurnsOnItsSchedule) {
+  const std::string harmonic_x = axis(0, "x", "[2.0e-4, -1.5e-4]");
+  const std::string averaged_x =
+      "    - {name: x, misalignment: [2.0e-4, -1.5e-4], resonator: {initial_theta: 0.2, drift: {orders: [2], mean: "
+      "1.0e-5, cos: [0.0], sin: [2.0e-5]}}, dynamics: {model: averaged, commands: [{time: 1.0, rate: 0.3}, {time: "
+      "7.0, rate: -0.3}]}}\n";
+  std::string text = scenario();
+  const TriadSimulationConfig harmonic = parseText(text);
+  text.replace(text.find(harmonic_x), harmonic_x.size(), averaged_x);
+  const TriadSimulationConfig c = parseText(text);
+  ASSERT_TRUE(c.axes[0].dynamics.averaged());
+  TriadSimulator sim_h(harmonic), sim_a(c);
+  const std::vector<TriadSample> h = runAll(sim_h), a = runAll(sim_a);
+  ASSERT_EQ(h.size(), a.size());
+  for (std::size_t n = 0; n < a.size(); ++n) {
+    ASSERT_EQ(a[n].stamp, h[n].stamp);
+    EXPECT_EQ(a[n].axes[0].truth.inertial_rate, h[n].axes[0].truth.inertial_rate) << n;
+    EXPECT_EQ(a[n].axes[0].truth.inertial_angle, h[n].axes[0].truth.inertial_angle) << n;
+    for (int i = 1; i < 3; ++i) {
+      ASSERT_EQ(a[n].axes[i].z, h[n].axes[i].z) << n;
+      EXPECT_EQ(a[n].axes[i].precession.commands, 0u);
+    }
+  }
+  // At rest in position a, precessed at +0.3 rad/s: theta by RK4 of -0.56 r + D(theta) + 0.3 here.
+  const TriadSample &s1 = sampleAt(c, a, 1.5), &s2 = sampleAt(c, a, 4.5);
+  const double r = s1.axes[0].truth.inertial_rate;
+  EXPECT_EQ(s1.axes[0].precession.rate, 0.3);
+  EXPECT_EQ(s1.axes[0].precession.commands, 1u);
+  double theta = s1.axes[0].truth.theta;
+  const int steps = 20000;
+  const double dt = (timeOf(c, s2) - timeOf(c, s1)) / steps;
+  auto f = [&](double th) { return -0.56 * r + 1.0e-5 + 2.0e-5 * std::sin(2 * th) + 0.3; };
+  for (int k = 0; k < steps; ++k) {
+    const double k1 = f(theta), k2 = f(theta + dt / 2 * k1), k3 = f(theta + dt / 2 * k2), k4 = f(theta + dt * k3);
+    theta += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+  }
+  std::printf("[ measured ] averaged axis at rest, precessed: theta %.12f, predicted %.12f\n", s2.axes[0].truth.theta,
+              theta);
+  EXPECT_NEAR(s2.axes[0].truth.theta, theta, 1e-7);
+  const TriadSample& s3 = sampleAt(c, a, 8.0);
+  EXPECT_EQ(s3.axes[0].precession.rate, -0.3);
+  EXPECT_EQ(s3.axes[0].precession.commands, 2u);
 }
 
 }  // namespace

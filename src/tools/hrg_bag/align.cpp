@@ -1,8 +1,9 @@
 // hrg_bag align: north-finding from a recorded session. The bag's records feed one core::Gyrocompass
 // as the gyrocompass node feeds it: the triad's body samples (its triad/output, or its axes' channels
 // through core::TriadProcessor as the processors and the triad node run them), one gyro's outputs
-// (single_gyro), the indexer's state (turntable/state) and the accelerometer (accel/data_raw), each in
-// record order. Prints the heading with its uncertainty and writes the result's YAML.
+// (single_gyro), each axis's outputs and precession state (sweep, from the channels), the indexer's
+// state (turntable/state) and the accelerometer (accel/data_raw), each in record order. Prints the heading with its
+// uncertainty and writes the result's YAML.
 #include <rosbag/view.h>
 #include <sensor_msgs/Imu.h>
 
@@ -14,6 +15,7 @@
 #include "align_run.h"
 #include "bag_tools.h"
 #include "hrg_gyro/GyroOutput.h"
+#include "hrg_gyro/PrecessionState.h"
 #include "hrg_gyro/TriadOutput.h"
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/core/model/parameter_file.h"
@@ -49,11 +51,6 @@ core::AlignmentSettings loadSettings(const AlignOptions& o) {
       throw UsageError("--duration: " + e.problem());
     }
   }
-  if (s.mode == core::AlignmentMode::kSweep) {
-    throw UsageError("--settings " + o.settings +
-                     ": mode sweep is aligned live only (the gyrocompass node); hrg_bag align reads the static and "
-                     "indexed modes");
-  }
   return s;
 }
 
@@ -61,7 +58,9 @@ core::AlignmentSettings loadSettings(const AlignOptions& o) {
 struct AlignInputs {
   std::string triad, gyro, turntable, accelerometer;
   bool channels = false;  // the triad from its axes' channels (--triad)
+  bool sweep = false;     // each axis's outputs and precession state to the sweep mode
   std::array<AxisInput, 3> axes;
+  std::array<std::string, 3> precession;  // sweep: each axis's /NAME/precession/state
 };
 
 /// The accelerometer: --accelerometer-topic, or the bag's one sensor_msgs/Imu topic ending in
@@ -92,6 +91,11 @@ AlignInputs findInputs(const rosbag::Bag& bag, const AlignCommand& c, const core
                        const std::array<AxisInput, 3>& axes) {
   AlignInputs in;
   const AlignOptions& o = c.align;
+  if (s.mode == core::AlignmentMode::kSweep && !*c.triad_option) {
+    throw UsageError(
+        "--triad: mode sweep aligns each axis's outputs, from its channels and its precession state "
+        "(--triad FILE --axis-params NAME=FILE for each axis)");
+  }
   if (s.single_gyro) {
     in.gyro = findTopic(bag, o.gyro_topic, ros::message_traits::datatype<GyroOutput>(), "gyro-topic", true,
                         " (single_gyro: the gyro's outputs)");
@@ -99,6 +103,16 @@ AlignInputs findInputs(const rosbag::Bag& bag, const AlignCommand& c, const core
     in.channels = true;
     in.axes = axes;
     findAxisTopics(bag, c.triad, &in.axes);
+    in.sweep = s.mode == core::AlignmentMode::kSweep;
+    for (std::size_t a = 0; in.sweep && a < 3; ++a) {
+      const std::string topic = "/" + triadAxisTopic(in.axes[a].name, "precession/state");
+      try {
+        in.precession[a] = findTopic(bag, topic, ros::message_traits::datatype<PrecessionState>(), "triad", true);
+      } catch (const UsageError& e) {
+        throw UsageError("mode sweep needs each axis's precession loop state, as its driver publishes it: " +
+                         std::string(e.what()));
+      }
+    }
   } else {
     in.triad = findTopic(bag, o.triad_topic, ros::message_traits::datatype<TriadOutput>(), "triad-topic", true,
                          " (or give the axes' channels: --triad FILE --axis-params NAME=FILE for each axis)");
@@ -126,10 +140,13 @@ class BagFeed {
     for (const std::string& t : {in_.triad, in_.gyro, in_.turntable, in_.accelerometer}) {
       if (!t.empty()) topics.push_back(t);
     }
-    std::map<std::string, std::size_t> axis_of_topic;
+    std::map<std::string, std::size_t> axis_of_topic, axis_of_precession;
     for (std::size_t a = 0; in_.channels && a < 3; ++a) {
       topics.push_back(in_.axes[a].topic);
       axis_of_topic[in_.axes[a].topic] = a;
+      if (!in_.sweep) continue;
+      topics.push_back(in_.precession[a]);
+      axis_of_precession[in_.precession[a]] = a;
     }
     rosbag::View view(bag, rosbag::TopicQuery(topics));
     Progress progress("align", view.size());
@@ -137,8 +154,11 @@ class BagFeed {
       for (const rosbag::MessageInstance& m : view) {
         const std::string& topic = m.getTopic();
         const auto axis = axis_of_topic.find(topic);
+        const auto precessing = axis_of_precession.find(topic);
         if (axis != axis_of_topic.end()) {
           channels(m, axis->second);
+        } else if (precessing != axis_of_precession.end()) {
+          precession(m, precessing->second);
         } else if (topic == in_.triad) {
           if (triad_reader_.read(m, &triad_) && admit(toNanoseconds(triad_.header.stamp))) {
             run_->addTriad(fromMessage(triad_));
@@ -163,9 +183,7 @@ class BagFeed {
       std::vector<core::TriadAxisOutput> decided;
       std::vector<core::TriadBodySample> completed;
       chain_->finish(&decided, &completed);
-      for (const core::TriadBodySample& s : completed) {
-        if (admit(s.stamp)) run_->addTriad(s);
-      }
+      hand(decided, completed);
     }
     if (!run_->complete()) run_->inputEnded("the bag");
   }
@@ -182,10 +200,35 @@ class BagFeed {
     if (!channel_reader_.read(m, &channels_)) return;
     chain_->process(axis, fromMessage(channels_), &result_);
     if (!result_.has_output) return;
+    release();
+  }
+
+  /// One axis's precession state to its processor's watch (and, sweep, to the run); the outputs it
+  /// decides go on.
+  void precession(const rosbag::MessageInstance& m, std::size_t axis) {
+    if (!precession_reader_.read(m, &precession_)) return;
+    const core::PrecessionStateRecord record = fromMessage(precession_);
+    chain_->addPrecessionState(axis, record);
+    run_->addPrecession(axis, record);
+    release();
+  }
+
+  void release() {
     decided_.clear();
     completed_.clear();
     chain_->release(&decided_, &completed_);
-    for (const core::TriadBodySample& s : completed_) {
+    hand(decided_, completed_);
+  }
+
+  /// The chain's decided outputs to the sweep, or its completed body samples to the other modes.
+  void hand(const std::vector<core::TriadAxisOutput>& decided, const std::vector<core::TriadBodySample>& completed) {
+    if (in_.sweep) {
+      for (const core::TriadAxisOutput& o : decided) {
+        if (admit(o.output.stamp)) run_->addSweepAxis(o.axis, o.output);
+      }
+      return;
+    }
+    for (const core::TriadBodySample& s : completed) {
       if (admit(s.stamp)) run_->addTriad(s);
     }
   }
@@ -200,6 +243,8 @@ class BagFeed {
   ReusedMessageReader<TurntableState> table_reader_;
   ReusedMessageReader<sensor_msgs::Imu> accelerometer_reader_;
   ReusedMessageReader<ChannelAmplitudes> channel_reader_;
+  PrecessionStateReader precession_reader_;
+  PrecessionState precession_;
   TriadOutput triad_;
   GyroOutput gyro_;
   TurntableState table_;
@@ -255,7 +300,7 @@ int runAlign(const AlignCommand& c) {
   const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
   const AlignInputs in = findInputs(*bag, c, settings, axes);
 
-  AlignmentRun run(settings, windows);
+  AlignmentRun run(settings, windows, triad ? *triad : core::TriadParameters());
   BagFeed feed(in, o.start, &run);
   feed.setChain(chain.get());
   feed.read(*bag);
@@ -274,10 +319,12 @@ int runAlign(const AlignCommand& c) {
 
 constexpr const char* kAlignFooter =
     "North-finding from the Earth's rate (docs/recorded_sessions.md): the settings' mode (static, indexed; one\n"
-    "gyro with single_gyro), site and gates, as the gyrocompass node's parameters. The triad's body samples\n"
-    "come from its triad/output, or from its axes' channels through the processors and the triad's combiner\n"
-    "(--triad FILE --axis-params NAME=FILE for each axis, as process --triad); mode indexed reads the indexer's\n"
-    "turntable/state; level/source accelerometer reads the sensor_msgs/Imu topic ending in accel/data_raw.\n"
+    "gyro with single_gyro; sweep), site and gates, as the gyrocompass node's parameters. The triad's body\n"
+    "samples come from its triad/output, or from its axes' channels through the processors and the triad's\n"
+    "combiner (--triad FILE --axis-params NAME=FILE for each axis, as process --triad); mode indexed reads\n"
+    "the indexer's turntable/state; mode sweep (with --triad) each axis's outputs from its channels and its\n"
+    "/NAME/precession/state, and the triad file's M and bias; level/source accelerometer reads the\n"
+    "sensor_msgs/Imu topic ending in accel/data_raw.\n"
     "Prints the true heading (deg clockwise from North) +- 1 sigma and the error budget; --output writes the\n"
     "whole result. Exit 0 accepted, 1 refused by a gate (named) or the bag ended before the window was full,\n"
     "2 bad usage or unreadable input, 3 the result could not be written (nothing left at its path).";

@@ -30,10 +30,11 @@ int runSimulateTriad(const SimulateOptions& o, const YAML::Node& document) {
   const bool truth = !o.no_truth;
   OutputBag bag(o.out, o.compression);
   core::TriadSimulator sim(config);
-  std::array<std::string, 3> channels_topic, truth_topic;
+  std::array<std::string, 3> channels_topic, truth_topic, precession_topic;
   for (int i = 0; i < 3; ++i) {
     channels_topic[i] = "/" + triadAxisTopic(config.axes[i].name, "channels");
     truth_topic[i] = "/" + triadAxisTopic(config.axes[i].name, "truth");
+    precession_topic[i] = "/" + triadAxisTopic(config.axes[i].name, "precession/state");
   }
   Progress progress("simulate", sim.duration());
   core::TriadSample s;
@@ -46,6 +47,10 @@ int runSimulateTriad(const SimulateOptions& o, const YAML::Node& document) {
           toChannelsMessage(axis, stamp, static_cast<std::uint32_t>(axis.index), config.axes[i].name);
       if (axis.channels_delivered) bag.write(channels_topic[i], stamp, ch);
       if (truth) bag.write(truth_topic[i], stamp, toTruthMessage(axis, trueHeader(ch.header, stamp)));
+      if (config.axes[i].dynamics.averaged()) {
+        bag.write(precession_topic[i], stamp,
+                  toPrecessionStateMessage(axis, trueHeader(ch.header, stamp), kScheduledPrecessionSource));
+      }
     }
     for (const core::TurntableLogRecord& r : s.turntable) {
       bag.write("/turntable/state", toRosTime(core::toNanoseconds(config.start_time + r.time)),
@@ -135,7 +140,8 @@ Command addSimulateCommand(CLI::App& root) {
       "commands (dynamics.commands) on /command/precession, as sent to a live driver. A triad scenario (a\n"
       "`triad` section) writes /<axis>/channels and /<axis>/truth for each axis, /turntable/state,\n"
       "/fixture/position, the body's /truth (hrg_gyro/BodyTruth) and, with triad.accelerometer, its\n"
-      "/accel/data_raw (sensor_msgs/Imu). Chunks are LZ4-compressed\n"
+      "/accel/data_raw (sensor_msgs/Imu); an axis with a precession loop adds /<axis>/precession/state\n"
+      "with every sample (its schedule's). Chunks are LZ4-compressed\n"
       "by default (several times faster to read back; every rosbag reader handles it).\n"
       "The bag is written to a temporary and renamed over --out when complete.\n"
       "Exit 0 success, 2 bad usage or unreadable scenario (or --out is the scenario file), 3 the bag\n"

@@ -43,8 +43,10 @@
 // of the table's vertical rotation: it is built with an AxisRateInput, whose rate replaces
 // Omega_table + Omega_E in the dynamics above; the truth's inertial angle is then that rate's
 // integral (Simpson's rule on the RK4 grid, exact to the order of the RK4 stages), and the axis logs no
-// table records (the triad logs its one table). Without an input the single-axis path is unchanged,
-// bit for bit (GyroSimulatorTest.ScenarioWithoutNewSectionsKeepsItsFingerprint).
+// table records (the triad logs its one table). With the averaged resonator the input's rate at the
+// ends of each carrier period is the body rate the resonator is stepped with, and the truth's angle
+// is Simpson's rule over each period (the rate at its middle added). Without an input the single-axis
+// path is unchanged, bit for bit (GyroSimulatorTest.ScenarioWithoutNewSectionsKeepsItsFingerprint).
 #pragma once
 
 #include <cstdint>
@@ -131,7 +133,6 @@ class GyroSimulator {
  public:
   /// `input` (not owned, must outlive the simulator): the rate this gyro senses, for one axis of a
   /// triad; nullptr (the default): the table's rate plus the vertical Earth rate, as a single gyro.
-  /// Throws std::invalid_argument for an input with the averaged resonator (a single gyro's only).
   explicit GyroSimulator(const SimulationConfig& config, const AxisRateInput* input = nullptr);
   // The dynamics evaluator points into config_: the simulator stays where it was built.
   GyroSimulator(const GyroSimulator&) = delete;
@@ -162,6 +163,12 @@ class GyroSimulator {
   double thetaRate(double t, double theta, double sensed);
   /// The inertial rate the gyro senses at t: the input's, or the table's plus the vertical Earth rate.
   double sensedRate(double t) const;
+  /// Adds the input's angle over one period of h s (Simpson's rule on its rates at the period's start,
+  /// middle and end) to input_angle_.
+  void integrateInputAngle(double h, double rate_start, double rate_middle, double rate_end);
+  /// A triad axis's truth at t_center: the input's rate there and its angle, Simpson's rule from the
+  /// period boundary t_lo where it was angle_lo.
+  void setInputTruth(double t_lo, double angle_lo, double t_center, TruthState* truth) const;
   void nextDynamic(SimulationSample* out);
   /// nextDynamic for the averaged resonator.
   void nextResonator(SimulationSample* out);

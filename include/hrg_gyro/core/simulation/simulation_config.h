@@ -102,6 +102,10 @@ struct SimulationConfig {
 /// pickoff section gives the electrode gap as A/d0.
 ResonatorConfig parseResonatorSection(const YamlField& resonator);
 PickoffDefects parsePickoffSection(const YamlField& pickoff, double amplitude);
+/// The `dynamics` section of `parent` (a single gyro's scenario, or a triad's axis), its resonator
+/// section already read into *resonator: with model: averaged the shell's K and the loops' B = 0
+/// replace the resonator's (a given resonator.scale_factor or quadrature is refused by name).
+DynamicsConfig parseDynamicsOf(const YamlField& parent, ResonatorConfig* resonator);
 TableRippleConfig parseRippleSection(const YamlField& ripple);
 DeliveryConfig parseChannelDeliverySection(const YamlField& channels);
 

@@ -17,7 +17,10 @@
 // the row, j < k the other two body axes in x, y, z order (x: [A_xy, A_xz]; y: [A_yx, A_yz]; z:
 // [A_zx, A_zy]), the tilt of axis i towards body axis j, rad. Not normalised: A is what the triad
 // file holds. Axis i then integrates d theta_i/dt = K_i(theta_i) r_i + D_i(theta_i) through its own
-// pickoffs (today's single-axis chain, GyroSimulator).
+// pickoffs (today's single-axis chain, GyroSimulator). An axis's `dynamics` section is a single gyro
+// scenario's (dynamics_config.h): with model: averaged the axis runs the resonator with its loops,
+// sensing r_i, and its precession loop follows the section's `commands` (whole turns of its wave while
+// the triad stands still: the gyrocompass's sweep mode).
 //
 // The positions: `up: "+x"` (one of +-x, +-y, +-z) puts that body axis along the table's axis, up
 // (+) or down (-), and the body axis after it in the cyclic order x -> y -> z -> x along the
@@ -63,6 +66,9 @@ struct TriadAxisConfig {
   DeliveryConfig channels;               ///< lost channel samples of this axis (default: none)
   std::array<double, 2> misalignment{};  ///< a_ij, a_ik: towards the other body axes in x, y, z order, rad
   double scale = 0.0;                    ///< residual scale s_i: A_ii = 1 + s_i
+  /// How its wave moves (dynamics_config.h): the given K and D by default, or the averaged resonator
+  /// with its loops and a schedule of precession commands (`dynamics/commands`).
+  DynamicsConfig dynamics;
 };
 
 /// The platter's top tilted against the table's axis by a tilt that turns with it.
