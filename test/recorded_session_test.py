@@ -120,6 +120,9 @@ class RecordedSession(unittest.TestCase):
 
     def assert_outputs_equal(self, reference, candidate, what, min_fraction):
         common = sorted(set(reference) & set(candidate))
+        print("%s: %d of the %d live outputs; missing: %d of the first 100, %d of the last 400" % (
+            what, len(common), len(reference), sum(1 for s in sorted(reference)[:100] if s not in candidate),
+            sum(1 for s in sorted(reference)[-400:] if s not in candidate)))
         self.assertGreaterEqual(len(common), min_fraction * len(reference),
                                 "%s: only %d of %d live outputs" % (what, len(common), len(reference)))
         for stamp in common:

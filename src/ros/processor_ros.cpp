@@ -87,6 +87,10 @@ ProcessorRos::ProcessorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     throw std::invalid_argument("processor: ~" + e.key() + " " + e.problem());
   }
   stall_timeout_ = params_.get("stall_timeout", stall_timeout_);
+  shutdown_when_idle_ = params_.get("shutdown_when_idle", shutdown_when_idle_);
+  if (!std::isfinite(shutdown_when_idle_) || shutdown_when_idle_ < 0.0) {
+    throw std::invalid_argument("processor: ~shutdown_when_idle must be 0 (never) or positive (s)");
+  }
   quadrature_warn_ = params_.get("quadrature_warn", quadrature_warn_);
   expected_rate_ = params_.get("expected_rate", expected_rate_);
   if (!(expected_rate_ > 0.0)) throw std::invalid_argument("processor: ~expected_rate must be positive (Hz)");
@@ -400,6 +404,11 @@ bool ProcessorRos::onCaptureBias(std_srvs::Trigger::Request&, std_srvs::Trigger:
   res.message = result.reason + saved;
   ROS_INFO("processor: bias capture: %s", res.message.c_str());
   return true;
+}
+
+bool ProcessorRos::idleFor(double seconds) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return seen_input_ && (ros::WallTime::now() - last_input_wall_).toSec() > seconds;
 }
 
 void ProcessorRos::diagnoseInput(diagnostic_updater::DiagnosticStatusWrapper& stat) {

@@ -47,6 +47,11 @@ class ProcessorRos {
 
   /// The private parameters as read at start-up (unknown and defaulted keys).
   const ParameterReader& parameters() const { return params_; }
+  /// ~shutdown_when_idle, s of wall time (0: never): the node's main ends the node once idleFor() it.
+  double shutdownWhenIdle() const { return shutdown_when_idle_; }
+  /// True once a channel sample was processed and none since for `seconds` of wall time (the input
+  /// queue drained: a lagging processor is not idle).
+  bool idleFor(double seconds);
 
  private:
   void onChannels(const ChannelAmplitudes::ConstPtr& msg);
@@ -75,6 +80,7 @@ class ProcessorRos {
   bool publish_imu_ = true;
   core::RateNoiseEstimator rate_noise_;  // the Imu's z variance
   double stall_timeout_ = 0.5;
+  double shutdown_when_idle_ = 0.0;
   double quadrature_warn_ = 0.1;
 
   InputThread input_;  // serves channels_sub_ and precession_sub_ (one thread: in arrival order)
