@@ -1,6 +1,7 @@
 #include "hrg_gyro/core/calibration/calibration_session.h"
 
 #include <algorithm>
+#include <utility>
 
 namespace hrg_gyro {
 namespace core {
@@ -150,6 +151,7 @@ void CalibrationSession::restart() {
   const std::uint64_t wave_jumps = counters_.wave_jumps;
   const std::uint64_t rotation_records_total = counters_.rotation_records_total;
   method_ = makeCalibrationMethod(settings_, prior_);
+  if (horizontal_slots_ > 0) method_->modelHorizontalEarthRate(horizontal_slots_);
   detector_ = PlateauDetector(settings_.plateau);
   regulariser_ = TableStampRegulariser(stampSettings(settings_.table_clock));
   clock_offset_ = TableClockOffsetEstimator(offsetSettings(settings_.table_clock));
@@ -222,6 +224,13 @@ void CalibrationSession::drain() {
   }
 }
 
+bool CalibrationSession::modelHorizontalEarthRate(int slots, std::function<void(PlateauSample*)> tag) {
+  if (!method_->modelHorizontalEarthRate(slots)) return false;
+  horizontal_slots_ = slots;
+  horizontal_tag_ = std::move(tag);
+  return true;
+}
+
 void CalibrationSession::classify(const WaveRecord& w) {
   // The last state at or before the sample and the first at or after it.
   const std::size_t after =
@@ -254,6 +263,7 @@ void CalibrationSession::classify(const WaveRecord& w) {
     ++counters_.unsettled;
     return;
   }
+  if (horizontal_tag_) horizontal_tag_(&s);
   method_->addSample(s);
   ++counters_.used;
 }

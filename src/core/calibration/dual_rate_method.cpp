@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "hrg_gyro/core/calibration/outcome_from_fits.h"
 #include "hrg_gyro/core/common/units.h"
@@ -38,10 +39,18 @@ void DualRateMethod::addSample(const PlateauSample& s) {
   regression_.setAngleSmoothError(s.angle_smooth_error);
   // The logged rate's integral too, where the angle is logged: the regression weighs the two by
   // their noise (without an angle, the angle is that integral already).
-  regression_.add(s.stamp, s.theta, angle, s.angle_logged ? rate_integral_ : NAN);
+  regression_.add(s.stamp, s.theta, angle, s.angle_logged ? rate_integral_ : NAN,
+                  s.horizontal_slot < regression_.horizontalSlots() ? s.horizontal_slot : -1, s.horizontal_phase);
   angle_logged_ = s.angle_logged;
   last_table_angle_ = angle;
   last_table_rate_ = s.rotation_rate;
+}
+
+bool DualRateMethod::modelHorizontalEarthRate(int slots) {
+  if (samples_ > 0) throw std::logic_error("dual-rate method: the horizontal Earth rate is modelled from the start");
+  regression_ = IncrementRegression(settings_.scale_factor_orders, settings_.drift_orders, settings_.bins,
+                                    settings_.bias_trend_order, slots);
+  return true;
 }
 
 bool DualRateMethod::complete() const { return progress().fraction >= 1.0; }
@@ -162,6 +171,7 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
   }
   o.binned = e.binned;
   o.bias_walk = e.walk;
+  o.horizontal_earth = e.horizontal;
   noteErrorBudget(e, &o);    // stated in the report
   o.smoothing_factor = 1.0;  // nothing is smoothed: the increments are fitted through their exact integrals
   if (e.trend.order > 0) gateBiasTrend(e, &o);

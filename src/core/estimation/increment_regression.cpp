@@ -42,19 +42,23 @@ int orderStep(const std::vector<int>& orders) {
 }  // namespace
 
 IncrementRegression::IncrementRegression(const std::vector<int>& k_orders, const std::vector<int>& d_orders, int bins,
-                                         int bias_trend_order)
+                                         int bias_trend_order, int horizontal_slots)
     : k_orders_(k_orders),
       d_orders_(d_orders),
       all_orders_(mergeOrders(k_orders, d_orders)),
       bins_(bins),
-      trend_order_(bias_trend_order) {
+      trend_order_(bias_trend_order),
+      horizontal_slots_(horizontal_slots) {
   for (int k : all_orders_)
     if (k <= 0) throw std::invalid_argument("increment regression: harmonic orders must be positive");
   if (bins_ <= 0) throw std::invalid_argument("increment regression: bins must be positive");
   if (trend_order_ < 0 || trend_order_ > kMaxTrendOrder)
     throw std::invalid_argument("increment regression: the bias trend order must be 0, 1 or 2");
+  if (horizontal_slots_ < 0) throw std::invalid_argument("increment regression: horizontal slots must be >= 0");
   const int n_k = static_cast<int>(k_orders_.size()), n_all = static_cast<int>(all_orders_.size());
-  m_ = 1 + 2 * n_k + 1 + 2 * n_all + trend_order_;
+  horizontal0_ = 1 + 2 * n_k + 1 + 2 * n_all + trend_order_;
+  m_ = horizontal0_ + 2 * horizontal_slots_;
+  slot_seen_.assign(horizontal_slots_, false);
   // Accumulated per sample: the regression's columns with the K block taken along the table angle,
   // then the same K block along the rate integral, then y.
   k_terms_ = 1 + 2 * n_k;
@@ -159,8 +163,12 @@ void IncrementRegression::flushChain() {
   chain_means_.clear();
 }
 
-void IncrementRegression::add(Nanoseconds stamp, double theta, double phi, double phi_rate) {
+void IncrementRegression::add(Nanoseconds stamp, double theta, double phi, double phi_rate, int horizontal_slot,
+                              double psi) {
   if (!in_chain_) throw std::logic_error("increment regression: add() outside a chain");
+  if (horizontal_slot >= horizontal_slots_)
+    throw std::invalid_argument("increment regression: horizontal slot " + std::to_string(horizontal_slot) +
+                                " beyond the " + std::to_string(horizontal_slots_) + " asked for");
   if (!has_sample_) origin_ = stamp;
   if (!has_origin_) {
     has_origin_ = true;
@@ -209,16 +217,8 @@ void IncrementRegression::add(Nanoseconds stamp, double theta, double phi, doubl
       before_power *= session_t_prev_;
       integrals_(t0 + 1 + 2 * n_all + j - 1) += (now_power - before_power) / (j + 1);
     }
-    // Angle noise: deviation of the previous sample from the line through its neighbours.
-    if (history_ >= 2) {
-      const double span = t - h_t_[0];
-      if (span > 0.0) {
-        const double a = (t - h_t_[1]) / span, b = 1.0 - a;
-        const double deviation = h_theta_[1] - (a * h_theta_[0] + b * theta);
-        noise_sum_ += deviation * deviation / (1.0 + a * a + b * b);
-        ++noise_count_;
-      }
-    }
+    if (horizontal_slot >= 0) addHorizontal(horizontal_slot, psi, dt);
+    addNoiseSample(t, theta);
   } else {
     integrals_.setZero();
     theta_start_ = theta;
@@ -255,8 +255,31 @@ void IncrementRegression::add(Nanoseconds stamp, double theta, double phi, doubl
   session_t_prev_ = t_session;
   phi_prev_ = phi;
   phi_rate_prev_ = phi_rate;
+  slot_prev_ = horizontal_slot;
+  psi_prev_ = psi;
   cos_prev_.swap(cos_now_);
   sin_prev_.swap(sin_now_);
+}
+
+void IncrementRegression::addNoiseSample(double t, double theta) {
+  // Angle noise: deviation of the previous sample from the line through its neighbours.
+  if (history_ < 2) return;
+  const double span = t - h_t_[0];
+  if (span > 0.0) {
+    const double a = (t - h_t_[1]) / span, b = 1.0 - a;
+    const double deviation = h_theta_[1] - (a * h_theta_[0] + b * theta);
+    noise_sum_ += deviation * deviation / (1.0 + a * a + b * b);
+    ++noise_count_;
+  }
+}
+
+void IncrementRegression::addHorizontal(int slot, double psi, double dt) {
+  // Trapezoid within the slot; a sample that starts a slot inside a chain counts from itself.
+  const bool same = slot_prev_ == slot;
+  const int col = horizontal0_ + 2 * slot;
+  integrals_(col) += 0.5 * (std::cos(psi) + std::cos(same ? psi_prev_ : psi)) * dt;
+  integrals_(col + 1) += 0.5 * (std::sin(psi) + std::sin(same ? psi_prev_ : psi)) * dt;
+  slot_seen_[slot] = true;
 }
 
 void IncrementRegression::closeWindow() {
@@ -545,6 +568,15 @@ IncrementRegression::Columns IncrementRegression::fittedColumns() const {
   c.without_trend = c.sel;
   c.trend_at = static_cast<int>(c.sel.size());
   for (int j = 0; j < trend_order_; ++j) c.sel.push_back(trend0 + j);
+  c.horizontal_at = static_cast<int>(c.sel.size());
+  for (int slot = 0; slot < horizontal_slots_; ++slot) {
+    if (!slot_seen_[slot]) continue;  // no data: the columns are zero
+    c.horizontal.push_back(slot);
+    for (int j = 0; j < 2; ++j) {
+      c.sel.push_back(horizontal0_ + 2 * slot + j);
+      c.without_trend.push_back(horizontal0_ + 2 * slot + j);
+    }
+  }
   return c;
 }
 
@@ -740,6 +772,11 @@ IncrementFit IncrementRegression::solve(double earth_rate, double earth_rate_std
   fillFit(terms, k_orders_, 0, solution.condition_number, &fit.k);
   fillFit(terms, d_orders_, n_kterms, solution.condition_number, &fit.d);
   if (trend_order_ > 0) fitTrend(columns, terms, solution, map, total, reference_time, &fit.trend);
+  for (std::size_t j = 0; j < columns.horizontal.size(); ++j) {
+    const int at = columns.horizontal_at + 2 * static_cast<int>(j);
+    fit.horizontal.push_back(
+        {columns.horizontal[j], terms.value[at], terms.value[at + 1], terms.total_std[at], terms.total_std[at + 1]});
+  }
   binCurves(sel, beta, map, earth_rate, min_bin_time, &fit);
   fit.ok = true;
   return fit;

@@ -17,10 +17,18 @@ namespace {
 const HarmonicModel kStrongK({2, 4, 8}, -0.56, {-6e-4, -0.56 * 0.03, 0.56 * 0.003}, {4e-4, 2e-4, 0.0});
 const HarmonicModel kDrift({2}, 1e-5, {2e-5}, {-1e-5});
 
+/// An axis leaning off the table's axis: its horizontal component in the platter frame, and the
+/// horizontal Earth rate it senses (heading psi = -phi, a zero azimuth), fitted in `slot` (-1: not).
+struct Lean {
+  double x = 0.0, y = 0.0, horizontal_rate = 0.0;
+  int slot = -1;
+  double rate(double phi) const { return horizontal_rate * (x * std::cos(-phi) + y * std::sin(-phi)); }
+};
+
 /// Two plateaus (table rates w1 and w2), RK4 at 1 kHz; table angle logged exactly; white noise of
 /// `noise` rad on the measured theta.
 void sweep(IncrementRegression* r, double w1, double w2, double seconds, double window, double earth,
-           const HarmonicModel& k_model = kStrongK, double noise = 0.0) {
+           const HarmonicModel& k_model = kStrongK, double noise = 0.0, const Lean& lean = Lean()) {
   double theta = 0.2, phi = 0.0, t = 0.0;
   std::mt19937_64 random(11);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -28,11 +36,11 @@ void sweep(IncrementRegression* r, double w1, double w2, double seconds, double 
   int group = 0;
   for (double w : {w1, w2}) {
     r->startChain(group++, window);
-    auto rate = [&](double th) { return k_model(th) * (w + earth) + kDrift(th); };
+    auto rate = [&](double th, double ph) { return k_model(th) * (w + earth + lean.rate(ph)) + kDrift(th); };
     for (long i = 0; i < static_cast<long>(seconds / h); ++i) {
-      r->add(toNanoseconds(1.0 + t), theta + noise * normal(random), phi);
-      const double k1 = rate(theta), k2 = rate(theta + h / 2 * k1), k3 = rate(theta + h / 2 * k2),
-                   k4 = rate(theta + h * k3);
+      r->add(toNanoseconds(1.0 + t), theta + noise * normal(random), phi, NAN, lean.slot, -phi);
+      const double k1 = rate(theta, phi), k2 = rate(theta + h / 2 * k1, phi + w * h / 2),
+                   k3 = rate(theta + h / 2 * k2, phi + w * h / 2), k4 = rate(theta + h * k3, phi + w * h);
       theta += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
       phi += w * h;
       t += h;
@@ -63,6 +71,41 @@ TEST(IncrementRegressionTest, ExactForAnyWindowUnderStrongNonlinearity) {
     }
     EXPECT_LT(fit.k.residual_rms / 0.56, 1e-6);
   }
+}
+
+TEST(IncrementRegressionTest, FitsTheHorizontalEarthRateOfALeaningAxisInsteadOfD) {
+  // An axis 3 mrad off the table's axis at latitude 0.9 rad: the horizontal Earth rate it senses
+  // turns with the table and, unmodelled, lands in D's order 2 (theta moves with about 1.8 phi).
+  const HarmonicModel k({2}, -0.56, {-6e-4}, {4e-4});
+  Lean lean;
+  lean.x = 3e-3;
+  lean.y = -2e-3;
+  lean.horizontal_rate = kEarthRotationRate * std::cos(0.9);
+  IncrementRegression without({2}, {2}, 64);
+  sweep(&without, 0.05, -0.05, 260.0, 2.0, 5e-5, k, 0.0, lean);
+  lean.slot = 1;  // slot 0 unused: no columns for it
+  IncrementRegression with({2}, {2}, 64, 0, 2);
+  sweep(&with, 0.05, -0.05, 260.0, 2.0, 5e-5, k, 0.0, lean);
+  const IncrementFit a = without.solve(5e-5, 0.0, 0.1, 1e8), b = with.solve(5e-5, 0.0, 0.1, 1e8);
+  ASSERT_TRUE(a.ok) << a.reason;
+  ASSERT_TRUE(b.ok) << b.reason;
+  const double leak = std::hypot(a.d.cos[0] - 2e-5, a.d.sin[0] + 1e-5);
+  const double left = std::hypot(b.d.cos[0] - 2e-5, b.d.sin[0] + 1e-5);
+  ASSERT_EQ(b.horizontal.size(), 1u);
+  const double expected_cos = -0.56 * lean.horizontal_rate * lean.x,
+               expected_sin = -0.56 * lean.horizontal_rate * lean.y;
+  std::printf(
+      "D order 2 off by %.3g rad/s unmodelled, %.3g rad/s with the lean fitted; lean's rate %.4g %.4g rad/s "
+      "(expected %.4g %.4g)\n",
+      leak, left, b.horizontal[0].cos, b.horizontal[0].sin, expected_cos, expected_sin);
+  EXPECT_GT(leak, 1e-9);
+  EXPECT_LT(left, 2e-10);
+  EXPECT_NEAR(b.d.mean, 1e-5, 2e-10);
+  EXPECT_EQ(b.horizontal[0].slot, 1);
+  EXPECT_NEAR(b.horizontal[0].cos, expected_cos, 1e-3 * std::abs(expected_cos));
+  EXPECT_NEAR(b.horizontal[0].sin, expected_sin, 1e-3 * std::abs(expected_sin));
+  without.startChain(0, 2.0);  // a slot it was not made with
+  EXPECT_THROW(without.add(toNanoseconds(999.0), 0.0, 0.0, NAN, 0, 0.0), std::invalid_argument);
 }
 
 TEST(IncrementRegressionTest, CorrectsTheBasisForNoiseInTheta) {

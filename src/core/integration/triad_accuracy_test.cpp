@@ -107,6 +107,25 @@ TEST(TriadAccuracyTest, DocumentedSessionPerfectFixture) {
                 scenario.axes[i].name.c_str(), triad_peak, single_peak);
     EXPECT_LE(triad_peak, std::max(1.0, 1.5 * single_peak)) << i;
   }
+  // Each axis's lean off the table's axis in its two positions along it (stage 1, from the Earth's
+  // horizontal rate), against what A and the logged orientation give (the fixture is perfect here).
+  ASSERT_EQ(o.tilts.size(), 6u);
+  for (const TriadAxisTilt& t : o.tilts) {
+    ASSERT_TRUE(t.from_directions_known);
+    const Eigen::Vector2d ratio = (t.tilt - t.from_directions).cwiseQuotient(t.tilt_std);
+    std::printf("[ measured ] axis %s in %s: lean (%+.3f %+.3f) mrad +- (%.3f %.3f), from A (%+.3f %+.3f) mrad\n",
+                scenario.axes[t.axis].name.c_str(), t.name.c_str(), 1e3 * t.tilt(0), 1e3 * t.tilt(1),
+                1e3 * t.tilt_std(0), 1e3 * t.tilt_std(1), 1e3 * t.from_directions(0), 1e3 * t.from_directions(1));
+    EXPECT_LE(ratio.cwiseAbs().maxCoeff(), 4.0) << t.name;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const HarmonicFitResult& d = o.axes[i].drift.front();
+    std::printf("[ measured ] axis %s: D standard errors: mean %.2e rad/s, cos/sin orders",
+                scenario.axes[i].name.c_str(), d.mean_std);
+    for (std::size_t h = 0; h < d.orders.size(); ++h)
+      std::printf(" %d: %.2e %.2e", d.orders[h], d.cos_std[h], d.sin_std[h]);
+    std::printf("\n");
+  }
   // No body bias was injected (each axis's own D is its file's): what is left is within its sigmas.
   ASSERT_TRUE(o.bias_estimated);
   for (int j = 0; j < 3; ++j) {

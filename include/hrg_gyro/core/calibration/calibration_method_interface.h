@@ -33,6 +33,11 @@ struct PlateauSample {
   /// rad^2: the variance the regularised stamps (table_stamp_regulariser.h) leave on rotation_angle,
   /// an error smooth in time that the angle's own scatter does not show (0: stamps as logged).
   double angle_smooth_error = 0.0;
+  /// Where the caller models the Earth's horizontal rate (a triad's axis on the table,
+  /// CalibrationSession::modelHorizontalEarthRate): the fixture position's slot whose tilt the sample
+  /// carries (-1: none), and psi, the heading of the platter's x (the table's azimuth minus its angle), rad.
+  int horizontal_slot = -1;
+  double horizontal_phase = 0.0;
 };
 
 struct CalibrationProgress {
@@ -50,6 +55,9 @@ class CalibrationMethod {
   virtual bool complete() const = 0;
   virtual CalibrationProgress progress() const = 0;
   virtual CalibrationOutcome finish(const GyroParameters& prior) const = 0;
+  /// Fit the Earth's horizontal rate of `slots` fixture positions with the method's model (before
+  /// any sample). False: the method does not model it (the samples' horizontal slots are ignored).
+  virtual bool modelHorizontalEarthRate(int /*slots*/) { return false; }
 };
 
 /// The method the settings choose; `prior` is the parameter set the data are measured with.

@@ -111,6 +111,9 @@ struct CalibrationOutcome {
   /// dual-rate: the bias's random walk estimated from the fit's residuals; when carried, the
   /// standard errors include what it predicts.
   BiasWalkFit bias_walk;
+  /// dual-rate, where the caller modelled it (a triad's axis): the Earth's horizontal rate each
+  /// fixture position's tilt let in, fitted with K and D.
+  std::vector<HorizontalEarthFit> horizontal_earth;
   TableClockReport table_clock;
   FieldReport field;  ///< method field only
 

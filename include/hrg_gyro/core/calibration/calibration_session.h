@@ -33,6 +33,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -77,6 +78,10 @@ class CalibrationSession {
   /// The generator stream has moved past its sweep (told by that same stream, so it cannot be
   /// confused by another stream's lag): the correction-matrix run may finish.
   void generatorSweepEnded();
+  /// A triad's axis on the table: the method fits the Earth's horizontal rate of up to `slots` fixture
+  /// positions, and `tag` gives each settled sample its slot and the platter's heading (before any
+  /// record; kept over a restart). False when the method does not model it.
+  bool modelHorizontalEarthRate(int slots, std::function<void(PlateauSample*)> tag);
 
   const CalibrationSettings& settings() const { return settings_; }
   const GyroParameters& prior() const { return prior_; }
@@ -114,6 +119,8 @@ class CalibrationSession {
   CalibrationSettings settings_;
   GyroParameters prior_;
   std::unique_ptr<CalibrationMethod> method_;
+  int horizontal_slots_ = 0;  // modelHorizontalEarthRate's, for a restarted method
+  std::function<void(PlateauSample*)> horizontal_tag_;
   PlateauDetector detector_;
   RingBuffer<PlateauRecord> rotation_;  // judged rotation records
   std::vector<PlateauRecord> judged_;   // scratch: records the detector has just judged

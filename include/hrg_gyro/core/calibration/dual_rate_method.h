@@ -24,6 +24,8 @@ class DualRateMethod : public CalibrationMethod {
   bool complete() const override;
   CalibrationProgress progress() const override;
   CalibrationOutcome finish(const GyroParameters& prior) const override;
+  /// Two more columns per slot in the increment regression (cos psi dt, sin psi dt).
+  bool modelHorizontalEarthRate(int slots) override;
 
  private:
   /// Swept time a theta bin needs to count (coverage) and to enter the fit: a quarter of the window

@@ -48,6 +48,14 @@
 //   Cov(X'e) = q^2 integral S(s) S(s)^T ds + N^2 sum x_i x_i^T dt_i,  S(s) = sum_{t_i > s} x_i dt_i,
 // summed as the increments arrive (S from prefix sums, so memory stays fixed), and each coefficient's
 // statistical variance is the larger of the sandwich and that model (with the white angle noise).
+//
+// An axis slightly tilted from the table's axis also senses the Earth's horizontal rate, which turns
+// with the table: Omega cos(latitude) (h_x cos psi + h_y sin psi), psi the heading of the platter's
+// x (the table's azimuth minus its angle) and h the axis's small horizontal component in the platter
+// frame, unknown and different in every fixture position. As theta moves with the table angle, that
+// rate would land in D's harmonics. Where the caller asks (horizontal slots > 0, one per fixture
+// position), each slot adds two columns, the integrals of cos psi dt and sin psi dt over the samples
+// tagged with it, whose coefficients (rad/s: K0 Omega cos(latitude) h) are fitted with K and D.
 #pragma once
 
 #include <Eigen/Core>
@@ -83,6 +91,14 @@ struct BiasWalkFit {
   bool carried = false;               ///< q^2 > 0: the covariance carries the walk
 };
 
+/// The Earth's horizontal rate that one fixture position's tilt lets into the axis: the coefficients
+/// of cos psi and sin psi (psi the heading of the platter's x), rad/s.
+struct HorizontalEarthFit {
+  int slot = 0;
+  double cos = 0.0, sin = 0.0;
+  double cos_std = 0.0, sin_std = 0.0;
+};
+
 /// The bias trend fitted with K and D (bias_trend_order > 0).
 struct BiasTrendFit {
   int order = 0;
@@ -108,9 +124,10 @@ struct IncrementFit {
   double angle_noise = 0.0;              ///< estimated white wave-angle noise per sample, rad
   double mean_window = 0.0;              ///< s between consecutive window means
   std::size_t increments = 0;
-  std::size_t blocks = 0;  ///< blocks of the sandwich covariance
-  BiasTrendFit trend;      ///< order 0: none fitted
-  BiasWalkFit walk;        ///< the bias's random walk, estimated whatever the trend order
+  std::size_t blocks = 0;                      ///< blocks of the sandwich covariance
+  BiasTrendFit trend;                          ///< order 0: none fitted
+  BiasWalkFit walk;                            ///< the bias's random walk, estimated whatever the trend order
+  std::vector<HorizontalEarthFit> horizontal;  ///< per horizontal slot with data, in slot order
   /// Weight of the logged table angle against the integral of the logged rate (with the angle's
   /// slope per chain), time-weighted over the chains: 1 the angle alone, 0 the rate's shape alone.
   double angle_weight = 1.0;
@@ -120,21 +137,25 @@ class IncrementRegression {
  public:
   /// Orders must be positive. bins: wave-angle bins over [0, pi) for the binned curves.
   /// bias_trend_order: degree of the bias's polynomial in time (0: a constant bias; at most 2).
+  /// horizontal_slots: fixture positions whose horizontal Earth rate is fitted (0: none).
   IncrementRegression(const std::vector<int>& k_orders, const std::vector<int>& d_orders, int bins,
-                      int bias_trend_order = 0);
+                      int bias_trend_order = 0, int horizontal_slots = 0);
 
   /// Starts a chain of plateau group `group` averaged over windows of `window` s (ends any open chain).
   void startChain(int group, double window);
   /// Adds a sample of the open chain: theta the measured wave angle, phi the table angle (without the
   /// Earth rate, which solve() adds), phi_rate the integral of the table's logged rate from the chain's
-  /// start (NaN: none); stamps increasing.
-  void add(Nanoseconds stamp, double theta, double phi, double phi_rate = NAN);
+  /// start (NaN: none); stamps increasing. horizontal_slot: the fixture position whose horizontal
+  /// Earth rate the sample carries (-1: none), psi the heading of the platter's x, rad.
+  void add(Nanoseconds stamp, double theta, double phi, double phi_rate = NAN, int horizontal_slot = -1,
+           double psi = 0.0);
   /// Closes the open chain (its last, partial window is left out).
   void endChain();
   /// rad^2: an error of the angle that is smooth in time (regularised stamps), which the window
   /// means' scatter does not show; counted against the angle when the two sources are weighed.
   void setAngleSmoothError(double variance) { angle_smooth_error_ = variance; }
   bool inChain() const { return in_chain_; }
+  int horizontalSlots() const { return horizontal_slots_; }
 
   std::size_t increments() const { return increments_; }
 
@@ -178,11 +199,13 @@ class IncrementRegression {
   };
 
   /// The fitted columns among the accumulated ones: the K block, T, the T harmonics of D's orders
-  /// (mean, cos..., sin...), then the trend's.
+  /// (mean, cos..., sin...), then the trend's, then the horizontal Earth rate's of the slots with data.
   struct Columns {
     std::vector<int> sel;
     std::vector<int> without_trend;  ///< sel without the trend's columns
     int trend_at = 0;                ///< index in sel of the trend's first coefficient
+    int horizontal_at = 0;           ///< index in sel of the first horizontal column
+    std::vector<int> horizontal;     ///< the slots fitted, in order (two columns each)
   };
   /// Each fitted coefficient with the basis-noise attenuation undone, and its total standard error.
   struct Terms {
@@ -190,6 +213,10 @@ class IncrementRegression {
   };
 
   void closeWindow();
+  /// The per-sample angle noise: the previous sample's deviation from the line through its neighbours.
+  void addNoiseSample(double t, double theta);
+  /// The trapezoid of cos psi dt and sin psi dt into the slot's columns.
+  void addHorizontal(int slot, double psi, double dt);
   /// The chain's window means into increments, the table angle taken as the weighted sum of the
   /// logged angle and the rate integral (with the chain's slope from the angle).
   void flushChain();
@@ -228,7 +255,9 @@ class IncrementRegression {
   std::vector<int> k_orders_, d_orders_, all_orders_;
   int bins_;
   int trend_order_;
-  int m_;  // regressors: K block (1 + 2 nK), then T and the T harmonics of every order, then the trend
+  int horizontal_slots_;
+  int horizontal0_ = 0;  // the first horizontal column: cos psi dt, sin psi dt per slot
+  int m_;  // regressors: K block (1 + 2 nK), then T and the T harmonics of every order, the trend, the slots
   int k_terms_ = 0, rate_k0_ = 0, raw_y_ = 0;  // the accumulated columns: K block along the rate integral, y
   std::vector<int> time_column_of_k_;
   HarmonicBasis basis_;
@@ -243,6 +272,9 @@ class IncrementRegression {
   double window_ = 0.0;
   Nanoseconds origin_ = 0;
   double t_prev_ = 0.0, phi_prev_ = 0.0, theta_start_ = 0.0, session_t_prev_ = 0.0, phi_rate_prev_ = 0.0;
+  int slot_prev_ = -1;
+  double psi_prev_ = 0.0;
+  std::vector<bool> slot_seen_;          // slots with samples
   std::vector<WindowMean> chain_means_;  // the open chain's, held until it ends
   LineSums line_;                        // of phi - phi_rate against t over the open chain
   bool chain_has_rate_ = true;

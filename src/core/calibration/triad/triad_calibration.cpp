@@ -62,7 +62,36 @@ TriadCalibration::TriadCalibration(const CalibrationSettings& axis_settings, con
       prior_triad_(prior_triad),
       timelines_(makeTimelines(axis_settings.stampRule())) {
   axis_settings_.method = CalibrationMethodKind::kDualRate;
-  for (int i = 0; i < 3; ++i) sessions_[i] = std::make_unique<CalibrationSession>(axis_settings_, priors_[i]);
+  for (int i = 0; i < 3; ++i) sessions_[i] = makeSession(i);
+}
+
+std::unique_ptr<CalibrationSession> TriadCalibration::makeSession(int axis) {
+  auto session = std::make_unique<CalibrationSession>(axis_settings_, priors_[axis]);
+  session->modelHorizontalEarthRate(kHorizontalSlots,
+                                    [this, axis](PlateauSample* sample) { tagHorizontal(axis, sample); });
+  return session;
+}
+
+void TriadCalibration::tagHorizontal(int axis, PlateauSample* sample) {
+  const FixtureRecord* fixture = fixtureAt(sample->stamp);
+  if (!fixture || !fixture->locked) return;
+  const int sign = verticalSign(*fixture, axis);
+  if (sign == 0) return;
+  // One slot per clamping: a position clamped again leans anew.
+  std::vector<std::size_t>& slots = slot_records_[axis];
+  const std::size_t record = static_cast<std::size_t>(fixture - fixtures_.data());
+  const auto known = std::find(slots.begin(), slots.end(), record);
+  if (known == slots.end() && slots.size() >= static_cast<std::size_t>(kHorizontalSlots)) {
+    ++unslotted_[axis];
+    return;
+  }
+  if (known == slots.end()) slots.push_back(record);
+  // The table angle back from the angle addTurntable handed the session.
+  const double vertical = priors_[0].earth_rate.verticalRate();
+  const double table_angle =
+      (sample->rotation_angle - (sign - 1) * vertical * toSeconds(sample->stamp - origin_)) / sign;
+  sample->horizontal_slot = static_cast<int>(std::find(slots.begin(), slots.end(), record) - slots.begin());
+  sample->horizontal_phase = settings_.azimuth - table_angle;
 }
 
 bool TriadCalibration::admit(int stream, Nanoseconds stamp) {
@@ -84,9 +113,10 @@ bool TriadCalibration::admit(int stream, Nanoseconds stamp) {
 void TriadCalibration::restart() {
   ++restarts_;
   for (int i = 0; i < 3; ++i) {
-    sessions_[i] = std::make_unique<CalibrationSession>(axis_settings_, priors_[i]);
+    sessions_[i] = makeSession(i);
     waves_[i].clear();
     wave_blocks_[i] = BlockMean();
+    slot_records_[i].clear();
   }
   fixtures_.clear();
   table_.clear();
@@ -237,6 +267,34 @@ std::array<GyroParameters, 3> TriadCalibration::fitAxes(TriadOutcome* o) const {
   return params;
 }
 
+void TriadCalibration::measureTilts(TriadOutcome* o) const {
+  const EarthRateSettings& earth = priors_[0].earth_rate;
+  const double horizontal = kEarthRotationRate * std::cos(earth.latitude);
+  for (int i = 0; i < 3; ++i) {
+    const CalibrationOutcome& axis = o->axes[i];
+    if (unslotted_[i] > 0) {
+      o->notes.push_back("axis " + o->axis_names[i] + " pointed along the table axis in more than " +
+                         std::to_string(kHorizontalSlots) +
+                         " clampings: the Earth's horizontal rate of the later ones (" + std::to_string(unslotted_[i]) +
+                         " samples) is not modelled in its D(theta)");
+    }
+    if (!earth.enabled || axis.scale_factor.empty() || !(horizontal > 0.0)) continue;
+    // The coefficients are K0 Omega cos(latitude) times the lean.
+    const double scale = axis.scale_factor.front().mean * horizontal;
+    for (const HorizontalEarthFit& h : axis.horizontal_earth) {
+      const FixtureRecord& fixture = fixtures_[slot_records_[i][h.slot]];
+      TriadAxisTilt t;
+      t.axis = i;
+      t.position = fixture.index;
+      t.name = fixture.name;
+      t.body_to_table = fixture.body_to_table.toRotationMatrix();
+      t.tilt = Eigen::Vector2d(h.cos, h.sin) / scale;
+      t.tilt_std = Eigen::Vector2d(h.cos_std, h.sin_std) / std::abs(scale);
+      o->tilts.push_back(t);
+    }
+  }
+}
+
 std::vector<TriadLockedPosition> TriadCalibration::lockedPositions(const std::array<GyroParameters, 3>& params) const {
   TriadSeries series;
   for (int i = 0; i < 3; ++i) {
@@ -267,6 +325,7 @@ TriadOutcome TriadCalibration::finish() const {
   o.triad = prior_triad_;
   noteRejects(&o);
   const std::array<GyroParameters, 3> params = fitAxes(&o);  // stage 1
+  measureTilts(&o);
   // What stages 2 and 3 measure in each locked position: the axes' responses, the rests.
   const double latitude = priors_[0].earth_rate.enabled ? priors_[0].earth_rate.latitude : 0.0;
   for (const TriadLockedPosition& position : lockedPositions(params)) {
@@ -276,6 +335,12 @@ TriadOutcome TriadCalibration::finish() const {
   if (!fitAxisDirections(settings_, fixtureDrops(), &o)) {  // stage 2
     o.decide();
     return o;
+  }
+  for (TriadAxisTilt& t : o.tilts) {
+    // The lean A's row gives in the position's logged orientation, against stage 1's.
+    const Eigen::Vector3d in_table = t.body_to_table * o.body_to_axis.row(t.axis).transpose();
+    t.from_directions = in_table.head<2>() / in_table.norm();
+    t.from_directions_known = true;
   }
   estimateBodyBias(settings_, &o);  // stage 3
   o.triad.calibration.method = ParameterOrigin::calibratedBy(CalibrationMethodKind::kTriad);

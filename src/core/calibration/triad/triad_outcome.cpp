@@ -21,6 +21,33 @@ void emitMatrix(YAML::Emitter& out, const Eigen::Matrix3d& m) {
   out << YAML::EndSeq;
 }
 
+void emitPair(YAML::Emitter& out, const Eigen::Vector2d& v) {
+  out << YAML::Flow << YAML::BeginSeq << formatDouble(v(0)) << formatDouble(v(1)) << YAML::EndSeq;
+}
+
+void emitTilts(YAML::Emitter& out, const std::vector<TriadAxisTilt>& tilts) {
+  out << YAML::Key << "axis_tilts"
+      << YAML::Comment("stage 1: each axis's horizontal component in the platter frame, rad, from the Earth's rate")
+      << YAML::Value << YAML::BeginSeq;
+  for (const TriadAxisTilt& t : tilts) {
+    out << YAML::BeginMap;
+    out << YAML::Key << "axis" << YAML::Value << t.axis;
+    out << YAML::Key << "position" << YAML::Value << t.position;
+    out << YAML::Key << "name" << YAML::Value << YAML::DoubleQuoted << t.name;
+    out << YAML::Key << "tilt" << YAML::Value;
+    emitPair(out, t.tilt);
+    out << YAML::Key << "tilt_std" << YAML::Value;
+    emitPair(out, t.tilt_std);
+    if (t.from_directions_known) {
+      out << YAML::Key << "from_directions" << YAML::Comment("A's row in the platter frame, the plan's orientation")
+          << YAML::Value;
+      emitPair(out, t.from_directions);
+    }
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+}
+
 }  // namespace
 
 void TriadOutcome::gate(const std::string& name, bool passed, double value, double limit, const std::string& message) {
@@ -99,6 +126,7 @@ std::string emitTriadReport(const TriadOutcome& o) {
     out << YAML::EndMap;
   }
   out << YAML::EndSeq;
+  emitTilts(out, o.tilts);
   emitGatesAndNotes(out, o.gates, o.notes);
   // Each axis's own calibration report, as `hrg_bag calibrate` writes it for one axis.
   out << YAML::Key << "axis_reports" << YAML::Value << YAML::BeginMap;

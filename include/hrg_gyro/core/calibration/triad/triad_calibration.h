@@ -6,7 +6,10 @@
 //  1. Each axis's K(theta) and D(theta): today's dual-rate method, fed with the axis's wave angle and
 //     the table while the axis points along the table axis (up, or down with the table angle's sign
 //     turned and the Earth's vertical rate with it), one single-axis CalibrationSession per axis
-//     (here: fitAxes).
+//     (here: fitAxes). An axis leans off the table's axis by its misalignment and the fixture's
+//     error, so it also senses the Earth's horizontal rate turning with the table; each position's
+//     lean is fitted with K and D (two unknowns per position and axis, the session's horizontal
+//     slots, up to kHorizontalSlots positions per axis), so that rate does not land in D(theta).
 //  2. The axes' directions A in the body frame: in every fixture position, each axis's compensated
 //     increments (stage 1's K and D applied to its wave angle: triad_position_samples.h) against the
 //     table angle give its response c_i,p = A_i . u_p to the table's rate (u_p: the table axis in the
@@ -80,6 +83,13 @@ class TriadCalibration {
   /// site's); `prior_triad`: the triad file whose frame_id and axis names the result keeps.
   TriadCalibration(const CalibrationSettings& axis_settings, const TriadCalibrationSettings& settings,
                    const std::array<GyroParameters, 3>& priors, const TriadParameters& prior_triad);
+  // The sessions call back into this object: it stays where it was made.
+  TriadCalibration(const TriadCalibration&) = delete;
+  TriadCalibration& operator=(const TriadCalibration&) = delete;
+
+  /// Positions per axis whose lean stage 1 fits (a later one's horizontal Earth rate is not modelled,
+  /// and the outcome says so).
+  static constexpr int kHorizontalSlots = 8;
 
   /// The orientation is checked (acceptFixtureOrientation): one that is no rotation is dropped.
   void addFixture(FixtureRecord record);
@@ -103,6 +113,13 @@ class TriadCalibration {
   bool admit(int stream, Nanoseconds stamp);
   /// Forgets every record: a new timeline.
   void restart();
+  /// Axis `axis`'s session for a new run, fitting each position's horizontal Earth rate.
+  std::unique_ptr<CalibrationSession> makeSession(int axis);
+  /// A settled sample of axis `axis`: the slot of its fixture position and the platter's heading.
+  void tagHorizontal(int axis, PlateauSample* sample);
+  /// Each axis's lean per position from its stage-1 horizontal Earth rate (and a note for positions
+  /// beyond the slots).
+  void measureTilts(TriadOutcome* o) const;
   /// The notes on dropped records and restarts.
   void noteRejects(TriadOutcome* o) const;
   /// Why a refusal for want of positions may lie in the fixture records dropped ("" when none was).
@@ -141,6 +158,8 @@ class TriadCalibration {
   Nanoseconds origin_ = 0;        // first stamp seen: the Earth-rate term's time origin
   std::array<StampTimeline, kTriadStreamCount> timelines_;
   std::array<TriadStreamRejects, kTriadStreamCount> rejects_;
+  std::array<std::vector<std::size_t>, 3> slot_records_;  // per axis, the fixtures_ index of each slot
+  std::array<std::uint64_t, 3> unslotted_{};              // samples of positions beyond the slots
   std::uint64_t restarts_ = 0;
 };
 

@@ -27,6 +27,21 @@ struct TriadPositionResponse {
   std::size_t increments = 0;  ///< window increments fitted
 };
 
+/// How far an axis leaned off the table's axis in a fixture position where it pointed along it, as
+/// stage 1 measured it through the Earth's horizontal rate it sensed: the axis's horizontal component
+/// in the platter frame (x along the zero mark), rad. Against it, what stage 2's A and the position's
+/// logged orientation give (the difference: the fixture's own error in that position, and noise).
+struct TriadAxisTilt {
+  int axis = 0;
+  std::uint32_t position = 0;
+  std::string name;
+  Eigen::Matrix3d body_to_table = Eigen::Matrix3d::Identity();  ///< the position's logged orientation
+  Eigen::Vector2d tilt = Eigen::Vector2d::Zero();
+  Eigen::Vector2d tilt_std = Eigen::Vector2d::Zero();
+  bool from_directions_known = false;                         ///< stage 2 fitted A
+  Eigen::Vector2d from_directions = Eigen::Vector2d::Zero();  ///< A_i turned into the platter frame (plan)
+};
+
 /// One rest of the table in a fixture position: the axes' rates against the Earth's.
 struct TriadRest {
   std::uint32_t position = 0;
@@ -55,6 +70,7 @@ struct TriadOutcome {
   bool bias_estimated = false;
   std::vector<TriadPositionResponse> positions;
   std::vector<TriadRest> rests;
+  std::vector<TriadAxisTilt> tilts;  ///< stage 1's, per axis and position along the table's axis
   std::vector<GateResult> gates;
   std::vector<std::string> notes;
 
