@@ -14,6 +14,7 @@
 #include <functional>
 
 #include "core/testing/refusal.h"
+#include "core/testing/temporary_file.h"
 #include "hrg_gyro/core/alignment/local_level.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/estimation/allan_readings_file.h"
@@ -133,26 +134,12 @@ queue_size: 10
 diagnostic_period: 1.0
 )";
 
-// A file of its own per test process and name, removed when the test ends.
-class SettingsFile {
- public:
-  SettingsFile(const std::string& name, const std::string& text)
-      : path_(std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".yaml")) {
-    std::ofstream(path_) << text;
-  }
-  ~SettingsFile() { std::remove(path_.c_str()); }
-  std::string path() const { return path_.string(); }
-
- private:
-  std::filesystem::path path_;
-};
-
 AlignmentSettings parseText(const std::string& text) {
   return AlignmentSettings::parse(YamlField(YAML::Load(text), ""), AlignmentSettings::nodeKeys());
 }
 
 TEST(AlignmentSettingsTest, EveryKeyIsReadFromAFile) {
-  const SettingsFile file("hrg_alignment_settings_full", kFullFile);
+  const TemporaryFile file("hrg_alignment_settings_full", kFullFile);
   const AlignmentSettings s = AlignmentSettings::load(file.path());
   EXPECT_EQ(s.mode, AlignmentMode::kIndexed);
   EXPECT_EQ(s.latitude, 0.9);
@@ -231,7 +218,7 @@ TEST(AlignmentSettingsTest, UnknownKeysAndBadValuesAreRefusedByName) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/gyrocompass.yaml"), std::string::npos) << e.what();
   }
-  const SettingsFile broken("hrg_alignment_settings_broken", "latitude: [0.9\n");
+  const TemporaryFile broken("hrg_alignment_settings_broken", "latitude: [0.9\n");
   EXPECT_EQ(refusedKey([&] { AlignmentSettings::load(broken.path()); }), "");
 }
 
@@ -246,12 +233,12 @@ TEST(AlignmentSettingsTest, TheNoiseComesFromAnAllanReadingsFile) {
   readings.result.angle_random_walk = {false, 0.0, 0.0, 0.0};
   readings.result.bias_instability = {true, 3e-9, 20.0, 60.0};
   readings.result.rate_random_walk = {true, 5e-10, 100.0, 300.0};
-  const SettingsFile allan("hrg_alignment_allan", allanReadingsYaml(readings));
+  const TemporaryFile allan("hrg_alignment_allan", allanReadingsYaml(readings));
   const std::string name = std::filesystem::path(allan.path()).filename().string();
-  const SettingsFile file("hrg_alignment_settings_allan",
-                          "latitude: 0.9\nnoise:\n  allan_file: " + name +
-                              "\n  angle_random_walk: 1.5e-7\n  rate_random_walk: 1e-9\n"
-                              "  residual_bias: 1e-8\n");
+  const TemporaryFile file("hrg_alignment_settings_allan",
+                           "latitude: 0.9\nnoise:\n  allan_file: " + name +
+                               "\n  angle_random_walk: 1.5e-7\n  rate_random_walk: 1e-9\n"
+                               "  residual_bias: 1e-8\n");
   const AlignmentSettings s = AlignmentSettings::load(file.path());
   EXPECT_EQ(s.noise.angle_white_noise, 4.9e-6);
   EXPECT_EQ(s.noise.angle_random_walk, 1.5e-7);  // not identified: the key's
@@ -263,7 +250,7 @@ TEST(AlignmentSettingsTest, TheNoiseComesFromAnAllanReadingsFile) {
   EXPECT_EQ(parseText(base + "noise: {allan_file: ''}\n").noise.rate_random_walk, 0.0);  // "": none
   EXPECT_EQ(refusedKey([&] { parseText(base + "noise: {allan_file: /nonexistent/allan.yaml}\n"); }),
             "noise.allan_file");
-  const SettingsFile bad("hrg_alignment_allan_bad", "samples: 10\ntau0: 0.005\n");
+  const TemporaryFile bad("hrg_alignment_allan_bad", "samples: 10\ntau0: 0.005\n");
   EXPECT_EQ(refusedKey([&] { parseText(base + "noise: {allan_file: " + bad.path() + "}\n"); }), "noise.allan_file");
 }
 
@@ -274,7 +261,7 @@ TEST(AlignmentSettingsTest, TheNodeTemplateIsASettingsFile) {
   EXPECT_EQ(refusedKey([&] { AlignmentSettings::load(shipped); }), "latitude");
   std::ifstream in(shipped);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const SettingsFile file("hrg_alignment_settings_template", text + "latitude: 0.9\n");
+  const TemporaryFile file("hrg_alignment_settings_template", text + "latitude: 0.9\n");
   const AlignmentSettings s = AlignmentSettings::load(file.path());
   const AlignmentSettings defaults;
   EXPECT_EQ(s.mode, defaults.mode);

@@ -12,25 +12,12 @@
 #include <string>
 
 #include "core/testing/refusal.h"
+#include "core/testing/temporary_file.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 
 namespace hrg_gyro {
 namespace core {
 namespace {
-
-// A file of its own per test process and name, removed when the test ends.
-class ReadingsFile {
- public:
-  ReadingsFile(const std::string& name, const std::string& text)
-      : path_(std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".yaml")) {
-    std::ofstream(path_) << text;
-  }
-  ~ReadingsFile() { std::remove(path_.c_str()); }
-  std::string path() const { return path_.string(); }
-
- private:
-  std::filesystem::path path_;
-};
 
 AllanReadings example() {
   AllanReadings r;
@@ -45,7 +32,7 @@ AllanReadings example() {
 
 TEST(AllanReadingsFileTest, WhatIsWrittenIsReadBackExactly) {
   const AllanReadings w = example();
-  const ReadingsFile file("hrg_allan_readings", allanReadingsYaml(w));
+  const TemporaryFile file("hrg_allan_readings", allanReadingsYaml(w));
   const AllanReadings r = loadAllanReadings(file.path());
   EXPECT_EQ(r.samples, w.samples);
   EXPECT_EQ(r.tau0, w.tau0);
@@ -64,7 +51,7 @@ TEST(AllanReadingsFileTest, WhatIsWrittenIsReadBackExactly) {
 TEST(AllanReadingsFileTest, ABadEntryIsRefusedNamingTheKeyAndTheFile) {
   const std::string good = allanReadingsYaml(example());
   auto refused = [](const std::string& text) {
-    const ReadingsFile file("hrg_allan_readings_bad", text);
+    const TemporaryFile file("hrg_allan_readings_bad", text);
     try {
       loadAllanReadings(file.path());
     } catch (const ConfigError& e) {
