@@ -188,6 +188,10 @@ class CalibrationMethod(unittest.TestCase):
             self.assertAlmostEqual(c4, K_COS4, delta=2e-5)  # the 4 theta term stays in K
         elif self.case == "field":
             r = self.final_result(1)
+            # The figures the gates judged, printed before any assertion: a refused run shows its margins.
+            for g in r.gates:
+                print("field live gate %s: %s %.4g (limit %.4g)" % (g.name, "passed" if g.passed else "FAILED",
+                                                                   g.value, g.limit))
             self.check_written(r, "field")
             self.assertEqual(len(r.scale_factor), 0, "K is not estimated by a field calibration")
             written, prior = util.load_yaml(rospy.get_param("~parameter_file")), util.load_yaml(
