@@ -1,6 +1,8 @@
 # hrg_gyro: the two set-up commands (README) and the benchmark entry point.
 #   make run    install missing Debian packages, build, run the main job, print the summary
 #   make test   install, build, run every unit test and rostest, then catkin_test_results
+#   make unit   install, build the gtest binaries alone (core, tools, bag writer, fuzz corpus) and run
+#               them, no master, no rostest: the daily loop (GTEST_FILTER selects cases)
 #   make bench  install, build, run the benchmarks
 #   make soak   1 simulated h at 10 kHz through the nodes (sim clock, 2x), memory and drops watched
 #   make fuzz   libFuzzer + ASan/UBSan on the parameter loader and the sample path (FUZZ_SECONDS each)
@@ -18,7 +20,7 @@ export PATH := /usr/bin:/bin:$(PATH)
 CATKIN_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build test run figures bench fuzz soak clean
+.PHONY: deps build test unit run figures bench fuzz soak clean
 
 deps:
 	@bash $(ROOT)/scripts/install_deps.sh
@@ -44,6 +46,16 @@ test: build
 	ROS_TEST_RESULTS_DIR=$(WS)/build/test_results /usr/bin/python3 $(ROOT)/test/fuzz/fuzz_sources_test.py
 	@# --verbose: a failed test's whole result file (its assertion and output) ends the log.
 	cd $(WS) && catkin_test_results --verbose build/test_results
+
+# The unit tests alone: their four binaries and what they link (the core library), not the nodes.
+UNIT_TESTS := core tools bag_writer fuzz_corpus
+GTEST_FILTER ?= *
+unit: deps
+	@bash $(ROOT)/scripts/link_workspace.sh $(ROOT) $(WS)
+	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) $(foreach t,$(UNIT_TESTS),hrg_gyro_$(t)_test)
+	@cd $(WS) && failed=""; for t in $(UNIT_TESTS); do \
+	  ./devel/lib/hrg_gyro/hrg_gyro_$${t}_test --gtest_filter='$(GTEST_FILTER)' || failed="$$failed $$t"; done; \
+	  if [ -n "$$failed" ]; then echo "make unit: failed:$$failed"; exit 1; fi
 
 run: build
 	cd $(WS) && source devel/setup.bash && bash $(ROOT)/scripts/run_main_job.sh

@@ -48,10 +48,12 @@ def read_result(directory, pattern):
     lines, failure = [], ""
     for path in summaries + glob.glob(os.path.join(directory, "hrg_gyro", "rosunit-*.xml")):
         root = ET.parse(path).getroot()
+        suites = [root] if root.tag == "testsuite" else list(root.iter("testsuite"))
+        # rostest's summary counts its test nodes (one failed node is one failure); the nodes' own
+        # files count their cases: a run is bad if either says so.
         if os.path.basename(path).startswith("rostest-"):
-            suites = [root] if root.tag == "testsuite" else list(root.iter("testsuite"))
             tests += sum(int(s.get("tests", 0)) for s in suites)
-            bad += sum(int(s.get("failures", 0)) + int(s.get("errors", 0)) for s in suites)
+        bad += sum(int(s.get("failures", 0)) + int(s.get("errors", 0)) for s in suites)
         for element in root.iter():
             if element.tag in ("failure", "error") and not failure:
                 text = (element.get("message") or element.text or element.tag).strip().splitlines()

@@ -33,18 +33,32 @@ latitude: 0.9                # rad, the scenario's
 duration: 60.0               # s
 noise:
   residual_bias: 1.0e-8      # rad/s, what a table calibration leaves (here the model is exact)
+  angle_random_walk: 0.0     # rad/sqrt(s): the simulated gyros' angle noise is white only
+  rate_random_walk: 0.0      # rad/s/sqrt(s): their bias does not wander
+  residual_drift_harmonics: 0.0  # rad/s: the scenario's D is exact in the processors' files
 level:
   source: declared           # no accelerometer in the session
   roll: 0.0                  # rad: the body on the platter, level
   pitch: 0.0                 # rad
+  roll_sigma: 0.0            # rad: exactly level (the scenario's)
+  pitch_sigma: 0.0           # rad
+  accelerometer_bias_sigma: 0.0      # m/s^2: the one added below has white noise only
+  accelerometer_mounting_sigma: 0.0  # rad: and sits on the body's axes
 """
 
 INDEXED = """# The triad on the indexer, two positions 180 deg apart (the whole session).
 mode: indexed                # the gyros' own bias cancels
 latitude: 0.9                # rad
 duration: 137.0              # s: both rests and the half turn between
+noise:
+  residual_bias: 1.0e-8      # rad/s (cancelled by the indexing)
+  angle_random_walk: 0.0     # rad/sqrt(s): the simulated gyros' angle noise is white only
+  rate_random_walk: 0.0      # rad/s/sqrt(s)
+  residual_drift_harmonics: 0.0  # rad/s
 level:
   source: declared           # the indexer's zero frame is level
+  roll_sigma: 0.0            # rad: exactly (the scenario's)
+  pitch_sigma: 0.0           # rad
 indexer:
   settle: 1.0                # s after the half turn before samples count
 """
@@ -55,10 +69,14 @@ latitude: 0.9                # rad, the scenario's
 duration: 270.0              # s: the field calibration's plan
 noise:
   residual_drift_harmonics: 1.0e-8  # rad/s: the scenario's order-2 residual of D over |K0|, rms
+  residual_bias: 0.0         # rad/s: the scenario has none
+  angle_random_walk: 0.0     # rad/sqrt(s): the simulated gyros' angle noise is white only
+  rate_random_walk: 0.0      # rad/s/sqrt(s)
 level:
   source: accelerometer      # accel/data_raw
   accelerometer_to_body: {roll: 0.0, pitch: 0.0, yaw: 1.5707963267948966}  # rad: the scenario's mounting
   accelerometer_bias_sigma: 5.0e-4  # m/s^2: the scenario's bias is within it per axis
+  accelerometer_mounting_sigma: 0.0 # rad: the scenario's mounting, exactly
 """
 
 SWEEP_AXIS = """# A gyro of config/scenarios/north_sweep.yaml: its K0; D = 0 (the scenario's D is the residual).
@@ -335,12 +353,29 @@ class HrgBagAlign(unittest.TestCase):
         bad = self.path("bad.yaml")
         with open(bad, "w") as f:
             f.write(STATIC.replace("  roll: 0.0 ", "  rol: 0.0  "))
+        # Settings that read an Allan file: --output onto that file is refused (it is an input), and
+        # nothing is written over it.
+        allan, allan_settings = self.path("allan.yaml"), self.path("with_allan.yaml")
+        with open(allan, "w") as f:
+            f.write("# hrg_bag allan readings\nsamples: 72000\ntau0: 0.005\nrecord_length: 360.0\n"
+                    "angle_white_noise: {identified: true, value: 8.75e-6, tau_min: 0.005, tau_max: 1.0}\n"
+                    "angle_random_walk: {identified: false, value: 0.0, tau_min: 0.0, tau_max: 0.0}\n"
+                    "bias_instability: {identified: false, value: 0.0, tau_min: 0.0, tau_max: 0.0}\n"
+                    "rate_random_walk: {identified: false, value: 0.0, tau_min: 0.0, tau_max: 0.0}\n")
+        with open(allan_settings, "w") as f:
+            f.write(STATIC.replace("noise:\n", "noise:\n  allan_file: allan.yaml\n"))
+        # No noise model at all: refused naming the first term not given, nothing claimed.
+        unmeasured = self.path("unmeasured.yaml")
+        with open(unmeasured, "w") as f:
+            f.write("mode: static\nlatitude: 0.9\nlevel: {source: declared, roll_sigma: 0.0, pitch_sigma: 0.0}\n")
         cases = [
             (["--settings", bad], "rol"),
             (["--settings", self.settings["static"], "--windows", "30,90"], "--windows"),
             (["--settings", self.settings["static"], "--windows", "30,15"], "--windows"),
             (["--settings", self.settings["static"], "--duration", "-1"], "--duration"),
             (["--settings", self.settings["static"], "--output", self.bag], "refused"),
+            (["--settings", allan_settings, "--output", allan], "refused"),
+            (["--settings", unmeasured], "noise.angle_random_walk"),
             (["--settings", self.settings["static"], "--triad-topic", "/triad/output"], "triad-topic"),
         ]
         for extra, fragment in cases:
@@ -351,6 +386,8 @@ class HrgBagAlign(unittest.TestCase):
             self.assertEqual(code, 2, (args, stdout, err))
             self.assertIn(fragment, err, args)
         self.assertTrue(os.path.getsize(self.bag) > 0)
+        with open(allan) as f:
+            self.assertIn("8.75e-6", f.read())
 
 
 if __name__ == "__main__":

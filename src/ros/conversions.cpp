@@ -496,12 +496,32 @@ AlignmentResult toMessage(const core::AlignmentResult& r, const std::string& fra
     }
     m.segment_rms_ratio.push_back(worst);
   }
+  m.last_sample = toRosTime(r.last_sample);
+  m.estimator = r.estimator;
+  m.estimator_reason = r.estimator_reason;
+  m.noise_sources = r.noise_sources;
+  for (const core::BaseStepRecord& s : r.base_steps) {
+    m.step_time.push_back(s.time);
+    for (int i = 0; i < 3; ++i) m.step_rotation.push_back(s.rotation(i));
+  }
+  m.excluded_seconds = r.excluded_seconds;
+  m.low_frequency_scatter = r.low_frequency_scatter;
+  m.tracking_heading_deg = r.tracking_heading;
+  m.tracking_heading_sigma_deg = r.tracking_heading_sigma;
+  m.estimator_difference = r.estimator_difference;
+  for (const core::EarthCheck& c : r.earth_checks) {
+    m.check_name.push_back(c.name);
+    m.check_measured.push_back(c.measured);
+    m.check_expected.push_back(c.expected);
+    m.check_sigma.push_back(c.sigma);
+    m.check_passed.push_back(c.passed);
+  }
   return m;
 }
 
 sensor_msgs::Imu toAlignmentImuMessage(const core::AlignmentResult& r, const std::string& frame_id) {
   sensor_msgs::Imu m;
-  m.header.stamp = toRosTime(r.end);
+  m.header.stamp = toRosTime(r.last_sample > 0 ? r.last_sample : r.end);
   m.header.frame_id = frame_id;
   m.orientation = toQuaternionMessage(r.body_orientation);
   copyMatrix(r.covariance_enu, &m.orientation_covariance);

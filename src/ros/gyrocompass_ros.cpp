@@ -50,20 +50,31 @@ GyrocompassRos::GyrocompassRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   if (settings_.mode == core::AlignmentMode::kSweep && !have_triad_file_) {
     throw startupError("~mode sweep needs ~triad_file (the axes' names, M and the body bias)");
   }
+  // No noise model, no start: every term given, from an Allan file, or the residual bias from a
+  // calibrated triad file (the probe resolves them as every alignment will).
+  try {
+    settings_ = core::Gyrocompass(settings_, triad_).settings();
+  } catch (const core::ConfigError& e) {
+    throw startupError(std::string("~") + e.what());
+  }
   hold_enabled_ = params_.get("hold/enabled", hold_enabled_);
   hold_settings_.latitude = settings_.latitude;
   hold_settings_.noise = settings_.noise;
   hold_settings_.covariance_interval =
       params_.getPositive("hold/covariance_interval", hold_settings_.covariance_interval, "s");
+  hold_settings_.max_bridge = params_.getInRange("hold/max_bridge", hold_settings_.max_bridge, 0.0, 1.0, "s");
+  hold_settings_.scale_factor_sigma = params_.get<double>("hold/scale_factor_sigma", hold_settings_.scale_factor_sigma);
   stall_timeout_ = params_.getPositive("stall_timeout", stall_timeout_, "s");
   const bool align_at_startup = params_.get("align_at_startup", false);
   const int queue_size = params_.getAtLeast("queue_size", 50000, 1, "messages");
   const std::vector<std::string> unknown = params_.unknownKeys();
   if (!unknown.empty()) throw startupError("~" + unknown.front() + ": unknown parameter (see config/gyrocompass.yaml)");
-  try {
-    hold_settings_.validate();
-  } catch (const core::ConfigError& e) {
-    throw startupError("~hold: " + std::string(e.what()));
+  if (hold_enabled_) {
+    try {
+      hold_settings_.validate();
+    } catch (const core::ConfigError& e) {
+      throw startupError("~" + std::string(e.what()));
+    }
   }
 
   result_pub_ = nh_.advertise<AlignmentResult>("alignment/result", 1, true);
@@ -99,9 +110,12 @@ GyrocompassRos::GyrocompassRos(ros::NodeHandle nh, ros::NodeHandle pnh)
     }
   }
   diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
-  ROS_INFO("gyrocompass: mode %s%s, latitude %.6f rad, window %.1f s, level %s; ~align starts one",
-           toString(settings_.mode), settings_.single_gyro ? " (one gyro)" : "", settings_.latitude, settings_.duration,
-           settings_.level.source == core::LevelSource::kDeclared ? "declared" : "accel/data_raw");
+  ROS_INFO(
+      "gyrocompass: mode %s%s, latitude %.6f rad, window %.1f s, level %s, estimator %s; noise: %s; ~align "
+      "starts one",
+      toString(settings_.mode), settings_.single_gyro ? " (one gyro)" : "", settings_.latitude, settings_.duration,
+      settings_.level.source == core::LevelSource::kDeclared ? "declared" : "accel/data_raw",
+      toString(settings_.estimator), settings_.noise_sources.summary().c_str());
   if (align_at_startup) {
     std::lock_guard<std::mutex> lock(mutex_);
     const std::string refused = start(0.0, "");
@@ -191,8 +205,9 @@ void GyrocompassRos::onTriad(const TriadOutput::ConstPtr& msg) {
     return;
   }
   running_frame_ = msg->header.frame_id;
-  alignment_input_ = ros::WallTime::now();
+  const std::uint64_t before = running_->progress().samples;
   running_->addTriad(sample);
+  noteProgress(before);
   finishIfComplete();
 }
 
@@ -200,8 +215,9 @@ void GyrocompassRos::onGyro(const GyroOutput::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_ || !running_->settings().single_gyro) return;
   running_frame_ = msg->header.frame_id;
-  alignment_input_ = ros::WallTime::now();
+  const std::uint64_t before = running_->progress().samples;
   running_->addAxis(toAxisOutput(*msg));
+  noteProgress(before);
   finishIfComplete();
 }
 
@@ -209,9 +225,18 @@ void GyrocompassRos::onSweepAxis(std::size_t axis, const GyroOutput::ConstPtr& m
   std::lock_guard<std::mutex> lock(mutex_);
   if (!running_ || running_->settings().mode != core::AlignmentMode::kSweep) return;
   running_frame_ = triad_.frame_id;
-  alignment_input_ = ros::WallTime::now();
+  const std::uint64_t before = running_->progress().samples;
   running_->addSweepAxis(axis, toAxisOutput(*msg));
+  noteProgress(before);
   finishIfComplete();
+}
+
+void GyrocompassRos::noteProgress(std::uint64_t samples_before) {
+  // A sample taken, or the window full: the input moves. Dropped ones (a stamp that cannot fill the
+  // window) leave the stall timer running, so a window that cannot fill says so.
+  if (running_ && (running_->progress().samples != samples_before || running_->complete())) {
+    alignment_input_ = ros::WallTime::now();
+  }
 }
 
 void GyrocompassRos::onPrecession(std::size_t axis, const PrecessionState::ConstPtr& msg) {
@@ -248,8 +273,9 @@ void GyrocompassRos::diagnoseAlignment(diagnostic_updater::DiagnosticStatusWrapp
     const double quiet = quietFor(alignment_input_);
     if (quiet > stall_timeout_) {
       stat.summaryf(DiagnosticStatus::ERROR,
-                    "aligning, input stalled: no %s for %.1f s (%.1f of %.1f s); ~align restarts it",
-                    running_topic_.c_str(), quiet, p.seconds, p.duration);
+                    "aligning, input stalled: no %s sample taken for %.1f s (%.1f of %.1f s; %llu dropped); ~align "
+                    "restarts it",
+                    running_topic_.c_str(), quiet, p.seconds, p.duration, static_cast<unsigned long long>(p.dropped));
     } else {
       stat.summaryf(DiagnosticStatus::WARN, "aligning: %.1f of %.1f s (%s)", p.seconds, p.duration,
                     toString(running_->settings().mode));
@@ -260,6 +286,7 @@ void GyrocompassRos::diagnoseAlignment(diagnostic_updater::DiagnosticStatusWrapp
     stat.add("samples", p.samples);
     stat.add("gaps", p.gaps);
     stat.add("dropped records", p.dropped);
+    stat.add("window restarts", p.restarts);
     stat.add("indexer records", p.indexer);
     stat.add("accelerometer records", p.accelerometer);
   } else if (!last_) {
@@ -271,6 +298,7 @@ void GyrocompassRos::diagnoseAlignment(diagnostic_updater::DiagnosticStatusWrapp
     stat.summaryf(DiagnosticStatus::ERROR, "alignment refused (%s): %s", last_->gate.c_str(), last_->reason.c_str());
   }
   stat.add("alignments started", alignments_);
+  stat.add("noise sources", settings_.noise_sources.summary());
   if (!last_) return;
   const core::AlignmentResult& r = *last_;
   stat.add("last accepted", r.accepted ? "true" : "false");
@@ -289,6 +317,15 @@ void GyrocompassRos::diagnoseAlignment(diagnostic_updater::DiagnosticStatusWrapp
   stat.add("horizontal earth rate rad/s", r.horizontal_rate);
   stat.add("expected horizontal earth rate rad/s", r.budget.horizontal_earth_rate);
   stat.add("scatter", r.scatter);
+  stat.add("last estimator", r.estimator);
+  stat.add("last estimator reason", r.estimator_reason);
+  stat.add("low frequency scatter", r.low_frequency_scatter);
+  stat.add("base steps carried", r.base_steps.size());
+  stat.add("excluded s", r.excluded_seconds);
+  for (const core::EarthCheck& c : r.earth_checks) {
+    stat.add("earth check " + c.name, core::formatDouble(c.measured) + " (expected " + core::formatDouble(c.expected) +
+                                          ", sigma " + core::formatDouble(c.sigma) + (c.passed ? ")" : ", FAILED)"));
+  }
 }
 
 void GyrocompassRos::diagnoseHold(diagnostic_updater::DiagnosticStatusWrapper& stat) {
@@ -313,6 +350,7 @@ void GyrocompassRos::diagnoseHold(diagnostic_updater::DiagnosticStatusWrapper& s
   stat.add("heading deg", hold_->heading());
   stat.add("heading sigma deg", hold_->headingSigma());
   stat.add("dropped samples", hold_->dropped());
+  stat.add("bridged samples", hold_->bridged());
   stat.add("lost reason", hold_->lostReason());
 }
 

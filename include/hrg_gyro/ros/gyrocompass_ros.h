@@ -64,6 +64,8 @@ class GyrocompassRos {
   /// Ends the running alignment when its window is full (or it was refused): publishes the result,
   /// starts the hold when accepted.
   void finishIfComplete();
+  /// The running alignment took a sample (or filled) since `samples_before`: its input moves.
+  void noteProgress(std::uint64_t samples_before);
   /// Seconds of wall time since `since`.
   static double quietFor(const ros::WallTime& since) { return (ros::WallTime::now() - since).toSec(); }
   bool alignmentStalled() const { return running_ && quietFor(alignment_input_) > stall_timeout_; }

@@ -51,11 +51,12 @@ std::string AlignmentResult::summary() const {
     return buffer;
   }
   std::snprintf(buffer, sizeof buffer,
-                "true heading %.4f deg +- %.4f deg (1 sigma), roll %.4f deg, pitch %.4f deg; %s%s, %.1f s; "
+                "true heading %.4f deg +- %.4f deg (1 sigma), roll %.4f deg, pitch %.4f deg; %s%s, %s, %.1f s; "
                 "mrad: noise %.3f, bias %.3f, drift harmonics %.3f, bias walk %.3f, level %.3f",
                 heading, heading_sigma, attitude.roll * kDegrees, attitude.pitch * kDegrees, toString(mode),
-                single_gyro ? " (one gyro)" : "", seconds, 1e3 * budget.noise, 1e3 * budget.residual_bias,
-                1e3 * budget.drift_harmonics, 1e3 * budget.bias_random_walk, 1e3 * budget.level);
+                single_gyro ? " (one gyro)" : "", estimator.c_str(), seconds, 1e3 * budget.noise,
+                1e3 * budget.residual_bias, 1e3 * budget.drift_harmonics, 1e3 * budget.bias_random_walk,
+                1e3 * budget.level);
   return buffer;
 }
 
@@ -72,8 +73,8 @@ std::string emitAlignmentResult(const AlignmentResult& r) {
   y << "mode: " << toString(r.mode) << "\n";
   y << "single_gyro: " << (r.single_gyro ? "true" : "false") << "\n";
   y << "frame: " << r.frame << "\n";
-  y << "window: {start_ns: " << r.start << ", end_ns: " << r.end << ", seconds: " << number(r.seconds)
-    << ", samples: " << r.samples << "}\n";
+  y << "window: {start_ns: " << r.start << ", end_ns: " << r.end << ", last_sample_ns: " << r.last_sample
+    << ", seconds: " << number(r.seconds) << ", samples: " << r.samples << "}\n";
   y << "heading_deg: " << number(r.heading) << "\n";
   y << "heading_sigma_deg: " << number(r.heading_sigma) << "\n";
   y << "attitude_rad: {roll: " << number(r.attitude.roll) << ", pitch: " << number(r.attitude.pitch)
@@ -107,6 +108,28 @@ std::string emitAlignmentResult(const AlignmentResult& r) {
   y << "scatter: " << number(r.scatter) << "\n";
   y << "worst_motion_rad_s: " << number(r.worst_motion) << "\n";
   y << "accelerometer_gravity_m_s2: " << number(r.accelerometer_gravity) << "\n";
+  y << "estimator: " << quoted(r.estimator) << "\n";
+  y << "estimator_reason: " << quoted(r.estimator_reason) << "\n";
+  y << "noise_sources: " << quoted(r.noise_sources) << "\n";
+  y << "low_frequency_scatter: " << number(r.low_frequency_scatter) << "\n";
+  y << "low_frequency_limit: " << number(r.low_frequency_limit) << "\n";
+  y << "excluded_s: " << number(r.excluded_seconds) << "\n";
+  y << "tracking: {heading_deg: " << number(r.tracking_heading)
+    << ", heading_sigma_deg: " << number(r.tracking_heading_sigma)
+    << ", difference_sigmas: " << number(r.estimator_difference) << ", velocity_white_m_s: " << number(r.velocity_white)
+    << ", velocity_random_walk_m_s_sqrt_s: " << number(r.velocity_random_walk) << "}\n";
+  y << "base_steps:";
+  for (const BaseStepRecord& b : r.base_steps) {
+    y << "\n  - {time_s: " << number(b.time) << ", rotation_rad: [" << number(b.rotation.x()) << ", "
+      << number(b.rotation.y()) << ", " << number(b.rotation.z()) << "], chi_square: " << number(b.chi_square) << "}";
+  }
+  y << (r.base_steps.empty() ? " []\n" : "\n");
+  y << "earth_checks:";
+  for (const EarthCheck& c : r.earth_checks) {
+    y << "\n  - {name: " << c.name << ", measured: " << number(c.measured) << ", expected: " << number(c.expected)
+      << ", sigma: " << number(c.sigma) << ", passed: " << (c.passed ? "true" : "false") << "}";
+  }
+  y << (r.earth_checks.empty() ? " []\n" : "\n");
   y << "segments:\n";
   for (const AlignmentSegment& s : r.segments) {
     y << "  - {start_s: " << number(s.start) << ", end_s: " << number(s.end)

@@ -23,8 +23,16 @@ void requirePositive(double value, const std::string& key, const char* unit) {
 }
 
 // The keys, listed once: parse() refuses any other, keyPaths() lists them.
-const std::vector<std::string> kScalarKeys = {
-    "mode", "latitude", "max_latitude", "duration", "single_gyro", "max_earth_rate_error", "max_condition"};
+const std::vector<std::string> kScalarKeys = {"mode",
+                                              "latitude",
+                                              "max_latitude",
+                                              "duration",
+                                              "single_gyro",
+                                              "max_earth_rate_error",
+                                              "max_earth_sigmas",
+                                              "max_estimator_sigmas",
+                                              "estimator",
+                                              "max_condition"};
 const std::vector<std::string> kNoiseKeys = {"angle_white_noise", "angle_random_walk",        "rate_random_walk",
                                              "residual_bias",     "residual_drift_harmonics", "allan_file"};
 const std::vector<std::string> kLevelKeys = {"source",
@@ -34,11 +42,13 @@ const std::vector<std::string> kLevelKeys = {"source",
                                              "pitch_sigma",
                                              "accelerometer_to_body",
                                              "accelerometer_bias_sigma",
+                                             "accelerometer_mounting_sigma",
                                              "max_gravity_error"};
 const std::vector<std::string> kIndexerKeys = {"continuous", "body_to_platform",   "gyro_axis",      "rest_rate",
                                                "settle",     "position_tolerance", "max_record_gap", "angle_sigma"};
 const std::vector<std::string> kSweepKeys = {"settle", "gain_orders", "min_turns"};
-const std::vector<std::string> kMotionKeys = {"block", "max_motion", "max_scatter"};
+const std::vector<std::string> kMotionKeys = {"block",      "max_motion", "max_scatter",  "step_threshold",
+                                              "step_guard", "max_steps",  "max_excluded", "block_false_alarm"};
 const std::vector<std::string> kSections = {"noise", "level", "indexer", "sweep", "motion"};
 const std::vector<std::string> kNodeKeys = {"align_at_startup", "triad_file",    "hold",
                                             "queue_size",       "stall_timeout", "diagnostic_period"};
@@ -63,19 +73,30 @@ std::string allanFilePath(const YamlField& f, const std::string& base_directory)
   return base_directory + "/" + path;
 }
 
-void parseNoise(const YamlField& f, GyroNoiseModel* n, const std::string& base_directory) {
+// One noise term: the key's value when given (its source "settings"), else left unset.
+void noiseTerm(const YamlField& f, const char* key, double* value, std::string* source) {
+  if (!f.has(key)) return;
+  *value = f[key].asDouble();
+  *source = std::string("settings (noise/") + key + ")";
+}
+
+void parseNoise(const YamlField& f, GyroNoiseModel* n, NoiseSources* sources, std::string* allan_file,
+                const std::string& base_directory) {
   f.requireMap();
   f.rejectUnknownKeys(kNoiseKeys);
-  n->angle_white_noise = f.getDouble("angle_white_noise", n->angle_white_noise);
-  n->angle_random_walk = f.getDouble("angle_random_walk", n->angle_random_walk);
-  n->rate_random_walk = f.getDouble("rate_random_walk", n->rate_random_walk);
-  n->residual_bias = f.getDouble("residual_bias", n->residual_bias);
-  n->residual_drift_harmonics = f.getDouble("residual_drift_harmonics", n->residual_drift_harmonics);
+  noiseTerm(f, "angle_white_noise", &n->angle_white_noise, &sources->angle_white_noise);
+  if (n->angle_white_noise < 0.0) sources->angle_white_noise = "measured from the window";
+  noiseTerm(f, "angle_random_walk", &n->angle_random_walk, &sources->angle_random_walk);
+  noiseTerm(f, "rate_random_walk", &n->rate_random_walk, &sources->rate_random_walk);
+  noiseTerm(f, "residual_bias", &n->residual_bias, &sources->residual_bias);
+  noiseTerm(f, "residual_drift_harmonics", &n->residual_drift_harmonics, &sources->residual_drift_harmonics);
   // The measured readings replace the keys above; one the record did not identify keeps its key.
   if (f.getString("allan_file", "").empty()) return;
   const YamlField file = f["allan_file"];
   try {
-    *n = noiseFromAllan(loadAllanReadings(allanFilePath(file, base_directory)).result, *n);
+    const std::string path = allanFilePath(file, base_directory);
+    *allan_file = path;
+    *n = noiseFromAllan(loadAllanReadings(path).result, *n, sources, "allan_file " + path);
   } catch (const ConfigError& e) {
     if (e.key() == file.path()) throw;
     file.fail(e.what());
@@ -101,6 +122,7 @@ void parseLevel(const YamlField& f, LevelSettings* l) {
   l->pitch_sigma = f.getDouble("pitch_sigma", l->pitch_sigma);
   if (f.has("accelerometer_to_body")) l->accelerometer_to_body = parseRotation(f["accelerometer_to_body"]);
   l->accelerometer_bias_sigma = f.getDouble("accelerometer_bias_sigma", l->accelerometer_bias_sigma);
+  l->accelerometer_mounting_sigma = f.getDouble("accelerometer_mounting_sigma", l->accelerometer_mounting_sigma);
   l->max_gravity_error = f.getDouble("max_gravity_error", l->max_gravity_error);
 }
 
@@ -139,6 +161,20 @@ void parseMotion(const YamlField& f, MotionSettings* m) {
   m->block = f.getDouble("block", m->block);
   m->max_motion = f.getDouble("max_motion", m->max_motion);
   m->max_scatter = f.getDouble("max_scatter", m->max_scatter);
+  m->step_threshold = f.getDouble("step_threshold", m->step_threshold);
+  m->step_guard = f.getDouble("step_guard", m->step_guard);
+  m->max_steps = static_cast<int>(std::clamp<long>(f.getInteger("max_steps", m->max_steps), -1, 1000));
+  m->max_excluded = f.getDouble("max_excluded", m->max_excluded);
+  m->block_false_alarm = f.getDouble("block_false_alarm", m->block_false_alarm);
+}
+
+EstimatorChoice parseEstimator(const YamlField& f) {
+  const std::string text = f.asString();
+  if (text == "auto") return EstimatorChoice::kAuto;
+  if (text == "still_base") return EstimatorChoice::kStillBase;
+  if (text == "tracking") return EstimatorChoice::kTracking;
+  f.fail("'" + text + "' is not an estimator: auto, still_base or tracking");
+  return EstimatorChoice::kAuto;
 }
 
 // validate() names nested keys as the node's parameters ("level/roll"); a file's errors name them
@@ -179,8 +215,13 @@ AlignmentSettings AlignmentSettings::parse(const YamlField& root, const std::vec
   s.duration = root.getDouble("duration", s.duration);
   s.single_gyro = root.getBool("single_gyro", s.single_gyro);
   s.max_earth_rate_error = root.getDouble("max_earth_rate_error", s.max_earth_rate_error);
+  s.max_earth_sigmas = root.getDouble("max_earth_sigmas", s.max_earth_sigmas);
+  s.max_estimator_sigmas = root.getDouble("max_estimator_sigmas", s.max_estimator_sigmas);
+  if (root.has("estimator")) s.estimator = parseEstimator(root["estimator"]);
   s.max_condition = root.getDouble("max_condition", s.max_condition);
-  if (root.has("noise")) parseNoise(root["noise"], &s.noise, base_directory);
+  s.noise_sources.angle_random_walk = s.noise_sources.rate_random_walk = "not given";
+  s.noise_sources.residual_bias = s.noise_sources.residual_drift_harmonics = "not given";
+  if (root.has("noise")) parseNoise(root["noise"], &s.noise, &s.noise_sources, &s.allan_file, base_directory);
   if (root.has("level")) parseLevel(root["level"], &s.level);
   if (root.has("indexer")) parseIndexer(root["indexer"], &s.indexer);
   if (root.has("sweep")) parseSweep(root["sweep"], &s.sweep);
@@ -227,33 +268,114 @@ void GyroNoiseModel::validate(const std::string& prefix) const {
   if (!std::isfinite(angle_white_noise) || angle_white_noise == 0.0) {
     throw ConfigError(prefix + "angle_white_noise", "must be positive (rad per sample), or negative to measure it");
   }
-  requireFiniteAtLeast(angle_random_walk, 0.0, prefix + "angle_random_walk", "rad/sqrt(s)");
-  requireFiniteAtLeast(rate_random_walk, 0.0, prefix + "rate_random_walk", "rad/s/sqrt(s)");
-  requireFiniteAtLeast(residual_bias, 0.0, prefix + "residual_bias", "rad/s");
-  requireFiniteAtLeast(residual_drift_harmonics, 0.0, prefix + "residual_drift_harmonics", "rad/s");
+  // Not given (NaN) passes here; requireComplete() refuses it where a budget needs it.
+  auto check = [&](double v, const char* key, const char* unit) {
+    if (!std::isnan(v)) requireFiniteAtLeast(v, 0.0, prefix + key, unit);
+  };
+  check(angle_random_walk, "angle_random_walk", "rad/sqrt(s)");
+  check(rate_random_walk, "rate_random_walk", "rad/s/sqrt(s)");
+  check(residual_bias, "residual_bias", "rad/s");
+  check(residual_drift_harmonics, "residual_drift_harmonics", "rad/s");
 }
 
-GyroNoiseModel noiseFromAllan(const AllanResult& allan, const GyroNoiseModel& base) {
+void GyroNoiseModel::requireComplete(const std::string& prefix) const {
+  validate(prefix);
+  const char* allan =
+      ": not given; measure it (hrg_bag allan --yaml on a still record, then noise/allan_file) or "
+      "set it from the gyro's own Allan deviation (0 only if it shows none)";
+  if (std::isnan(angle_random_walk))
+    throw ConfigError(prefix + "angle_random_walk", std::string("rad/sqrt(s)") + allan);
+  if (std::isnan(rate_random_walk))
+    throw ConfigError(prefix + "rate_random_walk", std::string("rad/s/sqrt(s)") + allan);
+  if (std::isnan(residual_bias)) {
+    throw ConfigError(prefix + "residual_bias",
+                      "rad/s: not given; the bias the calibration left, 1 sigma (the triad calibration's bias_std; "
+                      "a triad file with a calibrated bias_std gives it)");
+  }
+  if (std::isnan(residual_drift_harmonics)) {
+    throw ConfigError(prefix + "residual_drift_harmonics",
+                      "rad/s: not given; the rms of D(theta) - D0 the calibration left, over |K0| (the axes' "
+                      "calibration reports' D standard errors)");
+  }
+}
+
+std::string NoiseSources::summary() const {
+  return "white angle noise: " + angle_white_noise + "; angle random walk: " + angle_random_walk +
+         "; rate random walk: " + rate_random_walk + "; residual bias: " + residual_bias +
+         "; drift harmonics: " + residual_drift_harmonics;
+}
+
+GyroNoiseModel noiseFromAllan(const AllanResult& allan, const GyroNoiseModel& base, NoiseSources* sources,
+                              const std::string& origin) {
   GyroNoiseModel out = base;
-  if (allan.angle_white_noise.identified) out.angle_white_noise = allan.angle_white_noise.value;
-  if (allan.angle_random_walk.identified) out.angle_random_walk = allan.angle_random_walk.value;
-  if (allan.rate_random_walk.identified) out.rate_random_walk = allan.rate_random_walk.value;
+  NoiseSources ignored;
+  NoiseSources& s = sources ? *sources : ignored;
+  if (allan.angle_white_noise.identified) {
+    out.angle_white_noise = allan.angle_white_noise.value;
+    s.angle_white_noise = origin;
+  }
+  if (allan.angle_random_walk.identified) {
+    out.angle_random_walk = allan.angle_random_walk.value;
+    s.angle_random_walk = origin;
+  }
+  if (allan.rate_random_walk.identified) {
+    out.rate_random_walk = allan.rate_random_walk.value;
+    s.rate_random_walk = origin;
+  }
   return out;
+}
+
+const char* toString(EstimatorChoice choice) {
+  switch (choice) {
+    case EstimatorChoice::kAuto:
+      return "auto";
+    case EstimatorChoice::kStillBase:
+      return "still_base";
+    case EstimatorChoice::kTracking:
+      return "tracking";
+  }
+  return "?";
 }
 
 void LevelSettings::validate() const {
   if (source == LevelSource::kDeclared) {
     if (!std::isfinite(roll) || std::abs(roll) > 1.5) throw ConfigError("level/roll", "must be within +-1.5 rad");
     if (!std::isfinite(pitch) || std::abs(pitch) > 1.4) throw ConfigError("level/pitch", "must be within +-1.4 rad");
-    requireFiniteAtLeast(roll_sigma, 0.0, "level/roll_sigma", "rad");
-    requireFiniteAtLeast(pitch_sigma, 0.0, "level/pitch_sigma", "rad");
+    if (!std::isnan(roll_sigma)) requireFiniteAtLeast(roll_sigma, 0.0, "level/roll_sigma", "rad");
+    if (!std::isnan(pitch_sigma)) requireFiniteAtLeast(pitch_sigma, 0.0, "level/pitch_sigma", "rad");
   }
   const Eigen::Vector4d q = accelerometer_to_body.coeffs();
   if (!q.allFinite() || std::abs(q.norm() - 1.0) > 1e-6) {
     throw ConfigError("level/accelerometer_to_body", "must be a unit quaternion");
   }
-  requireFiniteAtLeast(accelerometer_bias_sigma, 0.0, "level/accelerometer_bias_sigma", "m/s^2");
+  if (!std::isnan(accelerometer_bias_sigma)) {
+    requireFiniteAtLeast(accelerometer_bias_sigma, 0.0, "level/accelerometer_bias_sigma", "m/s^2");
+  }
+  if (!std::isnan(accelerometer_mounting_sigma)) {
+    requireFiniteAtLeast(accelerometer_mounting_sigma, 0.0, "level/accelerometer_mounting_sigma", "rad");
+  }
   requirePositive(max_gravity_error, "level/max_gravity_error", "fraction of g");
+}
+
+void LevelSettings::requireComplete() const {
+  validate();
+  if (source == LevelSource::kDeclared) {
+    if (std::isnan(roll_sigma) || std::isnan(pitch_sigma)) {
+      throw ConfigError(std::isnan(roll_sigma) ? "level/roll_sigma" : "level/pitch_sigma",
+                        "rad: not given; how well the declared level is known, 1 sigma (0 claims it exact)");
+    }
+    return;
+  }
+  if (std::isnan(accelerometer_bias_sigma)) {
+    throw ConfigError(
+        "level/accelerometer_bias_sigma",
+        "m/s^2: not given; the accelerometer's residual bias, 1 sigma per axis (its calibration's, or its "
+        "datasheet's bias stability)");
+  }
+  if (std::isnan(accelerometer_mounting_sigma)) {
+    throw ConfigError("level/accelerometer_mounting_sigma",
+                      "rad: not given; how well accelerometer_to_body is known, 1 sigma per axis (0 claims it exact)");
+  }
 }
 
 void IndexerSettings::validate() const {
@@ -283,6 +405,16 @@ void MotionSettings::validate() const {
   requirePositive(block, "motion/block", "s");
   requirePositive(max_motion, "motion/max_motion", "rad/s");
   if (!std::isfinite(max_scatter) || max_scatter < 1.0) throw ConfigError("motion/max_scatter", "must be at least 1");
+  requirePositive(step_threshold, "motion/step_threshold", "chi-square");
+  requireFiniteAtLeast(step_guard, 0.0, "motion/step_guard", "s");
+  if (step_guard > 60.0) throw ConfigError("motion/step_guard", "must be at most 60 s");
+  if (max_steps < 0 || max_steps > 100) throw ConfigError("motion/max_steps", "must be in [0, 100]");
+  if (!std::isfinite(max_excluded) || max_excluded < 0.0 || max_excluded > 0.9) {
+    throw ConfigError("motion/max_excluded", "must be in [0, 0.9] of the window");
+  }
+  if (!(block_false_alarm >= 1e-9) || block_false_alarm > 0.1) {
+    throw ConfigError("motion/block_false_alarm", "must be in [1e-9, 0.1]");
+  }
 }
 
 void AlignmentSettings::validate() const {
@@ -295,6 +427,8 @@ void AlignmentSettings::validate() const {
   requirePositive(duration, "duration", "s");
   if (duration > 86400.0) throw ConfigError("duration", "must be at most a day (86400 s)");
   requirePositive(max_earth_rate_error, "max_earth_rate_error", "fraction");
+  requirePositive(max_earth_sigmas, "max_earth_sigmas", "standard errors");
+  requirePositive(max_estimator_sigmas, "max_estimator_sigmas", "standard errors");
   if (!std::isfinite(max_condition) || !(max_condition > 1.0)) throw ConfigError("max_condition", "must be above 1");
   if (single_gyro && mode != AlignmentMode::kIndexed) {
     throw ConfigError("single_gyro",
@@ -306,6 +440,12 @@ void AlignmentSettings::validate() const {
   indexer.validate();
   sweep.validate();
   motion.validate();
+}
+
+void AlignmentSettings::requireComplete() const {
+  validate();
+  noise.requireComplete();
+  level.requireComplete();
 }
 
 }  // namespace core

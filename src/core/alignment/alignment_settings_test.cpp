@@ -45,7 +45,16 @@ TEST(AlignmentSettingsTest, BadValuesAreRefusedNamingTheKey) {
   EXPECT_EQ(validateRefusal([](AlignmentSettings* s) { s->single_gyro = true; }), "single_gyro");
   EXPECT_EQ(validateRefusal([](AlignmentSettings* s) { s->noise.angle_white_noise = 0.0; }), "noise/angle_white_noise");
   EXPECT_EQ(validateRefusal([](AlignmentSettings* s) { s->noise.rate_random_walk = -1.0; }), "noise/rate_random_walk");
-  EXPECT_EQ(validateRefusal([](AlignmentSettings* s) { s->noise.residual_bias = NAN; }), "noise/residual_bias");
+  EXPECT_EQ(validateRefusal([](AlignmentSettings* s) { s->noise.residual_bias = INFINITY; }), "noise/residual_bias");
+  // Not given (NaN) is no error of the value: requireComplete() refuses it where a budget needs it.
+  EXPECT_EQ(validateRefusal([](AlignmentSettings* s) { s->noise.residual_bias = NAN; }), "");
+  EXPECT_EQ(validateRefusal([](AlignmentSettings* s) { s->motion.step_threshold = 0.0; }), "motion/step_threshold");
+  EXPECT_EQ(validateRefusal([](AlignmentSettings* s) { s->motion.max_excluded = 0.95; }), "motion/max_excluded");
+  EXPECT_EQ(validateRefusal([](AlignmentSettings* s) { s->motion.block_false_alarm = 0.5; }),
+            "motion/block_false_alarm");
+  EXPECT_EQ(validateRefusal([](AlignmentSettings* s) { s->max_earth_sigmas = -1.0; }), "max_earth_sigmas");
+  EXPECT_EQ(validateRefusal([](AlignmentSettings* s) { s->level.accelerometer_mounting_sigma = -1e-3; }),
+            "level/accelerometer_mounting_sigma");
   EXPECT_EQ(validateRefusal([](AlignmentSettings* s) {
               s->level.source = LevelSource::kDeclared;
               s->level.roll_sigma = -1e-3;
@@ -94,6 +103,9 @@ max_latitude: 1.2
 duration: 60.5
 single_gyro: true
 max_earth_rate_error: 0.3
+max_earth_sigmas: 6.0
+max_estimator_sigmas: 3.5
+estimator: still_base
 max_condition: 1.0e7
 noise:
   angle_white_noise: 8.8e-6
@@ -109,6 +121,7 @@ level:
   pitch_sigma: 2.0e-4
   accelerometer_to_body: {roll: 0.1, pitch: -0.2, yaw: 0.3}
   accelerometer_bias_sigma: 1.0e-3
+  accelerometer_mounting_sigma: 2.0e-3
   max_gravity_error: 0.05
 indexer:
   continuous: true
@@ -127,6 +140,11 @@ motion:
   block: 4.0
   max_motion: 2.0e-4
   max_scatter: 2.0
+  step_threshold: 50.0
+  step_guard: 0.7
+  max_steps: 5
+  max_excluded: 0.2
+  block_false_alarm: 1.0e-3
 align_at_startup: true
 triad_file: ""
 hold: {enabled: true, covariance_interval: 0.2}
@@ -148,6 +166,10 @@ TEST(AlignmentSettingsTest, EveryKeyIsReadFromAFile) {
   EXPECT_TRUE(s.single_gyro);
   EXPECT_EQ(s.max_earth_rate_error, 0.3);
   EXPECT_EQ(s.max_condition, 1e7);
+  EXPECT_EQ(s.max_earth_sigmas, 6.0);
+  EXPECT_EQ(s.max_estimator_sigmas, 3.5);
+  EXPECT_EQ(s.estimator, EstimatorChoice::kStillBase);
+  EXPECT_NE(s.noise_sources.residual_bias.find("settings"), std::string::npos);
   EXPECT_EQ(s.noise.angle_white_noise, 8.8e-6);
   EXPECT_EQ(s.noise.angle_random_walk, 1.5e-7);
   EXPECT_EQ(s.noise.rate_random_walk, 2e-10);
@@ -163,6 +185,7 @@ TEST(AlignmentSettingsTest, EveryKeyIsReadFromAFile) {
   EXPECT_NEAR(mount.pitch, -0.2, 1e-15);
   EXPECT_NEAR(mount.yaw, 0.3, 1e-15);
   EXPECT_EQ(s.level.accelerometer_bias_sigma, 1e-3);
+  EXPECT_EQ(s.level.accelerometer_mounting_sigma, 2e-3);
   EXPECT_EQ(s.level.max_gravity_error, 0.05);
   EXPECT_TRUE(s.indexer.continuous);
   // A quarter turn about z: the body's x is the platform's y.
@@ -179,9 +202,14 @@ TEST(AlignmentSettingsTest, EveryKeyIsReadFromAFile) {
   EXPECT_EQ(s.motion.block, 4.0);
   EXPECT_EQ(s.motion.max_motion, 2e-4);
   EXPECT_EQ(s.motion.max_scatter, 2.0);
+  EXPECT_EQ(s.motion.step_threshold, 50.0);
+  EXPECT_EQ(s.motion.step_guard, 0.7);
+  EXPECT_EQ(s.motion.max_steps, 5);
+  EXPECT_EQ(s.motion.max_excluded, 0.2);
+  EXPECT_EQ(s.motion.block_false_alarm, 1e-3);
   // keyPaths() names every key the file gives (the node's own aside).
   const std::vector<std::string> paths = AlignmentSettings::keyPaths();
-  EXPECT_EQ(paths.size(), 7u + 6u + 8u + 8u + 3u + 3u);
+  EXPECT_EQ(paths.size(), 10u + 6u + 9u + 8u + 3u + 8u);
   for (const char* key : {"mode", "noise/residual_drift_harmonics", "level/accelerometer_to_body", "indexer/gyro_axis",
                           "sweep/gain_orders", "motion/max_scatter"}) {
     EXPECT_NE(std::find(paths.begin(), paths.end(), key), paths.end()) << key;
@@ -247,7 +275,7 @@ TEST(AlignmentSettingsTest, TheNoiseComesFromAnAllanReadingsFile) {
   const std::string base = "latitude: 0.9\n";
   EXPECT_EQ(refusedKey([&] { parseText(base + "noise: {allan_file: " + name + "}\n"); }), "noise.allan_file");
   EXPECT_EQ(parseText(base + "noise: {allan_file: " + allan.path() + "}\n").noise.rate_random_walk, 5e-10);
-  EXPECT_EQ(parseText(base + "noise: {allan_file: ''}\n").noise.rate_random_walk, 0.0);  // "": none
+  EXPECT_TRUE(std::isnan(parseText(base + "noise: {allan_file: ''}\n").noise.rate_random_walk));  // "": none, unset
   EXPECT_EQ(refusedKey([&] { parseText(base + "noise: {allan_file: /nonexistent/allan.yaml}\n"); }),
             "noise.allan_file");
   const TemporaryFile bad("hrg_alignment_allan_bad", "samples: 10\ntau0: 0.005\n");

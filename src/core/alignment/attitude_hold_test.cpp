@@ -1,7 +1,8 @@
 // The attitude hold: exact increments from an exact start keep the attitude (the Earth's rate removed
 // in ENU) at rest and on a turning platform; the covariance grows as the noise model says (N^2 t for an
-// angle random walk, the bias's image for a constant bias); a gap, a reset or a wave turned on command
-// loses the attitude.
+// angle random walk, the bias's image for a constant bias, the scale factor's for a turning body); a
+// gap, a reset or a wave turned on command loses the attitude; one lost, glitched, jittered or
+// mis-timed sample does not.
 #include "hrg_gyro/core/alignment/attitude_hold.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <cmath>
 
 #include "core/testing/angle_level_mount.h"
+#include "core/testing/refusal.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -20,6 +22,9 @@ AttitudeHoldSettings holdSettings(double latitude) {
   AttitudeHoldSettings s;
   s.latitude = latitude;
   s.noise.angle_white_noise = 1e-12;
+  s.noise.angle_random_walk = s.noise.rate_random_walk = 0.0;
+  s.noise.residual_bias = s.noise.residual_drift_harmonics = 0.0;
+  s.scale_factor_sigma = 0.0;
   return s;
 }
 
@@ -113,12 +118,79 @@ TEST(AttitudeHoldTest, AGapOrACommandedWaveLosesTheAttitude) {
   EXPECT_FALSE(gapped.add(x));
   AttitudeHold skipped(holdSettings(0.9), start);
   x.flags = 0;
-  x.stamp = toNanoseconds(1.050);  // samples missing in between
+  x.stamp = toNanoseconds(1.200);  // samples missing in between, longer than max_bridge
   EXPECT_FALSE(skipped.add(x));
   EXPECT_NE(skipped.lostReason().find("missing"), std::string::npos);
+  // A stream that jumps ahead for good (five samples in a row 100 s on) loses it too.
+  AttitudeHold jumped(holdSettings(0.9), start);
+  for (int k = 0; k < 5; ++k) {
+    x.stamp = toNanoseconds(101.0 + 0.005 * k);
+    jumped.add(x);
+  }
+  EXPECT_FALSE(jumped.holding());
+  EXPECT_NE(jumped.lostReason().find("jumped ahead"), std::string::npos);
+  // Settings: a scale-factor sigma not given is refused, naming the key.
+  AttitudeHoldSettings unset = holdSettings(0.9);
+  unset.scale_factor_sigma = NAN;
+  EXPECT_EQ(refusedKey([&] { unset.validate(); }), "hold/scale_factor_sigma");
+  AttitudeHoldSettings no_noise = holdSettings(0.9);
+  no_noise.noise.residual_bias = NAN;
+  EXPECT_EQ(refusedKey([&] { no_noise.validate(); }), "noise/residual_bias");
   // A refused alignment or one gyro's gives no start.
   AlignmentResult refused;
   EXPECT_THROW(holdStartFrom(refused), std::invalid_argument);
+}
+
+TEST(AttitudeHoldTest, OneLostGlitchedJitteredOrMistimedSampleCostsThatSampleOnly) {
+  // At rest for 600 s: one sample lost, one stamped 1000 s ahead, one with dt = 1e6 s, every stamp
+  // jittered by +-0.1 ms (hardware stamps): the hold goes on, the attitude within the bridges' noise.
+  MountScenario s;
+  s.white_noise = 1e-13;
+  s.accelerometer = false;
+  s.mount = EulerAngles{0.01, 0.02, -1.0};
+  s.duration = 600.0;
+  AttitudeHold hold(holdSettings(s.latitude), exactStart(s));
+  GaussianNoise jitter(5);
+  long k = 0;
+  testing::MountSinks sinks;
+  sinks.triad = [&](const TriadBodySample& sample) {
+    ++k;
+    TriadBodySample x = sample;
+    x.stamp += static_cast<Nanoseconds>(1e5 * (2.0 * jitter.uniform() - 1.0));  // +-0.1 ms
+    if (k == 20000) return;                                                     // lost
+    if (k == 40000) x.stamp += toNanoseconds(1000.0);                           // glitched
+    if (k == 60000) x.dt = 1e6;                                                 // mis-timed
+    ASSERT_TRUE(hold.add(x)) << k << ": " << hold.lostReason();
+  };
+  testing::runMountScenario(s, sinks);
+  ASSERT_TRUE(hold.holding()) << hold.lostReason();
+  EXPECT_EQ(hold.dropped(), 2u);
+  EXPECT_EQ(hold.bridged(), 3u);
+  const double error = hold.orientation().angularDistance(orientationFromEuler(s.mount));
+  std::printf(
+      "[ measured ] 600 s, one lost, one glitched, one mis-timed sample, stamps jittered 0.1 ms: attitude "
+      "off by %.3e rad\n",
+      error);
+  // Each bridge assumes the previous rate for 5 ms (the body at rest: exact but for the jitter's share).
+  EXPECT_LT(error, 1e-8);
+}
+
+TEST(AttitudeHoldTest, ATurningBodysHeadingSigmaGrowsWithItsScaleFactorError) {
+  // 300 s at 0.05 rad/s about the vertical: 15 rad turned, a 1 ppm scale error is 15 urad of heading.
+  MountScenario s;
+  s.white_noise = 1e-13;
+  s.accelerometer = false;
+  s.indexed = true;
+  s.continuous = true;
+  s.duration = 300.0;
+  AttitudeHoldSettings settings = holdSettings(s.latitude);
+  settings.scale_factor_sigma = 1e-6;
+  AttitudeHold hold(settings, exactStart(s));
+  runHold(s, &hold);
+  ASSERT_TRUE(hold.holding());
+  const double sigma_yaw = std::sqrt(hold.covarianceRpy()(2, 2));
+  std::printf("[ measured ] 15 rad turned, scale sigma 1 ppm: heading sigma %.3e rad\n", sigma_yaw);
+  EXPECT_NEAR(sigma_yaw / 15e-6, 1.0, 0.01);
 }
 
 }  // namespace

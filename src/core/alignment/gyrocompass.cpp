@@ -45,9 +45,28 @@ void Gyrocompass::BlockMotion::add(double dt, const double* increment, double bl
   block_sum = {{0.0, 0.0, 0.0}};
 }
 
+StampRule Gyrocompass::gyrocompassStampRule() {
+  StampRule rule;
+  rule.backward_reset = 0.5;
+  rule.forward_jump = 1.0;
+  rule.persist = 5;
+  return rule;
+}
+
+void Gyrocompass::Stream::clear() {
+  stamp.clear();
+  dt.clear();
+  increment.clear();
+  broken.clear();
+  last = 0;
+  pending_break = false;
+  full = false;
+}
+
 Gyrocompass::Gyrocompass(const AlignmentSettings& settings, const TriadParameters& triad)
     : settings_(settings), triad_(triad) {
-  settings_.validate();
+  resolveNoise();
+  settings_.requireComplete();
   if (!triad_.axis_to_body.allFinite() || !triad_.bias.allFinite() ||
       std::abs(triad_.axis_to_body.determinant()) < 1e-6) {
     throw std::invalid_argument("gyrocompass: the triad's matrix and bias must be finite, the matrix invertible");
@@ -58,7 +77,6 @@ Gyrocompass::Gyrocompass(const AlignmentSettings& settings, const TriadParameter
   } else {
     streams_[0].channels = settings_.single_gyro ? 1 : 3;
   }
-  live_motion_.channels = streams_[0].channels;
   if (std::abs(settings_.latitude) > settings_.max_latitude) {
     refuse(
         "latitude",
@@ -66,6 +84,15 @@ Gyrocompass::Gyrocompass(const AlignmentSettings& settings, const TriadParameter
             "latitude %.3f deg is beyond max_latitude %.3f deg: the horizontal Earth rate Omega cos(lat) = "
             "%.3g rad/s is too small for a heading",
             settings_.latitude * kDegrees, settings_.max_latitude * kDegrees, horizontalEarthRate(settings_.latitude)));
+  }
+}
+
+void Gyrocompass::resolveNoise() {
+  // A residual bias not given: a calibrated triad file's (its largest bias_std; all 0 is no calibration).
+  GyroNoiseModel& n = settings_.noise;
+  if (std::isnan(n.residual_bias) && triad_.bias_std.allFinite() && triad_.bias_std.maxCoeff() > 0.0) {
+    n.residual_bias = triad_.bias_std.maxCoeff();
+    settings_.noise_sources.residual_bias = "triad_file bias_std (largest axis)";
   }
 }
 
@@ -77,20 +104,51 @@ void Gyrocompass::refuse(const std::string& gate, const std::string& reason) {
 
 void Gyrocompass::abort(const std::string& reason) { refuse("aborted", reason); }
 
+void Gyrocompass::startWindow(Nanoseconds stamp, double dt) {
+  start_ = stamp - toNanoseconds(dt);
+  end_ = start_ + toNanoseconds(settings_.duration);
+  started_ = true;
+}
+
+void Gyrocompass::restartWindow() {
+  for (Stream& s : streams_) {
+    s.clear();
+    s.timeline.clear();
+  }
+  indexer_.clear();
+  accelerometer_.clear();
+  for (auto& track : precession_) track.clear();
+  started_ = false;
+  ++restarts_;
+}
+
+bool Gyrocompass::timed(Stream* s, Nanoseconds stamp, double dt) {
+  // A sample that claims more time than its stamps left it (dt beyond 1.5 times the spacing) would
+  // integrate a rotation over time that was not its own: a glitch of the record, never integrated.
+  if (s->last > 0 && stamp > s->last && dt > 1.5 * toSeconds(stamp - s->last)) return false;
+  const StampVerdict v = s->timeline.check(stamp);
+  if (v == StampVerdict::kNewTimeline) {
+    restartWindow();  // the stream went back for good: a new window on its new timeline
+    s->timeline.check(stamp);
+    return true;
+  }
+  if (v == StampVerdict::kResumedAhead) s->pending_break = true;
+  return stampUsable(v);
+}
+
 bool Gyrocompass::admit(Stream* s, Nanoseconds stamp, double dt, const double* increment, std::size_t channels,
                         bool gap, bool precessing) {
   if (!refused_gate_.empty() || s->full) return false;
-  bool finite = stamp > 0 && std::isfinite(dt) && dt >= 1e-9;
+  bool finite = stamp > 0 && std::isfinite(dt) && dt >= 1e-9 && dt <= 10.0;
   for (std::size_t c = 0; c < channels && !gap; ++c) finite = finite && std::isfinite(increment[c]);
-  if (!finite || stamp <= s->last) {
+  if (!finite || !timed(s, stamp, dt)) {
     ++dropped_;
+    s->pending_break = true;
     return false;
   }
   if (!started_) {
     if (gap) return false;  // nothing to start from
-    start_ = stamp - toNanoseconds(dt);
-    end_ = start_ + toNanoseconds(settings_.duration);
-    started_ = true;
+    startWindow(stamp, dt);
   }
   if (stamp > end_) {
     s->full = true;
@@ -131,21 +189,9 @@ void Gyrocompass::addTriad(const TriadBodySample& sample) {
         "gyrocompass: triad samples are not this mode's input (sweep: addSweepAxis; one "
         "gyro: addAxis)");
   }
-  Stream& s = streams_[0];
   const double increment[3] = {sample.delta_angle.x(), sample.delta_angle.y(), sample.delta_angle.z()};
-  if (!admit(&s, sample.stamp, sample.dt, increment, 3, !sample.integrated(),
-             (sample.flags & kTriadFlagPrecessing) != 0)) {
-    return;
-  }
-  if (settings_.mode != AlignmentMode::kStatic) return;
-  // The static mode judges stillness as the samples come, as the bias capture does.
-  if (s.broken.back()) live_motion_.restart();
-  live_motion_.add(sample.dt, increment, settings_.motion.block);
-  if (live_motion_.worst > settings_.motion.max_motion) {
-    refuse("motion", formatAlignmentMessage(
-                         "the base moved during the window: block mean rates spread over %.3g rad/s (limit %.3g)",
-                         2.0 * live_motion_.worst, 2.0 * settings_.motion.max_motion));
-  }
+  admit(&streams_[0], sample.stamp, sample.dt, increment, 3, !sample.integrated(),
+        (sample.flags & kTriadFlagPrecessing) != 0);
 }
 
 void Gyrocompass::addAxis(const AxisOutput& output) {
@@ -161,33 +207,50 @@ void Gyrocompass::addSweepAxis(std::size_t axis, const AxisOutput& output) {
         false);
 }
 
+template <typename Record>
+bool Gyrocompass::takeRecord(StampTimeline* timeline, std::vector<Record>* records, Nanoseconds stamp) {
+  const StampVerdict v = timeline->check(stamp);
+  if (v == StampVerdict::kNewTimeline) records->clear();
+  if (!stampUsable(v)) return false;
+  // Records older than the window are nobody's: memory stays flat however long the stream ran before
+  // it (before the window starts, nothing is known to be old).
+  const Nanoseconds oldest = start_ - toNanoseconds(1.0);
+  if (started_ && records->size() >= 4096 && records->front().stamp < oldest) {
+    const auto keep = std::lower_bound(records->begin(), records->end(), oldest,
+                                       [](const Record& r, Nanoseconds t) { return r.stamp < t; });
+    records->erase(records->begin(), keep);
+  }
+  return true;
+}
+
+bool Gyrocompass::beforeWindow(Nanoseconds stamp) const { return started_ && stamp < start_ - toNanoseconds(1.0); }
+
 void Gyrocompass::addPrecession(std::size_t axis, const PrecessionStateRecord& record) {
   if (axis >= 3) throw std::out_of_range("gyrocompass: axis index must be 0, 1 or 2");
-  std::vector<PrecessionStateRecord>& track = precession_[axis];
   if (record.stamp <= 0 || !std::isfinite(record.rate) || !std::isfinite(record.angle) ||
-      (!track.empty() && record.stamp <= track.back().stamp)) {
+      !takeRecord(&precession_time_[axis], &precession_[axis], record.stamp)) {
     ++dropped_;
     return;
   }
-  track.push_back(record);
+  if (!beforeWindow(record.stamp)) precession_[axis].push_back(record);
 }
 
 void Gyrocompass::addIndexer(const IndexerRecord& record) {
   if (record.stamp <= 0 || !std::isfinite(record.angle) || std::isinf(record.rate) ||
-      (!indexer_.empty() && record.stamp <= indexer_.back().stamp)) {
+      !takeRecord(&indexer_time_, &indexer_, record.stamp)) {
     ++dropped_;
     return;
   }
-  indexer_.push_back(record);
+  if (!beforeWindow(record.stamp)) indexer_.push_back(record);
 }
 
 void Gyrocompass::addAccelerometer(const AccelerometerRecord& record) {
   if (record.stamp <= 0 || !record.specific_force.allFinite() ||
-      (!accelerometer_.empty() && record.stamp <= accelerometer_.back().stamp)) {
+      !takeRecord(&accelerometer_time_, &accelerometer_, record.stamp)) {
     ++dropped_;
     return;
   }
-  accelerometer_.push_back(record);
+  if (!beforeWindow(record.stamp)) accelerometer_.push_back(record);
 }
 
 bool Gyrocompass::complete() const {
@@ -212,6 +275,7 @@ AlignmentProgress Gyrocompass::progress() const {
   p.samples = streams_[0].stamp.size();
   p.gaps = gaps_;
   p.dropped = dropped_;
+  p.restarts = restarts_;
   p.indexer = indexer_.size();
   p.accelerometer = accelerometer_.size();
   for (const auto& track : precession_) p.precession += track.size();

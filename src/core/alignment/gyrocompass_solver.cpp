@@ -16,6 +16,12 @@ constexpr double kDegrees = 180.0 / kPi;
 
 Eigen::Matrix3d rotZ(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
 
+Eigen::Matrix3d skewOf(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
 // Linear interpolation of a value between records at stamps (seconds from the window's start); false
 // when `t` is not between two records at most `max_gap` apart.
 bool interpolate(const std::vector<double>& times, const std::vector<double>& values, double t, double max_gap,
@@ -62,10 +68,18 @@ bool GyrocompassSolver::buildStatic() {
   std::array<double, 3> y{{0.0, 0.0, 0.0}};
   int seg = -1;
   double last_time = -INFINITY;
+  bool broken = true;
   for (std::size_t k = 0; k < st.stamp.size(); ++k) {
     const double t_end = seconds(st.stamp[k]), t_start = std::max(t_end - st.dt[k], last_time);
-    const double* inc = &st.increment[3 * k];
-    if (k == 0 || st.broken[k]) {
+    if (excludedSample(t_start, t_end)) {  // around a step of the base: left out, the rest after it new
+      broken = true;
+      continue;
+    }
+    // In the first rest's frame: the base's steps before this sample turned back.
+    const Eigen::Vector3d turned = carriedRotation(t_end) * Eigen::Map<const Eigen::Vector3d>(&st.increment[3 * k]);
+    const double* inc = turned.data();
+    if (broken || st.broken[k]) {
+      broken = false;
       seg = static_cast<int>(segments_.size());
       segments_.push_back(Segment());
       segments_.back().start = t_start;
@@ -81,9 +95,9 @@ bool GyrocompassSolver::buildStatic() {
     segments_.back().end = t_end;
     motion.add(st.dt[k], inc, s_.motion.block);
     used_seconds_ += st.dt[k];
+    ++samples_;
     last_time = t_end;
   }
-  samples_ = st.stamp.size();
   worst_motion_ = motion.worst;
   return true;
 }
@@ -174,7 +188,7 @@ bool GyrocompassSolver::buildIndexed() {
     const double t_b = seconds(st.stamp[k]), t_a = std::max(t_b - st.dt[k], last_time);
     double psi_a, psi_b;
     int rest = -1;
-    if (!indexerSpan(t_a, t_b, &rest, &psi_a, &psi_b)) {
+    if (excludedSample(t_a, t_b) || !indexerSpan(t_a, t_b, &rest, &psi_a, &psi_b)) {
       continues = false;
       continue;
     }
@@ -409,12 +423,14 @@ bool GyrocompassSolver::level(LevelMeasurement* out) {
   const bool indexed = s_.mode == AlignmentMode::kIndexed;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero(), previous = Eigen::Vector3d::Zero();
   Eigen::Matrix3d differences = Eigen::Matrix3d::Zero(), transfer = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d mounting = Eigen::Matrix3d::Zero();  // d f_frame / d (the mounting's error, accelerometer axes)
   std::size_t n = 0, pairs = 0;
   int previous_group = -2;
   for (const AccelerometerRecord& r : g_.accelerometer_) {
     if (r.stamp < g_.start_ || r.stamp > g_.end_) continue;
     const double t = seconds(r.stamp);
-    Eigen::Matrix3d to_frame = mount;
+    if (excludedSample(t, t)) continue;
+    Eigen::Matrix3d to_frame = indexed ? mount : Eigen::Matrix3d(carriedRotation(t) * mount);
     int group = 0;
     if (indexed) {
       double psi = NAN;
@@ -442,6 +458,7 @@ bool GyrocompassSolver::level(LevelMeasurement* out) {
     previous_group = group;
     sum += f;
     transfer += to_frame;
+    mounting -= to_frame * skewOf(r.specific_force);
     ++n;
   }
   if (n < 10 || pairs < 2) {
@@ -460,9 +477,11 @@ bool GyrocompassSolver::level(LevelMeasurement* out) {
   // White noise from successive differences (blind to a slow change), the mean's; the bias through
   // the rotations it was seen in (an indexer's positions average its horizontal part away).
   const Eigen::Matrix3d noise = differences / (2.0 * static_cast<double>(pairs));
-  const Eigen::Matrix3d covariance = noise / static_cast<double>(n) + l.accelerometer_bias_sigma *
-                                                                          l.accelerometer_bias_sigma * transfer *
-                                                                          transfer.transpose();
+  mounting /= static_cast<double>(n);
+  const double bias2 = l.accelerometer_bias_sigma * l.accelerometer_bias_sigma;
+  const double mount2 = l.accelerometer_mounting_sigma * l.accelerometer_mounting_sigma;
+  const Eigen::Matrix3d covariance = noise / static_cast<double>(n) + bias2 * transfer * transfer.transpose() +
+                                     mount2 * mounting * mounting.transpose();
   const EulerAngles a = levelFromSpecificForce(mean);
   const Eigen::Matrix<double, 2, 3> j = levelJacobian(mean);
   out->roll = a.roll;
@@ -580,9 +599,11 @@ AlignmentResult GyrocompassSolver::solve() {
   r.frame = s_.mode == AlignmentMode::kIndexed ? "indexer" : "body";
   r.start = g_.start_;
   r.end = g_.end_;
+  for (std::size_t i = 0; i < g_.stream_count_; ++i) r.last_sample = std::max(r.last_sample, g_.streams_[i].last);
   r.budget.latitude = s_.latitude;
   r.budget.max_latitude = s_.max_latitude;
   r.budget.horizontal_earth_rate = horizontalEarthRate(s_.latitude);
+  r.noise_sources = s_.noise_sources.summary();
   if (!g_.refused_gate_.empty()) {
     refuse(g_.refused_gate_, g_.refused_reason_);
     return r;
@@ -592,64 +613,13 @@ AlignmentResult GyrocompassSolver::solve() {
     return r;
   }
   triad_matrix_ = g_.triad_.axis_to_body;
-  bool built = false;
-  switch (s_.mode) {
-    case AlignmentMode::kStatic:
-      built = buildStatic();
-      break;
-    case AlignmentMode::kIndexed:
-      built = buildIndexed();
-      break;
-    case AlignmentMode::kSweep:
-      built = buildSweep();
-      break;
-  }
-  if (!built) return r;
-  r.samples = samples_;
-  r.seconds = used_seconds_;
-  r.worst_motion = worst_motion_;
-  if (samples_ < 10) {
-    refuse("input", "too few gyro samples in the window");
-    return r;
-  }
-  if (worst_motion_ > s_.motion.max_motion) {
-    refuse("motion", formatAlignmentMessage(
-                         "the base moved during the window: block mean rates spread over %.3g rad/s (limit %.3g)",
-                         2.0 * worst_motion_, 2.0 * s_.motion.max_motion));
-    return r;
-  }
-  for (AngleSeries& series : series_) {
-    series.white_noise = s_.noise.angle_white_noise;
-    series.angle_random_walk = s_.noise.angle_random_walk;
-    series.rate_random_walk = s_.noise.rate_random_walk;
-  }
-  LevelMeasurement level_measured;
-  if (!level(&level_measured)) return r;
-  IntegratedAngleFit fit(parameters_, std::move(series_));
-  const AngleFitResult& f = fit.solve(s_.max_condition);
-  if (!f.ok) {
-    refuse("design", f.problem);
-    return r;
-  }
-  r.white_noise = f.white_noise;
-  r.scatter = *std::max_element(f.scatter.begin(), f.scatter.end());
-  summariseSegments(f);
-  EarthRateMeasurement m;
-  measure(fit, level_measured, &m);
-  const HeadingSolution h = solveHeading(m, level_measured, s_.latitude);
-  r.attitude = h.attitude;
-  r.orientation = h.orientation;
-  r.covariance_rpy = h.covariance_rpy;
-  r.covariance_enu = h.covariance_enu;
-  r.heading = trueHeadingDegrees(h.attitude.yaw);
-  r.heading_sigma = h.budget.total * kDegrees;
-  r.levelled_rate = h.levelled_rate;
-  r.horizontal_rate = h.horizontal_rate;
-  r.horizontal_rate_std = h.horizontal_rate_std;
-  r.budget = h.budget;
-  r.budget.max_latitude = s_.max_latitude;
-  describeHoldStart(h);
-  return applyGates(h);
+  HeadingSolution still;
+  if (!solveStill(&still)) return r;  // refused by what no estimator changes: input, design, level
+  const InertialFrameResult tracked = canTrack() ? track() : InertialFrameResult();
+  if (!chooseAndAnswer(still, tracked) || !gateAttitude()) return r;
+  r.accepted = true;
+  r.reason = r.summary();
+  return r;
 }
 
 void GyrocompassSolver::describeHoldStart(const HeadingSolution& h) {
@@ -671,34 +641,35 @@ void GyrocompassSolver::describeHoldStart(const HeadingSolution& h) {
   }
 }
 
-AlignmentResult GyrocompassSolver::applyGates(const HeadingSolution& h) {
+bool GyrocompassSolver::applyStillGates(const HeadingSolution& h) {
   AlignmentResult& r = result_;
-  if (r.scatter > s_.motion.max_scatter) {
-    refuse("stillness",
-           formatAlignmentMessage("the residuals scatter %.2f times what the noise model predicts (motion/max_scatter "
-                                  "%.2f): a base that sways, a bias that jumps, or angle noise beyond the settings'",
-                                  r.scatter, s_.motion.max_scatter));
-    return r;
-  }
   const double hh = r.budget.horizontal_earth_rate;
   const double mismatch = std::abs(h.horizontal_rate - hh);
   if (mismatch > std::max(s_.max_earth_rate_error * hh, 4.0 * h.horizontal_rate_std)) {
-    refuse("earth_rate",
-           formatAlignmentMessage("the horizontal rate measured, %.4g rad/s, is not the Earth's %.4g rad/s at "
-                                  "latitude %.3f deg (max_earth_rate_error %.2f): a bias far beyond the calibration's, "
-                                  "a wrong latitude or a turning base",
-                                  h.horizontal_rate, hh, s_.latitude * kDegrees, s_.max_earth_rate_error));
-    return r;
+    return refuse("earth_rate",
+                  formatAlignmentMessage("the horizontal rate measured, %.4g rad/s, is not the Earth's %.4g rad/s at "
+                                         "latitude %.3f deg (max_earth_rate_error %.2f): a bias far beyond the "
+                                         "calibration's, a wrong latitude or a turning base",
+                                         h.horizontal_rate, hh, s_.latitude * kDegrees, s_.max_earth_rate_error));
   }
-  if (std::abs(h.attitude.pitch) > kMaxPitch) {
-    refuse("attitude", formatAlignmentMessage(
-                           "pitch %.1f deg: the frame's x axis is within %.0f deg of vertical and has no heading",
-                           h.attitude.pitch * kDegrees, 90.0 - kMaxPitch * kDegrees));
-    return r;
-  }
-  r.accepted = true;
-  r.reason = r.summary();
-  return r;
+  return checkEarth(still_rate_, still_level_);
+}
+
+bool GyrocompassSolver::checkEarth(const EarthRateMeasurement& m, const LevelMeasurement& level) {
+  // The up direction in the measured frame, from its level; the indexed mode imposes the vertical part.
+  const Eigen::Vector3d up = levelRotation(level.roll, level.pitch).transpose() * Eigen::Vector3d::UnitZ();
+  result_.earth_checks =
+      checkAgainstTheEarth(m.rate, m.covariance(), up, upCovarianceFromLevel(level.roll, level.pitch, level.covariance),
+                           s_.latitude, s_.max_earth_sigmas, s_.mode != AlignmentMode::kIndexed);
+  const std::optional<EarthCheck> failed = firstFailed(result_.earth_checks);
+  return failed ? refuse("earth_check", failed->describe()) : true;
+}
+
+bool GyrocompassSolver::gateAttitude() {
+  if (std::abs(result_.attitude.pitch) <= kMaxPitch) return true;
+  return refuse("attitude", formatAlignmentMessage(
+                                "pitch %.1f deg: the frame's x axis is within %.0f deg of vertical and has no heading",
+                                result_.attitude.pitch * kDegrees, 90.0 - kMaxPitch * kDegrees));
 }
 
 }  // namespace core

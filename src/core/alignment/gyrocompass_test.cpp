@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "core/testing/angle_level_mount.h"
+#include "core/testing/refusal.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -27,6 +28,7 @@ AlignmentSettings settingsFor(const MountScenario& s, AlignmentMode mode) {
   a.indexer.continuous = s.continuous;
   a.indexer.body_to_platform = s.body_to_platform;
   a.indexer.gyro_axis = s.gyro_axis;
+  testing::setUnsetTermsToNone(&a);
   return a;
 }
 
@@ -158,47 +160,43 @@ TEST(GyrocompassTest, UnusableInputsAreRefusedNamingTheGate) {
   }
 }
 
-TEST(GyrocompassTest, AMovingBaseIsRefused) {
+TEST(GyrocompassTest, AMovingBaseIsTrackedWithAnAccelerometerAndRefusedWithout) {
   MountScenario s;
-  s.duration = 20.0;
-  // A base that rocks at 2e-4 rad/s, 0.2 Hz: the static mode stops as it happens.
+  s.duration = 60.0;
+  // A base that rocks: 1.6e-4 rad about East at 0.2 Hz. With a declared level the gyros alone cannot
+  // tell it from the Earth's rate: refused, saying what would follow it.
+  MountScenario rocking = s;
+  rocking.base_motion.sways.push_back({1.6e-4, 5.0, Eigen::Vector3d::UnitX(), 0.0});
   {
-    Gyrocompass g(settingsFor(s, AlignmentMode::kStatic));
-    testing::MountSinks sinks = testing::gyrocompassSinks(&g);
-    double t = 0.0;
-    const auto plain = sinks.triad;
-    sinks.triad = [&](const TriadBodySample& x) {
-      TriadBodySample rocked = x;
-      rocked.delta_angle.x() += 2e-4 * std::cos(2.0 * kPi * 0.2 * t) * x.dt;
-      t += x.dt;
-      plain(rocked);
-    };
-    testing::runMountScenario(s, sinks);
-    EXPECT_TRUE(g.progress().refused);
-    const AlignmentResult r = g.finish();
-    EXPECT_EQ(r.gate, "motion");
-    EXPECT_LT(g.progress().seconds, 10.0);
-    std::printf("[ measured ] a rocking base, after %.1f s: %s\n", g.progress().seconds, r.summary().c_str());
+    AlignmentSettings a = settingsFor(rocking, AlignmentMode::kStatic);
+    a.level.source = LevelSource::kDeclared;
+    a.level.roll = rocking.mount.roll;
+    a.level.pitch = rocking.mount.pitch;
+    const AlignmentResult r = testing::alignScenario(a, rocking);
+    EXPECT_FALSE(r.accepted);
+    EXPECT_TRUE(r.gate == "stillness" || r.gate == "motion") << r.summary();
+    EXPECT_NE(r.reason.find("accelerometer"), std::string::npos) << r.reason;
+    std::printf("[ measured ] a rocking base, level declared: %s\n", r.summary().c_str());
   }
-  // A slow sway of 5e-5 rad (0.05 Hz) is below the block gate but not below the residuals' scatter
-  // (2.7 times the prediction, against 1.00 to 1.03 for still windows); unrefused it would turn the
-  // heading by 2 deg.
+  // With the accelerometer the gyros track it and gravity is followed in the inertial frame.
   {
-    Gyrocompass g(settingsFor(s, AlignmentMode::kStatic));
-    testing::MountSinks sinks = testing::gyrocompassSinks(&g);
-    double t = 0.0;
-    const auto plain = sinks.triad;
-    sinks.triad = [&](const TriadBodySample& x) {
-      TriadBodySample swayed = x;
-      const double w = 2.0 * kPi * 0.05;
-      swayed.delta_angle.y() += 5e-5 * (std::sin(w * (t + x.dt)) - std::sin(w * t));
-      t += x.dt;
-      plain(swayed);
-    };
-    testing::runMountScenario(s, sinks);
-    const AlignmentResult r = g.finish();
-    EXPECT_EQ(r.gate, "stillness") << r.summary();
-    std::printf("[ measured ] a swaying base: %s\n", r.summary().c_str());
+    const AlignmentResult r = testing::alignScenario(settingsFor(rocking, AlignmentMode::kStatic), rocking);
+    ASSERT_TRUE(r.accepted) << r.summary();
+    EXPECT_EQ(r.estimator, "tracking");
+    EXPECT_NE(r.estimator_reason.find("not still"), std::string::npos) << r.estimator_reason;
+    EXPECT_LT(std::abs(testing::yawError(r, rocking)), 4.0 * r.budget.total) << r.summary();
+    std::printf("[ measured ] a rocking base, accelerometer: error %+.3f mrad, %s\n",
+                1e3 * testing::yawError(r, rocking), r.summary().c_str());
+  }
+  // A slow sway of 5e-5 rad (0.05 Hz), the level declared: the block means show it.
+  {
+    MountScenario swaying = s;
+    swaying.base_motion.sways.push_back({5e-5, 20.0, Eigen::Vector3d::UnitY(), 0.0});
+    AlignmentSettings a = settingsFor(swaying, AlignmentMode::kStatic);
+    a.level.source = LevelSource::kDeclared;
+    const AlignmentResult r = testing::alignScenario(a, swaying);
+    EXPECT_FALSE(r.accepted) << r.summary();
+    EXPECT_TRUE(r.gate == "stillness" || r.gate == "motion") << r.summary();
   }
   // A wave turned on command outside the sweep mode.
   {
@@ -210,6 +208,129 @@ TEST(GyrocompassTest, AMovingBaseIsRefused) {
     g.addTriad(x);
     EXPECT_EQ(g.finish().gate, "motion");
   }
+}
+
+// Feeds a scenario into a gyrocompass with `change` applied to the k-th triad sample (1-based) and
+// `accel_change` to the k-th accelerometer record.
+AlignmentResult alignWith(const MountScenario& s, const AlignmentSettings& a,
+                          const std::function<void(long, TriadBodySample*)>& change,
+                          const std::function<void(long, AccelerometerRecord*)>& accel_change, AlignmentProgress* p) {
+  Gyrocompass g(a);
+  testing::MountSinks sinks = testing::gyrocompassSinks(&g);
+  long k = 0, j = 0;
+  const auto plain = sinks.triad;
+  sinks.triad = [&](const TriadBodySample& x) {
+    TriadBodySample y = x;
+    change(++k, &y);
+    plain(y);
+  };
+  const auto accel = sinks.accelerometer;
+  sinks.accelerometer = [&](const AccelerometerRecord& r) {
+    AccelerometerRecord y = r;
+    accel_change(++j, &y);
+    accel(y);
+  };
+  testing::runMountScenario(s, sinks);
+  *p = g.progress();
+  return g.finish();
+}
+
+TEST(GyrocompassTest, OneBadStampCostsItsSampleNeverTheWindow) {
+  MountScenario s;
+  s.duration = 40.0;
+  AlignmentSettings a = settingsFor(s, AlignmentMode::kStatic);
+  a.duration = 30.0;
+  const auto none = [](long, AccelerometerRecord*) {};
+  const auto keep = [](long, TriadBodySample*) {};
+  AlignmentProgress clean_p;
+  const AlignmentResult clean = alignWith(s, a, keep, none, &clean_p);
+  ASSERT_TRUE(clean.accepted) << clean.summary();
+  struct Case {
+    const char* what;
+    std::function<void(long, TriadBodySample*)> change;
+    std::function<void(long, AccelerometerRecord*)> accel;
+    std::uint64_t dropped, restarts;  // at most: a timeline that goes back costs jump_persist - 1 records
+  };
+  const Case cases[] = {
+      {"the first sample stamped 1e6 s ahead",
+       [](long k, TriadBodySample* x) {
+         if (k == 1) x->stamp += toNanoseconds(1e6);
+       },
+       none, 4, 1},
+      {"one sample 1000 s ahead",
+       [](long k, TriadBodySample* x) {
+         if (k == 2000) x->stamp += toNanoseconds(1000.0);
+       },
+       none, 1, 0},
+      {"one sample with dt = 1e6 s",
+       [](long k, TriadBodySample* x) {
+         if (k == 2000) x->dt = 1e6;
+       },
+       none, 1, 0},
+      {"stamps jittered by 0.1 ms", [](long k, TriadBodySample* x) { x->stamp += (k % 3 - 1) * 100000; }, none, 0, 0},
+      {"the first accelerometer record 1000 s ahead", keep,
+       [](long j, AccelerometerRecord* r) {
+         if (j == 1) r->stamp += toNanoseconds(1000.0);
+       },
+       4, 0},
+  };
+  for (const Case& c : cases) {
+    AlignmentProgress p;
+    const AlignmentResult r = alignWith(s, a, c.change, c.accel, &p);
+    std::printf("[ measured ] %s: %llu dropped, %llu restarts; %s (%s; lf %.3f, steps %zu, clean lf %.3f)\n", c.what,
+                static_cast<unsigned long long>(p.dropped), static_cast<unsigned long long>(p.restarts),
+                r.summary().c_str(), r.estimator_reason.c_str(), r.low_frequency_scatter, r.base_steps.size(),
+                clean.low_frequency_scatter);
+    EXPECT_TRUE(r.accepted) << c.what << ": " << r.summary();
+    EXPECT_NEAR(r.seconds, clean.seconds, 0.1) << c.what;  // the window full, not cut
+    EXPECT_EQ(p.restarts, c.restarts) << c.what;
+    EXPECT_EQ(p.dropped, c.dropped) << c.what;
+    EXPECT_EQ(r.estimator, clean.estimator) << c.what;
+    // The same data less a sample: the two estimates differ by what the smaller loses (nested
+    // estimators: the variance of their difference is the difference of their variances).
+    // A restarted window is the same one shifted by a few samples: a tenth of its noise at most.
+    const double lost =
+        std::sqrt(std::max(r.budget.noise * r.budget.noise - clean.budget.noise * clean.budget.noise, 0.0));
+    EXPECT_LT(std::abs(wrapToPi(r.attitude.yaw - clean.attitude.yaw)), 3.0 * lost + 0.1 * clean.budget.noise) << c.what;
+  }
+  // Stamps that step back 100 s for good mid-window: the window restarts on the new timeline and fills.
+  MountScenario longer = s;
+  longer.duration = 80.0;
+  AlignmentProgress p;
+  const AlignmentResult r = alignWith(
+      longer, a,
+      [](long k, TriadBodySample* x) {
+        if (k > 1000) x->stamp -= toNanoseconds(100.0);
+      },
+      [](long j, AccelerometerRecord* r) {
+        if (j > 1000) r->stamp -= toNanoseconds(100.0);
+      },
+      &p);
+  EXPECT_TRUE(r.accepted) << r.summary();
+  EXPECT_EQ(p.restarts, 1u);
+  EXPECT_NEAR(r.seconds, a.duration, 0.1);
+}
+
+TEST(GyrocompassTest, WithoutANoiseModelItDoesNotStart) {
+  AlignmentSettings a;
+  a.latitude = 0.9;
+  EXPECT_EQ(refusedKey([&] { Gyrocompass g(a); }), "noise/angle_random_walk");
+  a.noise.angle_random_walk = a.noise.rate_random_walk = a.noise.residual_drift_harmonics = 0.0;
+  EXPECT_EQ(refusedKey([&] { Gyrocompass g(a); }), "noise/residual_bias");
+  // A calibrated triad file gives the residual bias (its largest bias_std); an uncalibrated one (0) does not.
+  TriadParameters triad;
+  EXPECT_EQ(refusedKey([&] { Gyrocompass g(a, triad); }), "noise/residual_bias");
+  triad.bias_std = Eigen::Vector3d(0.9e-8, 1.3e-8, 1.1e-8);
+  a.level.accelerometer_bias_sigma = a.level.accelerometer_mounting_sigma = 0.0;
+  Gyrocompass g(a, triad);
+  EXPECT_EQ(g.settings().noise.residual_bias, 1.3e-8);
+  EXPECT_NE(g.settings().noise_sources.residual_bias.find("triad_file"), std::string::npos);
+  // The level's sigmas too.
+  a.noise.residual_bias = 1e-8;
+  a.level.accelerometer_mounting_sigma = NAN;
+  EXPECT_EQ(refusedKey([&] { Gyrocompass h(a); }), "level/accelerometer_mounting_sigma");
+  a.level.source = LevelSource::kDeclared;
+  EXPECT_EQ(refusedKey([&] { Gyrocompass h(a); }), "level/roll_sigma");
 }
 
 TEST(GyrocompassTest, ASweepThatDoesNotTurnBothWaysIsRefused) {

@@ -244,6 +244,22 @@ void IntegratedAngleFit::propagate(std::size_t c) {
   result_.scatter[c] = std::sqrt(squares / predicted);
 }
 
+std::vector<double> IntegratedAngleFit::residuals(std::size_t channel) const {
+  const AngleSeries& s = channels_.at(channel);
+  const std::size_t qc = s.columns.size();
+  std::vector<double> out(s.size(), 0.0);
+  for (const Segment& g : segments_[channel]) {
+    for (std::size_t i = g.begin; i < g.end; ++i) {
+      double model = 0.0;
+      for (std::size_t k = 0; k < qc; ++k) {
+        model += (s.regressors[k][i] - g.mean_regressors[k]) * result_.parameters(s.columns[k]);
+      }
+      out[i] = (s.angle[i] - g.mean_angle) - model;
+    }
+  }
+  return out;
+}
+
 Eigen::VectorXd IntegratedAngleFit::response(std::size_t channel, const std::vector<double>& angle) const {
   const AngleSeries& s = channels_.at(channel);
   const std::size_t qc = s.columns.size();

@@ -45,6 +45,7 @@ AlignmentSettings settingsFor(const MountScenario& s, AlignmentMode mode) {
   a.noise.residual_bias = kBias;
   a.noise.residual_drift_harmonics = kDriftRms;
   a.level.accelerometer_bias_sigma = kAccelerometerBias;
+  testing::setUnsetTermsToNone(&a);
   return a;
 }
 
@@ -393,6 +394,8 @@ TEST(NorthFindingAccuracy, AnHourOfAttitudeHoldStaysWithinItsBound) {
     std::unique_ptr<AttitudeHold> hold;
     AttitudeHoldSettings hs;
     hs.latitude = kLatitude;
+    hs.noise = a.noise;           // the alignment's model: white noise and a bias the hold integrates
+    hs.scale_factor_sigma = 0.0;  // at rest nothing turns
     testing::runMountScenario(x, testing::gyrocompassSinks(&g, [&](const TriadBodySample& sample) {
                                 if (!hold) {
                                   const AlignmentResult r = g.finish();

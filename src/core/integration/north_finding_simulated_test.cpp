@@ -66,6 +66,7 @@ AlignmentSettings settingsFor(const TriadSimulationConfig& c, AlignmentMode mode
   a.level.source = LevelSource::kAccelerometer;
   a.level.accelerometer_to_body = Eigen::Quaterniond(c.accelerometer.accelerometer_to_body);
   a.level.accelerometer_bias_sigma = kAccelerometerBiasSigma;
+  testing::setUnsetTermsToNone(&a);
   return a;
 }
 

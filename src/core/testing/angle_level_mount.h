@@ -20,7 +20,13 @@
 //    each axis's compensated output then carries G_v psi_cmd / K0, and its precession state record
 //    (rate in force, commanded angle at the sample's centre) comes with it;
 //  - one gyro with its sensitive axis in the platform frame (the indexed mode's single gyro);
-//  - an accelerometer on the mount (its mounting rotation, bias and white noise).
+//  - an accelerometer on the mount (its mounting rotation, bias and white noise), and what users get
+//    wrong with one: its scale and misalignment, an axis reversed, gravity (-g up) reported instead
+//    of the specific force, quantised records;
+//  - a base that moves (simulation/base_motion.h: leans, knocks, sways, yaw jitter, vibration): the
+//    mount turned by D(t) in ENU, the body's inertial rate C^T (Omega + w_D) + the platform's turn
+//    integrated over each sample by Simpson's rule (16 panels), the accelerometer reading the
+//    vibration's mean over its sample. Without motion the closed forms above, bit for bit as before.
 //
 // What a table calibration leaves, the defaults of the tests: a residual body bias of 1e-8 rad/s per
 // axis (the triad calibration's body bias standard error, 0.9 to 1.3e-8 rad/s on the documented session,
@@ -39,6 +45,7 @@
 #include "hrg_gyro/core/alignment/gyrocompass.h"
 #include "hrg_gyro/core/alignment/local_level.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
+#include "hrg_gyro/core/simulation/base_motion.h"
 #include "hrg_gyro/core/simulation/gaussian_noise.h"
 
 namespace hrg_gyro {
@@ -94,8 +101,16 @@ struct MountScenario {
   // The accelerometer.
   bool accelerometer = true;
   Eigen::Quaterniond accelerometer_to_body = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d accelerometer_bias = Eigen::Vector3d::Zero();  ///< m/s^2
-  double accelerometer_noise = 2e-3;                             ///< m/s^2 per sample
+  Eigen::Vector3d accelerometer_bias = Eigen::Vector3d::Zero();          ///< m/s^2
+  double accelerometer_noise = 2e-3;                                     ///< m/s^2 per sample
+  Eigen::Vector3d accelerometer_scale = Eigen::Vector3d::Zero();         ///< relative, per axis
+  Eigen::Vector3d accelerometer_misalignment = Eigen::Vector3d::Zero();  ///< rad, rotation vector of its axes
+  Eigen::Vector3d accelerometer_signs = Eigen::Vector3d::Ones();         ///< -1: that axis reversed
+  bool accelerometer_reports_gravity = false;                            ///< -g up instead of the specific force
+  double accelerometer_quantum = 0.0;                                    ///< m/s^2 (0: none)
+
+  // The base under the mount (the indexer's base in the indexed mode).
+  BaseMotionConfig base_motion;
 
   std::uint64_t seed = 1;
 
@@ -198,23 +213,69 @@ inline void emitSweepSample(const MountScenario& s, const MountSinks& sinks, con
   }
 }
 
-/// The accelerometer's record at platform angle `psi`: gravity (`g0`, in the mount frame) seen through
-/// the platform and the body, then its mounting, bias and noise.
+/// The accelerometer's record at platform angle `psi`: the specific force (`g0`: gravity in the mount
+/// frame, the base still; `f_mount`: what the moving base gives, in the mount frame) seen through the
+/// platform and the body, then its mounting, misalignment, scale, axis signs, convention, bias, noise
+/// and quantisation, in that order.
 inline AccelerometerRecord accelerometerSample(const MountScenario& s, Nanoseconds stamp, double psi,
-                                               const Eigen::Vector3d& g0, GaussianNoise* noise) {
+                                               const Eigen::Vector3d& f_mount, GaussianNoise* noise) {
   const Eigen::Matrix3d body_to_mount =
       Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()).toRotationMatrix() * s.body_to_platform;
   AccelerometerRecord r;
   r.stamp = stamp;
-  r.specific_force =
-      s.accelerometer_to_body.toRotationMatrix().transpose() * (body_to_mount.transpose() * g0) + s.accelerometer_bias;
+  Eigen::Vector3d f = s.accelerometer_to_body.toRotationMatrix().transpose() * (body_to_mount.transpose() * f_mount);
+  if (s.accelerometer_misalignment.norm() > 0.0) {
+    f = rotationVectorToQuaternion(s.accelerometer_misalignment).toRotationMatrix().transpose() * f;
+  }
+  f = (Eigen::Vector3d::Ones() + s.accelerometer_scale).cwiseProduct(f).cwiseProduct(s.accelerometer_signs);
+  if (s.accelerometer_reports_gravity) f = -f;
+  r.specific_force = f + s.accelerometer_bias;
   for (int i = 0; i < 3; ++i) r.specific_force(i) += s.accelerometer_noise * noise->next();
+  if (s.accelerometer_quantum > 0.0) {
+    for (int i = 0; i < 3; ++i) {
+      r.specific_force(i) = s.accelerometer_quantum * std::round(r.specific_force(i) / s.accelerometer_quantum);
+    }
+  }
   return r;
+}
+
+/// The mount at time t (s from the session's start) on a moving base: D(t) mount, -> ENU.
+inline Eigen::Matrix3d movedMount(const MountScenario& s, const BaseMotion& base, double t) {
+  return base.rotationAt(t) * orientationFromEuler(s.mount).toRotationMatrix();
+}
+
+/// The inertial rate of the platform frame (the mount's, static) on a moving base, in that frame.
+inline Eigen::Vector3d movingPlatformRate(const MountScenario& s, const BaseMotion& base, double t) {
+  Eigen::Matrix3d d;
+  Eigen::Vector3d w;
+  base.stateAt(t, &d, &w);
+  double logged, psi = 0.0, rate = 0.0;
+  if (s.indexed) indexerAngle(s, t, &logged, &psi, &rate);
+  const Eigen::Matrix3d platform = d * orientationFromEuler(s.mount).toRotationMatrix() *
+                                   Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return platform.transpose() * (earthRateEnu(s.latitude) + w) + Eigen::Vector3d::UnitZ() * rate;
+}
+
+/// Its integral over [a, b]: Simpson's rule on 16 panels.
+inline Eigen::Vector3d movingPlatformIncrement(const MountScenario& s, const BaseMotion& base, double a, double b) {
+  constexpr int kPanels = 16;
+  const double h = (b - a) / kPanels;
+  Eigen::Vector3d sum = movingPlatformRate(s, base, a) + movingPlatformRate(s, base, b);
+  for (int k = 1; k < kPanels; ++k) sum += (k % 2 ? 4.0 : 2.0) * movingPlatformRate(s, base, a + k * h);
+  return sum * h / 3.0;
+}
+
+/// The true attitude (-> ENU) at `stamp` of the frame the alignment reports: the body (static,
+/// sweep) or the indexer's zero frame (indexed), the base's motion included.
+inline Eigen::Matrix3d trueFrameAt(const MountScenario& s, Nanoseconds stamp) {
+  const BaseMotion base(s.base_motion, s.seed);
+  return movedMount(s, base, toSeconds(stamp) - s.start);
 }
 
 /// Runs the session into the sinks, sample by sample in stamp order.
 inline void runMountScenario(const MountScenario& s, const MountSinks& sinks) {
   GaussianNoise noise(s.seed);
+  const BaseMotion base(s.base_motion, s.seed);
   const double h = 1.0 / s.rate_hz;
   const Eigen::Matrix3d mount = orientationFromEuler(s.mount).toRotationMatrix();
   const Eigen::Vector3d w0 = mount.transpose() * earthRateEnu(s.latitude);  // in the mount (platform zero) frame
@@ -239,7 +300,9 @@ inline void runMountScenario(const MountScenario& s, const MountSinks& sinks) {
     const double middle = 0.5 * (psi_a + psi_b), sinc_half = h * sinc(0.5 * (psi_b - psi_a));
     const double ic = sinc_half * std::cos(middle), is = sinc_half * std::sin(middle);
     const Eigen::Vector3d earth_platform(ic * w0.x() + is * w0.y(), -is * w0.x() + ic * w0.y(), h * w0.z());
-    const Eigen::Vector3d platform_increment = earth_platform + Eigen::Vector3d::UnitZ() * (psi_b - psi_a);
+    const Eigen::Vector3d platform_increment =
+        base.enabled() ? movingPlatformIncrement(s, base, t_b - h, t_b)
+                       : Eigen::Vector3d(earth_platform + Eigen::Vector3d::UnitZ() * (psi_b - psi_a));
     const Eigen::Vector3d body_increment = b.transpose() * platform_increment;
     double cmd_rate = 0.0, cmd_angle = 0.0;
     if (s.sweep) commandedPrecession(s, t_b, &cmd_rate, &cmd_angle);
@@ -291,8 +354,30 @@ inline void runMountScenario(const MountScenario& s, const MountSinks& sinks) {
       r.rate = rate_b;
       sinks.indexer(r);
     }
-    if (s.accelerometer && sinks.accelerometer) sinks.accelerometer(accelerometerSample(s, stamp, psi_b, g0, &noise));
+    if (s.accelerometer && sinks.accelerometer) {
+      // The moving base: the mount's attitude at the sample's end, the vibration's mean over it.
+      const Eigen::Vector3d f_mount =
+          base.enabled()
+              ? Eigen::Vector3d(movedMount(s, base, t_b).transpose() *
+                                (Eigen::Vector3d(0.0, 0.0, kStandardGravity) + base.meanAccelerationOver(t_b - h, t_b)))
+              : g0;
+      sinks.accelerometer(accelerometerSample(s, stamp, psi_b, f_mount, &noise));
+    }
     psi_a = psi_b;
+  }
+}
+
+/// Every noise term and level sigma a test left unset, set to what this generator puts in unless the
+/// scenario says otherwise: none. (The settings' own defaults leave them unset, and the gyrocompass
+/// refuses to start without them.)
+inline void setUnsetTermsToNone(AlignmentSettings* a) {
+  GyroNoiseModel& n = a->noise;
+  for (double* term : {&n.angle_random_walk, &n.rate_random_walk, &n.residual_bias, &n.residual_drift_harmonics}) {
+    if (std::isnan(*term)) *term = 0.0;
+  }
+  LevelSettings& l = a->level;
+  for (double* term : {&l.roll_sigma, &l.pitch_sigma, &l.accelerometer_bias_sigma, &l.accelerometer_mounting_sigma}) {
+    if (std::isnan(*term)) *term = 0.0;
   }
 }
 
@@ -316,14 +401,18 @@ inline MountSinks gyrocompassSinks(Gyrocompass* g, std::function<void(const Tria
 
 /// The alignment of a scenario: settings' latitude and duration as the scenario's unless set.
 inline AlignmentResult alignScenario(const AlignmentSettings& settings, const MountScenario& s) {
-  Gyrocompass g(settings);
+  AlignmentSettings complete = settings;
+  setUnsetTermsToNone(&complete);
+  Gyrocompass g(complete);
   runMountScenario(s, gyrocompassSinks(&g));
   return g.finish();
 }
 
-/// The heading error, rad, wrapped: estimate less truth.
+/// The heading error, rad, wrapped: estimate less truth (the frame at the window's end; the mount's
+/// own attitude when the base is still).
 inline double yawError(const AlignmentResult& r, const MountScenario& s) {
-  return wrapToPi(r.attitude.yaw - s.mount.yaw);
+  if (!s.base_motion.enabled()) return wrapToPi(r.attitude.yaw - s.mount.yaw);
+  return wrapToPi(r.attitude.yaw - eulerFromOrientation(Eigen::Quaterniond(trueFrameAt(s, r.last_sample))).yaw);
 }
 
 /// Two positions 180 deg apart, `dwell` s each.

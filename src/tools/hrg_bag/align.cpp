@@ -35,6 +35,12 @@ struct AlignCommand {
   CLI::Option* triad_option = nullptr;
 };
 
+/// A key as a settings file writes it ("noise.residual_bias"), from the settings' own naming ("noise/...").
+std::string dottedKey(std::string key) {
+  std::replace(key.begin(), key.end(), '/', '.');
+  return key;
+}
+
 /// The settings file, --duration in place of its duration; refusals name the file and the key.
 core::AlignmentSettings loadSettings(const AlignOptions& o) {
   core::AlignmentSettings s;
@@ -282,6 +288,7 @@ int runAlign(const AlignCommand& c) {
     throw UsageError(std::string("--windows: ") + e.what());
   }
   std::vector<std::string> inputs{o.bag, o.settings};
+  if (!settings.allan_file.empty()) inputs.push_back(settings.allan_file);  // read by the settings: an input too
   std::shared_ptr<const core::TriadParameters> triad;
   std::array<AxisInput, 3> axes;
   std::unique_ptr<core::TriadProcessor> chain;
@@ -297,6 +304,13 @@ int runAlign(const AlignCommand& c) {
     chain = std::make_unique<core::TriadProcessor>(chain_settings, parameters, triad);
   }
   checkOutputPaths(inputs, {o.output});
+  // No noise model, no alignment: every term given, from the Allan file, or the residual bias from a
+  // calibrated triad file, resolved as the gyrocompass will.
+  try {
+    settings = core::Gyrocompass(settings, triad ? *triad : core::TriadParameters()).settings();
+  } catch (const core::ConfigError& e) {
+    throw UsageError("--settings " + o.settings + ": " + dottedKey(e.key()) + ": " + e.problem());
+  }
   const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
   const AlignInputs in = findInputs(*bag, c, settings, axes);
 

@@ -115,6 +115,7 @@ core::AlignmentSettings staticSettings(const MountScenario& s) {
   a.duration = s.duration;
   a.noise.residual_bias = 1e-8;
   a.level.source = core::LevelSource::kDeclared;
+  core::testing::setUnsetTermsToNone(&a);
   return a;
 }
 

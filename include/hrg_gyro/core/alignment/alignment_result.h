@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "hrg_gyro/core/alignment/alignment_settings.h"
+#include "hrg_gyro/core/alignment/earth_checks.h"
 #include "hrg_gyro/core/alignment/earth_rate_heading.h"
 #include "hrg_gyro/core/common/units.h"
 
@@ -29,10 +30,18 @@ struct AlignmentSegment {
   std::vector<double> residual_rate, residual_rate_std, rms, predicted_rms;
 };
 
+/// A step of the base (a lean, a knock) the still-base fit carried: where the window was cut and the
+/// rotation the gyros measured across it.
+struct BaseStepRecord {
+  double time = 0.0;                                   ///< s from the window's start
+  Eigen::Vector3d rotation = Eigen::Vector3d::Zero();  ///< rad, body axes (static) or channels (indexed)
+  double chi_square = 0.0;                             ///< of the step against none
+};
+
 struct AlignmentResult {
   bool accepted = false;
   /// The check that refused it: "input", "latitude", "motion", "level", "design", "sweep",
-  /// "stillness", "earth_rate", "attitude", "aborted"; empty when accepted.
+  /// "stillness", "earth_rate", "earth_check", "attitude", "aborted"; empty when accepted.
   std::string gate;
   std::string reason;  ///< why it was refused, or the one-line summary
   std::vector<std::string> notes;
@@ -42,6 +51,7 @@ struct AlignmentResult {
   /// The frame whose attitude is given: "body" (static, sweep) or "indexer" (the indexer's zero frame).
   std::string frame = "body";
   Nanoseconds start = 0, end = 0;  ///< the window, gyro stamps
+  Nanoseconds last_sample = 0;     ///< the stamp of the window's last gyro sample: where the attitude is given
   double seconds = 0.0;            ///< s of data used
   std::uint64_t samples = 0;       ///< gyro samples used (per channel)
 
@@ -70,6 +80,22 @@ struct AlignmentResult {
   double worst_motion = 0.0;           ///< rad/s, largest block departure
   double accelerometer_gravity = NAN;  ///< m/s^2, |mean specific force| (accelerometer level)
   std::vector<AlignmentSegment> segments;
+
+  /// Which estimator answered, "still_base" (the Earth's rate fitted on the integrated angles, the
+  /// base's steps carried) or "tracking" (the gyros track the body, gravity followed in the inertial
+  /// frame), and why.
+  std::string estimator = "still_base";
+  std::string estimator_reason;
+  std::vector<BaseStepRecord> base_steps;  ///< the steps the still-base fit carried
+  double excluded_seconds = 0.0;           ///< s of the window left out around them
+  double low_frequency_scatter = 0.0;      ///< rms of block-mean residuals over the noise model's
+  double low_frequency_limit = INFINITY;   ///< what a still base exceeds once in 1 / motion/block_false_alarm
+  std::vector<EarthCheck> earth_checks;    ///< of the estimator that answered
+  /// The tracking estimator's heading and sigma (deg) when it ran, and the two estimators' heading
+  /// difference over its standard error (their noise), NaN when only one ran.
+  double tracking_heading = NAN, tracking_heading_sigma = NAN, estimator_difference = NAN;
+  double velocity_white = NAN, velocity_random_walk = NAN;  ///< m/s, m/s/sqrt(s): the tracking's measured noise
+  std::string noise_sources;                                ///< where each noise term came from
 
   /// One line: heading +- sigma, mode, window, the budget's main terms; or the refusal.
   std::string summary() const;

@@ -45,24 +45,39 @@ const char* toString(AlignmentMode mode);
 /// Throws ConfigError naming `key` for any other text.
 AlignmentMode parseAlignmentMode(const std::string& text, const std::string& key = "mode");
 
-/// One gyro axis's noise and what its calibration left, in body units.
+/// One gyro axis's noise and what its calibration left, in body units. A term that is NaN was not
+/// given: nothing claims a precision nobody measured, so the gyrocompass refuses to start until each
+/// is set, read from an Allan file, or (the residual bias) taken from a calibrated triad file.
 struct GyroNoiseModel {
   double angle_white_noise = -1.0;  ///< rad per sample (Q of the Allan deviation); negative: measured
-  double angle_random_walk = 0.0;   ///< N, rad/sqrt(s)
-  double rate_random_walk = 0.0;    ///< K, rad/s/sqrt(s): the bias that wanders at random
+  double angle_random_walk = NAN;   ///< N, rad/sqrt(s)
+  double rate_random_walk = NAN;    ///< K, rad/s/sqrt(s): the bias that wanders at random
   /// rad/s, 1 sigma: the bias the calibration left (for a triad, its file's bias_std), constant over
   /// the window: a floor of the static heading, cancelled by indexing.
-  double residual_bias = 0.0;
+  double residual_bias = NAN;
   /// rad/s, 1 sigma: the rms over the wave angle of the residual D(theta) - D0, divided by |K0| (body
   /// rate). A resting wave turns it into a bias of that size (static); a sweep averages it out.
-  double residual_drift_harmonics = 0.0;
-  /// Throws ConfigError naming `prefix` + the field.
+  double residual_drift_harmonics = NAN;
+  /// Throws ConfigError naming `prefix` + the field (a term not given passes: NaN).
   void validate(const std::string& prefix = "noise/") const;
+  /// Throws ConfigError naming the first term not given, and where to get it.
+  void requireComplete(const std::string& prefix = "noise/") const;
+};
+
+/// Where each noise term came from ("settings", "allan_file PATH", "triad_file bias_std", "measured
+/// from the window"): the diagnostics and the result say it.
+struct NoiseSources {
+  std::string angle_white_noise = "measured from the window";
+  std::string angle_random_walk = "settings", rate_random_walk = "settings";
+  std::string residual_bias = "settings", residual_drift_harmonics = "settings";
+  /// One line, term by term.
+  std::string summary() const;
 };
 
 /// The readings an Allan deviation identified (Q as the white angle noise at its sample period, N,
-/// K) in place of `base`'s; the rest of `base` kept.
-GyroNoiseModel noiseFromAllan(const AllanResult& allan, const GyroNoiseModel& base);
+/// K) in place of `base`'s; the rest of `base` kept. `sources` (optional) records `origin` for each.
+GyroNoiseModel noiseFromAllan(const AllanResult& allan, const GyroNoiseModel& base, NoiseSources* sources = nullptr,
+                              const std::string& origin = "allan_file");
 
 enum class LevelSource { kAccelerometer, kDeclared };
 
@@ -70,15 +85,21 @@ struct LevelSettings {
   LevelSource source = LevelSource::kAccelerometer;
   /// Declared level of the body (static, sweep) or of the indexer's zero frame (indexed), rad.
   double roll = 0.0, pitch = 0.0;
-  double roll_sigma = 0.0, pitch_sigma = 0.0;  ///< rad, 1 sigma (0: exact)
+  /// rad, 1 sigma of the declared level (0: exact); NaN: not given (required with a declared level).
+  double roll_sigma = NAN, pitch_sigma = NAN;
   /// The accelerometer's mounting: v_body = accelerometer_to_body v_accelerometer.
   Eigen::Quaterniond accelerometer_to_body = Eigen::Quaterniond::Identity();
-  /// m/s^2, 1 sigma per axis of the bias its calibration left (its mounting's error can be folded in
-  /// as g times the angle).
-  double accelerometer_bias_sigma = 0.0;
+  /// m/s^2, 1 sigma per axis of the bias its calibration left; NaN: not given (required with an
+  /// accelerometer).
+  double accelerometer_bias_sigma = NAN;
+  /// rad, 1 sigma per axis of the mounting's error (how well accelerometer_to_body is known); NaN:
+  /// not given (required with an accelerometer). It tips the level as a bias of g times it does.
+  double accelerometer_mounting_sigma = NAN;
   /// Largest | |f| / g - 1 | of the mean specific force (a wrong unit or a moving base).
   double max_gravity_error = 0.02;
   void validate() const;
+  /// Throws ConfigError naming the sigma the level source needs and that was not given.
+  void requireComplete() const;
 };
 
 struct IndexerSettings {
@@ -108,14 +129,34 @@ struct SweepSettings {
 };
 
 struct MotionSettings {
-  double block = 2.0;        ///< s: blocks whose mean rates judge stillness within a segment
-  double max_motion = 1e-4;  ///< rad/s: largest departure of a block's mean rate from the others'
-  /// Largest rms residual over the noise model's prediction. Still windows read 1.00 to 1.03 (every
-  /// mode, 300 simulated windows); a 0.05 Hz sway of 5e-5 rad reads 2.7 in 20 s and turns the heading
-  /// by 2 deg.
+  /// s: blocks whose mean rates judge stillness within a rest, and over which the residuals are
+  /// averaged for the low-frequency stillness (a sway slower than the blocks)
+  double block = 2.0;
+  double max_motion = 1e-4;  ///< rad/s: largest departure of a block's mean rate from the others' in a rest
+  /// Largest rms residual over the noise model's prediction, per point and per block mean. Still
+  /// windows read 1.00 to 1.03 (every mode, 300 simulated windows).
   double max_scatter = 1.5;
+  /// The still-base fit's steps of the base (a lean, a knock: a rotation that stays): a step whose
+  /// chi-square (3 degrees of freedom for the triad) exceeds `step_threshold` is carried: the window is
+  /// cut there, `step_guard` s each side left out, the rests on either side fitted together with the
+  /// rotation between them measured by the gyros. At most `max_steps`, at most `max_excluded` of the
+  /// window left out; beyond either the base is not still (the tracking estimator, or a refusal).
+  double step_threshold = 40.0;
+  double step_guard = 0.5;
+  int max_steps = 12;
+  double max_excluded = 0.3;
+  /// The block means' test (a slow sway): how often a still window is refused by it; its limit is the
+  /// chi-square quantile for the window's number of blocks.
+  double block_false_alarm = 1e-4;
   void validate() const;
 };
+
+/// Which estimator answers. kAuto: the still-base fit where the base is still (the most precise),
+/// the tracking estimator (the gyros track the body, gravity followed in the inertial frame; needs an
+/// accelerometer and the triad) where the base sways or moves in a way the still fit cannot carry, or
+/// where the two disagree beyond their noise.
+enum class EstimatorChoice { kAuto, kStillBase, kTracking };
+const char* toString(EstimatorChoice choice);
 
 struct AlignmentSettings {
   AlignmentMode mode = AlignmentMode::kStatic;
@@ -126,14 +167,25 @@ struct AlignmentSettings {
   /// Largest | h_measured / h - 1 | of the horizontal rate against the Earth's (a bias far beyond the
   /// calibration's, a wrong latitude, a turning base), beyond 4 of its sigmas.
   double max_earth_rate_error = 0.25;
+  /// Each check against the Earth (earth_checks.h: the measured Earth rate's length, its vertical part
+  /// and its angle to the measured up) refuses beyond this many of its standard errors.
+  double max_earth_sigmas = 5.0;
+  /// The tracking estimator replaces the still-base fit when their headings differ by more than this
+  /// many standard errors of the difference (their noise; the biases they share cancel).
+  double max_estimator_sigmas = 4.0;
+  EstimatorChoice estimator = EstimatorChoice::kAuto;
   double max_condition = 1e8;  ///< of the fit (a design that cannot separate the parameters)
   GyroNoiseModel noise;
+  NoiseSources noise_sources;  ///< set by parse(); a caller that fills `noise` itself keeps "settings"
+  std::string allan_file;      ///< the Allan readings file `noise` was read from (its path as opened), "" none
   LevelSettings level;
   IndexerSettings indexer;
   SweepSettings sweep;
   MotionSettings motion;
   /// Throws ConfigError naming the key.
   void validate() const;
+  /// validate(), and every noise term and level sigma given (the gyrocompass's start).
+  void requireComplete() const;
 
   /// Reads the settings map (the top level of a settings file or of the node's parameters) and
   /// validates it. Unknown keys are refused by name; `extra_keys` are also allowed at the top level,

@@ -14,16 +14,28 @@
 // The window is `duration` s of gyro stamps from the first sample's start; complete() says when
 // it is full. finish() fits, levels, finds the heading and its error budget, and applies the gates:
 //   latitude    above max_latitude (checked at once: the object starts refused);
-//   motion      within a segment, a block's mean rate departs from another's by more than
-//               2 max_motion (as the turn-on bias capture judges a still gyro; judged as the samples
-//               come in the static mode, so a moving base ends the alignment at once), or the wave
-//               was turned on command outside the sweep mode;
-//   stillness   the fit's residuals scatter beyond max_scatter times the noise model's prediction;
+//   motion      the base moved beyond what the still-base fit carries (too many steps, too much of the
+//               window in transitions, block mean rates spread beyond 2 max_motion within a rest) and
+//               no tracking estimator could answer, or the wave was turned on command outside the
+//               sweep mode;
+//   stillness   the residuals scatter beyond max_scatter times the noise model's prediction, per
+//               point or per block mean (a sway), and no tracking estimator could answer;
 //   level       no gravity reference, or |f| not g;
 //   design      the data cannot resolve the heading: one gyro at two positions (one horizontal
 //               component), positions that do not differ, a sweep that does not turn both ways;
 //   earth_rate  the horizontal rate measured is not the Earth's (a gross bias, a wrong latitude);
+//   earth_check the measured Earth rate's length, its part along the measured up, or its angle to
+//               the up disagrees with the declared latitude beyond max_earth_sigmas (earth_checks.h);
+//   tracking    estimator tracking asked for and not possible;
 //   attitude    the body's x axis too close to vertical for a heading.
+// Which estimator answers, the still-base fit or the tracking one: gyrocompass_solver.h.
+//
+// Time: every stream follows the one stamp rule (stamp_timeline.h; backward_reset 0.5 s, forward_jump
+// 1 s, jump_persist 5): a glitched stamp is dropped and counted, costing its sample only; a gyro
+// stream that goes back for good restarts the window on its new timeline (counted in `restarts`),
+// an accelerometer's or indexer's that does drops its old records. A gyro sample whose dt does not
+// match its stamps (beyond half of it) is dropped as a glitch, never integrated. Records of the
+// other streams older than the window are not kept.
 // Each fit is on the integrated angles (integrated_angle_fit.h), in segments: a gap or reset, an
 // indexer position, a commanded rate each start a new one. In the indexed mode a channel with
 // sensitive direction d (platform frame) at indexer angle psi senses
@@ -44,6 +56,7 @@
 
 #include "hrg_gyro/core/alignment/alignment_result.h"
 #include "hrg_gyro/core/alignment/alignment_settings.h"
+#include "hrg_gyro/core/common/stamp_timeline.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/triad_parameters.h"
 #include "hrg_gyro/core/processing/precession_watch.h"
@@ -72,16 +85,19 @@ struct AlignmentProgress {
   bool complete = false;  ///< full, or refused
   bool refused = false;   ///< refused before the end (latitude, motion, a commanded wave, abort)
   std::string reason;
-  std::uint64_t samples = 0;  ///< gyro samples taken (per channel)
-  std::uint64_t gaps = 0;     ///< gaps and resets in the gyro input
-  std::uint64_t dropped = 0;  ///< records dropped: out of order, duplicate, not finite
+  std::uint64_t samples = 0;   ///< gyro samples taken (per channel)
+  std::uint64_t gaps = 0;      ///< gaps and resets in the gyro input
+  std::uint64_t dropped = 0;   ///< records dropped: out of order, duplicate, not finite, a glitched stamp or dt
+  std::uint64_t restarts = 0;  ///< the window restarted: the gyro stream went back to a new timeline
   std::uint64_t indexer = 0, accelerometer = 0, precession = 0;  ///< records taken
 };
 
 class Gyrocompass {
  public:
-  /// Throws ConfigError (naming the key) for bad settings. `triad`: the triad's file, used by the
-  /// sweep mode (M and the body bias applied to the axes' outputs).
+  /// Throws ConfigError (naming the key) for bad settings, and for a noise term or level sigma not
+  /// given (AlignmentSettings::requireComplete): a residual bias not given is the triad file's
+  /// largest bias_std when that file is calibrated (bias_std not all 0). `triad`: the triad's file,
+  /// used by the sweep mode (M and the body bias applied to the axes' outputs).
   explicit Gyrocompass(const AlignmentSettings& settings, const TriadParameters& triad = TriadParameters());
 
   void addTriad(const TriadBodySample& sample);
@@ -115,7 +131,10 @@ class Gyrocompass {
     Nanoseconds last = 0;
     bool pending_break = false;
     bool full = false;
+    StampTimeline timeline{gyrocompassStampRule()};
+    void clear();
   };
+  static StampRule gyrocompassStampRule();
   // Running block means of one stream within a segment (the stillness judged as data come).
   struct BlockMotion {
     std::size_t channels = 3;
@@ -129,7 +148,16 @@ class Gyrocompass {
 
   bool admit(Stream* stream, Nanoseconds stamp, double dt, const double* increment, std::size_t channels, bool gap,
              bool precessing);
+  bool timed(Stream* stream, Nanoseconds stamp, double dt);
+  void restartWindow();
+  void startWindow(Nanoseconds stamp, double dt);
+  // The one stamp rule for a record stream (accelerometer, indexer, precession): false to drop it;
+  // a stream gone back for good loses its old records.
+  template <typename Record>
+  bool takeRecord(StampTimeline* timeline, std::vector<Record>* records, Nanoseconds stamp);
+  bool beforeWindow(Nanoseconds stamp) const;  // older than the window by more than a second: not kept
   void refuse(const std::string& gate, const std::string& reason);
+  void resolveNoise();
 
   AlignmentSettings settings_;
   TriadParameters triad_;
@@ -137,12 +165,15 @@ class Gyrocompass {
   std::size_t stream_count_ = 1;
   Nanoseconds start_ = 0, end_ = 0;
   bool started_ = false;
-  BlockMotion live_motion_;  // the static mode's, as samples come
   std::vector<IndexerRecord> indexer_;
   std::vector<AccelerometerRecord> accelerometer_;
   std::array<std::vector<PrecessionStateRecord>, 3> precession_;
+  StampTimeline indexer_time_{gyrocompassStampRule()}, accelerometer_time_{gyrocompassStampRule()};
+  std::array<StampTimeline, 3> precession_time_{{StampTimeline(gyrocompassStampRule()),
+                                                 StampTimeline(gyrocompassStampRule()),
+                                                 StampTimeline(gyrocompassStampRule())}};
   std::string refused_gate_, refused_reason_;
-  std::uint64_t gaps_ = 0, dropped_ = 0;
+  std::uint64_t gaps_ = 0, dropped_ = 0, restarts_ = 0;
 
   friend class GyrocompassSolver;
 };

@@ -114,6 +114,10 @@ class IntegratedAngleFit {
   /// indexer position off by a small angle). Valid after a successful solve().
   Eigen::VectorXd response(std::size_t channel, const std::vector<double>& angle) const;
 
+  /// Each point's residual angle (rad) of channel `channel`, its segment's intercept removed. Valid
+  /// after a successful solve().
+  std::vector<double> residuals(std::size_t channel) const;
+
   const std::vector<AngleSeries>& channels() const { return channels_; }
 
  private:
