@@ -8,9 +8,11 @@
 
 #include <Eigen/Dense>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <string>
 
+#include "core/testing/shipped_scenarios.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
 
@@ -363,6 +365,65 @@ TEST(TriadSimulatorTest, AccelerometerAddsItsBiasAndNoiseInItsMountedFrameFromIt
     EXPECT_FALSE(plain[k].accelerometer.present);
     for (int i = 0; i < 3; ++i) ASSERT_EQ(plain[k].axes[i].z, samples[k].axes[i].z);
   }
+}
+
+/// FNV-1a over the bytes of everything a triad sample carries: any changed bit changes it.
+class TriadFingerprint {
+ public:
+  template <typename T>
+  void add(const T& value) {
+    unsigned char bytes[sizeof(T)];
+    std::memcpy(bytes, &value, sizeof(T));
+    for (const unsigned char b : bytes) hash_ = (hash_ ^ b) * 0x100000001b3ULL;
+  }
+  void addVector(const Eigen::Vector3d& v) {
+    for (int j = 0; j < 3; ++j) add(v[j]);
+  }
+  void addQuaternion(const Eigen::Quaterniond& q) {
+    for (int j = 0; j < 4; ++j) add(q.coeffs()[j]);
+  }
+  void add(const TriadSample& s) {
+    add(s.index), add(s.stamp);
+    for (const SimulationSample& a : s.axes) {
+      add(a.index), add(a.stamp), add(a.channels_delivered);
+      for (int j = 0; j < 4; ++j) add(a.z[j]);
+      add(a.truth.theta), add(a.truth.table_angle), add(a.truth.table_rate), add(a.truth.inertial_angle);
+      add(a.truth.inertial_rate);
+    }
+    for (const TurntableLogRecord& r : s.turntable) add(r.index), add(r.time), add(r.stamp), add(r.angle), add(r.rate);
+    add(s.fixture.index), add(s.fixture.locked), add(s.fixture_logged), addQuaternion(s.fixture.body_to_table);
+    addVector(s.body.angular_velocity), addQuaternion(s.body.body_to_table), addQuaternion(s.body.body_to_enu);
+    add(s.body.position), add(s.accelerometer.present), addVector(s.accelerometer.specific_force);
+  }
+  std::uint64_t value() const { return hash_; }
+
+ private:
+  std::uint64_t hash_ = 0xcbf29ce484222325ULL;
+};
+
+// A scenario that gives none of the base's or the accelerometer's newer keys is what it was before
+// them, bit for bit: the hashes were recorded on the simulator before triad.base_motion existed.
+// The test scenario with every older feature (fixture error, wobble, table log, pickoff noise, an
+// accelerometer with bias, noise and mounting), and the first 10 s of north_static.yaml.
+TEST(TriadSimulatorTest, AScenarioWithoutTheNewKeysKeepsItsFingerprint) {
+  const std::string accelerometer =
+      "{latitude: 0.9, azimuth: 0.3, wobble: {amplitude: 1.0e-4, direction: 0.4}, log: {rate: 100, angle_noise: "
+      "2.0e-6}}\n  accelerometer: {bias: [1.0e-3, -2.0e-3, 3.0e-3], noise: 2.0e-3, mounting: {roll: 0.1, pitch: "
+      "-0.2, yaw: 0.3}}";
+  const TriadSimulationConfig c =
+      parseText(scenario(accelerometer, ", error: [1.2e-4, 2.0e-4, -0.5e-4]", ", pickoff: {noise: 2.0e-4}"));
+  TriadSimulator sim(c);
+  TriadFingerprint f;
+  TriadSample s;
+  while (sim.next(&s)) f.add(s);
+  const TriadSimulationConfig shipped = TriadSimulationConfig::load(testing::shippedScenarioPath("north_static.yaml"));
+  TriadSimulator sim_shipped(shipped);
+  TriadFingerprint g;
+  for (int n = 0; n < 2000 && sim_shipped.next(&s); ++n) g.add(s);
+  std::printf("[ measured ] fingerprints 0x%016llx 0x%016llx\n", static_cast<unsigned long long>(f.value()),
+              static_cast<unsigned long long>(g.value()));
+  EXPECT_EQ(f.value(), 0xfcf41c37d63cc5d2ULL);
+  EXPECT_EQ(g.value(), 0x43101a7023afb2c7ULL);
 }
 
 // An axis may run the averaged resonator: it senses the same A_x . omega_body as the harmonic axis
