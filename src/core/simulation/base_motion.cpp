@@ -34,7 +34,8 @@ Eigen::Vector3d readVector(const YamlField& f) {
 
 void checkBand(const BaseBand& b, const std::string& key) {
   if (!(b.rms >= 0.0)) throw ConfigError(key + ".rms", "must be >= 0");
-  if (!(b.low > 0.0) || !(b.high >= b.low) || b.high > 1e4) throw ConfigError(key + ".low", "need 0 < low <= high <= 1e4 Hz");
+  if (!(b.low > 0.0) || !(b.high >= b.low) || b.high > 1e4)
+    throw ConfigError(key + ".low", "need 0 < low <= high <= 1e4 Hz");
   if (b.components < 1 || b.components > 1000) throw ConfigError(key + ".components", "must be in [1, 1000]");
 }
 
@@ -58,7 +59,8 @@ void BaseMotionConfig::validate(const std::string& prefix) const {
   for (std::size_t i = 0; i < leans.size(); ++i) {
     const std::string key = prefix + ".leans[" + std::to_string(i) + "]";
     if (!(leans[i].time >= 0.0)) throw ConfigError(key + ".time", "must be >= 0 s");
-    if (!(leans[i].duration > 0.0) || leans[i].duration > 1e5) throw ConfigError(key + ".duration", "must be in (0, 1e5] s");
+    if (!(leans[i].duration > 0.0) || leans[i].duration > 1e5)
+      throw ConfigError(key + ".duration", "must be in (0, 1e5] s");
     if (!leans[i].rotation.allFinite() || leans[i].rotation.norm() > 0.1)
       throw ConfigError(key + ".rotation", "must be finite, at most 0.1 rad: a lean of the base, not a move");
   }
@@ -66,9 +68,11 @@ void BaseMotionConfig::validate(const std::string& prefix) const {
     const std::string key = prefix + ".knocks[" + std::to_string(i) + "]";
     const BaseKnock& k = knocks[i];
     if (!(k.time >= 0.0)) throw ConfigError(key + ".time", "must be >= 0 s");
-    if (!k.rotation.allFinite() || k.rotation.norm() > 0.1) throw ConfigError(key + ".rotation", "must be finite, at most 0.1 rad");
+    if (!k.rotation.allFinite() || k.rotation.norm() > 0.1)
+      throw ConfigError(key + ".rotation", "must be finite, at most 0.1 rad");
     if (!(k.ring >= 0.0) || k.ring > 100.0) throw ConfigError(key + ".ring", "must be in [0, 100]");
-    if (!(k.ring_frequency > 0.0) || k.ring_frequency > 1e4) throw ConfigError(key + ".ring_frequency", "must be in (0, 1e4] Hz");
+    if (!(k.ring_frequency > 0.0) || k.ring_frequency > 1e4)
+      throw ConfigError(key + ".ring_frequency", "must be in (0, 1e4] Hz");
     if (!(k.ring_decay > 0.0) || k.ring_decay > 100.0) throw ConfigError(key + ".ring_decay", "must be in (0, 100] s");
   }
   for (std::size_t i = 0; i < sways.size(); ++i) {
@@ -76,7 +80,8 @@ void BaseMotionConfig::validate(const std::string& prefix) const {
     const BaseSway& s = sways[i];
     if (!(s.amplitude >= 0.0) || s.amplitude > 0.1) throw ConfigError(key + ".amplitude", "must be in [0, 0.1] rad");
     if (!(s.period > 0.0) || s.period > 1e5) throw ConfigError(key + ".period", "must be in (0, 1e5] s");
-    if (!s.axis.allFinite() || std::abs(s.axis.norm() - 1.0) > 1e-6) throw ConfigError(key + ".axis", "must be a unit vector");
+    if (!s.axis.allFinite() || std::abs(s.axis.norm() - 1.0) > 1e-6)
+      throw ConfigError(key + ".axis", "must be a unit vector");
     if (!std::isfinite(s.phase)) throw ConfigError(key + ".phase", "must be finite");
   }
   checkBand(yaw_jitter, prefix + ".yaw_jitter");
@@ -144,7 +149,10 @@ BaseMotion::BaseMotion(const BaseMotionConfig& config, std::uint64_t seed) : con
     const Eigen::Vector3d& r = config_.knocks[i].rotation;
     if (r.norm() > 0.0) parts_.push_back({r.normalized(), Part::kKnock, i});
   }
-  for (std::size_t i = 0; i < config_.sways.size(); ++i) parts_.push_back({config_.sways[i].axis, Part::kSway, i});
+  for (std::size_t i = 0; i < config_.sways.size(); ++i) {
+    // Made exactly unit (validate() lets 1e-6 through): off it, D is no rotation and w not its rate.
+    parts_.push_back({config_.sways[i].axis.normalized(), Part::kSway, i});
+  }
   // The random bands: their own stream of the scenario's seed, so that they do not shift other draws.
   GaussianNoise draws(seed ^ 0x6261736557616b65ull);
   auto band = [&draws](const BaseBand& b, std::vector<Sine>* out) {

@@ -35,24 +35,24 @@ namespace hrg_gyro {
 namespace core {
 
 struct BaseLean {
-  double time = 0.0;                                  ///< s from the scenario start
-  double duration = 1.0;                              ///< s, > 0
+  double time = 0.0;                                   ///< s from the scenario start
+  double duration = 1.0;                               ///< s, > 0
   Eigen::Vector3d rotation = Eigen::Vector3d::Zero();  ///< rad, ENU rotation vector
 };
 
 struct BaseKnock {
-  double time = 0.0;                                  ///< s
+  double time = 0.0;                                   ///< s
   Eigen::Vector3d rotation = Eigen::Vector3d::Zero();  ///< rad, ENU: what it leaves
-  double ring = 2.0;                                  ///< ringing amplitude over the step's size
-  double ring_frequency = 8.0;                        ///< Hz
-  double ring_decay = 0.15;                           ///< s
+  double ring = 2.0;                                   ///< ringing amplitude over the step's size
+  double ring_frequency = 8.0;                         ///< Hz
+  double ring_decay = 0.15;                            ///< s
 };
 
 struct BaseSway {
-  double amplitude = 0.0;                                ///< rad
-  double period = 10.0;                                  ///< s, > 0
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();        ///< ENU, unit
-  double phase = 0.0;                                    ///< rad
+  double amplitude = 0.0;                           ///< rad
+  double period = 10.0;                             ///< s, > 0
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();  ///< ENU, unit
+  double phase = 0.0;                               ///< rad
 };
 
 /// A band of random sinusoids: rms over [low, high] Hz.
@@ -66,7 +66,7 @@ struct BaseMotionConfig {
   std::vector<BaseLean> leans;
   std::vector<BaseKnock> knocks;
   std::vector<BaseSway> sways;
-  BaseBand yaw_jitter{0.0, 0.5, 5.0, 20};  ///< rad
+  BaseBand yaw_jitter{0.0, 0.5, 5.0, 20};   ///< rad
   BaseBand vibration{0.0, 10.0, 40.0, 20};  ///< m/s^2 per ENU axis
   bool enabled() const;
   /// Throws ConfigError naming the key ("base_motion.leans[0].duration").
