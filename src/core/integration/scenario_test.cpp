@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -14,6 +16,7 @@
 #include "hrg_gyro/core/simulation/injected_model.h"
 #include "hrg_gyro/core/simulation/simulation_config.h"
 #include "hrg_gyro/core/simulation/triad_simulation_config.h"
+#include "hrg_gyro/core/simulation/triad_simulator.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -222,7 +225,7 @@ TEST(Scenarios, ShippedScenariosParseAndDescribeTheSameGyro) {
   files.erase("triad.yaml");
   files.erase("triad_verification.yaml");
   for (const std::string& name : {"north_static.yaml", "north_indexed_two.yaml", "north_indexed_four.yaml",
-                                  "north_continuous.yaml", "north_sweep.yaml"}) {
+                                  "north_continuous.yaml", "north_sweep.yaml", "north_vehicle_idle.yaml"}) {
     files.erase(name);  // the triad's north-finding sessions (NorthScenarios...)
   }
   for (const std::string& name : resonatorScenarios()) files.erase(name);
@@ -436,8 +439,8 @@ std::vector<std::pair<double, double>> restsOf(const TurntableProfile& p) {
 TEST(Scenarios, NorthScenariosAreTheCalibratedTriadInEachAlignmentMode) {
   const TriadSimulationConfig cal = loadTriadScenario(kScenarioDir + "triad.yaml");
   std::map<std::string, TriadSimulationConfig> north;
-  for (const char* name :
-       {"north_static.yaml", "north_indexed_two.yaml", "north_indexed_four.yaml", "north_continuous.yaml"}) {
+  for (const char* name : {"north_static.yaml", "north_indexed_two.yaml", "north_indexed_four.yaml",
+                           "north_continuous.yaml", "north_vehicle_idle.yaml"}) {
     SCOPED_TRACE(name);
     const TriadSimulationConfig c = loadTriadScenario(kScenarioDir + name);
     EXPECT_EQ(c.turntable.latitude, 0.9);
@@ -533,6 +536,68 @@ TEST(Scenarios, NorthSweepScenarioTurnsTheCalibratedTriadOnTheFieldPlan) {
       EXPECT_EQ(a.dynamics.commands[k].rate, plan[k].rate) << k;
     }
   }
+}
+
+// config/scenarios/north_vehicle_idle.yaml: north_static.yaml word for word up to its positions (the
+// triad, accelerometer and table), a 300 s rest, on a vehicle idling: yaw jitter, a roll sway about the
+// body's x and a pitch sway about its y (their ENU directions at the rest attitude), the engine's
+// vibration. Its first seconds run, against north_static.yaml's: the gyros see the base turn, the
+// accelerometer its vibration too.
+TEST(Scenarios, NorthVehicleIdleScenarioIsTheStaticTriadOnAnIdlingVehicle) {
+  const std::string static_text = readFile(kScenarioDir + "north_static.yaml"),
+                    idle_text = readFile(kScenarioDir + "north_vehicle_idle.yaml");
+  EXPECT_EQ(between(idle_text, "seed: 1", "  positions:"), between(static_text, "seed: 1", "  positions:"));
+  const TriadSimulationConfig st = loadTriadScenario(kScenarioDir + "north_static.yaml");
+  const TriadSimulationConfig c = loadTriadScenario(kScenarioDir + "north_vehicle_idle.yaml");
+  ASSERT_EQ(c.positions.size(), 1u);
+  EXPECT_EQ(c.positions[0].bodyToPlatter(), st.positions[0].bodyToPlatter());
+  const std::vector<std::pair<double, double>> rests = restsOf(c.table_profile);
+  ASSERT_EQ(rests.size(), 1u);
+  EXPECT_EQ(rests[0].second, 300.0);
+  EXPECT_FALSE(st.base_motion.enabled());
+  const BaseMotionConfig& b = c.base_motion;
+  EXPECT_TRUE(b.leans.empty());
+  EXPECT_TRUE(b.knocks.empty());
+  EXPECT_EQ(b.yaw_jitter.rms, 2.0e-5);
+  EXPECT_EQ(b.yaw_jitter.low, 0.5);
+  EXPECT_EQ(b.yaw_jitter.high, 5.0);
+  EXPECT_EQ(b.vibration.rms, 0.05);
+  EXPECT_EQ(b.vibration.low, 10.0);
+  EXPECT_EQ(b.vibration.high, 40.0);
+  ASSERT_EQ(b.sways.size(), 2u);
+  EXPECT_EQ(b.sways[0].amplitude, 5.0e-5);
+  EXPECT_EQ(b.sways[0].period, 1.7);
+  EXPECT_EQ(b.sways[1].amplitude, 3.0e-5);
+  EXPECT_EQ(b.sways[1].period, 0.9);
+  // Roll about the vehicle's forward axis (the body's x, heading 0.0137 rad: almost North, not East),
+  // pitch about its y, both level: their horizontal directions at the rest attitude.
+  const TriadSimulator still(st);
+  const Eigen::Matrix3d rest = still.motion().stateAt(0.0).body_to_enu;
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::Vector3d level = Eigen::Vector3d(rest(0, k), rest(1, k), 0.0).normalized();
+    EXPECT_LT((b.sways[k].axis - level).norm(), 1e-6) << k;
+  }
+  EXPECT_NEAR(std::atan2(b.sways[0].axis.x(), b.sways[0].axis.y()), 0.0137, 1e-4);
+  // Its first 2 s against north_static.yaml's: the same noise draws, the base's motion added.
+  TriadSimulator idle(c), calm(st);
+  TriadSample a, s;
+  double rate_squares = 0.0, force_squares = 0.0;
+  const int n = 400;  // 200 Hz
+  for (int k = 0; k < n; ++k) {
+    ASSERT_TRUE(idle.next(&a));
+    ASSERT_TRUE(calm.next(&s));
+    rate_squares += (a.body.angular_velocity - s.body.angular_velocity).squaredNorm();
+    force_squares += (a.accelerometer.specific_force - s.accelerometer.specific_force).squaredNorm();
+  }
+  const double rate_rms = std::sqrt(rate_squares / n), force_rms = std::sqrt(force_squares / n / 3.0);
+  std::printf(
+      "[ measured ] north_vehicle_idle.yaml, first 2 s: the base's rate %.2e rad/s rms, the accelerometer "
+      "%.4f m/s^2 rms per axis off north_static.yaml\n",
+      rate_rms, force_rms);
+  EXPECT_GT(rate_rms, 1e-4);
+  EXPECT_LT(rate_rms, 1e-3);
+  EXPECT_GT(force_rms, 0.03);
+  EXPECT_LT(force_rms, 0.08);
 }
 
 TEST(Scenarios, RejectsBadValuesByKey) {

@@ -149,7 +149,10 @@ BaseMotion::BaseMotion(const BaseMotionConfig& config, std::uint64_t seed) : con
     const Eigen::Vector3d& r = config_.knocks[i].rotation;
     if (r.norm() > 0.0) parts_.push_back({r.normalized(), Part::kKnock, i});
   }
-  for (std::size_t i = 0; i < config_.sways.size(); ++i) parts_.push_back({config_.sways[i].axis, Part::kSway, i});
+  for (std::size_t i = 0; i < config_.sways.size(); ++i) {
+    // Made exactly unit (validate() lets 1e-6 through): off it, D is no rotation and w not its rate.
+    parts_.push_back({config_.sways[i].axis.normalized(), Part::kSway, i});
+  }
   // The random bands: their own stream of the scenario's seed, so that they do not shift other draws.
   GaussianNoise draws(seed ^ 0x6261736557616b65ull);
   auto band = [&draws](const BaseBand& b, std::vector<Sine>* out) {

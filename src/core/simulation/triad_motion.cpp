@@ -12,7 +12,10 @@ TriadMotion::TriadMotion(const TriadSimulationConfig& config)
     : profile_(config.table_profile),
       wobble_(config.turntable.wobble.platterToTable()),
       table_zero_to_enu_(config.turntable.tableZeroToEnu()),
-      earth_zero_(config.turntable.earthRateInTableZero()) {
+      earth_zero_(config.turntable.earthRateInTableZero()),
+      earth_enu_(0.0, kEarthRotationRate * std::cos(config.turntable.latitude),
+                 verticalEarthRate(config.turntable.latitude)),
+      base_(config.base_motion, config.seed) {
   Eigen::Matrix3d previous =
       config.positions.empty() ? Eigen::Matrix3d::Identity() : config.positions[0].bodyToPlatter();
   for (const FixturePositionConfig& p : config.positions) {
@@ -48,13 +51,24 @@ void TriadMotion::moving(const Span& span, double t, Eigen::Matrix3d* body_to_pl
   *rate = sdot * span.rho;
 }
 
+Eigen::Vector3d TriadMotion::baseShareInTable(double t, double phi) const {
+  Eigen::Matrix3d d;
+  Eigen::Vector3d w;
+  base_.stateAt(t, &d, &w);
+  // C^T (Omega + w) - C_nominal^T Omega with C = D C_nominal: the still base's Earth rate replaced.
+  const Eigen::Vector3d enu = d.transpose() * (earth_enu_ + w) - earth_enu_;
+  return Eigen::AngleAxisd(-phi, Eigen::Vector3d::UnitZ()) * (table_zero_to_enu_.transpose() * enu);
+}
+
 Eigen::Vector3d TriadMotion::tableFrameRateAt(double t) const {
   double phi, phidot;
   profile_.evaluate(t, &phi, &phidot);
   const double c = std::cos(phi), s = std::sin(phi);
   // Rz(phi)^T omega_E0: the Earth's rate seen from the turned platter, plus the table's own rate.
-  return Eigen::Vector3d(c * earth_zero_.x() + s * earth_zero_.y(), -s * earth_zero_.x() + c * earth_zero_.y(),
-                         earth_zero_.z() + phidot);
+  const Eigen::Vector3d still(c * earth_zero_.x() + s * earth_zero_.y(), -s * earth_zero_.x() + c * earth_zero_.y(),
+                              earth_zero_.z() + phidot);
+  if (!base_.enabled()) return still;
+  return still + baseShareInTable(t, phi);
 }
 
 Eigen::Vector3d TriadMotion::angularVelocityAt(double t) const {
@@ -81,6 +95,10 @@ TriadBodyState TriadMotion::stateAt(double t) const {
   }
   b.body_to_table = wobble_ * b.body_to_platter;
   b.body_to_enu = table_zero_to_enu_ * Eigen::AngleAxisd(b.table_angle, Eigen::Vector3d::UnitZ()) * b.body_to_table;
+  if (base_.enabled()) {
+    b.base_rotation = base_.rotationAt(t);
+    b.body_to_enu = b.base_rotation * b.body_to_enu;
+  }
   b.angular_velocity = b.body_to_table.transpose() * tableFrameRateAt(t) + move_rate;
   return b;
 }

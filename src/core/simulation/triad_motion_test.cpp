@@ -176,6 +176,64 @@ TEST(TriadMotionTest, MoveCarriesTheBodyFromOnePositionToTheNext) {
   }
 }
 
+/// A base with every motion: a lean of 25 urad, a knock, a sway, yaw jitter and vibration.
+const char* const kMovingBase =
+    "  base_motion:\n"
+    "    leans: [{time: 3.0, duration: 2.0, rotation: [2.0e-5, -1.5e-5, 0.0]}]\n"
+    "    knocks: [{time: 12.0, rotation: [1.0e-5, 0.0, 2.0e-5]}]\n"
+    "    sways: [{amplitude: 5.0e-5, period: 1.7, axis: [0.6, 0.8, 0.0]}]\n"
+    "    yaw_jitter: {rms: 2.0e-5}\n"
+    "    vibration: {rms: 0.05}\n";
+
+// On a moving base the body's attitude is D C_nominal and its rate the still base's with the Earth's
+// rate seen through D and D's own rate added; the table frame turns with D; what is relative to the
+// base (table angle, body_to_table) does not move. Checked against the formula, against the table
+// frame's rate written from its attitude D T0 Rz(phi), and against the attitude's derivative
+// (C^T dC/dt = [omega_body - C^T Omega_enu]x, central differences).
+TEST(TriadMotionTest, AMovingBaseTurnsTheBodyAndTheTableWithIt) {
+  const TriadSimulationConfig still = parseText(scenario());
+  const TriadSimulationConfig c = parseText(scenario() + kMovingBase);
+  const TriadMotion moving(c), fixed(still);
+  const BaseMotion base(c.base_motion, c.seed);
+  const Eigen::Vector3d earth(0.0, kEarthRotationRate * std::cos(0.9), kEarthRotationRate * std::sin(0.9));
+  const Eigen::Matrix3d table_zero = Eigen::AngleAxisd(kPi / 2 - 0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  // At rest, in the lean, turning, in the knock's ringing, in a move, in the tilted position.
+  for (const double t : {2.0, 4.0, 10.0, 12.03, c.positions[1].move_start + 2.0, c.positions[2].start + 1.0}) {
+    SCOPED_TRACE(t);
+    const TriadBodyState s = moving.stateAt(t), n = fixed.stateAt(t);
+    Eigen::Matrix3d d;
+    Eigen::Vector3d w;
+    base.stateAt(t, &d, &w);
+    EXPECT_EQ(s.base_rotation, d);
+    EXPECT_EQ(n.base_rotation, Eigen::Matrix3d::Identity());
+    EXPECT_EQ(s.table_angle, n.table_angle);
+    EXPECT_EQ(s.body_to_table, n.body_to_table);
+    EXPECT_EQ(s.locked, n.locked);
+    EXPECT_LT((s.body_to_enu - d * n.body_to_enu).cwiseAbs().maxCoeff(), 1e-16);
+    const Eigen::Matrix3d ct = s.body_to_enu.transpose(), nt = n.body_to_enu.transpose();
+    const Eigen::Vector3d expected = n.angular_velocity + (ct - nt) * earth + ct * w;
+    // Rounding: 1e-18 rad/s of the Earth's rate, 2e-16 of the table's and the move's.
+    const double rounding = 1e-18 + 2e-16 * s.angular_velocity.norm();
+    EXPECT_LT((s.angular_velocity - expected).norm(), rounding);
+    EXPECT_LT((moving.angularVelocityAt(t) - s.angular_velocity).norm(), rounding);
+    const Eigen::Matrix3d table_to_enu = d * table_zero * Eigen::AngleAxisd(s.table_angle, Eigen::Vector3d::UnitZ());
+    const Eigen::Vector3d table_rate = table_to_enu.transpose() * (earth + w) + s.table_rate * Eigen::Vector3d::UnitZ();
+    EXPECT_LT((moving.tableFrameRateAt(t) - table_rate).norm(), 1e-18 + 2e-16 * table_rate.norm());
+    const double h = 1e-5;
+    const Eigen::Matrix3d dc = (moving.stateAt(t + h).body_to_enu - moving.stateAt(t - h).body_to_enu) / (2 * h);
+    const Eigen::Matrix3d relative = ct * dc;
+    const Eigen::Vector3d numeric = Eigen::Vector3d(relative(2, 1), relative(0, 2), relative(1, 0)) + ct * earth;
+    EXPECT_LT((numeric - s.angular_velocity).norm(), 2e-10 + 1e-9 * s.angular_velocity.norm());
+  }
+  // An empty section is a still base: the still path, bit for bit.
+  const TriadMotion empty(parseText(scenario() + "  base_motion: {}\n"));
+  EXPECT_FALSE(empty.base().enabled());
+  for (const double t : {2.0, 10.0, c.positions[1].move_start + 2.0}) {
+    EXPECT_EQ(empty.stateAt(t).body_to_enu, fixed.stateAt(t).body_to_enu);
+    EXPECT_EQ(empty.angularVelocityAt(t), fixed.angularVelocityAt(t));
+  }
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace hrg_gyro

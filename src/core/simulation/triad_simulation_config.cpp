@@ -13,13 +13,16 @@ namespace {
 
 // Limits of what the scenario calls small: beyond them the fixture is not the nominal one (and the
 // triad file, which refuses |M - I| > 0.1, could not hold the result).
-constexpr double kMaxMisalignment = 0.05;       // rad, and relative for the residual scale
-constexpr double kMaxFixtureError = 0.1;        // rad per component
-constexpr double kMaxFixtureErrorStd = 0.01;    // rad
-constexpr double kMaxWobble = 0.01;             // rad
-constexpr double kMaxMove = 3600.0;             // s
-constexpr double kMaxAccelerometerBias = 1.0;   // m/s^2: an accelerometer off by 0.1 g is broken
-constexpr double kMaxAccelerometerNoise = 1.0;  // m/s^2 per sample
+constexpr double kMaxMisalignment = 0.05;              // rad, and relative for the residual scale
+constexpr double kMaxFixtureError = 0.1;               // rad per component
+constexpr double kMaxFixtureErrorStd = 0.01;           // rad
+constexpr double kMaxWobble = 0.01;                    // rad
+constexpr double kMaxMove = 3600.0;                    // s
+constexpr double kMaxAccelerometerBias = 1.0;          // m/s^2: an accelerometer off by 0.1 g is broken
+constexpr double kMaxAccelerometerNoise = 1.0;         // m/s^2 per sample
+constexpr double kMaxAccelerometerScale = 0.1;         // relative: beyond it the accelerometer is broken
+constexpr double kMaxAccelerometerMisalignment = 0.1;  // rad per component: a small rotation
+constexpr double kMaxAccelerometerQuantum = 1.0;       // m/s^2: a tenth of g
 
 /// The stream the drawn fixture errors come from: switching it on changes no other draw.
 constexpr std::uint64_t kFixtureErrorStream = 0x6a09e667f3bcc908ULL;
@@ -116,9 +119,44 @@ Eigen::Matrix3d parseOrientation(const YamlField& p) {
                                   finite(b, "yaw", 0.0, "rad"));
 }
 
+/// Three numbers, each |v_j| <= limit, the element named when not.
+Eigen::Vector3d smallVector(const YamlField& a, const char* key, double limit, const std::string& what) {
+  const std::vector<double> v = a[key].asDoubles(3);
+  for (std::size_t j = 0; j < 3; ++j) {
+    if (!(std::abs(v[j]) <= limit)) a[key].at(j).fail(what + ": at most " + formatDouble(limit) + " in magnitude");
+  }
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+/// The accelerometer's own errors: scale, misalignment, axis signs, convention, quantum.
+void parseAccelerometerErrors(const YamlField& a, TriadAccelerometerConfig* c) {
+  if (a.has("scale")) c->scale = smallVector(a, "scale", kMaxAccelerometerScale, "a relative scale error");
+  if (a.has("misalignment")) {
+    c->misalignment = smallVector(a, "misalignment", kMaxAccelerometerMisalignment, "a small rotation, rad");
+  }
+  if (a.has("axis_signs")) {
+    const std::vector<double> v = a["axis_signs"].asDoubles(3);
+    for (std::size_t j = 0; j < 3; ++j) {
+      if (v[j] != 1.0 && v[j] != -1.0) a["axis_signs"].at(j).fail("must be 1 or -1 (-1: the axis reversed)");
+      c->axis_signs[static_cast<Eigen::Index>(j)] = v[j];
+    }
+  }
+  const std::string convention = a.getString("convention", "specific_force");
+  if (convention == "gravity") {
+    c->convention = TriadAccelerometerConfig::Convention::kGravity;
+  } else if (convention != "specific_force") {
+    a["convention"].fail("'" + convention + "' is not specific_force (+g up at rest) or gravity (-g up)");
+  }
+  c->quantum = a.getDouble("quantum", 0.0);
+  if (!(c->quantum >= 0.0 && c->quantum <= kMaxAccelerometerQuantum)) {
+    a["quantum"].fail("must be in [0, " + formatDouble(kMaxAccelerometerQuantum) + "] m/s^2 (0: not quantised)");
+  }
+}
+
 TriadAccelerometerConfig parseAccelerometer(const YamlField& a, double output_period) {
   a.requireMap();
-  a.rejectUnknownKeys({"enabled", "frame_id", "bias", "noise", "noise_density", "mounting"});
+  a.rejectUnknownKeys({"enabled", "frame_id", "bias", "noise", "noise_density", "mounting", "scale", "misalignment",
+                       "axis_signs", "convention", "quantum"});
   TriadAccelerometerConfig c;
   c.enabled = a.getBool("enabled", true);
   c.frame_id = frameId(a, c.frame_id);
@@ -148,6 +186,7 @@ TriadAccelerometerConfig parseAccelerometer(const YamlField& a, double output_pe
     c.accelerometer_to_body = rotationFromRollPitchYaw(finite(m, "roll", 0.0, "rad"), finite(m, "pitch", 0.0, "rad"),
                                                        finite(m, "yaw", 0.0, "rad"));
   }
+  parseAccelerometerErrors(a, &c);
   return c;
 }
 
@@ -286,7 +325,8 @@ TriadSimulationConfig TriadSimulationConfig::parse(const YamlField& root, const 
 
   const YamlField t = root["triad"];
   t.requireMap();
-  t.rejectUnknownKeys({"frame_id", "axes", "turntable", "positions", "fixture_error_std", "accelerometer"});
+  t.rejectUnknownKeys(
+      {"frame_id", "axes", "turntable", "positions", "fixture_error_std", "accelerometer", "base_motion"});
   c.frame_id = frameId(t, c.frame_id);
 
   const YamlField axes = t["axes"];
@@ -314,6 +354,7 @@ TriadSimulationConfig TriadSimulationConfig::parse(const YamlField& root, const 
     t["fixture_error_std"].fail("must be in [0, " + formatDouble(kMaxFixtureErrorStd) + "] rad");
   }
   if (t.has("accelerometer")) c.accelerometer = parseAccelerometer(t["accelerometer"], c.outputPeriod());
+  if (t.has("base_motion")) c.base_motion = parseBaseMotion(t["base_motion"]);
   c.positions = parsePositions(t["positions"], c.turntable.acceleration);
   c.setSeed(c.seed);
 

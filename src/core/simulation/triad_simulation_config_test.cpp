@@ -222,6 +222,38 @@ TEST(TriadSimulationConfigTest, AccelerometerIsOffUnlessGivenAndTakesItsNoiseAsG
   EXPECT_NEAR(d.accelerometer.noise, 1.0e-4 * std::sqrt(1000.0), 1e-15);
 }
 
+// The accelerometer's own errors and the base's motion: none unless given, read as given.
+TEST(TriadSimulationConfigTest, AccelerometerErrorsAndTheBaseMotionAreNoneUnlessGiven) {
+  const TriadSimulationConfig plain = parseText(scenario("  accelerometer: {noise: 1.0e-3}\n"));
+  const TriadAccelerometerConfig& p = plain.accelerometer;
+  EXPECT_EQ(p.scale, Eigen::Vector3d::Zero());
+  EXPECT_EQ(p.misalignment, Eigen::Vector3d::Zero());
+  EXPECT_EQ(p.axis_signs, Eigen::Vector3d::Ones());
+  EXPECT_EQ(p.convention, TriadAccelerometerConfig::Convention::kSpecificForce);
+  EXPECT_EQ(p.quantum, 0.0);
+  EXPECT_FALSE(plain.base_motion.enabled());
+  const TriadSimulationConfig c = parseText(scenario(
+      "  accelerometer: {scale: [1.0e-3, -2.0e-3, 0.0], misalignment: [1.0e-4, 0.0, -3.0e-4], axis_signs: [-1, 1, "
+      "1], convention: gravity, quantum: 1.0e-3}\n"
+      "  base_motion:\n"
+      "    leans: [{time: 1.0, duration: 2.0, rotation: [2.5e-5, 0.0, 0.0]}]\n"
+      "    sways: [{amplitude: 5.0e-5, period: 1.7, axis: [0.0, 1.0, 0.0]}]\n"
+      "    vibration: {rms: 0.05, low: 10.0, high: 40.0}\n"));
+  const TriadAccelerometerConfig& a = c.accelerometer;
+  EXPECT_EQ(a.scale, Eigen::Vector3d(1.0e-3, -2.0e-3, 0.0));
+  EXPECT_EQ(a.misalignment, Eigen::Vector3d(1.0e-4, 0.0, -3.0e-4));
+  EXPECT_EQ(a.axis_signs, Eigen::Vector3d(-1.0, 1.0, 1.0));
+  EXPECT_EQ(a.convention, TriadAccelerometerConfig::Convention::kGravity);
+  EXPECT_EQ(a.quantum, 1.0e-3);
+  ASSERT_TRUE(c.base_motion.enabled());
+  ASSERT_EQ(c.base_motion.leans.size(), 1u);
+  EXPECT_EQ(c.base_motion.leans[0].rotation, Eigen::Vector3d(2.5e-5, 0.0, 0.0));
+  ASSERT_EQ(c.base_motion.sways.size(), 1u);
+  EXPECT_EQ(c.base_motion.sways[0].period, 1.7);
+  EXPECT_EQ(c.base_motion.vibration.rms, 0.05);
+  EXPECT_EQ(c.base_motion.yaw_jitter.rms, 0.0);
+}
+
 // An axis's `dynamics` section is a single gyro's: the averaged resonator's K replaces the resonator's,
 // its schedule reaches the axis's scenario, and the other axes keep the given K and D.
 TEST(TriadSimulationConfigTest, AnAxisMayRunTheAveragedResonatorOnItsSchedule) {
@@ -280,9 +312,39 @@ TEST(TriadSimulationConfigTest, RejectsBadValuesByKey) {
       {"{frame_id: ' '}", "frame_id"},
       {"{mounting: {roll: .inf}}", "mounting.roll"},
       {"{mounting: {heading: 1}}", "mounting.heading"},
-      {"{enabled: maybe}", "enabled"}};
+      {"{enabled: maybe}", "enabled"},
+      {"{scale: [0, 0]}", "scale"},
+      {"{scale: [0, 0.5, 0]}", "scale[1]"},
+      {"{scale: [0, 0, .nan]}", "scale[2]"},
+      {"{misalignment: [0.2, 0, 0]}", "misalignment[0]"},
+      {"{misalignment: 1.0e-4}", "misalignment"},
+      {"{axis_signs: [1, 0, 1]}", "axis_signs[1]"},
+      {"{axis_signs: [1, 1, 0.5]}", "axis_signs[2]"},
+      {"{axis_signs: [1, -1]}", "axis_signs"},
+      {"{convention: up}", "convention"},
+      {"{convention: [gravity]}", "convention"},
+      {"{quantum: -1.0e-3}", "quantum"},
+      {"{quantum: 2.0}", "quantum"},
+      {"{quantum: .inf}", "quantum"}};
   for (const auto& [section, key] : accelerometer) {
     expectError(good + "  accelerometer: " + section + "\n", "triad.accelerometer" + (key.empty() ? "" : "." + key));
+  }
+  // The base's motion, named as the file writes it (its own checks: BaseMotionTest).
+  const std::vector<std::pair<std::string, std::string>> base = {
+      {"1", ""},
+      {"{sway: []}", "sway"},
+      {"{leans: [{time: 1.0, duration: 0.0, rotation: [0, 0, 1.0e-5]}]}", "leans[0].duration"},
+      {"{leans: [{duration: 1.0, rotation: [0, 0, 1.0e-5]}]}", "leans[0].time"},
+      {"{leans: [{time: 1.0, rotation: [0, 0.2, 0]}]}", "leans[0].rotation"},
+      {"{knocks: [{time: 1.0, rotation: [0, 0, 1.0e-5], ring_decay: 0.0}]}", "knocks[0].ring_decay"},
+      {"{sways: [{amplitude: 1.0e-4, period: 10.0, axis: [1.0, 1.0, 0.0]}]}", "sways[0].axis"},
+      {"{sways: [{amplitude: 1.0e-4}]}", "sways[0].period"},
+      {"{yaw_jitter: {rms: -1.0}}", "yaw_jitter.rms"},
+      {"{vibration: {rms: 0.05, low: 40.0, high: 10.0}}", "vibration.low"},
+      {"{vibration: {rms: 0.05, components: 0}}", "vibration.components"},
+      {"{vibration: {rms: 0.05, band: 1}}", "vibration.band"}};
+  for (const auto& [section, key] : base) {
+    expectError(good + "  base_motion: " + section + "\n", "triad.base_motion" + (key.empty() ? "" : "." + key));
   }
   // The axes.
   expectError(replaced(good, "    - {name: z, misalignment: [-2.5e-4, 0.5e-4], scale: -2.0e-4}\n", ""), "triad.axes");

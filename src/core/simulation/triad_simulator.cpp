@@ -1,5 +1,7 @@
 #include "hrg_gyro/core/simulation/triad_simulator.h"
 
+#include <cmath>
+
 #include "hrg_gyro/core/alignment/local_level.h"
 
 namespace hrg_gyro {
@@ -32,7 +34,8 @@ TriadSimulator::TriadSimulator(const TriadSimulationConfig& config)
     : config_(config),
       motion_(config_),
       logger_(config_.turntable.log, config_.seed),
-      accelerometer_noise_(config_.seed ^ kAccelerometerStream) {
+      accelerometer_noise_(config_.seed ^ kAccelerometerStream),
+      accelerometer_misalignment_(rotationFromVector(config_.accelerometer.misalignment).transpose()) {
   const Eigen::Matrix3d a = config_.bodyToAxis();
   for (int i = 0; i < 3; ++i) {
     inputs_[i] = std::make_unique<AxisInput>(config_, a.row(i));
@@ -75,14 +78,28 @@ void TriadSimulator::logFixture(double t_center, const TriadBodyState& state, Tr
   last_fixture_ = f;
 }
 
-void TriadSimulator::measureGravity(const TriadBodyState& state, TriadSample* out) {
+void TriadSimulator::measureAcceleration(double t_start, double t_end, const TriadBodyState& state, TriadSample* out) {
+  using Convention = TriadAccelerometerConfig::Convention;
   const TriadAccelerometerConfig& a = config_.accelerometer;
   out->accelerometer.present = a.enabled;
   if (!a.enabled) return;
   Eigen::Vector3d noise;
   for (int j = 0; j < 3; ++j) noise[j] = accelerometer_noise_.next();  // in order
-  out->accelerometer.specific_force =
-      specificForceAtRest(state.body_to_enu, a.accelerometer_to_body) + a.bias + a.noise * noise;
+  // Steps 1-2 (triad_simulator.h); without vibration (0, 0, g) is exactly specificForceAtRest's.
+  Eigen::Vector3d enu(0.0, 0.0, kStandardGravity);
+  if (motion_.base().enabled()) enu += motion_.base().meanAccelerationOver(t_start, t_end);
+  Eigen::Vector3d f = (state.body_to_enu * a.accelerometer_to_body).transpose() * enu;
+  // Steps 3-6, each skipped when it is the identity: older records keep their bits (an identity
+  // product would turn -0 into +0).
+  if (a.misalignment != Eigen::Vector3d::Zero()) f = accelerometer_misalignment_ * f;
+  if (a.scale != Eigen::Vector3d::Zero()) f = (Eigen::Vector3d::Ones() + a.scale).cwiseProduct(f);
+  if (a.axis_signs != Eigen::Vector3d::Ones()) f = a.axis_signs.cwiseProduct(f);
+  if (a.convention == Convention::kGravity) f = -f;
+  f = f + a.bias + a.noise * noise;
+  if (a.quantum > 0.0) {
+    for (int j = 0; j < 3; ++j) f[j] = a.quantum * std::round(f[j] / a.quantum);
+  }
+  out->accelerometer.specific_force = f;
 }
 
 bool TriadSimulator::next(TriadSample* out) {
@@ -100,7 +117,7 @@ bool TriadSimulator::next(TriadSample* out) {
   out->body.position = static_cast<std::uint32_t>(state.position);
   logTurntable(t_center, out->stamp, state, out);
   logFixture(t_center, state, out);
-  measureGravity(state, out);
+  measureAcceleration(t_start, elapsed(), state, out);
   return true;
 }
 

@@ -7,10 +7,13 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <string>
 
+#include "core/testing/shipped_scenarios.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
 
@@ -363,6 +366,295 @@ TEST(TriadSimulatorTest, AccelerometerAddsItsBiasAndNoiseInItsMountedFrameFromIt
     EXPECT_FALSE(plain[k].accelerometer.present);
     for (int i = 0; i < 3; ++i) ASSERT_EQ(plain[k].axes[i].z, samples[k].axes[i].z);
   }
+}
+
+/// FNV-1a over the bytes of everything a triad sample carries: any changed bit changes it.
+class TriadFingerprint {
+ public:
+  template <typename T>
+  void add(const T& value) {
+    unsigned char bytes[sizeof(T)];
+    std::memcpy(bytes, &value, sizeof(T));
+    for (const unsigned char b : bytes) hash_ = (hash_ ^ b) * 0x100000001b3ULL;
+  }
+  void addVector(const Eigen::Vector3d& v) {
+    for (int j = 0; j < 3; ++j) add(v[j]);
+  }
+  void addQuaternion(const Eigen::Quaterniond& q) {
+    for (int j = 0; j < 4; ++j) add(q.coeffs()[j]);
+  }
+  void add(const TriadSample& s) {
+    add(s.index), add(s.stamp);
+    for (const SimulationSample& a : s.axes) {
+      add(a.index), add(a.stamp), add(a.channels_delivered);
+      for (int j = 0; j < 4; ++j) add(a.z[j]);
+      add(a.truth.theta), add(a.truth.table_angle), add(a.truth.table_rate), add(a.truth.inertial_angle);
+      add(a.truth.inertial_rate);
+    }
+    for (const TurntableLogRecord& r : s.turntable) add(r.index), add(r.time), add(r.stamp), add(r.angle), add(r.rate);
+    add(s.fixture.index), add(s.fixture.locked), add(s.fixture_logged), addQuaternion(s.fixture.body_to_table);
+    addVector(s.body.angular_velocity), addQuaternion(s.body.body_to_table), addQuaternion(s.body.body_to_enu);
+    add(s.body.position), add(s.accelerometer.present), addVector(s.accelerometer.specific_force);
+  }
+  std::uint64_t value() const { return hash_; }
+
+ private:
+  std::uint64_t hash_ = 0xcbf29ce484222325ULL;
+};
+
+// A scenario that gives none of the base's or the accelerometer's newer keys is what it was before
+// them, bit for bit: the hashes were recorded on the simulator before triad.base_motion existed.
+// The test scenario with every older feature (fixture error, wobble, table log, pickoff noise, an
+// accelerometer with bias, noise and mounting), and the first 10 s of north_static.yaml.
+TEST(TriadSimulatorTest, AScenarioWithoutTheNewKeysKeepsItsFingerprint) {
+  const std::string accelerometer =
+      "{latitude: 0.9, azimuth: 0.3, wobble: {amplitude: 1.0e-4, direction: 0.4}, log: {rate: 100, angle_noise: "
+      "2.0e-6}}\n  accelerometer: {bias: [1.0e-3, -2.0e-3, 3.0e-3], noise: 2.0e-3, mounting: {roll: 0.1, pitch: "
+      "-0.2, yaw: 0.3}}";
+  const TriadSimulationConfig c =
+      parseText(scenario(accelerometer, ", error: [1.2e-4, 2.0e-4, -0.5e-4]", ", pickoff: {noise: 2.0e-4}"));
+  TriadSimulator sim(c);
+  TriadFingerprint f;
+  TriadSample s;
+  while (sim.next(&s)) f.add(s);
+  const TriadSimulationConfig shipped = TriadSimulationConfig::load(testing::shippedScenarioPath("north_static.yaml"));
+  TriadSimulator sim_shipped(shipped);
+  TriadFingerprint g;
+  for (int n = 0; n < 2000 && sim_shipped.next(&s); ++n) g.add(s);
+  std::printf("[ measured ] fingerprints 0x%016llx 0x%016llx\n", static_cast<unsigned long long>(f.value()),
+              static_cast<unsigned long long>(g.value()));
+  EXPECT_EQ(f.value(), 0xfcf41c37d63cc5d2ULL);
+  EXPECT_EQ(g.value(), 0x43101a7023afb2c7ULL);
+}
+
+// ---- A base that moves (triad.base_motion) and the accelerometer's own errors ----
+
+/// One tilted position at rest for `duration` s, the base and the accelerometer given by `extra`.
+std::string restScenario(const std::string& extra, double duration) {
+  return "seed: 5\n"
+         "triad:\n"
+         "  axes:\n" +
+         axis(0, "x", "[2.0e-4, -1.5e-4]") + axis(1, "y", "[3.0e-4, 1.0e-4]") + axis(2, "z", "[-2.5e-4, 0.5e-4]") +
+         "  turntable: {latitude: 0.9, azimuth: 0.3}\n"
+         "  positions:\n"
+         "    - {name: rest, body_to_table: {roll: 0.3, pitch: -0.2, yaw: 0.4}, profile: [{type: dwell, duration: " +
+         formatDouble(duration) + "}]}\n" + extra;
+}
+
+/// The centre of a sample's window as the simulator computes it (the stamp is rounded to the ns).
+double centreOf(const TriadSimulationConfig& c, const TriadSample& s) { return (s.index + 0.5) * c.outputPeriod(); }
+
+/// The rest position's attitude on a still base, written out: Rz(pi/2 - azimuth) R.
+Eigen::Matrix3d restAttitude() {
+  return Eigen::AngleAxisd(kPi / 2 - 0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+         rotationFromRollPitchYaw(0.3, -0.2, 0.4);
+}
+
+Eigen::Vector3d earthInEnu() {
+  return Eigen::Vector3d(0.0, kEarthRotationRate * std::cos(0.9), kEarthRotationRate * std::sin(0.9));
+}
+
+/// The integral over [t1, t2] of D^T Omega_enu, D = Exp(theta(t) n) about a fixed axis n, to second
+/// order in theta: Omega dt - (n x Omega) int theta + (n x (n x Omega)) int theta^2 / 2.
+Eigen::Vector3d earthThroughBase(const Eigen::Vector3d& n, double dt, double theta, double theta2_half) {
+  const Eigen::Vector3d earth = earthInEnu();
+  return earth * dt - n.cross(earth) * theta + n.cross(n.cross(earth)) * theta2_half;
+}
+
+// A lean of 25 urad: each axis integrates A_i C_nominal^T (r + int D^T Omega), the lean's rotation in
+// full (about a fixed axis, D^T w = w) and the Earth's rate seen through the leaning base; the truth's
+// attitude is D(t) C_nominal before, during and after it.
+TEST(TriadSimulatorTest, ALeanOfTheBaseIsSensedAsItsRotationAndCarriedByTheTruth) {
+  const Eigen::Vector3d r(2.0e-5, -1.5e-5, 0.0);
+  const TriadSimulationConfig c = parseText(
+      restScenario("  base_motion: {leans: [{time: 2.0, duration: 2.0, rotation: [2.0e-5, -1.5e-5, 0.0]}]}\n", 6.0));
+  TriadSimulator sim(c);
+  const std::vector<TriadSample> samples = runAll(sim);
+  const Eigen::Matrix3d a = c.bodyToAxis(), nominal = restAttitude();
+  const TriadSample &s1 = sampleAt(c, samples, 1.0), &s2 = sampleAt(c, samples, 5.0);
+  const double t1 = centreOf(c, s1), t2 = centreOf(c, s2), size = r.norm();
+  // The raised cosine s(u) over the lean: int s = T / 2, int s^2 = 3 T / 8; whole after it.
+  const double theta = size * (1.0 + (t2 - 4.0)), theta2_half = 0.5 * size * size * (0.75 + (t2 - 4.0));
+  const Eigen::Vector3d integral = nominal.transpose() * (r + earthThroughBase(r / size, t2 - t1, theta, theta2_half));
+  double worst = 0.0;
+  Eigen::Vector3d beyond_earth;
+  for (int i = 0; i < 3; ++i) {
+    const double sensed = s2.axes[i].truth.inertial_angle - s1.axes[i].truth.inertial_angle;
+    EXPECT_NEAR(sensed, a.row(i).dot(integral), 1e-12) << i;
+    worst = std::max(worst, std::abs(sensed - a.row(i).dot(integral)));
+    beyond_earth[i] = sensed - a.row(i).dot(nominal.transpose() * earthInEnu()) * (t2 - t1);
+  }
+  // What a still base would not give (its Earth's share alone): the lean's rotation through A, but
+  // for the Earth's rate the lean turns (r x Omega, 3.6e-9 rad over the lean and the second after).
+  EXPECT_NEAR(beyond_earth.norm(), (a * nominal.transpose() * r).norm(), 1e-8);
+  std::printf("[ measured ] a lean of 25 urad: sensed angles within %.2e rad of the closed form\n", worst);
+  // The truth: C_nominal before, Exp(s(u) r) C_nominal in the lean, Exp(r) C_nominal after.
+  EXPECT_LT(s1.body.body_to_enu.angularDistance(Eigen::Quaterniond(nominal)), 2e-15);
+  const TriadSample& mid = sampleAt(c, samples, 3.3);
+  const double u = (centreOf(c, mid) - 2.0) / 2.0;
+  const Eigen::Quaterniond leaning(rotationFromVector((0.5 - 0.5 * std::cos(kPi * u)) * r) * nominal);
+  EXPECT_LT(mid.body.body_to_enu.angularDistance(leaning), 2e-15);
+  EXPECT_LT(samples.back().body.body_to_enu.angularDistance(Eigen::Quaterniond(rotationFromVector(r) * nominal)),
+            2e-15);
+  EXPECT_EQ(samples.back().body.body_to_table.coeffs(), s1.body.body_to_table.coeffs()) << "relative to the base";
+}
+
+// A sway: the body integrates its angle's change about its axis and the Earth's rate through it. A
+// knock: its step, and a ringing whose rate steps by ring x size x 2 pi ring_frequency at its time,
+// which a resonator period's RK4 stages (and Simpson's rule on them) resolve only to that step times
+// T / 6 (7.5e-8 rad here); its closed form otherwise, and the truth after it D = Exp(rotation).
+TEST(TriadSimulatorTest, ASwayAndAKnockOfTheBaseAreSensedAsTheirRotations) {
+  const Eigen::Matrix3d nominal = restAttitude();
+  {
+    const double amplitude = 3.0e-5, period = 0.9, phase = 0.4;
+    const Eigen::Vector3d n = Eigen::Vector3d(1.0, -2.0, 0.5).normalized();
+    const TriadSimulationConfig c = parseText(
+        restScenario("  base_motion: {sways: [{amplitude: 3.0e-5, period: 0.9, phase: 0.4, axis: [" +
+                         formatDouble(n.x()) + ", " + formatDouble(n.y()) + ", " + formatDouble(n.z()) + "]}]}\n",
+                     5.0));
+    TriadSimulator sim(c);
+    const std::vector<TriadSample> samples = runAll(sim);
+    const TriadSample &s1 = sampleAt(c, samples, 0.5), &s2 = sampleAt(c, samples, 4.7);
+    const double t1 = centreOf(c, s1), t2 = centreOf(c, s2), w = kTwoPi / period;
+    const double p1 = w * t1 + phase, p2 = w * t2 + phase;
+    const double theta = amplitude / w * (std::cos(p1) - std::cos(p2));
+    const double theta2_half =
+        0.25 * amplitude * amplitude * ((t2 - t1) - (std::sin(2.0 * p2) - std::sin(2.0 * p1)) / (2.0 * w));
+    const Eigen::Vector3d integral = nominal.transpose() * (n * amplitude * (std::sin(p2) - std::sin(p1)) +
+                                                            earthThroughBase(n, t2 - t1, theta, theta2_half));
+    double worst = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const double sensed = s2.axes[i].truth.inertial_angle - s1.axes[i].truth.inertial_angle;
+      EXPECT_NEAR(sensed, c.bodyToAxis().row(i).dot(integral), 1e-12) << i;
+      worst = std::max(worst, std::abs(sensed - c.bodyToAxis().row(i).dot(integral)));
+    }
+    std::printf("[ measured ] a sway of 30 urad: sensed angles within %.2e rad of the closed form\n", worst);
+    const Eigen::Quaterniond swayed(rotationFromVector(amplitude * std::sin(p2) * n) * nominal);
+    EXPECT_LT(s2.body.body_to_enu.angularDistance(swayed), 2e-15);
+  }
+  {
+    const Eigen::Vector3d k(1.0e-5, 0.0, 2.0e-5);
+    const double ring = 2.0, f = 8.0, decay = 0.15, size = k.norm(), w = kTwoPi * f;
+    const TriadSimulationConfig c =
+        parseText(restScenario("  base_motion: {knocks: [{time: 2.0, rotation: [1.0e-5, 0.0, 2.0e-5]}]}\n", 7.0));
+    ASSERT_EQ(c.base_motion.knocks[0].ring, ring);
+    ASSERT_EQ(c.base_motion.knocks[0].ring_frequency, f);
+    ASSERT_EQ(c.base_motion.knocks[0].ring_decay, decay);
+    TriadSimulator sim(c);
+    const std::vector<TriadSample> samples = runAll(sim);
+    // From before the knock to 30 decay times after it (the ringing e^-30 of its size: gone).
+    const TriadSample &s1 = sampleAt(c, samples, 1.0), &s2 = sampleAt(c, samples, 6.5);
+    const double t1 = centreOf(c, s1), t2 = centreOf(c, s2);
+    // int theta: the step's raised cosine over 0.05 s (half of it), then whole; the ringing's integral
+    // a w / (w^2 + 1 / decay^2). The second order: the step's alone (the ringing's is 1e-15 rad).
+    const double theta = size * (0.025 + (t2 - 2.05)) + ring * size * w / (w * w + 1.0 / (decay * decay));
+    const double theta2_half = 0.5 * size * size * (0.05 * 0.375 + (t2 - 2.05));
+    const Eigen::Vector3d integral =
+        nominal.transpose() * (k + earthThroughBase(k / size, t2 - t1, theta, theta2_half));
+    const double resolved = ring * size * w * (1.0 / c.axes[0].resonator.frequency) / 6.0;
+    double worst = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const double sensed = s2.axes[i].truth.inertial_angle - s1.axes[i].truth.inertial_angle;
+      EXPECT_NEAR(sensed, c.bodyToAxis().row(i).dot(integral), resolved + 1e-12) << i;
+      worst = std::max(worst, std::abs(sensed - c.bodyToAxis().row(i).dot(integral)));
+    }
+    std::printf("[ measured ] a knock of 22 urad: sensed angles within %.2e rad of the closed form (bound %.2e)\n",
+                worst, resolved);
+    EXPECT_LT(s2.body.body_to_enu.angularDistance(Eigen::Quaterniond(rotationFromVector(k) * nominal)), 2e-15);
+    EXPECT_GT(sampleAt(c, samples, 2.06).body.angular_velocity.norm(), 1e-4) << "it rings";
+  }
+}
+
+/// Every sample of a rest scenario with the given accelerometer section (and base). Their names and
+/// labels point into the simulator, gone on return: the tests here read neither.
+std::vector<TriadSample> accelerometerRun(const std::string& accelerometer, const std::string& base = "") {
+  TriadSimulator sim(parseText(restScenario("  accelerometer: " + accelerometer + "\n" + base, 1.0)));
+  return runAll(sim);
+}
+
+// Each fault of the accelerometer does what its key says, in the documented order, on what a perfect
+// one reads, f0 = (C R)^T (0, 0, g), C the truth's attitude (the base leaning in it).
+TEST(TriadSimulatorTest, TheAccelerometerReadsWhatEachConventionAndFaultSays) {
+  const double g = 9.80665;
+  const std::string mounting = "mounting: {roll: 0.1, pitch: -0.2, yaw: 0.3}";
+  const std::string lean = "  base_motion: {leans: [{time: 0.2, duration: 0.5, rotation: [0.0, 3.0e-3, 0.0]}]}\n";
+  const Eigen::Matrix3d r = rotationFromRollPitchYaw(0.1, -0.2, 0.3);
+  const Eigen::Vector3d s(2.0e-3, -1.0e-3, 5.0e-4), rho(1.0e-3, -2.0e-3, 3.0e-3), b(1.0e-3, -2.0e-3, 3.0e-3);
+  const Eigen::Matrix3d misaligned = rotationFromVector(rho).transpose();
+  auto run = [&](const std::string& faults) { return accelerometerRun("{" + faults + mounting + "}", lean); };
+  const std::vector<TriadSample> perfect = run(""), gravity = run("convention: gravity, "),
+                                 flipped = run("axis_signs: [-1, 1, 1], "),
+                                 scaled = run("scale: [2.0e-3, -1.0e-3, 5.0e-4], "),
+                                 turned = run("misalignment: [1.0e-3, -2.0e-3, 3.0e-3], "),
+                                 quantised = run("quantum: 0.01, bias: [1.0e-3, -2.0e-3, 3.0e-3], ");
+  const std::vector<TriadSample> all =
+      run("misalignment: [1.0e-3, -2.0e-3, 3.0e-3], scale: [2.0e-3, -1.0e-3, 5.0e-4], axis_signs: [-1, 1, 1], "
+          "convention: gravity, bias: [1.0e-3, -2.0e-3, 3.0e-3], ");
+  ASSERT_EQ(perfect.size(), all.size());
+  double leaned = 0.0;
+  for (std::size_t n = 0; n < perfect.size(); ++n) {
+    SCOPED_TRACE(n);
+    const Eigen::Matrix3d c = perfect[n].body.body_to_enu.toRotationMatrix();
+    const Eigen::Vector3d f0 = (c * r).transpose() * Eigen::Vector3d(0.0, 0.0, g);
+    EXPECT_LT((perfect[n].accelerometer.specific_force - f0).norm(), 1e-12);
+    leaned = std::max(leaned, (f0 - (restAttitude() * r).transpose() * Eigen::Vector3d(0.0, 0.0, g)).norm());
+    // gravity: -g up; axis_signs -1: x reversed alone; scale and misalignment as defined.
+    const Eigen::Vector3d up = (c * r).transpose() * Eigen::Vector3d::UnitZ();
+    EXPECT_NEAR(gravity[n].accelerometer.specific_force.dot(up), -g, 1e-12);
+    EXPECT_LT((gravity[n].accelerometer.specific_force + f0).norm(), 1e-12);
+    EXPECT_LT((flipped[n].accelerometer.specific_force - Eigen::Vector3d(-f0.x(), f0.y(), f0.z())).norm(), 1e-12);
+    EXPECT_LT((scaled[n].accelerometer.specific_force - (Eigen::Vector3d::Ones() + s).cwiseProduct(f0)).norm(), 1e-12);
+    EXPECT_LT((turned[n].accelerometer.specific_force - misaligned * f0).norm(), 1e-12);
+    // Quantised last, after the bias: multiples of 0.01 within half of it of f0 + b.
+    for (int j = 0; j < 3; ++j) {
+      const double q = quantised[n].accelerometer.specific_force[j];
+      EXPECT_NEAR(q / 0.01, std::round(q / 0.01), 1e-9) << j;
+      EXPECT_LE(std::abs(q - (f0[j] + b[j])), 0.005 + 1e-12) << j;
+    }
+    // All of them: misalignment, scale, signs, convention, then the bias.
+    const Eigen::Vector3d signs(-1.0, 1.0, 1.0);
+    const Eigen::Vector3d expected =
+        -signs.cwiseProduct((Eigen::Vector3d::Ones() + s).cwiseProduct(misaligned * f0)) + b;
+    EXPECT_LT((all[n].accelerometer.specific_force - expected).norm(), 1e-12);
+  }
+  // The lean of 3 mrad reaches it through the truth's attitude: 2 g sin(1.5e-3) = 0.029 m/s^2.
+  EXPECT_NEAR(leaned, g * 2.0 * std::sin(1.5e-3), 1e-6);
+}
+
+// The base's vibration is a linear acceleration: the accelerometer reads its mean over each sample,
+// through the attitude, and the gyros read nothing of it (every channel and truth bit for bit those
+// of the still base).
+TEST(TriadSimulatorTest, TheVibrationReachesTheAccelerometerAndNotTheGyros) {
+  const std::string accelerometer = "  accelerometer: {mounting: {roll: 0.1, pitch: -0.2, yaw: 0.3}}\n";
+  const TriadSimulationConfig c =
+      parseText(restScenario(accelerometer + "  base_motion: {vibration: {rms: 0.05, low: 10.0, high: 40.0}}\n", 3.0));
+  const TriadSimulationConfig still = parseText(restScenario(accelerometer, 3.0));
+  TriadSimulator sim(c), sim_still(still);
+  const std::vector<TriadSample> shaken = runAll(sim), calm = runAll(sim_still);
+  ASSERT_EQ(shaken.size(), calm.size());
+  const BaseMotion base(c.base_motion, c.seed);
+  const Eigen::Matrix3d r = rotationFromRollPitchYaw(0.1, -0.2, 0.3);
+  double squares = 0.0, largest = 0.0;
+  for (std::size_t n = 0; n < shaken.size(); ++n) {
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_EQ(shaken[n].axes[i].z, calm[n].axes[i].z) << n;
+      ASSERT_EQ(shaken[n].axes[i].truth.theta, calm[n].axes[i].truth.theta) << n;
+      ASSERT_EQ(shaken[n].axes[i].truth.inertial_angle, calm[n].axes[i].truth.inertial_angle) << n;
+    }
+    ASSERT_EQ(shaken[n].body.angular_velocity, calm[n].body.angular_velocity) << n;
+    ASSERT_EQ(shaken[n].body.body_to_enu.coeffs(), calm[n].body.body_to_enu.coeffs()) << n;
+    const Eigen::Vector3d mean = base.meanAccelerationOver(n * c.outputPeriod(), (n + 1) * c.outputPeriod());
+    const Eigen::Matrix3d attitude = calm[n].body.body_to_enu.toRotationMatrix() * r;
+    const Eigen::Vector3d read = shaken[n].accelerometer.specific_force - calm[n].accelerometer.specific_force;
+    EXPECT_LT((read - attitude.transpose() * mean).norm(), 1e-12) << n;
+    squares += read.squaredNorm();
+    largest = std::max(largest, read.cwiseAbs().maxCoeff());
+  }
+  const double rms = std::sqrt(squares / shaken.size() / 3.0);
+  std::printf("[ measured ] vibration read by the accelerometer: %.4f m/s^2 rms per axis, largest %.4f\n", rms,
+              largest);
+  EXPECT_NEAR(rms, 0.05, 0.015);  // 20 sinusoids over 3 s
+  EXPECT_GT(largest, 0.05);
 }
 
 // An axis may run the averaged resonator: it senses the same A_x . omega_body as the harmonic axis

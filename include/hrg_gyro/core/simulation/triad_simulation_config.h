@@ -40,10 +40,12 @@
 // fixture, the same in the platter's frame in every position.
 //
 // The body's true orientation in ENU (REP-103, body -> ENU): Rz(pi/2 - azimuth) Rz(phi) body_to_table,
-// the table-zero frame's x axis at yaw pi/2 - azimuth (counter-clockwise from East). An accelerometer
-// (`accelerometer`, off by default) may ride on the fixture at the table's axis (no lever arm): it
-// measures the specific force of gravity at rest, f = C^T (0, 0, g) in its frame (REP-145: +g up),
-// C = body_to_enu accelerometer_to_body, plus its bias and white noise, at the axes' output stamps.
+// the table-zero frame's x axis at yaw pi/2 - azimuth (counter-clockwise from East). The ground may
+// move (`base_motion`, off by default; base_motion.h): the whole table stands on a base turned by
+// D(t), so the attitude becomes D(t) times that. An accelerometer (`accelerometer`, off by default)
+// may ride on the fixture at the table's axis (no lever arm): it measures the specific force, gravity's
+// (REP-145: +g up) plus the base's vibration, in its frame, with its own errors (scale, misalignment,
+// axis signs, convention, bias, noise, quantum: the order in triad_simulator.h), at the axes' stamps.
 #pragma once
 
 #include <Eigen/Core>
@@ -54,6 +56,7 @@
 
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/model/triad_parameters.h"
+#include "hrg_gyro/core/simulation/base_motion.h"
 #include "hrg_gyro/core/simulation/simulation_config.h"
 
 namespace hrg_gyro {
@@ -87,6 +90,14 @@ struct TriadAccelerometerConfig {
   double noise = 0.0;                              ///< m/s^2, white, 1 sigma per sample
   /// v_body = accelerometer_to_body v_accelerometer (`mounting: {roll, pitch, yaw}`).
   Eigen::Matrix3d accelerometer_to_body = Eigen::Matrix3d::Identity();
+  // Its own errors (the defaults: none). What users get wrong too: a reversed axis, the sign convention.
+  Eigen::Vector3d scale = Eigen::Vector3d::Zero();  ///< s_j: axis j reads (1 + s_j) of its component
+  /// rad, rho: its axes turned by Rot(rho) from the mounted ones, so it reads Rot(rho)^T f.
+  Eigen::Vector3d misalignment = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis_signs = Eigen::Vector3d::Ones();  ///< each +1 or -1 (-1: that axis reversed)
+  /// kSpecificForce: +g up at rest (REP-145); kGravity: it reports minus the specific force (-g up).
+  enum class Convention { kSpecificForce, kGravity } convention = Convention::kSpecificForce;
+  double quantum = 0.0;  ///< m/s^2: each record rounded to a multiple of it (0: not quantised)
 };
 
 struct TriadTurntableConfig {
@@ -128,6 +139,8 @@ struct TriadSimulationConfig {
   std::vector<FixturePositionConfig> positions;
   double fixture_error_std = 0.0;  ///< rad: the errors of the positions that give none, drawn
   TriadAccelerometerConfig accelerometer;
+  /// The ground under the table (`triad.base_motion`, base_motion.h): still by default.
+  BaseMotionConfig base_motion;
   /// The whole session's table motion: each position's profile in turn, the table at rest during the
   /// moves, ripple included; labels "<position>/<segment>" and "<position>/move" (set by the parser).
   TurntableProfile table_profile;

@@ -12,9 +12,21 @@
 //              locked), `fixture_logged` when it is to be published: at the first sample, whenever the
 //              position or the lock changed since the previous sample, and otherwise every second
 //   body       the body's truth at the sample: omega_body, the true body_to_table (fixture error and
-//              wobble included) and body_to_enu, the position index
-//   accelerometer  with `triad/accelerometer` enabled: its specific force at the sample (true attitude,
-//              standard gravity, its bias and white noise, drawn from a stream of its own)
+//              wobble included) and body_to_enu (the base's D included), the position index
+//   accelerometer  with `triad/accelerometer` enabled: its record at the sample, from a stream of its
+//              own for the noise, in this order (each step left out when its key is not given, so a
+//              scenario without them is bit for bit what it was):
+//                1. f_body = C^T ((0, 0, g) + a), C the true body_to_enu at the sample's centre, g
+//                   standard gravity, a the base's vibration averaged over the sample's interval
+//                   (BaseMotion::meanAccelerationOver: what a delta-velocity over dt reads)
+//                2. into its frame through its mounting: accelerometer_to_body^T f_body
+//                3. misalignment: Rot(rho)^T f
+//                4. scale: (1 + s_j) f_j
+//                5. axis signs: sign_j f_j
+//                6. convention gravity: -f
+//                7. + bias + noise (white, 1 sigma `noise`)
+//                8. quantum Q: Q round(f_j / Q) (halves away from zero)
+//              The vibration reaches the accelerometer only: the gyros sense the base's rotation.
 #pragma once
 
 #include <Eigen/Core>
@@ -95,7 +107,8 @@ class TriadSimulator {
   class AxisInput;
   void logTurntable(double t_center, Nanoseconds stamp, const TriadBodyState& state, TriadSample* out);
   void logFixture(double t_center, const TriadBodyState& state, TriadSample* out);
-  void measureGravity(const TriadBodyState& state, TriadSample* out);
+  /// The accelerometer's record over the sample [t_start, t_end] at the centre's state.
+  void measureAcceleration(double t_start, double t_end, const TriadBodyState& state, TriadSample* out);
 
   TriadSimulationConfig config_;
   TriadMotion motion_;
@@ -103,7 +116,8 @@ class TriadSimulator {
   std::array<std::unique_ptr<GyroSimulator>, 3> axes_;
   TurntableLogger logger_;
   GaussianNoise accelerometer_noise_;
-  std::uint64_t next_log_ = 0;  // index of the next record at the table's log rate
+  Eigen::Matrix3d accelerometer_misalignment_;  // Rot(rho)^T
+  std::uint64_t next_log_ = 0;                  // index of the next record at the table's log rate
   std::vector<Eigen::Quaterniond> nominal_;
   bool fixture_logged_once_ = false;
   double last_fixture_log_ = 0.0;  // s
