@@ -203,6 +203,7 @@ BodyTruth toBodyTruthMessage(const core::TriadSample& s, const ros::Time& stamp,
   m.angular_velocity.y = s.body.angular_velocity.y();
   m.angular_velocity.z = s.body.angular_velocity.z();
   m.body_to_table = toQuaternionMessage(s.body.body_to_table);
+  m.body_to_enu = toQuaternionMessage(Eigen::Quaterniond(s.body.body_to_enu).normalized());
   m.position = s.body.position;
   return m;
 }

@@ -10,6 +10,11 @@ namespace core {
 namespace {
 
 constexpr double kScanNoiseFloor = 1e-9;  // rad
+constexpr int kMaxChannels = 3, kMaxParameters = 16;
+using Parameters = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxParameters, kMaxParameters>;
+using Projection = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxParameters, kMaxChannels>;
+using Square = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxChannels, kMaxChannels>;
+using Column = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxChannels, 1>;
 
 bool sharePoints(const std::vector<AngleSeries>& channels) {
   for (const AngleSeries& s : channels) {
@@ -30,26 +35,29 @@ BaseStep strongestStep(const IntegratedAngleFit& fit, double margin) {
   BaseStep best;
   const AngleFitResult& r = fit.result();
   const std::vector<AngleSeries>& ch = fit.channels();
-  if (!r.ok || !sharePoints(ch)) return best;
-  const std::size_t channels = ch.size(), q = static_cast<std::size_t>(r.parameters.size());
-  std::vector<std::vector<double>> e(channels);
-  std::vector<double> w(channels);
-  for (std::size_t c = 0; c < channels; ++c) {
+  if (!r.ok || !sharePoints(ch) || ch.size() > static_cast<std::size_t>(kMaxChannels) ||
+      r.parameters.size() > static_cast<Eigen::Index>(kMaxParameters)) {
+    return best;
+  }
+  const Eigen::Index channels = static_cast<Eigen::Index>(ch.size()), q = r.parameters.size();
+  std::vector<std::vector<double>> e(ch.size());
+  std::vector<double> w(ch.size());
+  for (std::size_t c = 0; c < ch.size(); ++c) {
     e[c] = fit.residuals(c);
     // A noiseless series' rounding is not a step: no weight beyond a nanoradian's.
     const double white = std::max(r.white_noise[c], kScanNoiseFloor);
     w[c] = 1.0 / (white * white);
   }
+  // Fixed-capacity matrices: the scan visits every point, and must not allocate at each.
+  const Parameters n_inverse = r.normal_inverse;
   const std::vector<double>& time = ch[0].time;
-  Eigen::VectorXd z(channels);
-  Eigen::MatrixXd p(q, channels), jm(channels, channels);
   for (std::size_t begin = 0, end = 0; begin < time.size(); begin = end) {
     end = begin;
     while (end < time.size() && ch[0].segment[end] == ch[0].segment[begin]) ++end;
     const double n = static_cast<double>(end - begin);
-    std::vector<Eigen::VectorXd> mean(channels);
-    std::vector<Suffix> suffix(channels);
-    for (std::size_t c = 0; c < channels; ++c) {
+    std::vector<Eigen::VectorXd> mean(ch.size());
+    std::vector<Suffix> suffix(ch.size());
+    for (std::size_t c = 0; c < ch.size(); ++c) {
       mean[c] = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(ch[c].columns.size()));
       for (std::size_t k = 0; k < ch[c].columns.size(); ++k) {
         for (std::size_t i = begin; i < end; ++i) mean[c](k) += ch[c].regressors[k][i];
@@ -57,8 +65,11 @@ BaseStep strongestStep(const IntegratedAngleFit& fit, double margin) {
       mean[c] /= n;
       suffix[c].regressors = Eigen::VectorXd::Zero(mean[c].size());
     }
+    Projection p(q, channels);
+    Square jm(channels, channels);
+    Column z(channels), size(channels);
     for (std::size_t b = end - 1; b > begin; --b) {
-      for (std::size_t c = 0; c < channels; ++c) {
+      for (std::size_t c = 0; c < ch.size(); ++c) {
         suffix[c].residual += e[c][b];
         for (std::size_t k = 0; k < ch[c].columns.size(); ++k) {
           suffix[c].regressors(k) += ch[c].regressors[k][b] - mean[c](k);
@@ -67,15 +78,15 @@ BaseStep strongestStep(const IntegratedAngleFit& fit, double margin) {
       if (time[b - 1] - time[begin] < margin || time[end - 1] - time[b] < margin) continue;
       const double after = static_cast<double>(end - b), before = n - after;
       p.setZero();
-      for (std::size_t c = 0; c < channels; ++c) {
+      for (std::size_t c = 0; c < ch.size(); ++c) {
         z(c) = w[c] * suffix[c].residual;
         for (std::size_t k = 0; k < ch[c].columns.size(); ++k) p(ch[c].columns[k], c) += w[c] * suffix[c].regressors(k);
       }
-      jm = -(p.transpose() * r.normal_inverse * p);
-      for (std::size_t c = 0; c < channels; ++c) jm(c, c) += w[c] * before * after / n;
-      const Eigen::LDLT<Eigen::MatrixXd> solver(jm);
+      jm.noalias() = -(p.transpose() * n_inverse * p);
+      for (Eigen::Index c = 0; c < channels; ++c) jm(c, c) += w[c] * before * after / n;
+      const Eigen::LDLT<Square> solver(jm);
       if (solver.info() != Eigen::Success || !solver.isPositive()) continue;
-      const Eigen::VectorXd size = solver.solve(z);
+      size = solver.solve(z);
       const double chi = z.dot(size);
       if (!(chi > best.chi_square)) continue;
       best.found = true;

@@ -125,7 +125,13 @@ bool GyrocompassSolver::fitStillBase() {
     if (s_.mode == AlignmentMode::kSweep || !stepScanApplies(f)) return true;
     const BaseStep step = strongestStep(*fit_, std::max(2.0 * s_.motion.step_guard, 1.0));
     if (!step.found || step.chi_square < s_.motion.step_threshold) return true;
-    if (static_cast<int>(steps_.size()) >= s_.motion.max_steps) {
+    // Three steps cut and the block means still ten times their limit: the base sways, and steps will
+    // not carry it (cutting on would only cost the time of max_steps fits).
+    const bool hopeless = steps_.size() >= 3 && [&] {
+      const BlockScatter b = lowFrequencyScatter(*fit_, s_.motion.block, s_.motion.block_false_alarm);
+      return b.ratio > 10.0 * b.limit;
+    }();
+    if (static_cast<int>(steps_.size()) >= s_.motion.max_steps || hopeless) {
       steps_exhausted_ = true;
       return true;
     }
@@ -143,9 +149,9 @@ std::pair<std::string, std::string> GyrocompassSolver::stillBaseProblem() const 
                                              excluded, s_.duration, s_.motion.max_excluded)};
   }
   if (steps_exhausted_) {
-    return {"motion", formatAlignmentMessage("the base kept stepping: more than motion/max_steps (%.0f) steps in "
-                                             "the window",
-                                             s_.motion.max_steps)};
+    return {"motion", formatAlignmentMessage("the base kept moving: %.0f steps carried (motion/max_steps %.0f) and "
+                                             "it does not rest between them",
+                                             static_cast<double>(steps_.size()), s_.motion.max_steps)};
   }
   if (worst_motion_ > s_.motion.max_motion) {
     return {"motion", formatAlignmentMessage("the base moved within a rest: block mean rates spread over %.3g rad/s "

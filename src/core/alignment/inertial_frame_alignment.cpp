@@ -257,12 +257,14 @@ InertialFrameResult alignInInertialFrame(const BodyAttitudeTrack& track, const I
     const double length = p.time.back();
     const Eigen::Vector3d u(0.0, std::cos(in.latitude), std::sin(in.latitude));
     const Eigen::Matrix3d to_end = Eigen::AngleAxisd(-kEarthRotationRate * out.seconds, u).toRotationMatrix();
+    // Each share symmetric to the last bit (a covariance turned by a rotation is, but for rounding).
+    auto symmetric = [](const Eigen::Matrix3d& m) { return Eigen::Matrix3d(0.5 * (m + m.transpose())); };
     auto share = [&](const Eigen::Matrix3Xd& j, double sigma) {
-      return Eigen::Matrix3d(to_end * (sigma * sigma * j * j.transpose()) * to_end.transpose());
+      return symmetric(to_end * (sigma * sigma * j * j.transpose()) * to_end.transpose());
     };
     const Eigen::Matrix3Xd by_gyro = responseOf(fit, p.by_gyro_bias, about);
     InertialFrameBudget& b = out.budget;
-    b.noise = to_end * r.covariance().topLeftCorner<3, 3>() * to_end.transpose();
+    b.noise = symmetric(to_end * r.covariance().topLeftCorner<3, 3>() * to_end.transpose());
     b.residual_bias = share(by_gyro, in.gyro_bias);
     b.drift_harmonics = share(by_gyro, in.gyro_drift_harmonics);
     b.bias_random_walk =
