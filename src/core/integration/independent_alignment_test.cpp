@@ -69,9 +69,9 @@ Window generate(int seed, const std::string& moving = "") {
 }
 
 void removeWindow(const Window& w) {
-  for (const char* f : {"static_gyro.csv", "static_accel.csv", "indexed_gyro.csv", "indexed_accel.csv",
-                        "indexed_indexer.csv", "truth.csv", "moving_gyro.csv", "moving_accel.csv",
-                        "moving_indexer.csv", "moving_truth.json"}) {
+  for (const char* f :
+       {"static_gyro.csv", "static_accel.csv", "indexed_gyro.csv", "indexed_accel.csv", "indexed_indexer.csv",
+        "truth.csv", "moving_gyro.csv", "moving_accel.csv", "moving_indexer.csv", "moving_truth.json"}) {
     std::remove((w.dir + "/" + f).c_str());
   }
   rmdir(w.dir.c_str());
@@ -187,9 +187,10 @@ TEST(IndependentAlignment, AMovingBaseFromTheIndependentGenerator) {
     double error = r.heading - w.truth.at("moving_heading_deg");
     error -= 360.0 * std::round(error / 360.0);
     const double error_rad = error * kPi / 180.0;
-    std::printf("[ measured ] independent generator, %s%s: %s, error %+.4f mrad, sigma %.4f mrad (z %+.2f), %zu step(s)\n",
-                c.options, c.declared ? " (level declared)" : "", r.estimator.c_str(), 1e3 * error_rad,
-                1e3 * r.budget.total, error_rad / r.budget.total, r.base_steps.size());
+    std::printf(
+        "[ measured ] independent generator, %s%s: %s, error %+.4f mrad, sigma %.4f mrad (z %+.2f), %zu step(s)\n",
+        c.options, c.declared ? " (level declared)" : "", r.estimator.c_str(), 1e3 * error_rad, 1e3 * r.budget.total,
+        error_rad / r.budget.total, r.base_steps.size());
     EXPECT_EQ(r.estimator, c.estimator) << c.options;
     EXPECT_LT(std::abs(error_rad), 3.0 * r.budget.total) << c.options;
     removeWindow(w);
