@@ -277,6 +277,40 @@ class HrgBagAlign(unittest.TestCase):
         self.assertEqual(code, 2, err)
         self.assertIn("gyro-topic", err)
 
+    def test_a_moving_base_is_tracked_offline_as_live(self):
+        # config/scenarios/north_try.yaml (a standing vehicle whose engine runs; gyros the uncalibrated
+        # chain measures), its first 120 s recorded with its accelerometer and truth: the tracking
+        # estimator answers, within 3 sigmas of the truth's heading at the window's last sample.
+        bag = self.path("north_try.bag")
+        code, _, err = run("simulate", "--scenario", os.path.join(self.pkg, "config/scenarios/north_try.yaml"),
+                           "--out", bag)
+        self.assertEqual(code, 0, err)
+        chain = ["--triad", os.path.join(self.pkg, "config/triad.yaml")]
+        for name in "xyz":
+            chain += ["--axis-params", "%s=%s" % (name, os.path.join(self.pkg, "config/params_uncalibrated.yaml"))]
+        settings, out = self.path("moving.yaml"), self.path("moving.result.yaml")
+        with open(settings, "w") as f:
+            f.write(STATIC.replace("duration: 60.0               # s", "duration: 120.0              # s")
+                    .replace("  source: declared           # no accelerometer in the session",
+                             "  source: accelerometer      # accel/data_raw")
+                    .replace("  accelerometer_bias_sigma: 0.0      # m/s^2: the one added below has white noise only",
+                             "  accelerometer_bias_sigma: 5.0e-4   # m/s^2: the scenario's bias is within it"))
+        code, stdout, err = run("align", bag, "--settings", settings, "--output", out, *chain)
+        self.assertEqual(code, 0, stdout + err)
+        r = self.read(out)
+        self.assertEqual(r["estimator"], "tracking", r["estimator_reason"])
+        last = r["window"]["last_sample_ns"]
+        with rosbag.Bag(bag) as b:
+            truth = [m.body_to_enu for _, m, _ in b.read_messages(topics=["/truth"]) if m.header.stamp.to_nsec() == last]
+        self.assertEqual(len(truth), 1, "no truth at the last sample's stamp")
+        q = truth[0]
+        yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+        error, sigma = heading_error_deg(r["heading_deg"], (90.0 - math.degrees(yaw)) % 360.0), r["heading_sigma_deg"]
+        print("[ measured ] moving base offline, 120 s, tracking: error %+.4f mrad, sigma %.4f mrad (z %+.2f)" %
+              (1e3 * math.radians(error), 1e3 * math.radians(sigma), error / sigma))
+        self.assertLess(abs(error), 3.0 * sigma)
+        self.assertTrue(all(c["passed"] for c in r["earth_checks"]), r["earth_checks"])
+
     def test_the_sweep_of_config_north_sweep_finds_the_heading_from_each_axis_and_its_precession(self):
         # config/scenarios/north_sweep.yaml: each axis's wave turned + - - + by its precession loop, its
         # /<axis>/precession/state recorded beside its channels. Its pickoffs without their defects here,

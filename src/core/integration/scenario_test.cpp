@@ -13,6 +13,7 @@
 #include "hrg_gyro/core/calibration/calibration_settings.h"
 #include "hrg_gyro/core/calibration/field_command_plan.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/simulation/injected_model.h"
 #include "hrg_gyro/core/simulation/simulation_config.h"
 #include "hrg_gyro/core/simulation/triad_simulation_config.h"
@@ -225,8 +226,9 @@ TEST(Scenarios, ShippedScenariosParseAndDescribeTheSameGyro) {
   files.erase("triad.yaml");
   files.erase("triad_verification.yaml");
   for (const std::string& name : {"north_static.yaml", "north_indexed_two.yaml", "north_indexed_four.yaml",
-                                  "north_continuous.yaml", "north_sweep.yaml", "north_vehicle_idle.yaml"}) {
-    files.erase(name);  // the triad's north-finding sessions (NorthScenarios...)
+                                  "north_continuous.yaml", "north_sweep.yaml", "north_vehicle_idle.yaml",
+                                  "north_try.yaml"}) {
+    files.erase(name);  // the triad's north-finding sessions (NorthScenarios..., NorthTry...)
   }
   for (const std::string& name : resonatorScenarios()) files.erase(name);
   EXPECT_EQ(files, shipped);
@@ -536,6 +538,34 @@ TEST(Scenarios, NorthSweepScenarioTurnsTheCalibratedTriadOnTheFieldPlan) {
       EXPECT_EQ(a.dynamics.commands[k].rate, plan[k].rate) << k;
     }
   }
+}
+
+// config/scenarios/north_try.yaml, the README's scenario to try the gyrocompass with: gyros the
+// uncalibrated processors and the nominal triad file measure (K0 -0.56 and nothing else of K, no D, no
+// misalignment: config/params_uncalibrated.yaml and config/triad.yaml are their exact model), an
+// accelerometer, a base that moves, 150 s at latitude 0.9 rad.
+TEST(Scenarios, NorthTryIsATriadTheUncalibratedChainMeasuresOnAMovingBase) {
+  const TriadSimulationConfig c = loadTriadScenario(kScenarioDir + "north_try.yaml");
+  const GyroParameters nominal = loadParameterFile(std::string(HRG_GYRO_SOURCE_DIR) + "/config/params_uncalibrated.yaml");
+  for (const TriadAxisConfig& a : c.axes) {
+    SCOPED_TRACE(a.name);
+    EXPECT_EQ(a.misalignment, (std::array<double, 2>{0.0, 0.0}));
+    EXPECT_EQ(a.scale, 0.0);
+    EXPECT_EQ(a.resonator.scale_factor.meanAt(NAN), nominal.scale_factor.meanAt(NAN));
+    for (const HarmonicModel* m : {&a.resonator.scale_factor, &a.resonator.drift}) {
+      std::vector<double> terms(m->termCount());
+      m->coefficientsAt(NAN, terms.data());
+      for (std::size_t i = 1; i < terms.size(); ++i) EXPECT_EQ(terms[i], 0.0) << i;  // no harmonic
+    }
+    EXPECT_EQ(a.resonator.drift.meanAt(NAN), 0.0);
+  }
+  EXPECT_TRUE(c.accelerometer.enabled);
+  EXPECT_TRUE(c.base_motion.enabled());
+  EXPECT_EQ(c.base_motion.sways.size(), 2u);
+  EXPECT_EQ(c.base_motion.vibration.rms, 0.05);
+  EXPECT_EQ(c.turntable.latitude, 0.9);
+  EXPECT_EQ(c.turntable.azimuth, 1.0);
+  EXPECT_NEAR(c.duration(), 150.0, 1e-9);
 }
 
 // config/scenarios/north_vehicle_idle.yaml: north_static.yaml word for word up to its positions (the
