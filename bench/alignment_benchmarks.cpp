@@ -22,6 +22,21 @@ struct Window {
   std::vector<TriadBodySample> gyro;
   std::vector<AccelerometerRecord> accelerometer;
   std::vector<IndexerRecord> indexer;
+
+  // Records the triad's increment since `previous` (both integrated angles, rad) and the accelerometer's
+  // reading at stamp t (s after the window's start at 10 s); returns the gyro sample.
+  const TriadBodySample& record(double t, double h, const Eigen::Vector3d& measured, Eigen::Vector3d* previous,
+                                const Eigen::Vector3d& specific_force) {
+    TriadBodySample x;
+    x.stamp = toNanoseconds(10.0 + t);
+    x.dt = h;
+    x.delta_angle = measured - *previous;
+    x.angular_velocity = x.delta_angle / h;
+    *previous = measured;
+    gyro.push_back(x);
+    accelerometer.push_back(AccelerometerRecord{x.stamp, specific_force});
+    return gyro.back();
+  }
 };
 
 // A mount at yaw 0.3 rad on a base that sways by 1e-4 rad with a 10 s period about East: the body's
@@ -46,18 +61,9 @@ Window makeSwayingWindow() {
       angle += (d * mount).transpose() * (earthRateEnu(kLatitude) + rate) * (h / 8.0);
     }
     const Eigen::Vector3d measured = angle + white * Eigen::Vector3d(noise.next(), noise.next(), noise.next());
-    TriadBodySample x;
-    x.stamp = toNanoseconds(10.0 + t);
-    x.dt = h;
-    x.delta_angle = measured - previous;
-    x.angular_velocity = x.delta_angle / h;
-    previous = measured;
-    w.gyro.push_back(x);
-    AccelerometerRecord a;
-    a.stamp = x.stamp;
-    a.specific_force = (base.rotationAt(t) * mount).transpose() * Eigen::Vector3d(0, 0, kStandardGravity) +
-                       3.5e-3 * Eigen::Vector3d(noise.next(), noise.next(), noise.next());
-    w.accelerometer.push_back(a);
+    const Eigen::Vector3d force = (base.rotationAt(t) * mount).transpose() * Eigen::Vector3d(0, 0, kStandardGravity) +
+                                  3.5e-3 * Eigen::Vector3d(noise.next(), noise.next(), noise.next());
+    w.record(t, h, measured, &previous, force);
   }
   return w;
 }
@@ -81,17 +87,9 @@ Window makeWindow(bool indexed) {
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.5 * (psi0 + psi1), Eigen::Vector3d::UnitZ()).toRotationMatrix();
     angle += turn.transpose() * earth * h + Eigen::Vector3d::UnitZ() * (psi1 - psi0);
     const Eigen::Vector3d measured = angle + white * Eigen::Vector3d(noise.next(), noise.next(), noise.next());
-    TriadBodySample x;
-    x.stamp = toNanoseconds(10.0 + t);
-    x.dt = h;
-    x.delta_angle = measured - previous;
-    x.angular_velocity = x.delta_angle / h;
-    previous = measured;
-    w.gyro.push_back(x);
-    AccelerometerRecord a;
-    a.stamp = x.stamp;
-    a.specific_force = turn.transpose() * gravity + 2e-3 * Eigen::Vector3d(noise.next(), noise.next(), noise.next());
-    w.accelerometer.push_back(a);
+    const Eigen::Vector3d force =
+        turn.transpose() * gravity + 2e-3 * Eigen::Vector3d(noise.next(), noise.next(), noise.next());
+    const TriadBodySample& x = w.record(t, h, measured, &previous, force);
     if (indexed && k % 2 == 0) w.indexer.push_back(IndexerRecord{x.stamp, psi1, (psi1 - psi0) / h});
   }
   return w;

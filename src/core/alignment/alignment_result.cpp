@@ -60,6 +60,37 @@ std::string AlignmentResult::summary() const {
   return buffer;
 }
 
+namespace {
+
+// What the estimator chose and why, what the base did, where the noise terms came from, and the
+// checks against the Earth: the part of the result a moving base fills in.
+void emitEstimatorAndEarthChecks(const AlignmentResult& r, std::ostringstream& y) {
+  y << "estimator: " << quoted(r.estimator) << "\n";
+  y << "estimator_reason: " << quoted(r.estimator_reason) << "\n";
+  y << "noise_sources: " << quoted(r.noise_sources) << "\n";
+  y << "low_frequency_scatter: " << number(r.low_frequency_scatter) << "\n";
+  y << "low_frequency_limit: " << number(r.low_frequency_limit) << "\n";
+  y << "excluded_s: " << number(r.excluded_seconds) << "\n";
+  y << "tracking: {heading_deg: " << number(r.tracking_heading)
+    << ", heading_sigma_deg: " << number(r.tracking_heading_sigma)
+    << ", difference_sigmas: " << number(r.estimator_difference) << ", velocity_white_m_s: " << number(r.velocity_white)
+    << ", velocity_random_walk_m_s_sqrt_s: " << number(r.velocity_random_walk) << "}\n";
+  y << "base_steps:";
+  for (const BaseStepRecord& b : r.base_steps) {
+    y << "\n  - {time_s: " << number(b.time) << ", rotation_rad: [" << number(b.rotation.x()) << ", "
+      << number(b.rotation.y()) << ", " << number(b.rotation.z()) << "], chi_square: " << number(b.chi_square) << "}";
+  }
+  y << (r.base_steps.empty() ? " []\n" : "\n");
+  y << "earth_checks:";
+  for (const EarthCheck& c : r.earth_checks) {
+    y << "\n  - {name: " << c.name << ", measured: " << number(c.measured) << ", expected: " << number(c.expected)
+      << ", sigma: " << number(c.sigma) << ", passed: " << (c.passed ? "true" : "false") << "}";
+  }
+  y << (r.earth_checks.empty() ? " []\n" : "\n");
+}
+
+}  // namespace
+
 std::string emitAlignmentResult(const AlignmentResult& r) {
   std::ostringstream y;
   y << "# hrg_gyro alignment from the Earth's rate. Frames: ENU local level (x East, y North, z Up);\n"
@@ -108,28 +139,7 @@ std::string emitAlignmentResult(const AlignmentResult& r) {
   y << "scatter: " << number(r.scatter) << "\n";
   y << "worst_motion_rad_s: " << number(r.worst_motion) << "\n";
   y << "accelerometer_gravity_m_s2: " << number(r.accelerometer_gravity) << "\n";
-  y << "estimator: " << quoted(r.estimator) << "\n";
-  y << "estimator_reason: " << quoted(r.estimator_reason) << "\n";
-  y << "noise_sources: " << quoted(r.noise_sources) << "\n";
-  y << "low_frequency_scatter: " << number(r.low_frequency_scatter) << "\n";
-  y << "low_frequency_limit: " << number(r.low_frequency_limit) << "\n";
-  y << "excluded_s: " << number(r.excluded_seconds) << "\n";
-  y << "tracking: {heading_deg: " << number(r.tracking_heading)
-    << ", heading_sigma_deg: " << number(r.tracking_heading_sigma)
-    << ", difference_sigmas: " << number(r.estimator_difference) << ", velocity_white_m_s: " << number(r.velocity_white)
-    << ", velocity_random_walk_m_s_sqrt_s: " << number(r.velocity_random_walk) << "}\n";
-  y << "base_steps:";
-  for (const BaseStepRecord& b : r.base_steps) {
-    y << "\n  - {time_s: " << number(b.time) << ", rotation_rad: [" << number(b.rotation.x()) << ", "
-      << number(b.rotation.y()) << ", " << number(b.rotation.z()) << "], chi_square: " << number(b.chi_square) << "}";
-  }
-  y << (r.base_steps.empty() ? " []\n" : "\n");
-  y << "earth_checks:";
-  for (const EarthCheck& c : r.earth_checks) {
-    y << "\n  - {name: " << c.name << ", measured: " << number(c.measured) << ", expected: " << number(c.expected)
-      << ", sigma: " << number(c.sigma) << ", passed: " << (c.passed ? "true" : "false") << "}";
-  }
-  y << (r.earth_checks.empty() ? " []\n" : "\n");
+  emitEstimatorAndEarthChecks(r, y);
   y << "segments:\n";
   for (const AlignmentSegment& s : r.segments) {
     y << "  - {start_s: " << number(s.start) << ", end_s: " << number(s.end)

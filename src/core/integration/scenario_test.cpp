@@ -225,9 +225,9 @@ TEST(Scenarios, ShippedScenariosParseAndDescribeTheSameGyro) {
   files.erase("diagnosis.yaml");
   files.erase("triad.yaml");
   files.erase("triad_verification.yaml");
-  for (const std::string& name : {"north_static.yaml", "north_indexed_two.yaml", "north_indexed_four.yaml",
-                                  "north_continuous.yaml", "north_sweep.yaml", "north_vehicle_idle.yaml",
-                                  "north_try.yaml"}) {
+  for (const std::string& name :
+       {"north_static.yaml", "north_indexed_two.yaml", "north_indexed_four.yaml", "north_continuous.yaml",
+        "north_sweep.yaml", "north_vehicle_idle.yaml", "north_try.yaml"}) {
     files.erase(name);  // the triad's north-finding sessions (NorthScenarios..., NorthTry...)
   }
   for (const std::string& name : resonatorScenarios()) files.erase(name);
@@ -546,7 +546,8 @@ TEST(Scenarios, NorthSweepScenarioTurnsTheCalibratedTriadOnTheFieldPlan) {
 // accelerometer, a base that moves, 150 s at latitude 0.9 rad.
 TEST(Scenarios, NorthTryIsATriadTheUncalibratedChainMeasuresOnAMovingBase) {
   const TriadSimulationConfig c = loadTriadScenario(kScenarioDir + "north_try.yaml");
-  const GyroParameters nominal = loadParameterFile(std::string(HRG_GYRO_SOURCE_DIR) + "/config/params_uncalibrated.yaml");
+  const GyroParameters nominal =
+      loadParameterFile(std::string(HRG_GYRO_SOURCE_DIR) + "/config/params_uncalibrated.yaml");
   for (const TriadAxisConfig& a : c.axes) {
     SCOPED_TRACE(a.name);
     EXPECT_EQ(a.misalignment, (std::array<double, 2>{0.0, 0.0}));

@@ -17,13 +17,19 @@ Eigen::Vector3d rotationVector(const Eigen::Matrix3d& r) {
   return a.axis() * a.angle();
 }
 
-BaseMotionConfig everyMotion() {
+/// A lean of (2.5e-5, -1e-5, 0) rad from 10 s over 2 s, and a knock of 2e-5 rad about z at 20 s.
+BaseMotionConfig leanAndKnock() {
   BaseMotionConfig c;
   c.leans.push_back({10.0, 2.0, Eigen::Vector3d(2.5e-5, -1e-5, 0.0)});
   BaseKnock k;
   k.time = 20.0;
   k.rotation = Eigen::Vector3d(0.0, 0.0, 2e-5);
   c.knocks.push_back(k);
+  return c;
+}
+
+BaseMotionConfig everyMotion() {
+  BaseMotionConfig c = leanAndKnock();
   c.sways.push_back({1e-4, 7.0, Eigen::Vector3d(0.6, 0.8, 0.0), 0.3});
   c.yaw_jitter = {1e-5, 0.5, 5.0, 20};
   c.vibration = {0.05, 10.0, 40.0, 20};
@@ -38,12 +44,7 @@ TEST(BaseMotionTest, AStillBaseIsTheIdentity) {
 }
 
 TEST(BaseMotionTest, ALeanAndAKnockLeaveTheBaseTurnedByTheirRotation) {
-  BaseMotionConfig c;
-  c.leans.push_back({10.0, 2.0, Eigen::Vector3d(2.5e-5, -1e-5, 0.0)});
-  BaseKnock k;
-  k.time = 20.0;
-  k.rotation = Eigen::Vector3d(0.0, 0.0, 2e-5);
-  c.knocks.push_back(k);
+  const BaseMotionConfig c = leanAndKnock();
   const BaseMotion m(c, 3);
   EXPECT_NEAR(rotationVector(m.rotationAt(9.999)).norm(), 0.0, 1e-15);
   EXPECT_LT((rotationVector(m.rotationAt(15.0)) - c.leans[0].rotation).norm(), 1e-15);
@@ -55,7 +56,7 @@ TEST(BaseMotionTest, ALeanAndAKnockLeaveTheBaseTurnedByTheirRotation) {
   const Eigen::Matrix3d both = Eigen::AngleAxisd(lean.norm(), lean.normalized()).toRotationMatrix() *
                                Eigen::AngleAxisd(2e-5, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   EXPECT_LT((m.rotationAt(40.0) - both).cwiseAbs().maxCoeff(), 1e-16);
-  const Eigen::Vector3d sum(2.5e-5, -1e-5, 2e-5), half_cross = 0.5 * lean.cross(k.rotation);
+  const Eigen::Vector3d sum(2.5e-5, -1e-5, 2e-5), half_cross = 0.5 * lean.cross(c.knocks[0].rotation);
   EXPECT_LT((rotationVector(m.rotationAt(40.0)) - (sum + half_cross)).norm(), 1e-14);
 }
 

@@ -5,6 +5,7 @@
 
 #include <cstring>
 
+#include "core/testing/bit_fingerprint.h"
 #include "core/testing/simulator_pairs.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
@@ -319,28 +320,16 @@ TEST(GyroSimulatorTest, BiasRandomWalkIncrementsHaveTheStatedVariance) {
   EXPECT_NE(logs[0][5].angle, logs[1][5].angle);  // the seeds differ
 }
 
-/// FNV-1a over the bits of every simulated value a consumer sees: samples, truth and table records.
-class Fingerprint {
- public:
-  template <typename T>
-  void add(const T& value) {
-    unsigned char bytes[sizeof(T)];
-    std::memcpy(bytes, &value, sizeof(T));
-    for (const unsigned char b : bytes) hash_ = (hash_ ^ b) * 0x100000001b3ULL;
+/// Every simulated value a consumer sees, into the fingerprint: samples, truth and table records.
+void fingerprint(testing::BitFingerprint* f, const SimulationSample& s) {
+  f->add(s.index), f->add(s.stamp), f->add(s.channels_delivered), f->add(s.frequency), f->add(s.temperature);
+  for (int i = 0; i < 4; ++i) f->add(s.z[i]);
+  f->add(s.truth.theta), f->add(s.truth.table_angle), f->add(s.truth.table_rate), f->add(s.truth.inertial_angle);
+  for (const TurntableLogRecord& r : s.turntable) {
+    f->add(r.index), f->add(r.time), f->add(r.stamp), f->add(r.angle), f->add(r.rate),
+        f->add(static_cast<int>(r.glitch));
   }
-  void add(const SimulationSample& s) {
-    add(s.index), add(s.stamp), add(s.channels_delivered), add(s.frequency), add(s.temperature);
-    for (int i = 0; i < 4; ++i) add(s.z[i]);
-    add(s.truth.theta), add(s.truth.table_angle), add(s.truth.table_rate), add(s.truth.inertial_angle);
-    for (const TurntableLogRecord& r : s.turntable) {
-      add(r.index), add(r.time), add(r.stamp), add(r.angle), add(r.rate), add(static_cast<int>(r.glitch));
-    }
-  }
-  std::uint64_t value() const { return hash_; }
-
- private:
-  std::uint64_t hash_ = 0xcbf29ce484222325ULL;
-};
+}
 
 /// The single-axis table's own rate as an input: Omega_table(t) + Omega_E, computed as the simulator does.
 class TableRateInput : public AxisRateInput {
@@ -401,9 +390,9 @@ TEST(GyroSimulatorTest, ScenarioWithoutNewSectionsKeepsItsFingerprint) {
   std::vector<std::uint64_t> hashes;
   for (const std::string& log : logs) {
     GyroSimulator sim(SimulationConfig::parse(YamlField(YAML::Load(scenario + log), "")));
-    Fingerprint f;
+    testing::BitFingerprint f;
     SimulationSample s;
-    while (sim.next(&s)) f.add(s);
+    while (sim.next(&s)) fingerprint(&f, s);
     std::printf("[ measured ] fingerprint 0x%016llx\n", static_cast<unsigned long long>(f.value()));
     hashes.push_back(f.value());
   }

@@ -13,6 +13,7 @@
 #include <functional>
 #include <string>
 
+#include "core/testing/bit_fingerprint.h"
 #include "core/testing/shipped_scenarios.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
@@ -368,39 +369,22 @@ TEST(TriadSimulatorTest, AccelerometerAddsItsBiasAndNoiseInItsMountedFrameFromIt
   }
 }
 
-/// FNV-1a over the bytes of everything a triad sample carries: any changed bit changes it.
-class TriadFingerprint {
- public:
-  template <typename T>
-  void add(const T& value) {
-    unsigned char bytes[sizeof(T)];
-    std::memcpy(bytes, &value, sizeof(T));
-    for (const unsigned char b : bytes) hash_ = (hash_ ^ b) * 0x100000001b3ULL;
+/// Everything a triad sample carries, into the fingerprint: any changed bit changes it.
+void fingerprint(testing::BitFingerprint* f, const TriadSample& s) {
+  f->add(s.index), f->add(s.stamp);
+  for (const SimulationSample& a : s.axes) {
+    f->add(a.index), f->add(a.stamp), f->add(a.channels_delivered);
+    for (int j = 0; j < 4; ++j) f->add(a.z[j]);
+    f->add(a.truth.theta), f->add(a.truth.table_angle), f->add(a.truth.table_rate), f->add(a.truth.inertial_angle);
+    f->add(a.truth.inertial_rate);
   }
-  void addVector(const Eigen::Vector3d& v) {
-    for (int j = 0; j < 3; ++j) add(v[j]);
+  for (const TurntableLogRecord& r : s.turntable) {
+    f->add(r.index), f->add(r.time), f->add(r.stamp), f->add(r.angle), f->add(r.rate);
   }
-  void addQuaternion(const Eigen::Quaterniond& q) {
-    for (int j = 0; j < 4; ++j) add(q.coeffs()[j]);
-  }
-  void add(const TriadSample& s) {
-    add(s.index), add(s.stamp);
-    for (const SimulationSample& a : s.axes) {
-      add(a.index), add(a.stamp), add(a.channels_delivered);
-      for (int j = 0; j < 4; ++j) add(a.z[j]);
-      add(a.truth.theta), add(a.truth.table_angle), add(a.truth.table_rate), add(a.truth.inertial_angle);
-      add(a.truth.inertial_rate);
-    }
-    for (const TurntableLogRecord& r : s.turntable) add(r.index), add(r.time), add(r.stamp), add(r.angle), add(r.rate);
-    add(s.fixture.index), add(s.fixture.locked), add(s.fixture_logged), addQuaternion(s.fixture.body_to_table);
-    addVector(s.body.angular_velocity), addQuaternion(s.body.body_to_table), addQuaternion(s.body.body_to_enu);
-    add(s.body.position), add(s.accelerometer.present), addVector(s.accelerometer.specific_force);
-  }
-  std::uint64_t value() const { return hash_; }
-
- private:
-  std::uint64_t hash_ = 0xcbf29ce484222325ULL;
-};
+  f->add(s.fixture.index), f->add(s.fixture.locked), f->add(s.fixture_logged), f->add(s.fixture.body_to_table);
+  f->add(s.body.angular_velocity), f->add(s.body.body_to_table), f->add(s.body.body_to_enu);
+  f->add(s.body.position), f->add(s.accelerometer.present), f->add(s.accelerometer.specific_force);
+}
 
 // A scenario that gives none of the base's or the accelerometer's newer keys is what it was before
 // them, bit for bit: the hashes were recorded on the simulator before triad.base_motion existed.
@@ -414,13 +398,13 @@ TEST(TriadSimulatorTest, AScenarioWithoutTheNewKeysKeepsItsFingerprint) {
   const TriadSimulationConfig c =
       parseText(scenario(accelerometer, ", error: [1.2e-4, 2.0e-4, -0.5e-4]", ", pickoff: {noise: 2.0e-4}"));
   TriadSimulator sim(c);
-  TriadFingerprint f;
+  testing::BitFingerprint f;
   TriadSample s;
-  while (sim.next(&s)) f.add(s);
+  while (sim.next(&s)) fingerprint(&f, s);
   const TriadSimulationConfig shipped = TriadSimulationConfig::load(testing::shippedScenarioPath("north_static.yaml"));
   TriadSimulator sim_shipped(shipped);
-  TriadFingerprint g;
-  for (int n = 0; n < 2000 && sim_shipped.next(&s); ++n) g.add(s);
+  testing::BitFingerprint g;
+  for (int n = 0; n < 2000 && sim_shipped.next(&s); ++n) fingerprint(&g, s);
   std::printf("[ measured ] fingerprints 0x%016llx 0x%016llx\n", static_cast<unsigned long long>(f.value()),
               static_cast<unsigned long long>(g.value()));
   EXPECT_EQ(f.value(), 0xfcf41c37d63cc5d2ULL);

@@ -272,6 +272,25 @@ inline Eigen::Matrix3d trueFrameAt(const MountScenario& s, Nanoseconds stamp) {
   return movedMount(s, base, toSeconds(stamp) - s.start);
 }
 
+/// The platform's inertial angle increment over the h s that end at t (s), in the platform frame: the
+/// Earth's rate (w0, in the mount frame) seen through the platform turning from psi_a to psi_b, and
+/// that turn; on a moving base, the base's rate too (by quadrature).
+inline Eigen::Vector3d platformIncrement(const MountScenario& s, const BaseMotion& base, const Eigen::Vector3d& w0,
+                                         double t, double h, double psi_a, double psi_b) {
+  if (base.enabled()) return movingPlatformIncrement(s, base, t - h, t);
+  const double middle = 0.5 * (psi_a + psi_b), sinc_half = h * sinc(0.5 * (psi_b - psi_a));
+  const double ic = sinc_half * std::cos(middle), is = sinc_half * std::sin(middle);
+  const Eigen::Vector3d earth_platform(ic * w0.x() + is * w0.y(), -is * w0.x() + ic * w0.y(), h * w0.z());
+  return earth_platform + Eigen::Vector3d::UnitZ() * (psi_b - psi_a);
+}
+
+/// The specific force on the mount over [a, b] on a moving base, in the mount frame: gravity through
+/// the mount's attitude at b, plus the vibration's mean over the interval.
+inline Eigen::Vector3d mountSpecificForce(const MountScenario& s, const BaseMotion& base, double a, double b) {
+  return movedMount(s, base, b).transpose() *
+         (Eigen::Vector3d(0.0, 0.0, kStandardGravity) + base.meanAccelerationOver(a, b));
+}
+
 /// Runs the session into the sinks, sample by sample in stamp order.
 inline void runMountScenario(const MountScenario& s, const MountSinks& sinks) {
   GaussianNoise noise(s.seed);
@@ -295,14 +314,7 @@ inline void runMountScenario(const MountScenario& s, const MountSinks& sinks) {
     const Nanoseconds stamp = toNanoseconds(s.start + t_b);
     double logged_b = 0.0, psi_b = 0.0, rate_b = 0.0;
     if (s.indexed) indexerAngle(s, t_b, &logged_b, &psi_b, &rate_b);
-    // The body's inertial rate integrated over the sample: the Earth's, seen through the turning
-    // platform, and the platform's own turn.
-    const double middle = 0.5 * (psi_a + psi_b), sinc_half = h * sinc(0.5 * (psi_b - psi_a));
-    const double ic = sinc_half * std::cos(middle), is = sinc_half * std::sin(middle);
-    const Eigen::Vector3d earth_platform(ic * w0.x() + is * w0.y(), -is * w0.x() + ic * w0.y(), h * w0.z());
-    const Eigen::Vector3d platform_increment =
-        base.enabled() ? movingPlatformIncrement(s, base, t_b - h, t_b)
-                       : Eigen::Vector3d(earth_platform + Eigen::Vector3d::UnitZ() * (psi_b - psi_a));
+    const Eigen::Vector3d platform_increment = platformIncrement(s, base, w0, t_b, h, psi_a, psi_b);
     const Eigen::Vector3d body_increment = b.transpose() * platform_increment;
     double cmd_rate = 0.0, cmd_angle = 0.0;
     if (s.sweep) commandedPrecession(s, t_b, &cmd_rate, &cmd_angle);
@@ -313,13 +325,9 @@ inline void runMountScenario(const MountScenario& s, const MountSinks& sinks) {
       // The wave: K0 times the body's angle, the commanded turn (G_v), the residual drift.
       const double d_cmd = cmd_angle - psi_cmd_previous[i];
       const double theta_mid = theta[i] + 0.5 * (s.scale_factor * body_increment(i) + s.virtual_gain * d_cmd);
-      double c2, s2;
       const double theta_next = theta[i] + s.scale_factor * body_increment(i) + s.virtual_gain * d_cmd;
-      {
-        const double mid2 = theta[i] + theta_next, k2 = h * sinc(theta_next - theta[i]);
-        c2 = k2 * std::cos(mid2);
-        s2 = k2 * std::sin(mid2);
-      }
+      const double mid2 = theta[i] + theta_next, k2 = h * sinc(theta_next - theta[i]);
+      const double c2 = k2 * std::cos(mid2), s2 = k2 * std::sin(mid2);
       const double drift = (s.drift_cos2[i] * c2 + s.drift_sin2[i] * s2) / s.scale_factor;
       const double gain = s.virtual_gain * (1.0 + s.virtual_gain_cos2 * std::cos(2.0 * theta_mid));
       theta[i] = theta_next;
@@ -355,12 +363,7 @@ inline void runMountScenario(const MountScenario& s, const MountSinks& sinks) {
       sinks.indexer(r);
     }
     if (s.accelerometer && sinks.accelerometer) {
-      // The moving base: the mount's attitude at the sample's end, the vibration's mean over it.
-      const Eigen::Vector3d f_mount =
-          base.enabled()
-              ? Eigen::Vector3d(movedMount(s, base, t_b).transpose() *
-                                (Eigen::Vector3d(0.0, 0.0, kStandardGravity) + base.meanAccelerationOver(t_b - h, t_b)))
-              : g0;
+      const Eigen::Vector3d f_mount = base.enabled() ? mountSpecificForce(s, base, t_b - h, t_b) : g0;
       sinks.accelerometer(accelerometerSample(s, stamp, psi_b, f_mount, &noise));
     }
     psi_a = psi_b;
