@@ -356,7 +356,11 @@ class ReportTest(unittest.TestCase):
         chain = ["--triad", os.path.join(self.pkg, "config", "triad.yaml")]
         for axis in "xyz":
             chain += ["--axis-params", axis + "=" + os.path.join(self.pkg, "test", "scenarios", "north_align_axis.yaml")]
-        level = "level: {source: declared}  # the body on the platter is level\n"
+        # The gyrocompass claims no precision nobody measured: each noise term and the level's sigmas given
+        # (the simulated gyros' noise is white only, their model exact, the platter exactly level).
+        level = ("level: {source: declared, roll_sigma: 0.0, pitch_sigma: 0.0}  # the body on the platter is level\n"
+                 "noise: {residual_bias: 1.0e-8, angle_random_walk: 0.0, rate_random_walk: 0.0,"
+                 " residual_drift_harmonics: 0.0}\n")
         settings = {"static": "mode: static  # the triad at rest\nlatitude: 0.9  # rad\n" + level,
                     "indexed": "mode: indexed  # two positions\nlatitude: 0.9  # rad\n" + level,
                     "refused": "mode: static  # the triad at rest\nlatitude: 0.9  # rad\nmax_latitude: 0.5  # rad\n" +

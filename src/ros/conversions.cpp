@@ -428,6 +428,18 @@ core::AccelerometerRecord fromAccelerometerMessage(const sensor_msgs::Imu& m) {
   return r;
 }
 
+core::ImuSample fromImuMessage(const sensor_msgs::Imu& m) {
+  core::ImuSample s;
+  s.stamp = toNanoseconds(m.header.stamp);
+  s.angular_velocity = Eigen::Vector3d(m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) s.angular_velocity_covariance(i, j) = m.angular_velocity_covariance[3 * i + j];
+  }
+  s.linear_acceleration = Eigen::Vector3d(m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z);
+  s.has_acceleration = m.linear_acceleration_covariance[0] != -1.0;
+  return s;
+}
+
 core::PrecessionStateRecord fromMessage(const PrecessionState& m) {
   core::PrecessionStateRecord r;
   r.stamp = toNanoseconds(m.header.stamp);

@@ -86,16 +86,24 @@ GyrocompassRos::GyrocompassRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   updater_.add("gyrocompass", this, &GyrocompassRos::diagnoseAlignment);
   if (hold_enabled_) updater_.add("attitude hold", this, &GyrocompassRos::diagnoseHold);
 
-  // What the configured mode needs; triad/output also for the hold.
+  // What the configured mode needs; the gyro stream (triad/output or imu/data_raw) also for the hold.
   const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
-  subscribers_.push_back(nh_.subscribe("triad/output", queue_size, &GyrocompassRos::onTriad, this, hints));
+  const bool imu_input = settings_.gyro_input == core::GyroInput::kImu;
+  if (imu_input) {
+    imu_ = std::make_unique<core::ImuIncrementConverter>(settings_.imu.converter);
+    imu_accelerometer_ = settings_.level.source == core::LevelSource::kAccelerometer && settings_.imu.accelerometer;
+    subscribers_.push_back(nh_.subscribe("imu/data_raw", queue_size, &GyrocompassRos::onImu, this, hints));
+  } else {
+    subscribers_.push_back(nh_.subscribe("triad/output", queue_size, &GyrocompassRos::onTriad, this, hints));
+  }
+  gyro_topic_ = nh_.resolveName(imu_input ? "imu/data_raw" : "triad/output");
   if (settings_.single_gyro) {
     subscribers_.push_back(nh_.subscribe("output", queue_size, &GyrocompassRos::onGyro, this, hints));
   }
   if (settings_.mode == core::AlignmentMode::kIndexed) {
     subscribers_.push_back(nh_.subscribe("turntable/state", queue_size, &GyrocompassRos::onIndexer, this, hints));
   }
-  if (settings_.level.source == core::LevelSource::kAccelerometer) {
+  if (settings_.level.source == core::LevelSource::kAccelerometer && !imu_accelerometer_) {
     subscribers_.push_back(nh_.subscribe("accel/data_raw", queue_size, &GyrocompassRos::onAccelerometer, this, hints));
   }
   if (have_triad_file_) {
@@ -111,10 +119,13 @@ GyrocompassRos::GyrocompassRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   }
   diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
   ROS_INFO(
-      "gyrocompass: mode %s%s, latitude %.6f rad, window %.1f s, level %s, estimator %s; noise: %s; ~align "
-      "starts one",
-      toString(settings_.mode), settings_.single_gyro ? " (one gyro)" : "", settings_.latitude, settings_.duration,
-      settings_.level.source == core::LevelSource::kDeclared ? "declared" : "accel/data_raw",
+      "gyrocompass: mode %s%s, gyros %s, latitude %.6f rad, window %.1f s, level %s, estimator %s; noise: %s; "
+      "~align starts one",
+      toString(settings_.mode), settings_.single_gyro ? " (one gyro)" : "", gyro_topic_.c_str(), settings_.latitude,
+      settings_.duration,
+      settings_.level.source == core::LevelSource::kDeclared ? "declared"
+      : imu_accelerometer_                                   ? "imu/data_raw's linear_acceleration"
+                                                             : "accel/data_raw",
       toString(settings_.estimator), settings_.noise_sources.summary().c_str());
   if (align_at_startup) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -159,7 +170,7 @@ std::string GyrocompassRos::start(double duration, const std::string& mode) {
   running_topic_ = s.single_gyro ? nh_.resolveName("output")
                    : s.mode == core::AlignmentMode::kSweep
                        ? nh_.resolveName(triadAxisTopic(triad_.axes[0], "output")) + " (or another axis's)"
-                       : nh_.resolveName("triad/output");
+                       : gyro_topic_;
   alignment_input_ = ros::WallTime::now();
   ++alignments_;
   ROS_INFO("gyrocompass: alignment %llu started: mode %s, %.1f s of gyro stamps",
@@ -192,7 +203,21 @@ void GyrocompassRos::finishIfComplete() {
 
 void GyrocompassRos::onTriad(const TriadOutput::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const core::TriadBodySample sample = fromMessage(*msg);
+  takeBodySample(fromMessage(*msg), msg->header.frame_id);
+}
+
+void GyrocompassRos::onImu(const sensor_msgs::Imu::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const core::ImuSample in = fromImuMessage(*msg);
+  if (imu_accelerometer_ && running_) {
+    if (const auto force = imu_->specificForce(in)) running_->addAccelerometer({in.stamp, *force});
+  }
+  const std::optional<core::TriadBodySample> sample = imu_->convert(in);
+  if (sample)
+    takeBodySample(*sample, settings_.imu.body_frame.empty() ? msg->header.frame_id : settings_.imu.body_frame);
+}
+
+void GyrocompassRos::takeBodySample(const core::TriadBodySample& sample, const std::string& frame) {
   if (hold_ && hold_->holding()) {
     hold_input_ = ros::WallTime::now();
     if (hold_->add(sample)) {
@@ -204,7 +229,7 @@ void GyrocompassRos::onTriad(const TriadOutput::ConstPtr& msg) {
   if (!running_ || running_->settings().single_gyro || running_->settings().mode == core::AlignmentMode::kSweep) {
     return;
   }
-  running_frame_ = msg->header.frame_id;
+  running_frame_ = frame;
   const std::uint64_t before = running_->progress().samples;
   running_->addTriad(sample);
   noteProgress(before);
@@ -289,6 +314,12 @@ void GyrocompassRos::diagnoseAlignment(diagnostic_updater::DiagnosticStatusWrapp
     stat.add("window restarts", p.restarts);
     stat.add("indexer records", p.indexer);
     stat.add("accelerometer records", p.accelerometer);
+    if (imu_) {
+      stat.add("imu samples converted", imu_->counts().samples);
+      stat.add("imu gaps", imu_->counts().gaps);
+      stat.add("imu samples dropped", imu_->counts().dropped);
+      stat.add("imu typical period s", imu_->typicalPeriod());
+    }
   } else if (!last_) {
     stat.summary(DiagnosticStatus::WARN, "no alignment yet: call ~align");
   } else if (last_->accepted) {
@@ -337,7 +368,7 @@ void GyrocompassRos::diagnoseHold(diagnostic_updater::DiagnosticStatusWrapper& s
   const double quiet = quietFor(hold_input_);
   if (hold_->holding() && quiet > stall_timeout_) {
     stat.summaryf(DiagnosticStatus::ERROR, "holding, input stalled: no %s for %.1f s; the attitude is not updated",
-                  nh_.resolveName("triad/output").c_str(), quiet);
+                  gyro_topic_.c_str(), quiet);
   } else if (hold_->holding()) {
     stat.summaryf(DiagnosticStatus::OK, "holding %.1f s: heading %.4f +- %.4f deg", hold_->elapsed(), hold_->heading(),
                   hold_->headingSigma());
@@ -345,7 +376,7 @@ void GyrocompassRos::diagnoseHold(diagnostic_updater::DiagnosticStatusWrapper& s
     stat.summaryf(DiagnosticStatus::ERROR, "attitude lost after %.1f s: %s; align again", hold_->elapsed(),
                   hold_->lostReason().c_str());
   }
-  stat.add("seconds without triad input", quiet);
+  stat.add(imu_ ? "seconds without imu input" : "seconds without triad input", quiet);
   stat.add("elapsed s", hold_->elapsed());
   stat.add("heading deg", hold_->heading());
   stat.add("heading sigma deg", hold_->headingSigma());

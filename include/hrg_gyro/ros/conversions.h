@@ -128,6 +128,9 @@ core::TriadBodySample fromMessage(const TriadOutput& msg);
 core::IndexerRecord fromMessage(const TurntableState& msg);
 /// An accelerometer's specific force (linear_acceleration, REP-145: +g up at rest), in its own frame.
 core::AccelerometerRecord fromAccelerometerMessage(const sensor_msgs::Imu& msg);
+/// Any IMU's message as the gyrocompass's IMU input reads it (REP-145: a covariance of all 0 or with
+/// [0] = -1 is not given; linear_acceleration_covariance[0] = -1: no acceleration).
+core::ImuSample fromImuMessage(const sensor_msgs::Imu& msg);
 /// The driver's precession state.
 core::PrecessionStateRecord fromMessage(const PrecessionState& msg);
 /// The result as a message: stamped with the window's end; frame_id the frame its triad or gyro

@@ -13,7 +13,10 @@
 // body's orientation -> ENU with its covariance, angular velocity and acceleration marked not
 // measured), so a navigation filter fuses it as an absolute attitude. After an accepted alignment of
 // the triad, a core::AttitudeHold integrates `triad/output` from the aligned attitude and `imu/data`
-// carries the held orientation with its growing covariance and the triad's angular velocity. The
+// carries the held orientation with its growing covariance and the triad's angular velocity. With
+// `gyro_input: imu` the gyros are any IMU's `imu/data_raw` (sensor_msgs/Imu) instead of the triad:
+// each message turned back into a body increment (core::ImuIncrementConverter, its mounting from
+// `imu/mounting`), its linear_acceleration the level's accelerometer, the hold on its behalf. The
 // vehicle's own travel over the Earth is out of scope: the hold is for a base at or near its site.
 // Diagnostics: `gyrocompass` (progress, the last result and its budget) and `attitude hold`; either
 // turns ERROR "input stalled" when its gyro stream has been quiet for `~stall_timeout` s of wall time
@@ -52,6 +55,10 @@ class GyrocompassRos {
 
  private:
   void onTriad(const TriadOutput::ConstPtr& msg);
+  void onImu(const sensor_msgs::Imu::ConstPtr& msg);
+  /// One body sample of the gyro stream (the triad's, or the IMU's converted) to the hold and to the
+  /// running alignment; `frame`: the frame the results are reported in.
+  void takeBodySample(const core::TriadBodySample& sample, const std::string& frame);
   void onGyro(const GyroOutput::ConstPtr& msg);
   void onSweepAxis(std::size_t axis, const GyroOutput::ConstPtr& msg);
   void onPrecession(std::size_t axis, const PrecessionState::ConstPtr& msg);
@@ -79,6 +86,9 @@ class GyrocompassRos {
   core::TriadParameters triad_;  // ~triad_file's (sweep); default when none
   bool have_triad_file_ = false;
   bool hold_enabled_ = true;
+  std::unique_ptr<core::ImuIncrementConverter> imu_;  // gyro_input imu
+  bool imu_accelerometer_ = false;                    // the level's specific force from imu/data_raw
+  std::string gyro_topic_;                            // triad/output or imu/data_raw, resolved
   core::AttitudeHoldSettings hold_settings_;
   std::unique_ptr<core::Gyrocompass> running_;
   std::string running_frame_;      // the frame_id of the gyro messages fed to it

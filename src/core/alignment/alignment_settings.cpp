@@ -32,9 +32,11 @@ const std::vector<std::string> kScalarKeys = {"mode",
                                               "max_earth_sigmas",
                                               "max_estimator_sigmas",
                                               "estimator",
-                                              "max_condition"};
+                                              "max_condition",
+                                              "gyro_input"};
 const std::vector<std::string> kNoiseKeys = {"angle_white_noise", "angle_random_walk",        "rate_random_walk",
-                                             "residual_bias",     "residual_drift_harmonics", "allan_file"};
+                                             "residual_bias",     "residual_drift_harmonics", "allan_file",
+                                             "angle_quantum"};
 const std::vector<std::string> kLevelKeys = {"source",
                                              "roll",
                                              "pitch",
@@ -49,7 +51,9 @@ const std::vector<std::string> kIndexerKeys = {"continuous", "body_to_platform",
 const std::vector<std::string> kSweepKeys = {"settle", "gain_orders", "min_turns"};
 const std::vector<std::string> kMotionKeys = {"block",      "max_motion", "max_scatter",  "step_threshold",
                                               "step_guard", "max_steps",  "max_excluded", "block_false_alarm"};
-const std::vector<std::string> kSections = {"noise", "level", "indexer", "sweep", "motion"};
+const std::vector<std::string> kImuKeys = {"mounting", "period",        "max_bridge", "rate_variance",
+                                           "max_rate", "accelerometer", "body_frame"};
+const std::vector<std::string> kSections = {"noise", "level", "indexer", "sweep", "motion", "imu"};
 const std::vector<std::string> kNodeKeys = {"align_at_startup", "triad_file",    "hold",
                                             "queue_size",       "stall_timeout", "diagnostic_period"};
 
@@ -81,7 +85,7 @@ void noiseTerm(const YamlField& f, const char* key, double* value, std::string* 
 }
 
 void parseNoise(const YamlField& f, GyroNoiseModel* n, NoiseSources* sources, std::string* allan_file,
-                const std::string& base_directory) {
+                double* allan_tau0, const std::string& base_directory) {
   f.requireMap();
   f.rejectUnknownKeys(kNoiseKeys);
   noiseTerm(f, "angle_white_noise", &n->angle_white_noise, &sources->angle_white_noise);
@@ -90,13 +94,17 @@ void parseNoise(const YamlField& f, GyroNoiseModel* n, NoiseSources* sources, st
   noiseTerm(f, "rate_random_walk", &n->rate_random_walk, &sources->rate_random_walk);
   noiseTerm(f, "residual_bias", &n->residual_bias, &sources->residual_bias);
   noiseTerm(f, "residual_drift_harmonics", &n->residual_drift_harmonics, &sources->residual_drift_harmonics);
+  n->angle_quantum = f.getDouble("angle_quantum", n->angle_quantum);
+  if (n->angle_quantum > 0.0) sources->angle_white_noise += " + the angle quantum's q^2/12";
   // The measured readings replace the keys above; one the record did not identify keeps its key.
   if (f.getString("allan_file", "").empty()) return;
   const YamlField file = f["allan_file"];
   try {
     const std::string path = allanFilePath(file, base_directory);
     *allan_file = path;
-    *n = noiseFromAllan(loadAllanReadings(path).result, *n, sources, "allan_file " + path);
+    const AllanReadings readings = loadAllanReadings(path);
+    *allan_tau0 = readings.tau0;
+    *n = noiseFromAllan(readings.result, *n, sources, "allan_file " + path);
   } catch (const ConfigError& e) {
     if (e.key() == file.path()) throw;
     file.fail(e.what());
@@ -168,6 +176,27 @@ void parseMotion(const YamlField& f, MotionSettings* m) {
   m->block_false_alarm = f.getDouble("block_false_alarm", m->block_false_alarm);
 }
 
+void parseImu(const YamlField& f, ImuInput* imu) {
+  f.requireMap();
+  f.rejectUnknownKeys(kImuKeys);
+  ImuInputSettings& c = imu->converter;
+  if (f.has("mounting")) c.imu_to_body = parseRotation(f["mounting"]);
+  c.period = f.getDouble("period", c.period);
+  c.max_bridge = f.getDouble("max_bridge", c.max_bridge);
+  c.fallback_rate_variance = f.getDouble("rate_variance", c.fallback_rate_variance);
+  c.max_rate = f.getDouble("max_rate", c.max_rate);
+  imu->accelerometer = f.getBool("accelerometer", imu->accelerometer);
+  if (f.has("body_frame")) imu->body_frame = f["body_frame"].asString();
+}
+
+GyroInput parseGyroInput(const YamlField& f) {
+  const std::string text = f.asString();
+  if (text == "triad") return GyroInput::kTriad;
+  if (text == "imu") return GyroInput::kImu;
+  f.fail("'" + text + "' is not a gyro input: triad (TriadOutput) or imu (sensor_msgs/Imu)");
+  return GyroInput::kTriad;
+}
+
 EstimatorChoice parseEstimator(const YamlField& f) {
   const std::string text = f.asString();
   if (text == "auto") return EstimatorChoice::kAuto;
@@ -190,11 +219,9 @@ const std::vector<std::string>& AlignmentSettings::nodeKeys() { return kNodeKeys
 
 std::vector<std::string> AlignmentSettings::keyPaths() {
   std::vector<std::string> keys = kScalarKeys;
-  const std::vector<std::pair<const char*, const std::vector<std::string>*>> sections = {{"noise", &kNoiseKeys},
-                                                                                         {"level", &kLevelKeys},
-                                                                                         {"indexer", &kIndexerKeys},
-                                                                                         {"sweep", &kSweepKeys},
-                                                                                         {"motion", &kMotionKeys}};
+  const std::vector<std::pair<const char*, const std::vector<std::string>*>> sections = {
+      {"noise", &kNoiseKeys}, {"level", &kLevelKeys},   {"indexer", &kIndexerKeys},
+      {"sweep", &kSweepKeys}, {"motion", &kMotionKeys}, {"imu", &kImuKeys}};
   for (const auto& section : sections) {
     for (const std::string& k : *section.second) keys.push_back(std::string(section.first) + "/" + k);
   }
@@ -221,11 +248,14 @@ AlignmentSettings AlignmentSettings::parse(const YamlField& root, const std::vec
   s.max_condition = root.getDouble("max_condition", s.max_condition);
   s.noise_sources.angle_random_walk = s.noise_sources.rate_random_walk = "not given";
   s.noise_sources.residual_bias = s.noise_sources.residual_drift_harmonics = "not given";
-  if (root.has("noise")) parseNoise(root["noise"], &s.noise, &s.noise_sources, &s.allan_file, base_directory);
+  if (root.has("noise"))
+    parseNoise(root["noise"], &s.noise, &s.noise_sources, &s.allan_file, &s.allan_tau0, base_directory);
   if (root.has("level")) parseLevel(root["level"], &s.level);
   if (root.has("indexer")) parseIndexer(root["indexer"], &s.indexer);
   if (root.has("sweep")) parseSweep(root["sweep"], &s.sweep);
   if (root.has("motion")) parseMotion(root["motion"], &s.motion);
+  if (root.has("gyro_input")) s.gyro_input = parseGyroInput(root["gyro_input"]);
+  if (root.has("imu")) parseImu(root["imu"], &s.imu);
   try {
     s.validate();
   } catch (const ConfigError& e) {
@@ -276,6 +306,7 @@ void GyroNoiseModel::validate(const std::string& prefix) const {
   check(rate_random_walk, "rate_random_walk", "rad/s/sqrt(s)");
   check(residual_bias, "residual_bias", "rad/s");
   check(residual_drift_harmonics, "residual_drift_harmonics", "rad/s");
+  requireFiniteAtLeast(angle_quantum, 0.0, prefix + "angle_quantum", "rad");
 }
 
 void GyroNoiseModel::requireComplete(const std::string& prefix) const {
@@ -324,6 +355,8 @@ GyroNoiseModel noiseFromAllan(const AllanResult& allan, const GyroNoiseModel& ba
   }
   return out;
 }
+
+const char* toString(GyroInput input) { return input == GyroInput::kImu ? "imu" : "triad"; }
 
 const char* toString(EstimatorChoice choice) {
   switch (choice) {
@@ -440,6 +473,11 @@ void AlignmentSettings::validate() const {
   indexer.validate();
   sweep.validate();
   motion.validate();
+  imu.converter.validate("imu/");
+  if (gyro_input == GyroInput::kImu && (single_gyro || mode == AlignmentMode::kSweep)) {
+    throw ConfigError("gyro_input",
+                      "imu: an IMU's three gyros align in mode static or indexed (not single_gyro, not sweep)");
+  }
 }
 
 void AlignmentSettings::requireComplete() const {

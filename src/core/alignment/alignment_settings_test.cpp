@@ -107,7 +107,17 @@ max_earth_sigmas: 6.0
 max_estimator_sigmas: 3.5
 estimator: still_base
 max_condition: 1.0e7
+gyro_input: triad
+imu:
+  mounting: {roll: 3.141592653589793, pitch: 0.0, yaw: 0.0}
+  period: 0.005
+  max_bridge: 3.0
+  rate_variance: 1.0e-10
+  max_rate: 10.0
+  accelerometer: false
+  body_frame: base_link
 noise:
+  angle_quantum: 4.8e-7
   angle_white_noise: 8.8e-6
   angle_random_walk: 1.5e-7
   rate_random_walk: 2.0e-10
@@ -175,6 +185,15 @@ TEST(AlignmentSettingsTest, EveryKeyIsReadFromAFile) {
   EXPECT_EQ(s.noise.rate_random_walk, 2e-10);
   EXPECT_EQ(s.noise.residual_bias, 3e-9);
   EXPECT_EQ(s.noise.residual_drift_harmonics, 4e-9);
+  EXPECT_EQ(s.noise.angle_quantum, 4.8e-7);
+  EXPECT_EQ(s.gyro_input, GyroInput::kTriad);
+  EXPECT_NEAR(s.imu.converter.imu_to_body.angularDistance(Eigen::Quaterniond(0, 1, 0, 0)), 0.0, 1e-12);
+  EXPECT_EQ(s.imu.converter.period, 0.005);
+  EXPECT_EQ(s.imu.converter.max_bridge, 3.0);
+  EXPECT_EQ(s.imu.converter.fallback_rate_variance, 1e-10);
+  EXPECT_EQ(s.imu.converter.max_rate, 10.0);
+  EXPECT_FALSE(s.imu.accelerometer);
+  EXPECT_EQ(s.imu.body_frame, "base_link");
   EXPECT_EQ(s.level.source, LevelSource::kDeclared);
   EXPECT_EQ(s.level.roll, 0.01);
   EXPECT_EQ(s.level.pitch, -0.02);
@@ -209,11 +228,32 @@ TEST(AlignmentSettingsTest, EveryKeyIsReadFromAFile) {
   EXPECT_EQ(s.motion.block_false_alarm, 1e-3);
   // keyPaths() names every key the file gives (the node's own aside).
   const std::vector<std::string> paths = AlignmentSettings::keyPaths();
-  EXPECT_EQ(paths.size(), 10u + 6u + 9u + 8u + 3u + 8u);
+  EXPECT_EQ(paths.size(), 11u + 7u + 9u + 8u + 3u + 8u + 7u);
   for (const char* key : {"mode", "noise/residual_drift_harmonics", "level/accelerometer_to_body", "indexer/gyro_axis",
                           "sweep/gain_orders", "motion/max_scatter"}) {
     EXPECT_NE(std::find(paths.begin(), paths.end(), key), paths.end()) << key;
   }
+}
+
+TEST(AlignmentSettingsTest, AnImuIsTheGyroInputOfTheTriadModesOnly) {
+  const TemporaryFile imu(
+      "hrg_alignment_settings_imu",
+      "latitude: 0.6\ngyro_input: imu\nimu: {mounting: {yaw: -1.5707963267948966}, period: 0.01}\n");
+  const AlignmentSettings s = AlignmentSettings::load(imu.path());
+  EXPECT_EQ(s.gyro_input, GyroInput::kImu);
+  EXPECT_NEAR((s.imu.converter.imu_to_body * Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitX()).norm(), 0.0, 1e-12)
+      << "right-front-up: the IMU's y is the body's x";
+  auto key = [](const std::string& text) {
+    const TemporaryFile f("hrg_alignment_settings_imu_bad", "latitude: 0.6\n" + text);
+    return refusedKey([&] { AlignmentSettings::load(f.path()); });
+  };
+  EXPECT_EQ(key("gyro_input: imu\nmode: sweep\n"), "gyro_input");
+  EXPECT_EQ(key("gyro_input: imu\nmode: indexed\nsingle_gyro: true\n"), "gyro_input");
+  EXPECT_EQ(key("gyro_input: fog\n"), "gyro_input");
+  EXPECT_EQ(key("imu: {period: -1.0}\n"), "imu.period");
+  EXPECT_EQ(key("imu: {mounting: {heading: 1.0}}\n"), "imu.mounting.heading");
+  EXPECT_EQ(key("imu: {lever_arm: [0, 0, 0]}\n"), "imu.lever_arm");
+  EXPECT_EQ(key("noise: {angle_quantum: -1.0e-7}\n"), "noise.angle_quantum");
 }
 
 TEST(AlignmentSettingsTest, UnknownKeysAndBadValuesAreRefusedByName) {

@@ -14,6 +14,7 @@ namespace core {
 namespace {
 
 constexpr double kDegrees = 180.0 / kPi;
+constexpr double kPreWindowHorizon = 60.0;  // s of a stream kept before the window starts, beyond its length
 
 }  // namespace
 
@@ -213,9 +214,14 @@ bool Gyrocompass::takeRecord(StampTimeline* timeline, std::vector<Record>* recor
   if (v == StampVerdict::kNewTimeline) records->clear();
   if (!stampUsable(v)) return false;
   // Records older than the window are nobody's: memory stays flat however long the stream ran before
-  // it (before the window starts, nothing is known to be old).
-  const Nanoseconds oldest = start_ - toNanoseconds(1.0);
-  if (started_ && records->size() >= 4096 && records->front().stamp < oldest) {
+  // it. Before the window starts (no gyro sample yet: hrg_bag align --start skipping minutes of them,
+  // or a caller feeding one stream whole before the gyros), only the last window's length plus
+  // kPreWindowHorizon s of this stream are kept: the gyros may lag it by that much.
+  // (Trimmed a horizon at a time, not at every record: the erase moves what is kept.)
+  const Nanoseconds keep_after = stamp - toNanoseconds(settings_.duration + kPreWindowHorizon);
+  const Nanoseconds oldest = started_ ? start_ - toNanoseconds(1.0) : keep_after;
+  const Nanoseconds trim_below = started_ ? oldest : keep_after - toNanoseconds(kPreWindowHorizon);
+  if (records->size() >= 4096 && records->front().stamp < trim_below) {
     const auto keep = std::lower_bound(records->begin(), records->end(), oldest,
                                        [](const Record& r, Nanoseconds t) { return r.stamp < t; });
     records->erase(records->begin(), keep);
@@ -279,6 +285,7 @@ AlignmentProgress Gyrocompass::progress() const {
   p.indexer = indexer_.size();
   p.accelerometer = accelerometer_.size();
   for (const auto& track : precession_) p.precession += track.size();
+  p.held = p.indexer + p.accelerometer + p.precession;
   return p;
 }
 

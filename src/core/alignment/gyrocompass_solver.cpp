@@ -612,6 +612,7 @@ AlignmentResult GyrocompassSolver::solve() {
     refuse("input", "no gyro samples");
     return r;
   }
+  if (!allanRateMatches()) return r;
   triad_matrix_ = g_.triad_.axis_to_body;
   HeadingSolution still;
   if (!solveStill(&still)) return r;  // refused by what no estimator changes: input, design, level
@@ -620,6 +621,19 @@ AlignmentResult GyrocompassSolver::solve() {
   r.accepted = true;
   r.reason = r.summary();
   return r;
+}
+
+bool GyrocompassSolver::allanRateMatches() {
+  const std::vector<double>& dt = g_.streams_[0].dt;
+  if (s_.allan_tau0 <= 0.0 || dt.empty()) return true;
+  std::vector<double> sorted = dt;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double period = sorted[sorted.size() / 2];
+  if (std::abs(period / s_.allan_tau0 - 1.0) <= 0.02) return true;
+  return refuse("noise", formatAlignmentMessage("the window's samples are %.6g s apart, the Allan file's (tau0) %.6g "
+                                                "s: its white angle noise Q is per sample of another rate; measure "
+                                                "it at this stream's rate (hrg_bag allan)",
+                                                period, s_.allan_tau0));
 }
 
 void GyrocompassSolver::describeHoldStart(const HeadingSolution& h) {

@@ -114,6 +114,7 @@ bool GyrocompassSolver::fitStillBase() {
     if (!buildSeries()) return false;
     for (AngleSeries& series : series_) {
       series.white_noise = s_.noise.angle_white_noise;
+      series.angle_quantum = s_.noise.angle_quantum;
       series.angle_random_walk = s_.noise.angle_random_walk;
       series.rate_random_walk = s_.noise.rate_random_walk;
     }

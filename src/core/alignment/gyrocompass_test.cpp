@@ -311,6 +311,46 @@ TEST(GyrocompassTest, OneBadStampCostsItsSampleNeverTheWindow) {
   EXPECT_NEAR(r.seconds, a.duration, 0.1);
 }
 
+TEST(GyrocompassTest, RecordsBeforeTheWindowKeepMemoryFlat) {
+  // hrg_bag align --start 5000: an hour and a half of accelerometer (and indexer) records before the
+  // window's first gyro sample. Only the last window's length and one to two minutes of each stream are kept.
+  MountScenario s;
+  AlignmentSettings a = settingsFor(s, AlignmentMode::kStatic);
+  a.level.source = LevelSource::kAccelerometer;
+  a.level.accelerometer_bias_sigma = 5e-4;
+  Gyrocompass g(a);
+  std::uint64_t most = 0;
+  for (long k = 1; k <= 500000; ++k) {
+    AccelerometerRecord r;
+    r.stamp = toNanoseconds(1000.0 + 0.01 * k);
+    r.specific_force = Eigen::Vector3d(0.0, 0.0, 9.81);
+    g.addAccelerometer(r);
+    IndexerRecord x;
+    x.stamp = r.stamp;
+    g.addIndexer(x);
+    most = std::max(most, g.progress().held);
+  }
+  std::printf("[ measured ] 500000 accelerometer and indexer records before the window: at most %llu held\n",
+              static_cast<unsigned long long>(most));
+  EXPECT_LE(most, 2u * static_cast<std::uint64_t>((a.duration + 120.0) * 100.0 + 2.0));
+  EXPECT_EQ(g.progress().dropped, 0u);
+}
+
+TEST(GyrocompassTest, AnAllanFileOfAnotherRateIsRefused) {
+  // Its Q is per sample of the rate it was measured at: a window sampled otherwise cannot use it.
+  MountScenario s;
+  s.duration = 20.0;
+  AlignmentSettings a = settingsFor(s, AlignmentMode::kStatic);
+  a.allan_tau0 = 1.0 / s.rate_hz;
+  const AlignmentResult same = testing::alignScenario(a, s);
+  EXPECT_TRUE(same.accepted) << same.summary();
+  a.allan_tau0 = 2.0 / s.rate_hz;
+  const AlignmentResult other = testing::alignScenario(a, s);
+  std::printf("[ measured ] %s\n", other.reason.c_str());
+  EXPECT_FALSE(other.accepted);
+  EXPECT_EQ(other.gate, "noise");
+}
+
 TEST(GyrocompassTest, WithoutANoiseModelItDoesNotStart) {
   AlignmentSettings a;
   a.latitude = 0.9;

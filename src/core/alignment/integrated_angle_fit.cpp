@@ -39,7 +39,8 @@ bool IntegratedAngleFit::validate() {
       }
     }
     if (!std::isfinite(s.angle_random_walk) || s.angle_random_walk < 0.0 || !std::isfinite(s.rate_random_walk) ||
-        s.rate_random_walk < 0.0 || !std::isfinite(s.white_noise)) {
+        s.rate_random_walk < 0.0 || !std::isfinite(s.white_noise) || !std::isfinite(s.angle_quantum) ||
+        s.angle_quantum < 0.0) {
       result_.problem = "noise terms must be finite and not negative";
       return false;
     }
@@ -114,12 +115,16 @@ const AngleFitResult& IntegratedAngleFit::solve(double max_condition) {
   weights_.assign(channels_.size(), 0.0);
   for (std::size_t c = 0; c < channels_.size(); ++c) {
     double s = channels_[c].white_noise;
+    const double quantisation = channels_[c].angle_quantum * channels_[c].angle_quantum / 12.0;
     if (s < 0.0) {
       s = measureWhiteNoise(channels_[c], segments_[c]);
       if (!std::isfinite(s)) {
         result_.problem = "too few points to measure the white angle noise";
         return result_;
       }
+      s = std::sqrt(s * s + quantisation);
+    } else {
+      s = std::max(s, std::sqrt(quantisation));
     }
     s = std::max(s, kMinimumWhiteNoise);
     result_.white_noise[c] = s;

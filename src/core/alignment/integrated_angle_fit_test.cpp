@@ -9,6 +9,7 @@
 
 #include <cmath>
 
+#include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/simulation/gaussian_noise.h"
 
 namespace hrg_gyro {
@@ -125,6 +126,45 @@ TEST(IntegratedAngleFitTest, SegmentsHaveTheirOwnInterceptsAndAChangeOfRateLeave
   for (double w : r.white_noise) EXPECT_NEAR(w / white, 1.0, 0.03);
   for (double s : r.scatter) EXPECT_LT(s, 1.2);
   EXPECT_EQ(r.segments.size(), 4u);
+}
+
+TEST(IntegratedAngleFitTest, AQuantisedAngleIsCoveredByItsQuantum) {
+  // An IMU counting its angle in 0.1 arcsec: 100 Hz at an Earth-rate-sized 4.4e-5 rad/s, the
+  // increments 0 or one count (most neighbours' departures 0), a white noise far below the count.
+  const double q = 0.1 / 3600.0 * kPi / 180.0, f = 100.0, length = 60.0;
+  GaussianNoise g(5);
+  double z2_blind = 0.0, z2_quantum = 0.0, white_blind = 0.0, white_quantum = 0.0;
+  const int trials = 60;
+  for (int trial = 0; trial < trials; ++trial) {
+    const double rate = 4.4e-5 * (1.0 + 0.01 * g.next()), phase = 0.5 + 0.3 * g.next();
+    AngleSeries s;
+    s.columns = {0};
+    s.regressors.assign(1, {});
+    for (long i = 0; i <= static_cast<long>(f * length); ++i) {
+      const double t = i / f;
+      const double y = q * std::round((rate * t + 2e-8 * g.next()) / q + phase);
+      s.push(t, 0, y, &t);
+    }
+    for (double quantum : {0.0, q}) {
+      AngleSeries c = s;
+      c.white_noise = -1.0;
+      c.angle_quantum = quantum;
+      IntegratedAngleFit fit(1, {c});
+      const AngleFitResult& r = fit.solve(1e8);
+      ASSERT_TRUE(r.ok) << r.problem;
+      const double z = (r.parameters(0) - rate) / std::sqrt(r.covariance()(0, 0));
+      (quantum > 0.0 ? z2_quantum : z2_blind) += z * z / trials;
+      (quantum > 0.0 ? white_quantum : white_blind) += r.white_noise[0] / trials;
+    }
+  }
+  std::printf(
+      "[ measured ] 0.1 arcsec counts at 100 Hz, %d windows of %.0f s: white noise measured %.3g rad "
+      "(rms z %.2f); with the quantum's q^2/12 %.3g rad (rms z %.2f)\n",
+      trials, length, white_blind, std::sqrt(z2_blind), white_quantum, std::sqrt(z2_quantum));
+  EXPECT_LT(white_blind, 0.2 * q) << "the measurement alone cannot see the rounding";
+  EXPECT_NEAR(white_quantum, q / std::sqrt(12.0), 0.05 * q);
+  EXPECT_GT(std::sqrt(z2_blind), 2.0) << "without the quantum the sigma claims too much";
+  EXPECT_LT(std::sqrt(z2_quantum), 1.3) << "with it the sigma covers the error";
 }
 
 TEST(IntegratedAngleFitTest, RefusesWhatItCannotSolve) {

@@ -37,7 +37,31 @@ NoiseReading parseReading(const YamlField& f) {
   return r;
 }
 
+void emitReadings(YAML::Emitter& y, const AllanResult& result) {
+  for (const Term& t : kTerms) {
+    const NoiseReading& r = result.*t.reading;
+    y << YAML::Key << t.key << YAML::Value << YAML::Flow << YAML::BeginMap;
+    y << YAML::Key << "identified" << YAML::Value << r.identified;
+    y << YAML::Key << "value" << YAML::Value << r.value;
+    y << YAML::Key << "tau_min" << YAML::Value << r.tau_min;
+    y << YAML::Key << "tau_max" << YAML::Value << r.tau_max;
+    y << YAML::EndMap;
+  }
+}
+
 }  // namespace
+
+AllanResult worstOfAxes(const std::vector<AxisAllanReadings>& axes) {
+  AllanResult out;
+  for (const AxisAllanReadings& a : axes) {
+    for (const Term& t : kTerms) {
+      const NoiseReading& r = a.result.*t.reading;
+      NoiseReading& w = out.*t.reading;
+      if (r.identified && (!w.identified || r.value > w.value)) w = r;
+    }
+  }
+  return out;
+}
 
 std::string allanReadingsYaml(const AllanReadings& readings) {
   YAML::Emitter y;
@@ -46,13 +70,14 @@ std::string allanReadingsYaml(const AllanReadings& readings) {
   y << YAML::Key << "samples" << YAML::Value << readings.samples;
   y << YAML::Key << "tau0" << YAML::Value << readings.tau0;
   y << YAML::Key << "record_length" << YAML::Value << readings.tau0 * static_cast<double>(readings.samples);
-  for (const Term& t : kTerms) {
-    const NoiseReading& r = readings.result.*t.reading;
-    y << YAML::Key << t.key << YAML::Value << YAML::Flow << YAML::BeginMap;
-    y << YAML::Key << "identified" << YAML::Value << r.identified;
-    y << YAML::Key << "value" << YAML::Value << r.value;
-    y << YAML::Key << "tau_min" << YAML::Value << r.tau_min;
-    y << YAML::Key << "tau_max" << YAML::Value << r.tau_max;
+  emitReadings(y, readings.result);
+  if (!readings.axes.empty()) {
+    y << YAML::Key << "axes" << YAML::Value << YAML::BeginMap;
+    for (const AxisAllanReadings& a : readings.axes) {
+      y << YAML::Key << a.axis << YAML::Value << YAML::BeginMap;
+      emitReadings(y, a.result);
+      y << YAML::EndMap;
+    }
     y << YAML::EndMap;
   }
   y << YAML::EndMap;
@@ -66,7 +91,7 @@ AllanReadings loadAllanReadings(const std::string& path) {
     const YamlField root(node, "");
     root.requireMap();
     root.rejectUnknownKeys({"samples", "tau0", "record_length", "angle_white_noise", "angle_random_walk",
-                            "bias_instability", "rate_random_walk"});
+                            "bias_instability", "rate_random_walk", "axes"});
     AllanReadings out;
     const long samples = root["samples"].asInteger();
     if (samples < 0) root["samples"].fail("must be at least 0");
@@ -74,6 +99,20 @@ AllanReadings loadAllanReadings(const std::string& path) {
     out.tau0 = root["tau0"].asDouble();
     if (!(out.tau0 > 0.0)) root["tau0"].fail("must be positive (s)");
     for (const Term& t : kTerms) out.result.*t.reading = parseReading(root[t.key]);
+    if (root.has("axes")) {
+      const YamlField axes = root["axes"];
+      axes.requireMap();
+      for (const std::string& name : {"x", "y", "z"}) {
+        if (!axes.has(name)) continue;
+        AxisAllanReadings a;
+        a.axis = name;
+        const YamlField f = axes[name];
+        f.requireMap();
+        for (const Term& t : kTerms) a.result.*t.reading = parseReading(f[t.key]);
+        out.axes.push_back(a);
+      }
+      axes.rejectUnknownKeys({"x", "y", "z"});
+    }
     return out;
   } catch (const ConfigError& e) {
     throw ConfigError(e.key(), e.problem() + " (in '" + path + "')");

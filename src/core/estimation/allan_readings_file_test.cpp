@@ -48,6 +48,33 @@ TEST(AllanReadingsFileTest, WhatIsWrittenIsReadBackExactly) {
   EXPECT_EQ(allanReadingsYaml(w).rfind("# hrg_bag allan readings, SI", 0), 0u);
 }
 
+TEST(AllanReadingsFileTest, EachAxisIsKeptAndTheTopLevelIsTheWorstAxis) {
+  AllanReadings w = example();
+  AllanResult x = w.result, y = w.result, z = w.result;
+  y.angle_white_noise.value = 6e-6;               // the largest Q
+  z.angle_random_walk = {true, 2e-7, 1.0, 10.0};  // the only axis that shows an N
+  x.rate_random_walk.value = 9e-10;               // the largest K
+  w.axes = {{"x", x}, {"y", y}, {"z", z}};
+  w.result = worstOfAxes(w.axes);
+  EXPECT_EQ(w.result.angle_white_noise.value, 6e-6);
+  EXPECT_TRUE(w.result.angle_random_walk.identified);
+  EXPECT_EQ(w.result.angle_random_walk.value, 2e-7);
+  EXPECT_EQ(w.result.angle_random_walk.tau_max, 10.0) << "with its axis's tau range";
+  EXPECT_EQ(w.result.rate_random_walk.value, 9e-10);
+  const TemporaryFile file("hrg_allan_readings_axes", allanReadingsYaml(w));
+  const AllanReadings r = loadAllanReadings(file.path());
+  ASSERT_EQ(r.axes.size(), 3u);
+  EXPECT_EQ(r.axes[1].axis, "y");
+  EXPECT_EQ(r.axes[1].result.angle_white_noise.value, 6e-6);
+  EXPECT_EQ(r.axes[2].result.angle_random_walk.value, 2e-7);
+  EXPECT_EQ(r.result.angle_random_walk.value, 2e-7);
+  EXPECT_EQ(refusedKey([] {
+              const TemporaryFile bad("hrg_allan_readings_axes_bad", allanReadingsYaml(example()) + "axes: {w: {}}\n");
+              loadAllanReadings(bad.path());
+            }),
+            "axes.w");
+}
+
 TEST(AllanReadingsFileTest, ABadEntryIsRefusedNamingTheKeyAndTheFile) {
   const std::string good = allanReadingsYaml(example());
   auto refused = [](const std::string& text) {

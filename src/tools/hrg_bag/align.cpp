@@ -2,7 +2,9 @@
 // as the gyrocompass node feeds it: the triad's body samples (its triad/output, or its axes' channels
 // through core::TriadProcessor as the processors and the triad node run them), one gyro's outputs
 // (single_gyro), each axis's outputs and precession state (sweep, from the channels), the indexer's
-// state (turntable/state) and the accelerometer (accel/data_raw), each in record order. Prints the heading with its
+// state (turntable/state) and the accelerometer (accel/data_raw), each in record order; or any IMU's
+// sensor_msgs/Imu (gyro_input imu, --imu-topic) through core::ImuIncrementConverter as the node runs it,
+// its linear_acceleration the level. Prints the heading with its
 // uncertainty and writes the result's YAML.
 #include <rosbag/view.h>
 #include <sensor_msgs/Imu.h>
@@ -11,6 +13,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include "align_run.h"
 #include "bag_tools.h"
@@ -63,20 +66,20 @@ core::AlignmentSettings loadSettings(const AlignOptions& o) {
 /// Where the bag holds each stream the mode needs.
 struct AlignInputs {
   std::string triad, gyro, turntable, accelerometer;
-  bool channels = false;  // the triad from its axes' channels (--triad)
-  bool sweep = false;     // each axis's outputs and precession state to the sweep mode
+  std::string imu;                 // gyro_input imu: the IMU's sensor_msgs/Imu
+  bool imu_accelerometer = false;  // the level's specific force from the IMU's messages
+  bool channels = false;           // the triad from its axes' channels (--triad)
+  bool sweep = false;              // each axis's outputs and precession state to the sweep mode
   std::array<AxisInput, 3> axes;
   std::array<std::string, 3> precession;  // sweep: each axis's /NAME/precession/state
 };
 
-/// The accelerometer: --accelerometer-topic, or the bag's one sensor_msgs/Imu topic ending in
-/// accel/data_raw (the bag may hold the triad's imu/data_raw too).
-std::string accelerometerTopic(const rosbag::Bag& bag, const std::string& chosen) {
+/// A sensor_msgs/Imu topic: `chosen` (--OPTION), or the bag's one ending in `suffix` (accel/data_raw:
+/// the bag may hold the triad's imu/data_raw too; imu/data_raw: an IMU's raw stream beside its filter's).
+std::string imuTopic(const rosbag::Bag& bag, const std::string& chosen, const std::string& suffix,
+                     const std::string& option, const std::string& hint) {
   const std::string type = ros::message_traits::datatype<sensor_msgs::Imu>();
-  const std::string hint =
-      " for level/source accelerometer (or declare the level in the settings: level/source declared)";
-  if (!chosen.empty()) return findTopic(bag, chosen, type, "accelerometer-topic", true, hint);
-  const std::string suffix = "accel/data_raw";
+  if (!chosen.empty()) return findTopic(bag, chosen, type, option, true, hint);
   std::vector<std::string> found;
   rosbag::View all(bag);
   for (const rosbag::ConnectionInfo* c : all.getConnections()) {
@@ -88,9 +91,9 @@ std::string accelerometerTopic(const rosbag::Bag& bag, const std::string& chosen
   }
   if (found.size() == 1) return found.front();
   if (found.size() > 1)
-    throw UsageError("several " + type + " topics end in " + suffix + ": choose one with --accelerometer-topic");
-  throw UsageError("no " + type + " topic ending in " + suffix + " in the bag" + hint +
-                   "; name another with --accelerometer-topic");
+    throw UsageError("several " + type + " topics end in " + suffix + ": choose one with --" + option);
+  throw UsageError("no " + type + " topic ending in " + suffix + " in the bag" + hint + "; name another with --" +
+                   option);
 }
 
 AlignInputs findInputs(const rosbag::Bag& bag, const AlignCommand& c, const core::AlignmentSettings& s,
@@ -119,6 +122,8 @@ AlignInputs findInputs(const rosbag::Bag& bag, const AlignCommand& c, const core
                          std::string(e.what()));
       }
     }
+  } else if (s.gyro_input == core::GyroInput::kImu) {
+    in.imu = imuTopic(bag, o.imu_topic, "imu/data_raw", "imu-topic", " (gyro_input imu: the IMU's messages)");
   } else {
     in.triad = findTopic(bag, o.triad_topic, ros::message_traits::datatype<TriadOutput>(), "triad-topic", true,
                          " (or give the axes' channels: --triad FILE --axis-params NAME=FILE for each axis)");
@@ -127,8 +132,15 @@ AlignInputs findInputs(const rosbag::Bag& bag, const AlignCommand& c, const core
     in.turntable = findTopic(bag, o.turntable_topic, ros::message_traits::datatype<TurntableState>(), "turntable-topic",
                              true, " (mode indexed: the indexer's angle)");
   }
-  if (s.level.source == core::LevelSource::kAccelerometer)
-    in.accelerometer = accelerometerTopic(bag, o.accelerometer_topic);
+  if (s.level.source == core::LevelSource::kAccelerometer) {
+    if (!in.imu.empty() && s.imu.accelerometer && o.accelerometer_topic.empty()) {
+      in.imu_accelerometer = true;
+    } else {
+      in.accelerometer =
+          imuTopic(bag, o.accelerometer_topic, "accel/data_raw", "accelerometer-topic",
+                   " for level/source accelerometer (or declare the level in the settings: level/source declared)");
+    }
+  }
   return in;
 }
 
@@ -136,14 +148,16 @@ AlignInputs findInputs(const rosbag::Bag& bag, const AlignCommand& c, const core
 /// stamped before the first one plus --start are skipped.
 class BagFeed {
  public:
-  BagFeed(const AlignInputs& in, double start, AlignmentRun* run)
-      : in_(in), start_(core::toNanoseconds(start)), run_(run) {}
+  BagFeed(const AlignInputs& in, double start, const core::ImuInputSettings& imu, AlignmentRun* run)
+      : in_(in), start_(core::toNanoseconds(start)), run_(run), imu_converter_(imu) {}
+
+  const core::ImuIncrementConverter& imuConverter() const { return imu_converter_; }
 
   void setChain(core::TriadProcessor* chain) { chain_ = chain; }
 
   void read(const rosbag::Bag& bag) {
     std::vector<std::string> topics;
-    for (const std::string& t : {in_.triad, in_.gyro, in_.turntable, in_.accelerometer}) {
+    for (const std::string& t : {in_.triad, in_.gyro, in_.turntable, in_.accelerometer, in_.imu}) {
       if (!t.empty()) topics.push_back(t);
     }
     std::map<std::string, std::size_t> axis_of_topic, axis_of_precession;
@@ -173,6 +187,8 @@ class BagFeed {
           if (gyro_reader_.read(m, &gyro_) && admit(toNanoseconds(gyro_.header.stamp))) {
             run_->addAxis(toAxisOutput(gyro_));
           }
+        } else if (topic == in_.imu) {
+          if (accelerometer_reader_.read(m, &imu_)) imuSample();
         } else if (topic == in_.turntable) {
           if (table_reader_.read(m, &table_)) run_->addIndexer(fromMessage(table_));
         } else if (accelerometer_reader_.read(m, &imu_)) {
@@ -199,6 +215,18 @@ class BagFeed {
   bool admit(core::Nanoseconds ns) {
     if (first_ == 0) first_ = ns;
     return ns >= first_ + start_;
+  }
+
+  /// An IMU's message: its increment (from --start on) and, as the level's, its specific force. The
+  /// force is fed from the window's start on too: before it, nothing reads it.
+  void imuSample() {
+    const core::ImuSample in = fromImuMessage(imu_);
+    const std::optional<core::TriadBodySample> sample = imu_converter_.convert(in);
+    const bool take = sample && admit(sample->stamp);
+    if (in_.imu_accelerometer && (take || (first_ != 0 && in.stamp >= first_ + start_))) {
+      if (const auto force = imu_converter_.specificForce(in)) run_->addAccelerometer({in.stamp, *force});
+    }
+    if (take) run_->addTriad(*sample);
   }
 
   /// One axis's channels through the triad's chain; the samples it completes go to the run.
@@ -243,6 +271,7 @@ class BagFeed {
   core::Nanoseconds start_ = 0, first_ = 0;
   AlignmentRun* run_;
   core::TriadProcessor* chain_ = nullptr;
+  core::ImuIncrementConverter imu_converter_;
   std::uint64_t records_ = 0;
   ReusedMessageReader<TriadOutput> triad_reader_;
   ReusedMessageReader<GyroOutput> gyro_reader_;
@@ -278,9 +307,63 @@ void printResult(const AlignmentRun& run, const core::AlignmentResult& r, const 
   }
 }
 
+/// --scan: one alignment per window of the settings' duration, every `o.scan` s from --start, each
+/// from a fresh read of the bag, until a window cannot fill. Prints a line per window and the agreement
+/// of the accepted ones; exit 0 when at least one was accepted.
+int runScan(const AlignOptions& o, const core::AlignmentSettings& settings, const core::TriadParameters& triad,
+            const AlignInputs& in, const rosbag::Bag& bag) {
+  std::vector<ScanWindow> scan;
+  for (double start = o.start;; start += o.scan) {
+    AlignmentRun run(settings, {}, triad);
+    BagFeed feed(in, start, settings.imu.converter, &run);
+    feed.read(bag);
+    const core::AlignmentResult r = run.finish();
+    if (!r.accepted && r.gate == "aborted") break;  // the bag ended inside this window
+    char line[320];
+    if (r.accepted) {
+      std::snprintf(line, sizeof line, "scan: from %8.1f s: heading %9.4f deg +- %.4f deg (noise %.4f mrad, %s)\n",
+                    start, r.heading, r.heading_sigma, 1e3 * r.budget.noise, r.estimator.c_str());
+    } else {
+      std::snprintf(line, sizeof line, "scan: from %8.1f s: refused (%s): %.200s\n", start, r.gate.c_str(),
+                    r.reason.c_str());
+    }
+    std::cout << line << std::flush;
+    scan.push_back({start, r});
+  }
+  std::vector<double> headings;
+  for (const ScanWindow& w : scan) {
+    if (w.result.accepted) headings.push_back(w.result.heading);
+  }
+  double largest = 0.0;
+  for (std::size_t i = 1; i < headings.size(); ++i)
+    largest = std::max(largest, std::abs(std::remainder(headings[i] - headings[i - 1], 360.0)));
+  std::cout << "scan: " << headings.size() << " of " << scan.size() << " windows accepted; consecutive accepted "
+            << "headings differ by at most " << core::formatDouble(largest) << " deg\n";
+  if (!o.output.empty()) {
+    try {
+      OutputText file(o.output);
+      file.stream() << emitScan(scan, o.bag, o.settings);
+      file.commit();
+    } catch (const std::exception& e) {
+      throw OutputError("--output " + o.output + " not written: " + e.what());
+    }
+  }
+  return headings.empty() ? 1 : 0;
+}
+
 int runAlign(const AlignCommand& c) {
   const AlignOptions& o = c.align;
   core::AlignmentSettings settings = loadSettings(o);
+  if (!o.imu_topic.empty()) {
+    settings.gyro_input = core::GyroInput::kImu;  // --imu-topic: the gyros are that IMU's
+    try {
+      settings.validate();
+    } catch (const core::ConfigError& e) {
+      throw UsageError("--imu-topic: " + dottedKey(e.key()) + ": " + e.problem());
+    }
+  }
+  if (settings.gyro_input == core::GyroInput::kImu && *c.triad_option)
+    throw UsageError("--triad: the gyros are an IMU's sensor_msgs/Imu (gyro_input imu), not the triad's channels");
   std::vector<double> windows;
   try {
     windows = parseWindows(o.windows, settings.duration);
@@ -313,13 +396,25 @@ int runAlign(const AlignCommand& c) {
   }
   const std::unique_ptr<rosbag::Bag> bag = openBag(o.bag);
   const AlignInputs in = findInputs(*bag, c, settings, axes);
+  if (!in.imu.empty()) std::cerr << "align: gyros from " << in.imu << " (sensor_msgs/Imu)\n";
 
+  if (o.scan > 0.0) {
+    if (chain) throw UsageError("--scan: the triad's output or an IMU's messages, not the axes' channels (--triad)");
+    if (!windows.empty()) throw UsageError("--scan and --windows: one or the other");
+    return runScan(o, settings, triad ? *triad : core::TriadParameters(), in, *bag);
+  }
   AlignmentRun run(settings, windows, triad ? *triad : core::TriadParameters());
-  BagFeed feed(in, o.start, &run);
+  BagFeed feed(in, o.start, settings.imu.converter, &run);
   feed.setChain(chain.get());
   feed.read(*bag);
   const core::AlignmentResult result = run.finish();
   const std::vector<WindowResult> window_results = run.finishWindows();
+  if (!in.imu.empty()) {
+    const core::ImuInputCounts& n = feed.imuConverter().counts();
+    std::cerr << "align: " << in.imu << ": " << n.samples << " increments (typical period "
+              << core::formatDouble(feed.imuConverter().typicalPeriod()) << " s), " << n.gaps << " gaps, " << n.dropped
+              << " dropped\n";
+  }
   printResult(run, result, window_results);
   if (!o.output.empty()) {
     try {
@@ -338,7 +433,9 @@ constexpr const char* kAlignFooter =
     "combiner (--triad FILE --axis-params NAME=FILE for each axis, as process --triad); mode indexed reads\n"
     "the indexer's turntable/state; mode sweep (with --triad) each axis's outputs from its channels and its\n"
     "/NAME/precession/state, and the triad file's M and bias; level/source accelerometer reads the\n"
-    "sensor_msgs/Imu topic ending in accel/data_raw.\n"
+    "sensor_msgs/Imu topic ending in accel/data_raw. Any IMU (gyro_input imu, or --imu-topic): its\n"
+    "sensor_msgs/Imu as the gyros, turned back into increments through the settings' imu/ keys, its\n"
+    "linear_acceleration the level (docs/north_finding.md, \"North from any IMU\").\n"
     "Prints the true heading (deg clockwise from North) +- 1 sigma and the error budget; --output writes the\n"
     "whole result. Exit 0 accepted, 1 refused by a gate (named) or the bag ended before the window was full,\n"
     "2 bad usage or unreadable input, 3 the result could not be written (nothing left at its path).";

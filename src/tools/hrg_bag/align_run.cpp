@@ -65,6 +65,12 @@ void addAlignOptions(CLI::App& cmd, AlignOptions* o) {
                  "S1,S2,...: also solve the window's first S1, S2, ... s alone (the heading against window length, "
                  "under `windows` of --output)")
       ->check(tools::notEmpty());
+  cmd.add_option("--scan", o->scan,
+                 "S: consecutive windows of --duration every S s from --start until the bag ends, each aligned "
+                 "alone (the quiet stretches of a long log, and how the windows agree); --output then writes the "
+                 "scan")
+      ->transform(tools::finiteNumber())
+      ->check(tools::above(0.0));
   const std::string group = "Topics (default: the bag's single topic of the type)";
   cmd.add_option("--triad-topic", o->triad_topic, "hrg_gyro/TriadOutput, the triad's body samples")
       ->check(tools::notEmpty())
@@ -73,6 +79,12 @@ void addAlignOptions(CLI::App& cmd, AlignOptions* o) {
       ->check(tools::notEmpty())
       ->group(group);
   cmd.add_option("--turntable-topic", o->turntable_topic, "hrg_gyro/TurntableState, the indexer (mode indexed)")
+      ->check(tools::notEmpty())
+      ->group(group);
+  cmd.add_option("--imu-topic", o->imu_topic,
+                 "sensor_msgs/Imu as the gyros (any IMU: gyro_input imu, its imu/ settings; default with gyro_input "
+                 "imu: the one ending in imu/data_raw); its linear_acceleration the level unless imu/accelerometer "
+                 "false")
       ->check(tools::notEmpty())
       ->group(group);
   cmd.add_option("--accelerometer-topic", o->accelerometer_topic,
@@ -195,6 +207,43 @@ void writeAlignmentFile(const std::string& path, const std::string& text, const 
       throw std::runtime_error(std::string("the written result does not read back: ") + e.what());
     }
   });
+}
+
+std::string emitScan(const std::vector<ScanWindow>& windows, const std::string& bag, const std::string& settings) {
+  YAML::Emitter y;
+  y.SetDoublePrecision(12);
+  y << YAML::BeginMap << YAML::Key << "bag" << YAML::Value << bag << YAML::Key << "settings" << YAML::Value << settings;
+  std::vector<double> accepted;
+  y << YAML::Key << "windows" << YAML::Value << YAML::BeginSeq;
+  for (const ScanWindow& w : windows) {
+    const core::AlignmentResult& r = w.result;
+    y << YAML::BeginMap << YAML::Key << "start_s" << YAML::Value << w.start << YAML::Key << "accepted" << YAML::Value
+      << r.accepted << YAML::Key << "gate" << YAML::Value << r.gate;
+    if (r.accepted) {
+      accepted.push_back(r.heading);
+      y << YAML::Key << "heading_deg" << YAML::Value << r.heading << YAML::Key << "heading_sigma_deg" << YAML::Value
+        << r.heading_sigma << YAML::Key << "noise_rad" << YAML::Value << r.budget.noise << YAML::Key << "estimator"
+        << YAML::Value << r.estimator;
+    } else {
+      y << YAML::Key << "reason" << YAML::Value << r.reason;
+    }
+    y << YAML::EndMap;
+  }
+  y << YAML::EndSeq;
+  if (accepted.size() >= 2) {
+    double largest = 0.0, lo = accepted.front(), hi = accepted.front();
+    for (std::size_t i = 0; i < accepted.size(); ++i) {
+      // Headings compared on the circle, against the first.
+      const double h = accepted.front() + std::remainder(accepted[i] - accepted.front(), 360.0);
+      lo = std::min(lo, h);
+      hi = std::max(hi, h);
+      if (i > 0) largest = std::max(largest, std::abs(std::remainder(accepted[i] - accepted[i - 1], 360.0)));
+    }
+    y << YAML::Key << "accepted_spread_deg" << YAML::Value << hi - lo << YAML::Key
+      << "largest_consecutive_difference_deg" << YAML::Value << largest;
+  }
+  y << YAML::EndMap;
+  return std::string("# hrg_bag align --scan: consecutive windows, each aligned alone\n") + y.c_str() + "\n";
 }
 
 }  // namespace bag_tools

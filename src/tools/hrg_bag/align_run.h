@@ -19,7 +19,9 @@ struct AlignOptions {
   double duration = 0.0;  ///< s; 0: the settings' duration
   double start = 0.0;     ///< s of gyro stamps skipped from the first sample
   std::string windows;    ///< "30,60,120": s, each at most the window
+  double scan = 0.0;      ///< s; > 0: consecutive windows every `scan` s from --start until the bag ends
   std::string triad_topic, gyro_topic, turntable_topic, accelerometer_topic;
+  std::string imu_topic;  ///< sensor_msgs/Imu as the gyros (gyro_input imu); "" the settings' input
 };
 
 /// BAG, --settings, --duration, --start, --output, --windows and the topic options.
@@ -65,6 +67,16 @@ class AlignmentRun {
 /// length).
 std::string emitAlignmentRun(const core::AlignmentResult& result, const std::vector<WindowResult>& windows,
                              const std::string& bag, const std::string& settings);
+
+/// One window of a scan (--scan): where it started, and its result.
+struct ScanWindow {
+  double start = 0.0;  ///< s after the bag's first gyro sample
+  core::AlignmentResult result;
+};
+
+/// The scan's file: each window's start, verdict, heading, sigma and budget's noise term, and how the
+/// accepted ones agree (their spread and their consecutive differences), as YAML.
+std::string emitScan(const std::vector<ScanWindow>& windows, const std::string& bag, const std::string& settings);
 
 /// Writes `text` to `path` atomically: read back (YAML, its accepted, heading and windows those of
 /// `result` and `windows`) before it replaces the path. std::runtime_error on any failure, the path

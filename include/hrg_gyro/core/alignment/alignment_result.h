@@ -40,7 +40,7 @@ struct BaseStepRecord {
 
 struct AlignmentResult {
   bool accepted = false;
-  /// The check that refused it: "input", "latitude", "motion", "level", "design", "sweep",
+  /// The check that refused it: "input", "noise", "latitude", "motion", "level", "design", "sweep",
   /// "stillness", "earth_rate", "earth_check", "attitude", "aborted"; empty when accepted.
   std::string gate;
   std::string reason;  ///< why it was refused, or the one-line summary

@@ -35,6 +35,7 @@
 
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/estimation/allan_deviation.h"
+#include "hrg_gyro/core/processing/imu_increment_converter.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -58,6 +59,10 @@ struct GyroNoiseModel {
   /// rad/s, 1 sigma: the rms over the wave angle of the residual D(theta) - D0, divided by |K0| (body
   /// rate). A resting wave turns it into a bias of that size (static); a sweep averages it out.
   double residual_drift_harmonics = NAN;
+  /// rad, the quantum of the angle an IMU's increments are counted in (0.1 arcsec counts: 4.848e-7),
+  /// 0 none: its rounding's white angle noise q^2/12, which a window's measurement cannot see, is added
+  /// to the measured white noise and floors a given one. An HRG's angle is not quantised: 0.
+  double angle_quantum = 0.0;
   /// Throws ConfigError naming `prefix` + the field (a term not given passes: NaN).
   void validate(const std::string& prefix = "noise/") const;
   /// Throws ConfigError naming the first term not given, and where to get it.
@@ -158,6 +163,21 @@ struct MotionSettings {
 enum class EstimatorChoice { kAuto, kStillBase, kTracking };
 const char* toString(EstimatorChoice choice);
 
+/// The gyros' stream: the HRG triad's body samples (TriadOutput), or any IMU's sensor_msgs/Imu turned
+/// back into increments (processing/imu_increment_converter.h), its accelerometer the level's.
+enum class GyroInput { kTriad, kImu };
+const char* toString(GyroInput input);
+
+/// The IMU input's keys beside the converter's: where the level's specific force comes from, and the
+/// frame the results and the hold are reported in.
+struct ImuInput {
+  ImuInputSettings converter;
+  /// level/source accelerometer: the IMU's own linear_acceleration (true), or accel/data_raw (false).
+  bool accelerometer = true;
+  /// frame_id of the results and of the held imu/data; "": the IMU messages' own frame_id.
+  std::string body_frame;
+};
+
 struct AlignmentSettings {
   AlignmentMode mode = AlignmentMode::kStatic;
   double latitude = NAN;            ///< rad, geodetic, north positive (required)
@@ -178,10 +198,15 @@ struct AlignmentSettings {
   GyroNoiseModel noise;
   NoiseSources noise_sources;  ///< set by parse(); a caller that fills `noise` itself keeps "settings"
   std::string allan_file;      ///< the Allan readings file `noise` was read from (its path as opened), "" none
+  /// s, that file's sample period: its Q is per sample of that rate, so a window whose samples are
+  /// spaced otherwise (by more than 2 %) is refused (gate noise); 0: no file.
+  double allan_tau0 = 0.0;
   LevelSettings level;
   IndexerSettings indexer;
   SweepSettings sweep;
   MotionSettings motion;
+  GyroInput gyro_input = GyroInput::kTriad;
+  ImuInput imu;  ///< gyro_input imu
   /// Throws ConfigError naming the key.
   void validate() const;
   /// validate(), and every noise term and level sigma given (the gyrocompass's start).

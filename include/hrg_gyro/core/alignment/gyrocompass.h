@@ -90,6 +90,7 @@ struct AlignmentProgress {
   std::uint64_t dropped = 0;   ///< records dropped: out of order, duplicate, not finite, a glitched stamp or dt
   std::uint64_t restarts = 0;  ///< the window restarted: the gyro stream went back to a new timeline
   std::uint64_t indexer = 0, accelerometer = 0, precession = 0;  ///< records taken
+  std::uint64_t held = 0;  ///< indexer, accelerometer and precession records held in memory now
 };
 
 class Gyrocompass {

@@ -91,6 +91,8 @@ class GyrocompassSolver {
                     std::vector<double>* psi, std::vector<double>* change_time, std::vector<double>* change_rate) const;
   bool sweptBothWays(std::size_t axis, double turned_up, double turned_down);
   void describeHoldStart(const HeadingSolution& h);
+  /// An Allan file's tau0 against the window's sample spacing (gate noise).
+  bool allanRateMatches();
   bool applyStillGates(const HeadingSolution& h);
   bool gateAttitude();
   bool level(LevelMeasurement* out);

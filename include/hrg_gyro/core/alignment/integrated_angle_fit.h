@@ -34,7 +34,7 @@
 // s is measured, unless given, from the data alone: each point's departure from the line through its
 // two neighbours (unit variance per s^2 for white angle noise), whose median absolute value is robust
 // to the few points at a change of commanded rate and blind to any smooth rate, less the share of a
-// given angle random walk. No ROS.
+// given angle random walk; a quantised angle's q^2/12 added (AngleSeries::angle_quantum). No ROS.
 #pragma once
 
 #include <Eigen/Core>
@@ -54,8 +54,12 @@ struct AngleSeries {
   std::vector<int> columns;                     ///< the fit's parameter index of each regressor
   std::vector<std::vector<double>> regressors;  ///< per regressor: its integral up to `time`
   double white_noise = -1.0;                    ///< rad per point; negative: measured from the data
-  double angle_random_walk = 0.0;               ///< N, rad/sqrt(s)
-  double rate_random_walk = 0.0;                ///< K, rad/s/sqrt(s)
+  /// rad, the quantum of the angle the increments were differenced from (0: none). Its rounding is a
+  /// white angle noise of q^2/12 that the measurement cannot see (most neighbours' departures are 0):
+  /// added to a measured white noise, a floor under a given one (an Allan Q of the same data has it).
+  double angle_quantum = 0.0;
+  double angle_random_walk = 0.0;  ///< N, rad/sqrt(s)
+  double rate_random_walk = 0.0;   ///< K, rad/s/sqrt(s)
 
   std::size_t size() const { return time.size(); }
   /// Appends a point; `x` holds one value per regressor.
