@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cerrno>
 #include <charconv>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 
@@ -150,6 +151,14 @@ core::Nanoseconds parseIso8601(std::string_view s, std::string_view field) {
   return checkedAdd(checkedScale(seconds, kNanosecondsPerSecond, field), ns, field);
 }
 
+/// The layout of a bench log: '#' comments, no preamble, the delimiter and header as given.
+TextLayout benchLayout(char delimiter, bool has_header) {
+  TextLayout layout;
+  layout.delimiter = delimiter;
+  layout.has_header = has_header;
+  return layout;
+}
+
 }  // namespace
 
 std::string excerpt(std::string_view text) {
@@ -186,6 +195,14 @@ DescriptorInputBuffer::int_type DescriptorInputBuffer::underflow() {
     if (n == 0) return traits_type::eof();
     if (errno != EINTR) throw std::runtime_error(std::string("read error: ") + std::strerror(errno));
   }
+}
+
+std::string secondsText(core::Nanoseconds ns) {
+  const char* sign = ns < 0 ? "-" : "";
+  const auto magnitude = ns < 0 ? -static_cast<std::uint64_t>(ns) : static_cast<std::uint64_t>(ns);
+  char fraction[16];
+  std::snprintf(fraction, sizeof fraction, ".%09llu", static_cast<unsigned long long>(magnitude % 1000000000ULL));
+  return sign + std::to_string(magnitude / 1000000000ULL) + fraction;
 }
 
 StampFormat parseStampFormat(const std::string& name) {
@@ -233,17 +250,33 @@ LineTooLongError::LineTooLongError()
                          std::to_string(kMaxLineBytes >> 20) + " MiB), the limit of a line") {}
 
 CsvReader::CsvReader(std::istream& in, std::string name, char delimiter, bool has_header)
-    : in_(in), name_(std::move(name)), delimiter_(delimiter), line_buffer_(new char[kMaxLineBytes + 2]) {
+    : CsvReader(in, std::move(name), benchLayout(delimiter, has_header)) {}
+
+CsvReader::CsvReader(std::istream& in, std::string name, const TextLayout& layout)
+    : in_(in),
+      name_(std::move(name)),
+      delimiter_(layout.delimiter),
+      comment_(layout.comment),
+      line_buffer_(new char[kMaxLineBytes + 2]) {
+  const bool has_header = layout.has_header;
   bool found = false;
   try {
-    found = readLine();
+    for (std::size_t i = 0; i <= layout.preamble_lines; ++i) {
+      found = readLine();
+      if (!found) break;
+      if (i < layout.preamble_lines) preamble_.push_back({line_, std::string(text_)});
+    }
   } catch (const LineTooLongError& e) {
     throw std::runtime_error(name_ + ":" + std::to_string(line_) + ": line too long: " + e.what() +
                              (has_header ? " (is this a log? no header row within the limit)" : ""));
   }
   if (!found) {
-    throw std::runtime_error(name_ + (has_header ? ": no header row" : ": no record") +
-                             " (the file is empty or only comments)");
+    const std::string lacking = preamble_.size() < layout.preamble_lines
+                                    ? ": " + std::to_string(preamble_.size()) + " of its " +
+                                          std::to_string(layout.preamble_lines) + " header lines"
+                                    : (has_header ? ": no header row" : ": no record");
+    throw std::runtime_error(name_ + lacking + " (the file is empty or only comments" +
+                             (layout.preamble_lines > 0 ? " after them)" : ")"));
   }
   if (delimiter_ == 0) {
     int kinds = 0;
@@ -253,7 +286,9 @@ CsvReader::CsvReader(std::istream& in, std::string name, char delimiter, bool ha
         ++kinds;
       }
     }
-    if (kinds != 1) {
+    if (kinds == 0 && layout.blanks_when_no_delimiter) {
+      delimiter_ = kWhitespace;
+    } else if (kinds != 1) {
       throw std::runtime_error(name_ + ":" + std::to_string(line_) + ": cannot tell the delimiter from the header (" +
                                (kinds == 0 ? "none" : "several") + " of ',' ';' tab): give --delimiter");
     }
@@ -295,7 +330,7 @@ bool CsvReader::readLine() {
     text_ = std::string_view(line_buffer_.get(), length);
     if (line_ == 1 && text_.substr(0, 3) == "\xEF\xBB\xBF") text_.remove_prefix(3);  // UTF-8 byte-order mark
     const std::string_view t = trim(text_);
-    if (t.empty() || t.front() == '#') continue;
+    if (t.empty() || (!comment_.empty() && t.substr(0, comment_.size()) == comment_)) continue;
     return true;
   }
   // A failed read ends getline like the end of the file: never take a cut-off log for a whole one.
@@ -306,6 +341,21 @@ bool CsvReader::readLine() {
 void CsvReader::split() {
   fields_.clear();
   std::string_view rest(text_);
+  if (delimiter_ == kWhitespace) {
+    // Runs of blanks and tabs part the fields; the line is not empty (readLine skips those).
+    for (;;) {
+      const std::size_t begin = rest.find_first_not_of(" \t\r");
+      if (begin == std::string_view::npos) break;
+      rest.remove_prefix(begin);
+      const std::size_t cut = rest.find_first_of(" \t\r");
+      std::string_view f = rest.substr(0, cut);
+      if (f.size() >= 2 && f.front() == '"' && f.back() == '"') f = f.substr(1, f.size() - 2);
+      fields_.push_back(f);
+      if (cut == std::string_view::npos) break;
+      rest.remove_prefix(cut);
+    }
+    return;
+  }
   for (;;) {
     const std::size_t cut = rest.find(delimiter_);
     std::string_view f = trim(rest.substr(0, cut));

@@ -3,7 +3,8 @@
 // at a time in a buffer of fixed size (kMaxLineBytes), so a log of any size, even one without a
 // single line end, is read in constant memory. Numbers are read whole ("1.5abc" and "1,5" are
 // errors, never 1.5 or 1), stamps exactly as integer nanoseconds. Messages quote fields and header
-// names cut to an excerpt. No ROS.
+// names cut to an excerpt. An IMU's text log is laid out more freely (other comment prefixes, fields
+// apart by blanks, header lines of numbers before the records): TextLayout says how. No ROS.
 #pragma once
 
 #include <cstdint>
@@ -85,10 +86,40 @@ double parseNumber(std::string_view field);
 /// Negative stamps, stamps before 1970 and values beyond the signed 64-bit nanosecond range throw
 /// OutOfRangeError, anything else that is not a stamp FieldError.
 core::Nanoseconds parseStamp(std::string_view field, StampFormat format);
+/// Nanoseconds as exact decimal seconds, for messages: 4294967296000000000 -> "4294967296.000000000".
+std::string secondsText(core::Nanoseconds ns);
+
+/// The delimiter value that splits a line at runs of blanks and tabs (leading and trailing ones
+/// ignored), as IMU logs written by `fprintf("%d %d ...")` or MATLAB's `save -ascii` have them.
+constexpr char kWhitespace = ' ';
+
+/// How the lines of a delimited file are laid out. The defaults are a bench log's (the channel and
+/// turntable logs of `hrg_bag import`); an IMU's log sets the rest.
+struct TextLayout {
+  /// ',' ';' '\t', kWhitespace, or 0: taken from the header line (the one of ',' ';' '\t' it holds).
+  char delimiter = 0;
+  /// With delimiter 0, a header line holding none of ',' ';' '\t' is split at blanks instead of
+  /// refused (a log of numbers apart by spaces); several of them are refused either way.
+  bool blanks_when_no_delimiter = false;
+  /// A line whose first non-blank characters are this prefix is a comment, wherever it stands (empty:
+  /// no line is).
+  std::string comment = "#";
+  /// Lines (neither empty nor comments) before the header row or the first record, kept whole for the
+  /// caller (an IMU log's header lines of numbers: its site, interval, scales).
+  std::size_t preamble_lines = 0;
+  bool has_header = true;
+};
+
+/// A line of the file kept whole, with its 1-based number.
+struct NumberedLine {
+  std::uint64_t number = 0;
+  std::string text;
+};
 
 /// The reader of one delimited file. The first line that is neither empty nor a comment ('#'
 /// first) is the header; every following such line is a record. A file without a header row
 /// (`has_header` false) has columns named only by index ("#N"), as many as its first record's.
+/// TextLayout's preamble lines, when asked for, come before the header (or the first record).
 /// A UTF-8 byte-order mark (as spreadsheet programs write) before the first line is ignored.
 /// No line may be longer than kMaxLineBytes: the reader never holds more of a line than that.
 class CsvReader {
@@ -97,8 +128,13 @@ class CsvReader {
   /// none or several of them is refused: give it). std::runtime_error (naming `name`) on an empty
   /// file, an undecidable delimiter or a first line longer than kMaxLineBytes.
   CsvReader(std::istream& in, std::string name, char delimiter = 0, bool has_header = true);
+  /// The same for a file laid out as `layout` says; a file that ends within the preamble is refused
+  /// like an empty one.
+  CsvReader(std::istream& in, std::string name, const TextLayout& layout);
 
   const std::vector<std::string>& header() const { return header_; }
+  /// The layout's preamble lines, in file order.
+  const std::vector<NumberedLine>& preamble() const { return preamble_; }
   char delimiter() const { return delimiter_; }
   /// Reads the next record; false at the end of the file, ReadError when reading failed before it.
   /// A line longer than kMaxLineBytes throws LineTooLongError, line() being its number; the next
@@ -124,6 +160,8 @@ class CsvReader {
   std::istream& in_;
   std::string name_;
   char delimiter_;
+  std::string comment_;
+  std::vector<NumberedLine> preamble_;
   /// The current line, in a buffer of kMaxLineBytes + 2 bytes (one more to tell a line of the limit
   /// ended by "\r\n" from a longer one, and getline's terminating zero) allocated once: the pages no
   /// line reaches are never touched.

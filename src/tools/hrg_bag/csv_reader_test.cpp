@@ -153,6 +153,57 @@ TEST(CsvReaderTest, WithoutHeaderTheFirstLineIsARecordAndColumnsGoByIndex) {
   EXPECT_FALSE(reader.next());
 }
 
+TEST(CsvReaderTest, LayoutOfAnImuLogCommentsBlanksAndPreamble) {
+  // A PSINS-like log: '%' comments, a blank line, two header lines of numbers, rows apart by blanks.
+  std::istringstream in(
+      "% SIMU log\n"
+      "\n"
+      "34.2 108.9  380\n"
+      "% a comment among the header lines\n"
+      "0.1 0.1 0.1 \n"
+      " 1  -2\t3 \r\n"
+      "# not a comment here\n");
+  TextLayout layout;
+  layout.delimiter = kWhitespace;
+  layout.comment = "%";
+  layout.preamble_lines = 2;
+  layout.has_header = false;
+  CsvReader reader(in, "simu.imu", layout);
+  ASSERT_EQ(reader.preamble().size(), 2u);
+  EXPECT_EQ(reader.preamble()[0].number, 3u);
+  EXPECT_EQ(reader.preamble()[0].text, "34.2 108.9  380");
+  EXPECT_EQ(reader.preamble()[1].number, 5u);
+  EXPECT_EQ(reader.header().size(), 3u);
+  ASSERT_TRUE(reader.next());
+  EXPECT_EQ(reader.line(), 6u);
+  EXPECT_EQ(reader.fields(), (std::vector<std::string_view>{"1", "-2", "3"}));
+  ASSERT_TRUE(reader.next());  // '#' is no comment prefix in this layout
+  EXPECT_EQ(reader.fields(), (std::vector<std::string_view>{"#", "not", "a", "comment", "here"}));
+  EXPECT_FALSE(reader.next());
+  // A file that ends within its preamble says how many header lines it had.
+  std::istringstream short_file("% c\n1 2\n");
+  try {
+    CsvReader(short_file, "short.imu", layout);
+    FAIL() << "a file of one header line was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("short.imu: 1 of its 2 header lines"), std::string::npos) << e.what();
+  }
+  // Auto: the one of , ; tab the first line holds, blanks when it holds none (if the layout says so).
+  TextLayout automatic;
+  automatic.has_header = false;
+  automatic.blanks_when_no_delimiter = true;
+  std::istringstream blanks("1 2  3\n");
+  EXPECT_EQ(CsvReader(blanks, "b", automatic).delimiter(), kWhitespace);
+  std::istringstream commas("1, 2, 3\n");
+  EXPECT_EQ(CsvReader(commas, "c", automatic).delimiter(), ',');
+  std::istringstream several("1,2;3\n");
+  EXPECT_THROW(CsvReader(several, "s", automatic), std::runtime_error);
+  automatic.blanks_when_no_delimiter = false;  // the bench logs' rule: refused
+  std::istringstream refused("1 2 3\n");
+  EXPECT_THROW(CsvReader(refused, "r", automatic), std::runtime_error);
+  EXPECT_EQ(secondsText(-1500000000), "-1.500000000");
+}
+
 TEST(CsvReaderTest, MessagesQuoteAnExcerptOfAField) {
   EXPECT_EQ(excerpt("1.5abc"), "1.5abc");
   EXPECT_EQ(excerpt(std::string(kQuotedBytes, 'x')), std::string(kQuotedBytes, 'x'));

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
 namespace hrg_gyro {
@@ -20,15 +19,6 @@ struct Refusal {
 std::string shortest(double value) {
   char text[32];
   return std::string(text, std::to_chars(text, text + sizeof text, value).ptr);
-}
-
-/// Nanoseconds as exact decimal seconds: 4294967296000000000 -> "4294967296.000000000".
-std::string secondsText(core::Nanoseconds ns) {
-  const char* sign = ns < 0 ? "-" : "";
-  const auto magnitude = ns < 0 ? -static_cast<std::uint64_t>(ns) : static_cast<std::uint64_t>(ns);
-  char fraction[16];
-  std::snprintf(fraction, sizeof fraction, ".%09llu", static_cast<unsigned long long>(magnitude % 1000000000ULL));
-  return sign + std::to_string(magnitude / 1000000000ULL) + fraction;
 }
 
 }  // namespace
@@ -77,27 +67,32 @@ RecordSource::RecordSource(std::istream& in, const std::string& name, const LogS
       skipped_(skipped),
       stamp_column_(column("stamp", true)) {}
 
-int RecordSource::column(const std::string& key, bool required) const {
-  const auto given = settings_.columns.find(key);
-  const std::string wanted = given == settings_.columns.end() ? key : given->second;
-  const int index = csv_.column(wanted);
-  if (index < 0 && (required || given != settings_.columns.end())) {
-    if (!settings_.has_header) {
-      throw std::runtime_error(csv_.name() + ": no header row, so " + key + " needs its column by index: --column " +
-                               key + "=#N (N from 1 to " + std::to_string(csv_.header().size()) + ")");
+int findColumn(const CsvReader& csv, const std::map<std::string, std::string>& columns, bool has_header,
+               const std::string& key, bool required) {
+  const auto given = columns.find(key);
+  const std::string wanted = given == columns.end() ? key : given->second;
+  const int index = csv.column(wanted);
+  if (index < 0 && (required || given != columns.end())) {
+    if (!has_header) {
+      throw std::runtime_error(csv.name() + ": no header row, so " + key + " needs its column by index: --column " +
+                               key + "=#N (N from 1 to " + std::to_string(csv.header().size()) + ")");
     }
     // The names, each an excerpt, and not more of them than a reader takes in.
     constexpr std::size_t kListedColumns = 16;
-    const std::vector<std::string>& header = csv_.header();
+    const std::vector<std::string>& header = csv.header();
     std::string names;
     for (std::size_t i = 0; i < std::min(header.size(), kListedColumns); ++i) {
       names += (i == 0 ? "'" : ", '") + excerpt(header[i]) + "'";
     }
     if (header.size() > kListedColumns) names += ", ... (" + std::to_string(header.size()) + " columns)";
-    throw std::runtime_error(csv_.name() + ":" + std::to_string(csv_.line()) + ": no column '" + excerpt(wanted) +
+    throw std::runtime_error(csv.name() + ":" + std::to_string(csv.line()) + ": no column '" + excerpt(wanted) +
                              "' for " + key + " in the header (" + names + "): name it with the column option");
   }
   return index;
+}
+
+int RecordSource::column(const std::string& key, bool required) const {
+  return findColumn(csv_, settings_.columns, settings_.has_header, key, required);
 }
 
 void RecordSource::bad(BadRowReason reason, const std::string& detail) const { throw Refusal{reason, detail}; }

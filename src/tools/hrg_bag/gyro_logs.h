@@ -69,6 +69,13 @@ struct TurntableRecord {
   double rate = 0;   ///< rad/s
 };
 
+/// The column of `key` in `csv`: `columns[key]` when given (a header name or "#N"), else the header
+/// column named `key` (any case); -1 when there is none and the key is neither `required` nor given.
+/// Otherwise std::runtime_error naming the file and the key, with the header's names (or, in a file
+/// `has_header` false, the #N range to map it with).
+int findColumn(const CsvReader& csv, const std::map<std::string, std::string>& columns, bool has_header,
+               const std::string& key, bool required);
+
 /// The records of one log and the rules every record meets; shared by the two readers below.
 class RecordSource {
  public:

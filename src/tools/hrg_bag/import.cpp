@@ -1,6 +1,8 @@
 // hrg_bag import: a test bench's delimited text logs (channel amplitudes, turntable) into a gyro
 // bag that `hrg_bag calibrate/process` read like a recorded one. Both logs are streamed record by
-// record and merged by stamp as they are read, so memory stays flat for a log of any size.
+// record and merged by stamp as they are read, so memory stays flat for a log of any size. With
+// --imu instead, an IMU's text log into sensor_msgs/Imu (imu_import.cpp); the two modes share the
+// command and its common options, and each refuses the other's own.
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -13,6 +15,7 @@
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "imu_import.h"
 
 namespace hrg_gyro {
 
@@ -24,7 +27,13 @@ struct ImportOptions {
   std::string angle_unit = "rad", rate_unit = "rad/s", stamp_format = "auto", delimiter = "auto";
   std::vector<std::string> columns;
   bool skip_bad_rows = false, quiet = false, no_header = false;
+  bag_tools::ImuImportOptions imu;  ///< --imu and the options only it takes
 };
+
+/// The options only the bench logs' import takes, which --imu refuses.
+const std::vector<std::string> kBenchOnlyOptions = {"--channels",       "--turntable",    "--angle-unit",
+                                                    "--rate-unit",      "--stamp-format", "--channels-topic",
+                                                    "--turntable-topic"};
 
 const std::vector<std::string> kChannelKeys = {"stamp", "ac", "bc", "as", "bs", "frequency", "temperature", "periods"};
 const std::vector<std::string> kTurntableKeys = {"stamp", "angle", "rate"};
@@ -97,8 +106,32 @@ InputLog openLog(const std::string& path, const char* option, double* bytes) {
   return log;
 }
 
+/// The IMU mode: the shared options handed over, the bench logs' own refused.
+int runImuMode(ImportOptions& o, const CLI::App& command) {
+  using namespace bag_tools;
+  for (const std::string& name : kBenchOnlyOptions) {
+    if (command.count(name) > 0) throw UsageError(name + " is for a bench's logs, not with --imu");
+  }
+  ImuImportOptions& imu = o.imu;
+  imu.out = o.out;
+  imu.compression = o.compression;
+  imu.frame_id = command.count("--frame-id") > 0 ? o.frame_id : "imu_link";
+  imu.delimiter = o.delimiter;
+  imu.columns = o.columns;
+  imu.no_header = o.no_header;
+  imu.skip_bad_rows = o.skip_bad_rows;
+  imu.quiet = o.quiet;
+  imu.command = &command;
+  checkOutputPaths({imu.log}, {imu.out});
+  double bytes = 0;
+  const InputLog log = openLog(imu.log, "--imu", &bytes);
+  return runImuImport(imu, *log.stream, bytes);
+}
+
 int runImport(const ImportOptions& o) {
   using namespace bag_tools;
+  if (o.channels.empty()) throw UsageError("--channels (a bench's logs) or --imu (an IMU's log) is required");
+  if (o.delimiter == "whitespace") throw UsageError("--delimiter whitespace is for --imu logs");
   if (!o.turntable.empty() && o.channels_topic == o.turntable_topic) {
     throw UsageError("--channels-topic and --turntable-topic are both " + o.channels_topic +
                      ": one topic cannot carry both message types");
@@ -203,10 +236,10 @@ namespace bag_tools {
 
 Command addImportCommand(CLI::App& root) {
   auto o = std::make_shared<ImportOptions>();
-  CLI::App* cmd = root.add_subcommand("import", "a test bench's CSV logs (channels, turntable) into a gyro bag");
+  CLI::App* cmd = root.add_subcommand(
+      "import", "a test bench's CSV logs (channels, turntable) into a gyro bag, or an IMU's text log (--imu)");
   cmd->add_option("--channels", o->channels,
-                  "channel-amplitude log: stamp, ac, bc, as, bs [, frequency, temperature, periods]")
-      ->required()
+                  "channel-amplitude log: stamp, ac, bc, as, bs [, frequency, temperature, periods] (or --imu)")
       ->check(tools::notEmpty());
   cmd->add_option("--turntable", o->turntable, "turntable log: stamp and angle and/or rate")->check(tools::notEmpty());
   cmd->add_option("--out", o->out, "output bag")->required()->check(tools::notEmpty());
@@ -219,8 +252,10 @@ Command addImportCommand(CLI::App& root) {
                   "auto (ISO 8601 if it holds a T, seconds if it holds a '.', else nanoseconds), s, ns, iso")
       ->check(CLI::IsMember({"auto", "s", "ns", "iso"}))
       ->capture_default_str();
-  cmd->add_option("--delimiter", o->delimiter, "auto (the one of , ; tab in the header), comma, semicolon, tab")
-      ->check(CLI::IsMember({"auto", "comma", "semicolon", "tab"}))
+  cmd->add_option("--delimiter", o->delimiter,
+                  "auto (the one of , ; tab in the header; --imu: blanks when it holds none), comma, semicolon, tab, "
+                  "whitespace (--imu: runs of blanks and tabs)")
+      ->check(CLI::IsMember({"auto", "comma", "semicolon", "tab", "whitespace"}))
       ->capture_default_str();
   cmd->add_option("--angle-unit", o->angle_unit, "unit of the logged angle")
       ->check(CLI::IsMember({"rad", "deg"}))
@@ -236,10 +271,11 @@ Command addImportCommand(CLI::App& root) {
   cmd->add_option("--turntable-topic", o->turntable_topic, "topic of the turntable states (not --channels-topic)")
       ->check(topicName())
       ->capture_default_str();
-  cmd->add_option("--frame-id", o->frame_id, "frame_id of the written messages")
+  cmd->add_option("--frame-id", o->frame_id, "frame_id of the written messages (--imu: default imu_link)")
       ->check(tools::frameId())
       ->capture_default_str();
   addCompressionOption(*cmd, &o->compression);
+  addImuImportOptions(*cmd, &o->imu);
   cmd->footer(
       "Each log: '#' comment lines, then a header row naming the columns, then one record a line,\n"
       "sorted by stamp (strictly increasing). Default column names (any case): stamp, ac, bc, as, bs,\n"
@@ -257,8 +293,23 @@ Command addImportCommand(CLI::App& root) {
       "The bag is written to a temporary and renamed over --out when complete.\n"
       "Exit 0 success, 1 a bad record or no usable record (nothing written), 2 bad usage, a log that is\n"
       "no regular file (a FIFO, a device, a directory: refused before it is opened), unreadable, without\n"
-      "a header row within 1 MiB or without the columns, 3 the bag could not be written.");
-  return [o] { return runImport(*o); };
+      "a header row within 1 MiB or without the columns, 3 the bag could not be written.\n"
+      "\n"
+      "--imu LOG: an IMU's text log into sensor_msgs/Imu on --imu-topic (angular velocity rad/s and specific\n"
+      "force m/s^2 in FLU; orientation_covariance[0] = -1, angular velocity covariance 0 = unknown,\n"
+      "linear_acceleration_covariance[0] = -1 without accelerometer columns) and, when the site is known,\n"
+      "one sensor_msgs/NavSatFix on --fix-topic at the first stamp. Columns (a header row naming them, or\n"
+      "--no-header and --column KEY=#N): time (optional, s), gx gy gz, ax ay az (optional). Increments are\n"
+      "divided by the interval their row closes (its stamp difference; without a time column --interval).\n"
+      "Rows are checked like the bench logs' records (file:line and the column named, or --skip-bad-rows).\n"
+      "Example: hrg_bag import --imu lasergyro.imu --format psins --epoch 1395394311 --out lasergyro.bag");
+  return [o, cmd] {
+    if (!o->imu.log.empty()) return runImuMode(*o, *cmd);
+    for (const std::string& name : imuOnlyOptions()) {
+      if (cmd->count(name) > 0) throw UsageError(name + " is for an IMU's log (--imu)");
+    }
+    return runImport(*o);
+  };
 }
 
 }  // namespace bag_tools

@@ -1,5 +1,9 @@
 // hrg_bag info: is this a usable gyro bag? Topics and types, counts, rates and the dt histogram,
-// gaps, stamp order, lost sequence numbers, header vs record time. Non-zero exit on errors.
+// gaps, stamp order, lost sequence numbers, header vs record time. Non-zero exit on errors. A bag of
+// an IMU's log (sensor_msgs/Imu, no gyro channels, as `hrg_bag import --imu` writes) gets the same
+// checks on its Imu topics.
+#include <sensor_msgs/Imu.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -79,13 +83,6 @@ int runInfo(const InfoOptions& o) {
     std::printf("  %-28s %-34s %10lu\n", kv.first.c_str(), kv.second.first.c_str(),
                 static_cast<unsigned long>(kv.second.second));
   int errors = 0, warnings = 0;
-  GyroTopics t;
-  try {
-    t = findTopics(*bag, o.topics, true, false);
-  } catch (const UsageError& e) {
-    std::printf("ERROR: %s\n", e.what());
-    return 1;
-  }
   const double gap_factor = o.gap_factor;
   auto report = [&](const std::string& name, const StampStats& s, bool required) {
     std::printf("%s (%s): %lu messages\n", name.c_str(), name.c_str(), static_cast<unsigned long>(s.count));
@@ -130,6 +127,27 @@ int runInfo(const InfoOptions& o) {
         ++warnings;
     }
   };
+  // A bag of an IMU's log (hrg_bag import --imu) holds no channels: its sensor_msgs/Imu topics are what
+  // is validated, each as channels would be.
+  std::vector<std::string> imu_topics;
+  bool has_channels = false;
+  for (const auto& kv : topics) {
+    if (kv.second.first == "hrg_gyro/ChannelAmplitudes") has_channels = true;
+    if (kv.second.first == "sensor_msgs/Imu") imu_topics.push_back(kv.first);
+  }
+  if (!has_channels && !imu_topics.empty() && o.topics.channels.empty()) {
+    for (const std::string& topic : imu_topics) report(topic, scan<sensor_msgs::Imu>(*bag, topic), true);
+    std::printf("%s: %d error(s), %d warning(s) (an IMU bag: no gyro channels)\n", errors ? "INVALID" : "OK", errors,
+                warnings);
+    return errors ? 1 : 0;
+  }
+  GyroTopics t;
+  try {
+    t = findTopics(*bag, o.topics, true, false);
+  } catch (const UsageError& e) {
+    std::printf("ERROR: %s\n", e.what());
+    return 1;
+  }
   report(t.channels, scan<ChannelAmplitudes>(*bag, t.channels), true);
   if (!t.turntable.empty()) {
     report(t.turntable, scan<TurntableState>(*bag, t.turntable), false);
@@ -158,6 +176,8 @@ Command addInfoCommand(CLI::App& root) {
   cmd->footer(
       "Validates a gyro bag: topics and types, counts, rates and dt histogram, gaps, stamp order, lost\n"
       "sequence numbers, header vs record time.\n"
+      "A bag without gyro channels but with sensor_msgs/Imu topics (hrg_bag import --imu) gets the\n"
+      "same checks on each Imu topic.\n"
       "Exit 0 usable, 1 when the bag cannot be processed as it is (no channels, bad stamps),\n"
       "2 bad usage or unreadable bag.");
   return [o] { return runInfo(*o); };
