@@ -131,8 +131,10 @@ bool coarseAlignment(const VelocityPoints& p, Eigen::Matrix3d* c0) {
 // The fine fit's series: per ENU channel of n0, y = C0^ V_b0 - V_n0 against [C0^ V_b0 x] psi (columns
 // 0..2), for Up a velocity slope (column 3) and, where the body turns (an indexer), the accelerometer's
 // bias in the body frame (columns 4..6: C0^ int C dt, which the turns tell from a tilt).
+// The gyros' angle random walk tilts the tracked body at random: g times that tilt is a random walk of
+// the horizontal velocity's rate (tilt_walk = g N), which the fit carries as its rate random walk.
 std::vector<AngleSeries> fineSeries(const VelocityPoints& p, const Eigen::Matrix3d& c0, double white, double walk,
-                                    bool accel_bias) {
+                                    double tilt_walk, bool accel_bias) {
   std::vector<AngleSeries> series(3);
   for (int c = 0; c < 3; ++c) {
     series[c].columns = {0, 1, 2};
@@ -141,6 +143,7 @@ std::vector<AngleSeries> fineSeries(const VelocityPoints& p, const Eigen::Matrix
     series[c].regressors.assign(series[c].columns.size(), {});
     series[c].white_noise = white;
     series[c].angle_random_walk = walk;
+    series[c].rate_random_walk = c < 2 ? tilt_walk : 0.0;
   }
   double x[7];
   for (std::size_t i = 0; i < p.time.size(); ++i) {
@@ -243,7 +246,8 @@ InertialFrameResult alignInInertialFrame(const BodyAttitudeTrack& track, const I
   double white = -1.0, walk = 0.0;
   const bool accel_bias = bodyTurns(track);
   for (int step = 0; step <= kGaussNewtonSteps; ++step) {
-    IntegratedAngleFit fit(accel_bias ? 7 : 4, fineSeries(p, c0, white, walk, accel_bias));
+    IntegratedAngleFit fit(accel_bias ? 7 : 4,
+                           fineSeries(p, c0, white, walk, out.gravity * in.gyro_angle_random_walk, accel_bias));
     const AngleFitResult& r = fit.solve(1e12);
     if (!r.ok) {
       out.problem = "the zero-velocity fit: " + r.problem;

@@ -125,6 +125,19 @@ int runAxesAllan(const AllanOptions& o) {
     readings.axes.push_back({names[a], core::allanDeviation(angles.best[a], tau0)});
     std::printf(" axis %s (the stream's own frame):\n", names[a]);
     printReadings(readings.axes.back().result);
+    // Whatever else the record holds (a base that rocks, a count's rounding), the angle random walk is
+    // at most the smallest deviation times sqrt(tau): the bound to give where no slope reads N.
+    double bound = INFINITY, at = 0.0;
+    for (const core::AllanPoint& p : readings.axes.back().result.curve) {
+      if (p.clusters >= 8 && p.deviation * std::sqrt(p.tau) < bound) {
+        bound = p.deviation * std::sqrt(p.tau);
+        at = p.tau;
+      }
+    }
+    if (std::isfinite(bound)) {
+      std::printf("  %-22s %.4g rad/sqrt(s) (%.4g deg/sqrt(h)): the smallest deviation x sqrt(tau), at tau %.3g s\n",
+                  "N at most", bound, bound * 180.0 / M_PI * 60.0, at);
+    }
   }
   readings.result = core::worstOfAxes(readings.axes);
   std::printf(" the worst axis per term (the readings file's top level, what noise/allan_file takes):\n");
