@@ -7,21 +7,11 @@
 
 namespace hrg_gyro {
 namespace csv {
-namespace {
 
-/// A record refused inside RecordSource::nextRecord, before the file:line is added.
-struct Refusal {
-  BadRowReason reason;
-  std::string detail;
-};
-
-/// The shortest text that reads back to `value` ("inf", "1e+308").
-std::string shortest(double value) {
+std::string shortestText(double value) {
   char text[32];
   return std::string(text, std::to_chars(text, text + sizeof text, value).ptr);
 }
-
-}  // namespace
 
 const char* describe(BadRowReason reason) {
   switch (reason) {
@@ -95,7 +85,7 @@ int RecordSource::column(const std::string& key, bool required) const {
   return findColumn(csv_, settings_.columns, settings_.has_header, key, required);
 }
 
-void RecordSource::bad(BadRowReason reason, const std::string& detail) const { throw Refusal{reason, detail}; }
+void RecordSource::bad(BadRowReason reason, const std::string& detail) const { throw RowRefusal{reason, detail}; }
 
 double RecordSource::number(int column, const char* key, bool nan_allowed) const {
   double value = 0.0;
@@ -154,7 +144,7 @@ bool RecordSource::nextRecord(const std::function<void(core::Nanoseconds)>& pars
       have_last_ = true;
       last_ = stamp;
       return true;
-    } catch (const Refusal& r) {
+    } catch (const RowRefusal& r) {
       refuseOrCount(r.reason, csv_.line(), r.detail);
     }
   }
@@ -246,10 +236,10 @@ bool TurntableLogReader::next(TurntableRecord* record) {
       record->rate = rate;
     } else {
       source_.refuseOrCount(BadRowReason::kNotANumber, current_.line,
-                            "rate derived from the angle is " + shortest(rate) + ": the central difference of lines " +
-                                std::to_string(a.line) + " and " + std::to_string(b.line) + " overflows (angles " +
-                                shortest(a.record.angle) + " and " + shortest(b.record.angle) + " rad, " +
-                                shortest(span) + " s apart)");
+                            "rate derived from the angle is " + shortestText(rate) +
+                                ": the central difference of lines " + std::to_string(a.line) + " and " +
+                                std::to_string(b.line) + " overflows (angles " + shortestText(a.record.angle) +
+                                " and " + shortestText(b.record.angle) + " rad, " + shortestText(span) + " s apart)");
     }
     before_ = current_;
     have_before_ = true;

@@ -26,6 +26,16 @@ enum class BadRowReason { kLineTooLong, kFieldCount, kStamp, kStampRange, kStamp
 constexpr std::size_t kBadRowReasons = 7;
 const char* describe(BadRowReason reason);
 
+/// A record refused while it is read, before the file:line is added (the readers' own signal to their
+/// loop, which turns it into a BadRowError or a skipped row).
+struct RowRefusal {
+  BadRowReason reason;
+  std::string detail;
+};
+
+/// The shortest text that reads back to `value` ("inf", "1e+308"), for the readers' messages.
+std::string shortestText(double value);
+
 /// Records skipped by reason (with --skip-bad-rows).
 struct BadRowCounts {
   std::array<std::uint64_t, kBadRowReasons> by_reason{};

@@ -16,17 +16,6 @@ namespace {
 constexpr double kDegree = core::kPi / 180.0;
 constexpr double kArcsecond = kDegree / 3600.0;  // PSINS's glv.sec, bit for bit
 
-/// A row refused inside readRow, before the file:line is added.
-struct Refusal {
-  BadRowReason reason;
-  std::string detail;
-};
-
-std::string shortest(double value) {
-  char text[32];
-  return std::string(text, std::to_chars(text, text + sizeof text, value).ptr);
-}
-
 std::string fixed(double value, int decimals) {
   char text[64];
   std::snprintf(text, sizeof text, "%.*f", decimals, value);
@@ -138,12 +127,13 @@ AxisMatrix eulerAxes(double roll, double pitch, double yaw) {
 
 void checkSite(const Site& site) {
   if (!(std::abs(site.latitude_deg) <= 90.0)) {
-    throw std::invalid_argument("latitude " + shortest(site.latitude_deg) + " deg is outside [-90, 90]");
+    throw std::invalid_argument("latitude " + shortestText(site.latitude_deg) + " deg is outside [-90, 90]");
   }
   if (!(std::abs(site.longitude_deg) <= 180.0)) {
-    throw std::invalid_argument("longitude " + shortest(site.longitude_deg) + " deg is outside [-180, 180]");
+    throw std::invalid_argument("longitude " + shortestText(site.longitude_deg) + " deg is outside [-180, 180]");
   }
-  if (std::isinf(site.height_m)) throw std::invalid_argument("height " + shortest(site.height_m) + " m is not finite");
+  if (std::isinf(site.height_m))
+    throw std::invalid_argument("height " + shortestText(site.height_m) + " m is not finite");
 }
 
 double PsinsHeader::trueHeadingDeg() const {
@@ -193,7 +183,7 @@ PsinsHeader parsePsinsHeader(const std::vector<NumberedLine>& lines, const std::
     }
     auto refuse = [&](int j, const std::string& why) {
       throw std::runtime_error(where + " field " + std::to_string(j + 1) + " (" + kMeaning[k][j] +
-                               "): " + shortest(v[k][j]) + " " + why);
+                               "): " + shortestText(v[k][j]) + " " + why);
     };
     if (k == 1) {
       if (!(std::abs(v[1][0]) <= 90.0)) refuse(0, "is outside [-90, 90]");
@@ -262,7 +252,7 @@ ImuLogReader::ImuLogReader(std::istream& in, const std::string& name, const ImuL
   // Quantities and units: a setting given wins, else the header's, else the default.
   setup_.gravity = settings.gravity ? *settings.gravity : header ? header->gravity : kStandardGravity;
   if (!(setup_.gravity > 0.0) || !std::isfinite(setup_.gravity)) {
-    throw std::invalid_argument("gravity " + shortest(setup_.gravity) + " m/s^2 is not a positive number");
+    throw std::invalid_argument("gravity " + shortestText(setup_.gravity) + " m/s^2 is not a positive number");
   }
   setup_.gyro_unit = settings.gyro_unit ? *settings.gyro_unit : header ? "arcsec" : "rad/s";
   setup_.accel_unit = settings.accel_unit ? *settings.accel_unit : header ? "ug*s" : "m/s^2";
@@ -274,7 +264,7 @@ ImuLogReader::ImuLogReader(std::istream& in, const std::string& name, const ImuL
                                             : std::array{1., 1., 1.};
   auto check_scale = [](const char* what, double scale, int axis) {
     if (scale == 0.0 || !std::isfinite(scale)) {
-      throw std::invalid_argument(std::string(what) + " scale " + shortest(scale) + " of the log's " + "xyz"[axis] +
+      throw std::invalid_argument(std::string(what) + " scale " + shortestText(scale) + " of the log's " + "xyz"[axis] +
                                   " axis is not a finite non-zero number");
     }
   };
@@ -289,11 +279,11 @@ ImuLogReader::ImuLogReader(std::istream& in, const std::string& name, const ImuL
   setup_.interval = settings.interval;
   if (!setup_.interval && header) setup_.interval = header->interval_ms / 1000.0;
   if (setup_.interval && !(*setup_.interval >= 1e-9 && *setup_.interval <= 1e6)) {
-    throw std::invalid_argument("interval " + shortest(*setup_.interval) + " s is outside [1e-9, 1e6] s");
+    throw std::invalid_argument("interval " + shortestText(*setup_.interval) + " s is outside [1e-9, 1e6] s");
   }
   setup_.start = settings.start ? *settings.start : header ? header->t0 : 0.0;
   if (!(std::abs(setup_.start) <= 4294967296.0)) {
-    throw std::invalid_argument("start " + shortest(setup_.start) + " s is beyond the 2^32 s a bag's time holds");
+    throw std::invalid_argument("start " + shortestText(setup_.start) + " s is beyond the 2^32 s a bag's time holds");
   }
   setup_.epoch = settings.epoch;
   time_ = psins ? -1 : findColumn(csv_, columns, has_header, "time", false);
@@ -329,10 +319,11 @@ ImuLogReader::ImuLogReader(std::istream& in, const std::string& name, const ImuL
   if (settings.rotation) {
     const auto& r = *settings.rotation;
     for (double angle : r) {
-      if (!std::isfinite(angle)) throw std::invalid_argument("rotation angle " + shortest(angle) + " is not finite");
+      if (!std::isfinite(angle))
+        throw std::invalid_argument("rotation angle " + shortestText(angle) + " is not finite");
     }
     setup_.axes = eulerAxes(r[0], r[1], r[2]);
-    setup_.frame = "rotation " + shortest(r[0]) + "," + shortest(r[1]) + "," + shortest(r[2]) + " rad";
+    setup_.frame = "rotation " + shortestText(r[0]) + "," + shortestText(r[1]) + "," + shortestText(r[2]) + " rad";
   } else {
     setup_.frame = upper(settings.frame ? *settings.frame : header ? "RFU" : "FLU");
     setup_.axes = frameAxes(setup_.frame);
@@ -356,7 +347,7 @@ ImuLogReader::ImuLogReader(std::istream& in, const std::string& name, const ImuL
   if (setup_.site) checkSite(*setup_.site);
 }
 
-void ImuLogReader::bad(BadRowReason reason, const std::string& detail) const { throw Refusal{reason, detail}; }
+void ImuLogReader::bad(BadRowReason reason, const std::string& detail) const { throw RowRefusal{reason, detail}; }
 
 bool ImuLogReader::readRow(Row* row) {
   for (;;) {
@@ -433,7 +424,7 @@ bool ImuLogReader::readRow(Row* row) {
         row->accel[i] = setup_.accelerometer ? value(accel_columns_[i], kAccelKeys[i], setup_.accel_factor[i]) : 0.0;
       }
       return true;
-    } catch (const Refusal& r) {
+    } catch (const RowRefusal& r) {
       if (!settings_.skip_bad_rows || skipped_ == nullptr) {
         throw BadRowError(r.reason,
                           name_ + ":" + std::to_string(csv_.line()) + ": " + describe(r.reason) + ": " + r.detail);
@@ -458,7 +449,7 @@ bool ImuLogReader::finish(Row& row, ImuRecord* record) {
   }
   for (int r = 0; r < 3; ++r) {
     if (!std::isfinite(record->angular_velocity[r]) || !std::isfinite(record->specific_force[r])) {
-      const std::string detail = "an increment divided by its interval (" + shortest(dt) + " s) overflows";
+      const std::string detail = "an increment divided by its interval (" + shortestText(dt) + " s) overflows";
       if (!settings_.skip_bad_rows || skipped_ == nullptr) {
         throw BadRowError(BadRowReason::kNotANumber, name_ + ":" + std::to_string(row.record.line) + ": " +
                                                          describe(BadRowReason::kNotANumber) + ": " + detail);
