@@ -95,7 +95,6 @@ void parseNoise(const YamlField& f, GyroNoiseModel* n, NoiseSources* sources, st
   noiseTerm(f, "residual_bias", &n->residual_bias, &sources->residual_bias);
   noiseTerm(f, "residual_drift_harmonics", &n->residual_drift_harmonics, &sources->residual_drift_harmonics);
   n->angle_quantum = f.getDouble("angle_quantum", n->angle_quantum);
-  if (n->angle_quantum > 0.0) sources->angle_white_noise += " + the angle quantum's q^2/12";
   // The measured readings replace the keys above; one the record did not identify keeps its key.
   if (f.getString("allan_file", "").empty()) return;
   const YamlField file = f["allan_file"];
@@ -250,6 +249,8 @@ AlignmentSettings AlignmentSettings::parse(const YamlField& root, const std::vec
   s.noise_sources.residual_bias = s.noise_sources.residual_drift_harmonics = "not given";
   if (root.has("noise"))
     parseNoise(root["noise"], &s.noise, &s.noise_sources, &s.allan_file, &s.allan_tau0, base_directory);
+  // After the Allan file, which names the white noise's source anew: the quantum adds to whichever.
+  if (s.noise.angle_quantum > 0.0) s.noise_sources.angle_white_noise += " + the angle quantum's q^2/12";
   if (root.has("level")) parseLevel(root["level"], &s.level);
   if (root.has("indexer")) parseIndexer(root["indexer"], &s.indexer);
   if (root.has("sweep")) parseSweep(root["sweep"], &s.sweep);

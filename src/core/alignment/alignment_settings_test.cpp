@@ -312,6 +312,14 @@ TEST(AlignmentSettingsTest, TheNoiseComesFromAnAllanReadingsFile) {
   EXPECT_EQ(s.noise.angle_random_walk, 1.5e-7);  // not identified: the key's
   EXPECT_EQ(s.noise.rate_random_walk, 5e-10);    // the file's, not the key's
   EXPECT_EQ(s.noise.residual_bias, 1e-8);
+  EXPECT_EQ(s.allan_tau0, 0.005);
+  // A quantum beside the file: the white noise's source says both (the file's Q, the count's q^2/12).
+  const AlignmentSettings q =
+      parseText("latitude: 0.9\nnoise: {angle_quantum: 4.8e-7, allan_file: " + allan.path() + "}\n");
+  EXPECT_NE(q.noise_sources.angle_white_noise.find("allan_file"), std::string::npos)
+      << q.noise_sources.angle_white_noise;
+  EXPECT_NE(q.noise_sources.angle_white_noise.find("angle quantum"), std::string::npos)
+      << q.noise_sources.angle_white_noise;
   const std::string base = "latitude: 0.9\n";
   EXPECT_EQ(refusedKey([&] { parseText(base + "noise: {allan_file: " + name + "}\n"); }), "noise.allan_file");
   EXPECT_EQ(parseText(base + "noise: {allan_file: " + allan.path() + "}\n").noise.rate_random_walk, 5e-10);
