@@ -53,18 +53,23 @@ void printReadings(const core::AllanResult& a) {
 }
 
 /// The three axes' integrated angles over the longest continuous stretch of a triad's or an IMU's
-/// stream (no gap, reset or lost sample) within --from..--to, and the stretch's median interval.
+/// stream within --from..--to, and the stretch's median interval. A gap, a reset, and a sample over
+/// another interval than the stretch's first (one that spans a lost sample) end the stretch: the
+/// deviation needs the angle every tau0.
 struct AxisAngles {
   std::array<std::vector<double>, 3> angle, best;
   std::vector<double> dts;
   std::array<double, 3> sum{{0.0, 0.0, 0.0}};
+  double spacing = 0.0;  // s, the stretch's first interval
 
   void add(const core::TriadBodySample& s, double from, double to) {
     const double t = core::toSeconds(s.stamp);
-    if (t < from || t > to || !s.integrated()) {
+    const bool uneven = spacing > 0.0 && std::abs(s.dt / spacing - 1.0) > 0.5;
+    if (t < from || t > to || !s.integrated() || uneven) {
       cut();
       return;
     }
+    if (spacing == 0.0) spacing = s.dt;
     for (int a = 0; a < 3; ++a) {
       sum[a] += s.delta_angle[a];
       angle[a].push_back(sum[a]);
@@ -74,6 +79,7 @@ struct AxisAngles {
   void cut() {
     if (angle[0].size() > best[0].size()) best.swap(angle);
     for (auto& v : angle) v.clear();
+    spacing = 0.0;
   }
 };
 
@@ -100,9 +106,7 @@ int runAxesAllan(const AllanOptions& o) {
     for (const rosbag::MessageInstance& m : view) {
       ++records;
       if (imu && imu_reader.read(m, &imu_message)) {
-        const std::uint64_t dropped = converter.counts().dropped;
         const auto sample = converter.convert(fromImuMessage(imu_message));
-        if (converter.counts().dropped != dropped) angles.cut();  // a lost sample ends the stretch
         if (sample) angles.add(*sample, o.from, o.to);
       } else if (!imu && triad_reader.read(m, &triad_message)) {
         angles.add(fromMessage(triad_message), o.from, o.to);
