@@ -330,25 +330,18 @@ int runScan(const AlignOptions& o, const core::AlignmentSettings& settings, cons
     std::cout << line << std::flush;
     scan.push_back({start, r});
   }
-  std::vector<double> headings;
-  for (const ScanWindow& w : scan) {
-    if (w.result.accepted) headings.push_back(w.result.heading);
-  }
-  double largest = 0.0;
-  for (std::size_t i = 1; i < headings.size(); ++i)
-    largest = std::max(largest, std::abs(std::remainder(headings[i] - headings[i - 1], 360.0)));
-  std::cout << "scan: " << headings.size() << " of " << scan.size() << " windows accepted; consecutive accepted "
-            << "headings differ by at most " << core::formatDouble(largest) << " deg\n";
+  const ScanAgreement agreement = scanAgreement(scan);
+  std::cout << "scan: " << agreement.accepted << " of " << scan.size() << " windows accepted; consecutive accepted "
+            << "headings differ by at most " << core::formatDouble(agreement.largest_consecutive) << " deg, spread "
+            << core::formatDouble(agreement.spread) << " deg\n";
   if (!o.output.empty()) {
     try {
-      OutputText file(o.output);
-      file.stream() << emitScan(scan, o.bag, o.settings);
-      file.commit();
+      writeScanFile(o.output, emitScan(scan, o.bag, o.settings), scan);
     } catch (const std::exception& e) {
       throw OutputError("--output " + o.output + " not written: " + e.what());
     }
   }
-  return headings.empty() ? 1 : 0;
+  return agreement.accepted == 0 ? 1 : 0;
 }
 
 int runAlign(const AlignCommand& c) {

@@ -209,18 +209,35 @@ void writeAlignmentFile(const std::string& path, const std::string& text, const 
   });
 }
 
+ScanAgreement scanAgreement(const std::vector<ScanWindow>& windows) {
+  ScanAgreement a;
+  double first = 0.0, previous = 0.0, lo = 0.0, hi = 0.0;
+  for (const ScanWindow& w : windows) {
+    if (!w.result.accepted) continue;
+    const double h = w.result.heading;
+    if (a.accepted == 0) first = previous = lo = hi = h;
+    // Headings compared on the circle: the spread against the first, each against the one before.
+    const double unwrapped = first + std::remainder(h - first, 360.0);
+    lo = std::min(lo, unwrapped);
+    hi = std::max(hi, unwrapped);
+    a.largest_consecutive = std::max(a.largest_consecutive, std::abs(std::remainder(h - previous, 360.0)));
+    previous = h;
+    ++a.accepted;
+  }
+  a.spread = hi - lo;
+  return a;
+}
+
 std::string emitScan(const std::vector<ScanWindow>& windows, const std::string& bag, const std::string& settings) {
   YAML::Emitter y;
   y.SetDoublePrecision(12);
   y << YAML::BeginMap << YAML::Key << "bag" << YAML::Value << bag << YAML::Key << "settings" << YAML::Value << settings;
-  std::vector<double> accepted;
   y << YAML::Key << "windows" << YAML::Value << YAML::BeginSeq;
   for (const ScanWindow& w : windows) {
     const core::AlignmentResult& r = w.result;
     y << YAML::BeginMap << YAML::Key << "start_s" << YAML::Value << w.start << YAML::Key << "accepted" << YAML::Value
       << r.accepted << YAML::Key << "gate" << YAML::Value << r.gate;
     if (r.accepted) {
-      accepted.push_back(r.heading);
       y << YAML::Key << "heading_deg" << YAML::Value << r.heading << YAML::Key << "heading_sigma_deg" << YAML::Value
         << r.heading_sigma << YAML::Key << "noise_rad" << YAML::Value << r.budget.noise << YAML::Key << "estimator"
         << YAML::Value << r.estimator;
@@ -230,20 +247,30 @@ std::string emitScan(const std::vector<ScanWindow>& windows, const std::string& 
     y << YAML::EndMap;
   }
   y << YAML::EndSeq;
-  if (accepted.size() >= 2) {
-    double largest = 0.0, lo = accepted.front(), hi = accepted.front();
-    for (std::size_t i = 0; i < accepted.size(); ++i) {
-      // Headings compared on the circle, against the first.
-      const double h = accepted.front() + std::remainder(accepted[i] - accepted.front(), 360.0);
-      lo = std::min(lo, h);
-      hi = std::max(hi, h);
-      if (i > 0) largest = std::max(largest, std::abs(std::remainder(accepted[i] - accepted[i - 1], 360.0)));
-    }
-    y << YAML::Key << "accepted_spread_deg" << YAML::Value << hi - lo << YAML::Key
-      << "largest_consecutive_difference_deg" << YAML::Value << largest;
+  const ScanAgreement a = scanAgreement(windows);
+  if (a.accepted >= 2) {
+    y << YAML::Key << "accepted_spread_deg" << YAML::Value << a.spread << YAML::Key
+      << "largest_consecutive_difference_deg" << YAML::Value << a.largest_consecutive;
   }
   y << YAML::EndMap;
   return std::string("# hrg_bag align --scan: consecutive windows, each aligned alone\n") + y.c_str() + "\n";
+}
+
+void writeScanFile(const std::string& path, const std::string& text, const std::vector<ScanWindow>& windows) {
+  core::writeFileAtomically(path, text, {}, [&](const std::string& temporary) {
+    try {
+      const YAML::Node w = YAML::LoadFile(temporary)["windows"];
+      bool same = w.IsSequence() && w.size() == windows.size();
+      for (std::size_t i = 0; same && i < windows.size(); ++i) {
+        same = sameNumber(windows[i].start, w[i]["start_s"].as<double>()) &&
+               w[i]["accepted"].as<bool>() == windows[i].result.accepted &&
+               (!windows[i].result.accepted || sameNumber(windows[i].result.heading, w[i]["heading_deg"].as<double>()));
+      }
+      if (!same) throw std::runtime_error("the scan does not read back as written");
+    } catch (const YAML::Exception& e) {
+      throw std::runtime_error(std::string("the written scan does not read back: ") + e.what());
+    }
+  });
 }
 
 }  // namespace bag_tools

@@ -74,9 +74,22 @@ struct ScanWindow {
   core::AlignmentResult result;
 };
 
+/// How a scan's accepted windows agree: their number, the spread of their headings and the largest
+/// difference between consecutive ones (deg, on the circle).
+struct ScanAgreement {
+  std::size_t accepted = 0;
+  double spread = 0.0, largest_consecutive = 0.0;
+};
+ScanAgreement scanAgreement(const std::vector<ScanWindow>& windows);
+
 /// The scan's file: each window's start, verdict, heading, sigma and budget's noise term, and how the
 /// accepted ones agree (their spread and their consecutive differences), as YAML.
 std::string emitScan(const std::vector<ScanWindow>& windows, const std::string& bag, const std::string& settings);
+
+/// Writes emitScan's `text` to `path` atomically: read back (YAML, its windows' starts, verdicts and
+/// headings those of `windows`) before it replaces the path. std::runtime_error on any failure, the
+/// path then unchanged.
+void writeScanFile(const std::string& path, const std::string& text, const std::vector<ScanWindow>& windows);
 
 /// Writes `text` to `path` atomically: read back (YAML, its accepted, heading and windows those of
 /// `result` and `windows`) before it replaces the path. std::runtime_error on any failure, the path

@@ -36,9 +36,29 @@ std::string parse(std::vector<std::string> args, AlignOptions* o) {
 
 TEST(AlignOptions, ReadsEveryOption) {
   AlignOptions o;
-  ASSERT_EQ(parse({"s.bag", "--settings", "a.yaml", "--duration", "90", "--start", "5", "--output", "r.yaml",
-                   "--windows", "30,60", "--triad-topic", "/t/triad/output", "--gyro-topic", "/g/output",
-                   "--turntable-topic", "/tt", "--accelerometer-topic", "/accel/data_raw"},
+  ASSERT_EQ(parse({"s.bag",
+                   "--settings",
+                   "a.yaml",
+                   "--duration",
+                   "90",
+                   "--start",
+                   "5",
+                   "--output",
+                   "r.yaml",
+                   "--windows",
+                   "30,60",
+                   "--triad-topic",
+                   "/t/triad/output",
+                   "--gyro-topic",
+                   "/g/output",
+                   "--turntable-topic",
+                   "/tt",
+                   "--accelerometer-topic",
+                   "/accel/data_raw",
+                   "--imu-topic",
+                   "/imu/data_raw",
+                   "--scan",
+                   "300"},
                   &o),
             "");
   EXPECT_EQ(o.bag, "s.bag");
@@ -51,6 +71,8 @@ TEST(AlignOptions, ReadsEveryOption) {
   EXPECT_EQ(o.gyro_topic, "/g/output");
   EXPECT_EQ(o.turntable_topic, "/tt");
   EXPECT_EQ(o.accelerometer_topic, "/accel/data_raw");
+  EXPECT_EQ(o.imu_topic, "/imu/data_raw");
+  EXPECT_EQ(o.scan, 300.0);
   AlignOptions defaults;
   ASSERT_EQ(parse({"s.bag", "--settings", "a.yaml"}, &defaults), "");
   EXPECT_EQ(defaults.duration, 0.0);  // the settings' own
@@ -204,6 +226,34 @@ TEST_F(AlignmentRunFile, TheResultFileReadsBackWithItsWindows) {
   EXPECT_THROW(writeAlignmentFile(dir_, emitAlignmentRun(r, windows, "b", "s"), r, windows), std::runtime_error);
   // Neither refusal left a temporary file beside the result.
   EXPECT_EQ(listing(), std::set<std::string>{"result.yaml"});
+}
+
+TEST_F(AlignmentRunFile, AScanSaysHowItsWindowsAgreeAndReadsBack) {
+  std::vector<ScanWindow> scan(4);
+  const double headings[] = {359.99, 0.0, 0.03, 0.0};
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    scan[i].start = 300.0 * static_cast<double>(i);
+    scan[i].result.accepted = i != 3;
+    scan[i].result.heading = headings[i];
+    scan[i].result.gate = i == 3 ? "stillness" : "";
+  }
+  // On the circle: 359.99 and 0.03 are 0.04 apart, not 359.96; the refused window counts for nothing.
+  const ScanAgreement a = scanAgreement(scan);
+  EXPECT_EQ(a.accepted, 3u);
+  EXPECT_NEAR(a.spread, 0.04, 1e-9);
+  EXPECT_NEAR(a.largest_consecutive, 0.03, 1e-9);
+  const std::string path = at("scan.yaml");
+  writeScanFile(path, emitScan(scan, "b.bag", "s.yaml"), scan);
+  const YAML::Node doc = YAML::LoadFile(path);
+  ASSERT_EQ(doc["windows"].size(), 4u);
+  EXPECT_EQ(doc["windows"][3]["gate"].as<std::string>(), "stillness");
+  EXPECT_NEAR(doc["accepted_spread_deg"].as<double>(), 0.04, 1e-9);
+  // A text that does not say what the scan says is not written; the file stays as it was.
+  std::vector<ScanWindow> other = scan;
+  other[1].result.heading = 1.0;
+  EXPECT_THROW(writeScanFile(path, emitScan(other, "b.bag", "s.yaml"), scan), std::runtime_error);
+  EXPECT_EQ(YAML::LoadFile(path)["windows"][1]["heading_deg"].as<double>(), 0.0);
+  EXPECT_EQ(listing(), std::set<std::string>{"scan.yaml"});
 }
 
 }  // namespace
