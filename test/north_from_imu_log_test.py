@@ -103,40 +103,38 @@ class NorthFromImuLog(unittest.TestCase):
             truth = yaml.safe_load(open(truth_file))
             bag = self.imported(log, "gen%d" % seed)
             for estimator in ("still_base", "tracking"):
-                for quantum in (truth["angle_quantum"], 0.0):
-                    settings = self.path("gen%d.%s.settings.yaml" % (seed, estimator))
-                    with open(settings, "w") as f:
-                        f.write("latitude: %.12f\nduration: 290.0\ngyro_input: imu\nestimator: %s\n" %
-                                (truth["latitude"], estimator))
-                        f.write("noise: {angle_white_noise: -1.0, angle_quantum: %.9e, angle_random_walk: %.6e,"
-                                " rate_random_walk: 0.0, residual_bias: 4.0e-8, residual_drift_harmonics: 0.0}\n" %
-                                (quantum, truth["angle_random_walk"]))
-                        f.write("level: {source: accelerometer, accelerometer_bias_sigma: 1.0e-3,"
-                                " accelerometer_mounting_sigma: 0.0}\n")
-                    result = self.path("gen%d.%s.alignment.yaml" % (seed, estimator))
-                    code, out, err = run(HRG_BAG, "align", bag, "--settings", settings, "--output", result)
-                    r = yaml.safe_load(open(result))
-                    if estimator == "tracking" and code == 1:
-                        # A north finder answers with an honest sigma or refuses naming why: a refusal counts
-                        # as no answer, never as a wrong one. The still base must answer.
-                        print("generated, seed %d, tracking, quantum %.3g: refused (%s): %s" %
-                              (seed, quantum, r["gate"], r["reason"]))
-                        refusals += 1
-                        continue
-                    self.assertEqual(code, 0, out + err)
-                    z = wrap(r["heading_deg"] - truth["heading_deg"]) / r["heading_sigma_deg"]
-                    print("generated, seed %d, %s, quantum %.3g: heading %.4f +- %.4f deg against %.4f: z = %+.2f; "
-                          "roll %+.6f pitch %+.6f (truth %+.6f %+.6f)" %
-                          (seed, estimator, quantum, r["heading_deg"], r["heading_sigma_deg"], truth["heading_deg"], z,
-                           r["attitude_rad"]["roll"], r["attitude_rad"]["pitch"], truth["roll"], truth["pitch"]))
-                    if quantum > 0.0:
-                        worst = max(worst, abs(z))
-                        self.assertLess(abs(z), 3.0)
-                        self.assertAlmostEqual(r["attitude_rad"]["roll"], truth["roll"], delta=3e-4)
-                        self.assertAlmostEqual(r["attitude_rad"]["pitch"], truth["pitch"], delta=3e-4)
+                settings = self.path("gen%d.%s.settings.yaml" % (seed, estimator))
+                with open(settings, "w") as f:
+                    f.write("latitude: %.12f\nduration: 290.0\ngyro_input: imu\nestimator: %s\n" %
+                            (truth["latitude"], estimator))
+                    f.write("noise: {angle_white_noise: -1.0, angle_quantum: %.9e, angle_random_walk: %.6e,"
+                            " rate_random_walk: 0.0, residual_bias: 4.0e-8, residual_drift_harmonics: 0.0}\n" %
+                            (truth["angle_quantum"], truth["angle_random_walk"]))
+                    f.write("level: {source: accelerometer, accelerometer_bias_sigma: 1.0e-3,"
+                            " accelerometer_mounting_sigma: 0.0}\n")
+                result = self.path("gen%d.%s.alignment.yaml" % (seed, estimator))
+                code, out, err = run(HRG_BAG, "align", bag, "--settings", settings, "--output", result)
+                r = yaml.safe_load(open(result))
+                if estimator == "tracking" and code == 1:
+                    # A north finder answers with an honest sigma or refuses naming why: a refusal counts as
+                    # no answer, never as a wrong one. The still base must answer.
+                    print("generated, seed %d, tracking: refused (%s): %s" % (seed, r["gate"], r["reason"]))
+                    self.assertNotEqual(r["gate"], "")
+                    refusals += 1
+                    continue
+                self.assertEqual(code, 0, out + err)
+                z = wrap(r["heading_deg"] - truth["heading_deg"]) / r["heading_sigma_deg"]
+                print("generated, seed %d, %s: heading %.4f +- %.4f deg against %.4f: z = %+.2f; roll %+.6f pitch "
+                      "%+.6f (truth %+.6f %+.6f)" %
+                      (seed, estimator, r["heading_deg"], r["heading_sigma_deg"], truth["heading_deg"], z,
+                       r["attitude_rad"]["roll"], r["attitude_rad"]["pitch"], truth["roll"], truth["pitch"]))
+                worst = max(worst, abs(z))
+                self.assertLess(abs(z), 3.0)
+                self.assertAlmostEqual(r["attitude_rad"]["roll"], truth["roll"], delta=3e-4)
+                self.assertAlmostEqual(r["attitude_rad"]["pitch"], truth["pitch"], delta=3e-4)
         print("generated logs: worst |z| %.2f of what was accepted over 3 seeds and both estimators; the tracking "
-              "refused %d of 6" % (worst, refusals))
-        self.assertLessEqual(refusals, 4, "the tracking estimator answers on a still base at least once in three")
+              "refused %d of 3" % (worst, refusals))
+        self.assertLessEqual(refusals, 2, "the tracking estimator answers on a still base at least once in three")
 
 
 if __name__ == "__main__":
