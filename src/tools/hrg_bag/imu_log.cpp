@@ -247,21 +247,30 @@ ImuLogReader::ImuLogReader(std::istream& in, const std::string& name, const ImuL
   }
   const PsinsHeader* header = setup_.psins ? &*setup_.psins : nullptr;
   has_header_ = !psins && settings.layout.has_header;
-  const bool has_header = has_header_;
 
+  setupUnits(header);
+  setupTime(header, columns);
+  setupColumns(columns);
+  setupAxes(header);
+  setupSite(header);
+}
+
+void ImuLogReader::setupUnits(const PsinsHeader* header) {
   // Quantities and units: a setting given wins, else the header's, else the default.
-  setup_.gravity = settings.gravity ? *settings.gravity : header ? header->gravity : kStandardGravity;
+  setup_.gravity = settings_.gravity ? *settings_.gravity : header ? header->gravity : kStandardGravity;
   if (!(setup_.gravity > 0.0) || !std::isfinite(setup_.gravity)) {
     throw std::invalid_argument("gravity " + shortestText(setup_.gravity) + " m/s^2 is not a positive number");
   }
-  setup_.gyro_unit = settings.gyro_unit ? *settings.gyro_unit : header ? "arcsec" : "rad/s";
-  setup_.accel_unit = settings.accel_unit ? *settings.accel_unit : header ? "ug*s" : "m/s^2";
+  setup_.gyro_unit = settings_.gyro_unit ? *settings_.gyro_unit : header ? "arcsec" : "rad/s";
+  setup_.accel_unit = settings_.accel_unit ? *settings_.accel_unit : header ? "ug*s" : "m/s^2";
   setup_.gyro = gyroUnit(setup_.gyro_unit);
   setup_.accel = accelUnit(setup_.accel_unit, setup_.gravity);
-  setup_.gyro_scale = settings.gyro_scale ? *settings.gyro_scale : header ? header->gyro_scale : std::array{1., 1., 1.};
-  setup_.accel_scale = settings.accel_scale ? *settings.accel_scale
-                       : header             ? header->accel_scale
-                                            : std::array{1., 1., 1.};
+  setup_.gyro_scale = settings_.gyro_scale ? *settings_.gyro_scale
+                      : header             ? header->gyro_scale
+                                           : std::array{1., 1., 1.};
+  setup_.accel_scale = settings_.accel_scale ? *settings_.accel_scale
+                       : header              ? header->accel_scale
+                                             : std::array{1., 1., 1.};
   auto check_scale = [](const char* what, double scale, int axis) {
     if (scale == 0.0 || !std::isfinite(scale)) {
       throw std::invalid_argument(std::string(what) + " scale " + shortestText(scale) + " of the log's " + "xyz"[axis] +
@@ -274,50 +283,56 @@ ImuLogReader::ImuLogReader(std::istream& in, const std::string& name, const ImuL
     setup_.gyro_factor[i] = setup_.gyro_scale[i] * setup_.gyro.to_si;
     setup_.accel_factor[i] = setup_.accel_scale[i] * setup_.accel.to_si;
   }
+}
 
+void ImuLogReader::setupTime(const PsinsHeader* header, const std::map<std::string, std::string>& columns) {
   // Time: a time column, else row n closes start + n interval.
-  setup_.interval = settings.interval;
+  setup_.interval = settings_.interval;
   if (!setup_.interval && header) setup_.interval = header->interval_ms / 1000.0;
   if (setup_.interval && !(*setup_.interval >= 1e-9 && *setup_.interval <= 1e6)) {
     throw std::invalid_argument("interval " + shortestText(*setup_.interval) + " s is outside [1e-9, 1e6] s");
   }
-  setup_.start = settings.start ? *settings.start : header ? header->t0 : 0.0;
+  setup_.start = settings_.start ? *settings_.start : header ? header->t0 : 0.0;
   if (!(std::abs(setup_.start) <= 4294967296.0)) {
     throw std::invalid_argument("start " + shortestText(setup_.start) + " s is beyond the 2^32 s a bag's time holds");
   }
-  setup_.epoch = settings.epoch;
-  time_ = psins ? -1 : findColumn(csv_, columns, has_header, "time", false);
+  setup_.epoch = settings_.epoch;
+  time_ = setup_.psins ? -1 : findColumn(csv_, columns, has_header_, "time", false);
   setup_.time_column = time_ >= 0;
+}
 
+void ImuLogReader::setupColumns(const std::map<std::string, std::string>& columns) {
   // Columns: the gyro's three, the accelerometer's three or none.
   int accel_found = 0;
   std::string accel_names;
   for (int i = 0; i < 3; ++i) {
-    gyro_columns_[i] = findColumn(csv_, columns, has_header, kGyroKeys[i], true);
-    accel_columns_[i] = findColumn(csv_, columns, has_header, kAccelKeys[i], false);
+    gyro_columns_[i] = findColumn(csv_, columns, has_header_, kGyroKeys[i], true);
+    accel_columns_[i] = findColumn(csv_, columns, has_header_, kAccelKeys[i], false);
     if (accel_columns_[i] >= 0) {
       ++accel_found;
       accel_names += std::string(accel_names.empty() ? "" : ", ") + kAccelKeys[i];
     }
   }
   if (accel_found != 0 && accel_found != 3) {
-    throw std::runtime_error(name + ": the accelerometer needs ax, ay and az or none of them, found " + accel_names);
+    throw std::runtime_error(name_ + ": the accelerometer needs ax, ay and az or none of them, found " + accel_names);
   }
   setup_.accelerometer = accel_found == 3;
   if (!setup_.time_column && !setup_.interval) {
-    throw std::invalid_argument(name + ": no time column" + (has_header ? " ('time' or --column time=...)" : "") +
+    throw std::invalid_argument(name_ + ": no time column" + (has_header_ ? " ('time' or --column time=...)" : "") +
                                 ": give the rows' spacing with --interval S");
   }
   increments_ = setup_.gyro.quantity == Quantity::kIncrement ||
                 (setup_.accelerometer && setup_.accel.quantity == Quantity::kIncrement);
+}
 
+void ImuLogReader::setupAxes(const PsinsHeader* header) {
   // Axes: to FLU.
-  if (settings.frame && settings.rotation) {
-    throw std::invalid_argument("the log's axes are given twice: a frame (" + *settings.frame +
+  if (settings_.frame && settings_.rotation) {
+    throw std::invalid_argument("the log's axes are given twice: a frame (" + *settings_.frame +
                                 ") and a rotation; give one");
   }
-  if (settings.rotation) {
-    const auto& r = *settings.rotation;
+  if (settings_.rotation) {
+    const auto& r = *settings_.rotation;
     for (double angle : r) {
       if (!std::isfinite(angle))
         throw std::invalid_argument("rotation angle " + shortestText(angle) + " is not finite");
@@ -325,25 +340,27 @@ ImuLogReader::ImuLogReader(std::istream& in, const std::string& name, const ImuL
     setup_.axes = eulerAxes(r[0], r[1], r[2]);
     setup_.frame = "rotation " + shortestText(r[0]) + "," + shortestText(r[1]) + "," + shortestText(r[2]) + " rad";
   } else {
-    setup_.frame = upper(settings.frame ? *settings.frame : header ? "RFU" : "FLU");
+    setup_.frame = upper(settings_.frame ? *settings_.frame : header ? "RFU" : "FLU");
     setup_.axes = frameAxes(setup_.frame);
   }
+}
 
+void ImuLogReader::setupSite(const PsinsHeader* header) {
   // The site: the header's, each field given replacing its own.
   if (header) setup_.site = header->site;
-  if (!header && settings.latitude.has_value() != settings.longitude.has_value()) {
+  if (!header && settings_.latitude.has_value() != settings_.longitude.has_value()) {
     throw std::invalid_argument(std::string("a latitude without a longitude or the reverse: give both (") +
-                                (settings.latitude ? "no longitude" : "no latitude") + ")");
+                                (settings_.latitude ? "no longitude" : "no latitude") + ")");
   }
-  if (!header && settings.height && !settings.latitude) {
+  if (!header && settings_.height && !settings_.latitude) {
     throw std::invalid_argument("a height without a latitude and longitude");
   }
-  if (settings.latitude || settings.longitude) {
+  if (settings_.latitude || settings_.longitude) {
     if (!setup_.site) setup_.site = Site{0.0, 0.0, std::numeric_limits<double>::quiet_NaN()};
-    if (settings.latitude) setup_.site->latitude_deg = *settings.latitude;
-    if (settings.longitude) setup_.site->longitude_deg = *settings.longitude;
+    if (settings_.latitude) setup_.site->latitude_deg = *settings_.latitude;
+    if (settings_.longitude) setup_.site->longitude_deg = *settings_.longitude;
   }
-  if (settings.height) setup_.site->height_m = *settings.height;
+  if (settings_.height) setup_.site->height_m = *settings_.height;
   if (setup_.site) checkSite(*setup_.site);
 }
 

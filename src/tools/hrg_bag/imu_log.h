@@ -182,6 +182,13 @@ class ImuLogReader {
     bool have_previous = false;  ///< a previous row's stamp is known: record.interval holds the difference
   };
   bool readRow(Row* row);
+  // The constructor's sections, in order: each setting given wins over the PSINS header's (`header`,
+  // nullptr without one), which wins over the default; each throws what the constructor documents.
+  void setupUnits(const PsinsHeader* header);
+  void setupTime(const PsinsHeader* header, const std::map<std::string, std::string>& columns);
+  void setupColumns(const std::map<std::string, std::string>& columns);
+  void setupAxes(const PsinsHeader* header);
+  void setupSite(const PsinsHeader* header);
   /// Divides increments by the row's interval and turns the vectors to FLU; BadRowError (or counted,
   /// false) when that overflows.
   bool finish(Row& row, ImuRecord* record);
