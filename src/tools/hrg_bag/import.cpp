@@ -128,6 +128,44 @@ int runImuMode(ImportOptions& o, const CLI::App& command) {
   return runImuImport(imu, *log.stream, bytes);
 }
 
+ChannelAmplitudes channelMessage(const csv::ChannelRecord& c, std::uint64_t seq, const std::string& frame_id) {
+  ChannelAmplitudes m;
+  m.header.stamp = toRosTime(c.stamp);
+  m.header.seq = static_cast<std::uint32_t>(seq);
+  m.header.frame_id = frame_id;
+  m.c_in = c.ac;
+  m.c_quad = c.bc;
+  m.s_in = c.as;
+  m.s_quad = c.bs;
+  m.frequency = c.frequency;
+  m.temperature = c.temperature;
+  m.periods = c.periods;
+  return m;
+}
+
+TurntableState turntableMessage(const csv::TurntableRecord& t, std::uint64_t seq, const std::string& frame_id) {
+  TurntableState m;
+  m.header.stamp = toRosTime(t.stamp);
+  m.header.seq = static_cast<std::uint32_t>(seq);
+  m.header.frame_id = frame_id;
+  m.angle = t.angle;
+  m.rate = t.rate;
+  return m;
+}
+
+/// What was written, and with --skip-bad-rows what each log's skipped records were (no turntable log:
+/// `turntable_skips` null).
+void printSummary(const ImportOptions& o, std::uint64_t channel_count, const csv::BadRowCounts& channel_skips,
+                  const csv::BadRowCounts* turntable_skips, std::uint64_t turntable_count) {
+  std::cerr << "import: wrote " << o.out << ": " << channel_count << " channel records on " << o.channels_topic;
+  if (turntable_skips) std::cerr << ", " << turntable_count << " turntable records on " << o.turntable_topic;
+  std::cerr << "\n";
+  if (!o.skip_bad_rows) return;
+  std::cerr << "import: skipped records in " << o.channels << ": " << channel_skips.summary() << "\n";
+  if (turntable_skips)
+    std::cerr << "import: skipped records in " << o.turntable << ": " << turntable_skips->summary() << "\n";
+}
+
 int runImport(const ImportOptions& o) {
   using namespace bag_tools;
   if (o.channels.empty()) throw UsageError("--channels (a bench's logs) or --imu (an IMU's log) is required");
@@ -171,27 +209,12 @@ int runImport(const ImportOptions& o) {
       // Both logs are sorted by stamp: the older head goes first (a channel record before a
       // turntable record of the same stamp, as the simulator records them).
       if (have_channel && (!have_turntable || c.stamp <= t.stamp)) {
-        ChannelAmplitudes m;
-        m.header.stamp = toRosTime(c.stamp);
         // A skipped record leaves a gap in the sequence, which the processor node reports as a lost sample.
-        m.header.seq = static_cast<std::uint32_t>(channel_count++ + channel_skips.total());
-        m.header.frame_id = o.frame_id;
-        m.c_in = c.ac;
-        m.c_quad = c.bc;
-        m.s_in = c.as;
-        m.s_quad = c.bs;
-        m.frequency = c.frequency;
-        m.temperature = c.temperature;
-        m.periods = c.periods;
+        const ChannelAmplitudes m = channelMessage(c, channel_count++ + channel_skips.total(), o.frame_id);
         bag.write(o.channels_topic, m.header.stamp, m);
         have_channel = channels->next(&c);
       } else {
-        TurntableState m;
-        m.header.stamp = toRosTime(t.stamp);
-        m.header.seq = static_cast<std::uint32_t>(turntable_count++);
-        m.header.frame_id = o.frame_id;
-        m.angle = t.angle;
-        m.rate = t.rate;
+        const TurntableState m = turntableMessage(t, turntable_count++, o.frame_id);
         bag.write(o.turntable_topic, m.header.stamp, m);
         have_turntable = turntable->next(&t);
       }
@@ -219,14 +242,7 @@ int runImport(const ImportOptions& o) {
   }
   bag.commit();
   if (progress) progress->finish(channel_count + turntable_count);
-  std::cerr << "import: wrote " << o.out << ": " << channel_count << " channel records on " << o.channels_topic;
-  if (turntable) std::cerr << ", " << turntable_count << " turntable records on " << o.turntable_topic;
-  std::cerr << "\n";
-  if (o.skip_bad_rows) {
-    std::cerr << "import: skipped records in " << o.channels << ": " << channel_skips.summary() << "\n";
-    if (turntable)
-      std::cerr << "import: skipped records in " << o.turntable << ": " << turntable_skips.summary() << "\n";
-  }
+  printSummary(o, channel_count, channel_skips, turntable ? &turntable_skips : nullptr, turntable_count);
   return 0;
 }
 
