@@ -86,6 +86,25 @@ GyrocompassRos::GyrocompassRos(ros::NodeHandle nh, ros::NodeHandle pnh)
   updater_.add("gyrocompass", this, &GyrocompassRos::diagnoseAlignment);
   if (hold_enabled_) updater_.add("attitude hold", this, &GyrocompassRos::diagnoseHold);
 
+  subscribe(queue_size);
+  diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
+  ROS_INFO(
+      "gyrocompass: mode %s%s, gyros %s, latitude %.6f rad, window %.1f s, level %s, estimator %s; noise: %s; "
+      "~align starts one",
+      toString(settings_.mode), settings_.single_gyro ? " (one gyro)" : "", gyro_topic_.c_str(), settings_.latitude,
+      settings_.duration,
+      settings_.level.source == core::LevelSource::kDeclared ? "declared"
+      : imu_accelerometer_                                   ? "imu/data_raw's linear_acceleration"
+                                                             : "accel/data_raw",
+      toString(settings_.estimator), settings_.noise_sources.summary().c_str());
+  if (align_at_startup) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const std::string refused = start(0.0, "");
+    if (!refused.empty()) ROS_ERROR("gyrocompass: the alignment at start-up was refused: %s", refused.c_str());
+  }
+}
+
+void GyrocompassRos::subscribe(int queue_size) {
   // What the configured mode needs; the gyro stream (triad/output or imu/data_raw) also for the hold.
   const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
   const bool imu_input = settings_.gyro_input == core::GyroInput::kImu;
@@ -116,21 +135,6 @@ GyrocompassRos::GyrocompassRos(ros::NodeHandle nh, ros::NodeHandle pnh)
           triadAxisTopic(axis, "precession/state"), queue_size,
           [this, a](const PrecessionState::ConstPtr& m) { onPrecession(a, m); }, ros::VoidConstPtr(), hints));
     }
-  }
-  diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
-  ROS_INFO(
-      "gyrocompass: mode %s%s, gyros %s, latitude %.6f rad, window %.1f s, level %s, estimator %s; noise: %s; "
-      "~align starts one",
-      toString(settings_.mode), settings_.single_gyro ? " (one gyro)" : "", gyro_topic_.c_str(), settings_.latitude,
-      settings_.duration,
-      settings_.level.source == core::LevelSource::kDeclared ? "declared"
-      : imu_accelerometer_                                   ? "imu/data_raw's linear_acceleration"
-                                                             : "accel/data_raw",
-      toString(settings_.estimator), settings_.noise_sources.summary().c_str());
-  if (align_at_startup) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    const std::string refused = start(0.0, "");
-    if (!refused.empty()) ROS_ERROR("gyrocompass: the alignment at start-up was refused: %s", refused.c_str());
   }
 }
 

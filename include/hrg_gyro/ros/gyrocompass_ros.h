@@ -54,6 +54,8 @@ class GyrocompassRos {
   const ParameterReader& parameters() const { return params_; }
 
  private:
+  /// The topics the configured mode and gyro input need (the gyro stream also for the hold).
+  void subscribe(int queue_size);
   void onTriad(const TriadOutput::ConstPtr& msg);
   void onImu(const sensor_msgs::Imu::ConstPtr& msg);
   /// One body sample of the gyro stream (the triad's, or the IMU's converted) to the hold and to the
