@@ -129,61 +129,76 @@ void TableClockOffsetEstimator::add(Nanoseconds stamp, double theta, double tabl
     tail_.clear();
   }
   if (in_transition_) {
-    const double t = toSeconds(stamp - open_origin_);
-    int side = 0;
-    if (settled && plateau != before_plateau_) {
-      if (!has_after_ || plateau != after_plateau_) {
-        has_after_ = true;
-        after_plateau_ = plateau;
-        after_start_ = t;
-      }
-      side = 1;
-    }
-    keep(&open_samples_, open_origin_, stamp, theta, table_angle, side);
-    if (side == 1 && t - after_start_ >= settings_.window) {
-      // Settled long enough on the new plateau: the change is complete.
-      if (std::abs(plateau_rate - before_rate_) >= settings_.min_rate_change &&
-          done_.size() < settings_.max_transitions) {
-        Transition done;
-        done.origin = open_origin_;
-        done.left = left_;
-        done.rate_before = before_rate_;
-        done.rate_after = plateau_rate;
-        done.samples.assign(open_samples_.begin(), open_samples_.end());
-        done_.push_back(std::move(done));
-      }
-      in_transition_ = false;
-      // The new plateau's first window is where the next change will be measured from, if it is that short.
-      on_plateau_ = true;
-      plateau_ = plateau;
-      plateau_rate_ = plateau_rate;
-      tail_.clear();
-      tail_origin_ = stamp;
-      for (const Sample& s : open_samples_) {
-        if (s.side == 1) tail_.push_back({s.t - t, s.theta, s.phi, -1});
-      }
-      open_samples_.clear();
-    } else if (t > settings_.max_transition) {
-      in_transition_ = false;  // no settled plateau after it in time: nothing to measure
-      open_samples_.clear();
-      on_plateau_ = false;
-    }
-    return;
+    addInTransition(stamp, theta, table_angle, plateau, plateau_rate, settled);
+  } else if (settled) {
+    addOnPlateau(stamp, theta, table_angle, plateau, plateau_rate);
+  } else if (on_plateau_ && !tail_.empty()) {
+    beginTransition(stamp, theta, table_angle);
   }
-  if (settled) {
-    if (!on_plateau_ || plateau != plateau_) {
-      on_plateau_ = true;
-      plateau_ = plateau;
-      tail_.clear();
-      tail_origin_ = stamp;
+}
+
+void TableClockOffsetEstimator::addInTransition(Nanoseconds stamp, double theta, double table_angle,
+                                                std::uint64_t plateau, double plateau_rate, bool settled) {
+  const double t = toSeconds(stamp - open_origin_);
+  int side = 0;
+  if (settled && plateau != before_plateau_) {
+    if (!has_after_ || plateau != after_plateau_) {
+      has_after_ = true;
+      after_plateau_ = plateau;
+      after_start_ = t;
     }
-    plateau_rate_ = plateau_rate;
-    keep(&tail_, tail_origin_, stamp, theta, table_angle, -1);
-    const double t = toSeconds(stamp - tail_origin_);
-    while (!tail_.empty() && t - tail_.front().t > settings_.window + settings_.guard) tail_.pop_front();
-    return;
+    side = 1;
   }
-  if (!on_plateau_ || tail_.empty()) return;
+  keep(&open_samples_, open_origin_, stamp, theta, table_angle, side);
+  if (side == 1 && t - after_start_ >= settings_.window) {
+    completeTransition(stamp, t, plateau, plateau_rate);
+  } else if (t > settings_.max_transition) {
+    in_transition_ = false;  // no settled plateau after it in time: nothing to measure
+    open_samples_.clear();
+    on_plateau_ = false;
+  }
+}
+
+void TableClockOffsetEstimator::completeTransition(Nanoseconds stamp, double t, std::uint64_t plateau,
+                                                   double plateau_rate) {
+  // Settled long enough on the new plateau: the change is complete.
+  if (std::abs(plateau_rate - before_rate_) >= settings_.min_rate_change && done_.size() < settings_.max_transitions) {
+    Transition done;
+    done.origin = open_origin_;
+    done.left = left_;
+    done.rate_before = before_rate_;
+    done.rate_after = plateau_rate;
+    done.samples.assign(open_samples_.begin(), open_samples_.end());
+    done_.push_back(std::move(done));
+  }
+  in_transition_ = false;
+  // The new plateau's first window is where the next change will be measured from, if it is that short.
+  on_plateau_ = true;
+  plateau_ = plateau;
+  plateau_rate_ = plateau_rate;
+  tail_.clear();
+  tail_origin_ = stamp;
+  for (const Sample& s : open_samples_) {
+    if (s.side == 1) tail_.push_back({s.t - t, s.theta, s.phi, -1});
+  }
+  open_samples_.clear();
+}
+
+void TableClockOffsetEstimator::addOnPlateau(Nanoseconds stamp, double theta, double table_angle, std::uint64_t plateau,
+                                             double plateau_rate) {
+  if (!on_plateau_ || plateau != plateau_) {
+    on_plateau_ = true;
+    plateau_ = plateau;
+    tail_.clear();
+    tail_origin_ = stamp;
+  }
+  plateau_rate_ = plateau_rate;
+  keep(&tail_, tail_origin_, stamp, theta, table_angle, -1);
+  const double t = toSeconds(stamp - tail_origin_);
+  while (!tail_.empty() && t - tail_.front().t > settings_.window + settings_.guard) tail_.pop_front();
+}
+
+void TableClockOffsetEstimator::beginTransition(Nanoseconds stamp, double theta, double table_angle) {
   // The table left its settled plateau: a change of rate begins. Times from the tail's first sample.
   in_transition_ = true;
   has_after_ = false;

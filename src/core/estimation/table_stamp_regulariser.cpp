@@ -109,71 +109,85 @@ double TableStampRegulariser::countOf(Nanoseconds stamp, std::uint64_t sequence,
 Nanoseconds TableStampRegulariser::regularise(Nanoseconds stamp, std::uint64_t sequence) {
   ++statistics_.records;
   if (!settings_.enabled) return stamp;
-  if (!started_) {
-    started_ = true;
-    statistics_.used_sequence = sequence != kNoSequence;
-    restart(stamp, 0.0);
-    const Point p{0.0, 0.0};
-    points_.push_back(p);
-    addToSums(p, 1.0);
-    last_count_ = 0.0;
-    last_stamp_ = stamp;
-    last_sequence_ = sequence;
-    return stamp;
-  }
+  if (!started_) return first(stamp, sequence);
   if (decided_ && !statistics_.fixed_rate) return stamp;
   bool trustworthy = true;
   const double count = countOf(stamp, sequence, &trustworthy);
   const double t = toSeconds(stamp - origin_);
-  if (!fitted()) {
-    // Too few records for a line yet: take them as they come (a log starts at rest, mostly).
-    const Point p{count, t};
-    points_.push_back(p);
-    addToSums(p, 1.0);
-    refit();
-    if (stamp > last_stamp_ && last_stamp_ != 0 && early_intervals_.size() < 64) {
-      early_intervals_.push_back(toSeconds(stamp - last_stamp_) / (count - last_count_));
-    }
-    last_count_ = count;
-    last_stamp_ = stamp;
-    last_sequence_ = sequence;
-    if (fitted() && !decided_) decide();
-    return stamp;
-  }
+  if (!fitted()) return beforeTheLine(stamp, sequence, count, t);
   const double residual = t - line(count);
   const double jitter = residual_count_ > 0 ? std::sqrt(residual_squares_ / residual_count_) : initial_scatter_;
   const double threshold = std::max(settings_.outlier_sigmas * jitter, 0.1 * slope_);
-  if (!trustworthy || std::abs(residual) > threshold) {
-    ++statistics_.off_line;
-    // A run of records off the line by about the same amount is a clock step: start a new line there.
-    if (off_run_ > 0 && std::abs(residual - off_run_first_) <= threshold) {
-      ++off_run_;
-    } else {
-      off_run_ = 1;
-      off_run_first_ = residual;
-      off_run_stamp_ = stamp;
-      off_run_count_ = count;
-    }
-    if (sequence != kNoSequence && sequence_trusted_) {
-      last_count_ = count;
-      last_sequence_ = sequence;
-    }
-    if (off_run_ >= settings_.step_persist) {
-      ++statistics_.clock_steps;
-      const double run_start = off_run_count_;
-      const Nanoseconds run_stamp = off_run_stamp_;
-      restart(run_stamp, run_start);
-      const Point first{run_start, 0.0}, now{count, toSeconds(stamp - run_stamp)};
-      for (const Point& p : {first, now}) {
-        points_.push_back(p);
-        addToSums(p, 1.0);
-      }
-      refit();
-      last_count_ = count;
-      last_sequence_ = sequence;
-    }
-    return stamp;
+  if (!trustworthy || std::abs(residual) > threshold) return offTheLine(stamp, sequence, count, residual, threshold);
+  return onTheLine(stamp, sequence, count, t, residual);
+}
+
+void TableStampRegulariser::remember(Nanoseconds stamp, std::uint64_t sequence, double count) {
+  last_count_ = count;
+  last_stamp_ = stamp;
+  last_sequence_ = sequence;
+}
+
+Nanoseconds TableStampRegulariser::first(Nanoseconds stamp, std::uint64_t sequence) {
+  started_ = true;
+  statistics_.used_sequence = sequence != kNoSequence;
+  restart(stamp, 0.0);
+  const Point p{0.0, 0.0};
+  points_.push_back(p);
+  addToSums(p, 1.0);
+  remember(stamp, sequence, 0.0);
+  return stamp;
+}
+
+Nanoseconds TableStampRegulariser::beforeTheLine(Nanoseconds stamp, std::uint64_t sequence, double count, double t) {
+  // Too few records for a line yet: take them as they come (a log starts at rest, mostly).
+  const Point p{count, t};
+  points_.push_back(p);
+  addToSums(p, 1.0);
+  refit();
+  if (stamp > last_stamp_ && last_stamp_ != 0 && early_intervals_.size() < 64) {
+    early_intervals_.push_back(toSeconds(stamp - last_stamp_) / (count - last_count_));
   }
+  remember(stamp, sequence, count);
+  if (fitted() && !decided_) decide();
+  return stamp;
+}
+
+Nanoseconds TableStampRegulariser::offTheLine(Nanoseconds stamp, std::uint64_t sequence, double count, double residual,
+                                              double threshold) {
+  ++statistics_.off_line;
+  // A run of records off the line by about the same amount is a clock step: start a new line there.
+  if (off_run_ > 0 && std::abs(residual - off_run_first_) <= threshold) {
+    ++off_run_;
+  } else {
+    off_run_ = 1;
+    off_run_first_ = residual;
+    off_run_stamp_ = stamp;
+    off_run_count_ = count;
+  }
+  if (sequence != kNoSequence && sequence_trusted_) {
+    last_count_ = count;
+    last_sequence_ = sequence;
+  }
+  if (off_run_ >= settings_.step_persist) {
+    ++statistics_.clock_steps;
+    const double run_start = off_run_count_;
+    const Nanoseconds run_stamp = off_run_stamp_;
+    restart(run_stamp, run_start);
+    const Point first{run_start, 0.0}, now{count, toSeconds(stamp - run_stamp)};
+    for (const Point& p : {first, now}) {
+      points_.push_back(p);
+      addToSums(p, 1.0);
+    }
+    refit();
+    last_count_ = count;
+    last_sequence_ = sequence;
+  }
+  return stamp;
+}
+
+Nanoseconds TableStampRegulariser::onTheLine(Nanoseconds stamp, std::uint64_t sequence, double count, double t,
+                                             double residual) {
   off_run_ = 0;
   residual_squares_ += residual * residual;
   ++residual_count_;
@@ -191,9 +205,7 @@ Nanoseconds TableStampRegulariser::regularise(Nanoseconds stamp, std::uint64_t s
     points_.pop_front();
   }
   refit();
-  last_count_ = count;
-  last_stamp_ = stamp;
-  last_sequence_ = sequence;
+  remember(stamp, sequence, count);
   statistics_.period = slope_;
   ++statistics_.regularised;
   return origin_ + toNanoseconds(line(count));

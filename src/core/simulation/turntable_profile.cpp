@@ -93,6 +93,53 @@ void TurntableProfile::moveBy(double angle, double cruise, double acceleration, 
   append(t_acc, dir * peak, -dir * acceleration, label + "/move");
 }
 
+namespace {
+
+/// A dual-rate segment's keys: the two plateau rates, how often the pair repeats and in which order.
+struct DualRateSegment {
+  std::vector<double> rates;
+  long repeat = 1;
+  bool balanced = false;  ///< Thue-Morse order (cancels a bias trend), else alternating
+  double duration = 0.0, settle = 0.0;
+};
+
+DualRateSegment readDualRate(const YamlField& seg) {
+  seg.rejectUnknownKeys({"type", "label", "rates", "duration", "settle", "repeat", "order"});
+  DualRateSegment d;
+  d.rates = seg["rates"].asDoubles(2);
+  if (d.rates[0] == d.rates[1]) seg["rates"].fail("the two plateau rates must differ");
+  d.repeat = seg.getInteger("repeat", 1);
+  if (d.repeat < 1) seg["repeat"].fail("must be >= 1");
+  const std::string order = seg.getString("order", "alternating");
+  if (order != "alternating" && order != "balanced") {
+    seg["order"].fail("must be 'alternating' or 'balanced', not '" + order + "'");
+  }
+  d.balanced = order == "balanced";
+  d.duration = seg["duration"].asDouble();
+  if (!(d.duration > 0.0)) seg["duration"].fail("must be positive");
+  d.settle = seg.getDouble("settle", 0.0);
+  return d;
+}
+
+/// A piecewise segment's [time, rate] points, from time 0, times strictly increasing.
+void readPoints(const YamlField& seg, std::vector<double>* t, std::vector<double>* w) {
+  seg.rejectUnknownKeys({"type", "label", "points"});
+  const YamlField pts = seg["points"];
+  pts.requireSequence();
+  if (pts.size() < 2) pts.fail("need at least two [time, rate] points");
+  t->resize(pts.size());
+  w->resize(pts.size());
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    const std::vector<double> p = pts.at(k).asDoubles(2);
+    (*t)[k] = p[0];
+    (*w)[k] = p[1];
+    if (k == 0 && p[0] != 0.0) pts.at(0).fail("the first point must be at time 0");
+    if (k > 0 && !((*t)[k] > (*t)[k - 1])) pts.at(k).fail("times must be strictly increasing");
+  }
+}
+
+}  // namespace
+
 TurntableProfile TurntableProfile::parse(const YamlField& profile, double acceleration) {
   if (!(acceleration > 0.0)) throw ConfigError("turntable.acceleration", "must be positive (rad/s^2)");
   profile.requireSequence();
@@ -119,19 +166,12 @@ TurntableProfile TurntableProfile::parse(const YamlField& profile, double accele
       tp.append(seg.getDouble("settle", 0.0), rate, 0.0, label + "/settle");
       tp.append(positive("duration"), rate, 0.0, label);
     } else if (type == "dual_rate") {
-      seg.rejectUnknownKeys({"type", "label", "rates", "duration", "settle", "repeat", "order"});
-      const std::vector<double> rates = seg["rates"].asDoubles(2);
-      if (rates[0] == rates[1]) seg["rates"].fail("the two plateau rates must differ");
-      const long repeat = seg.getInteger("repeat", 1);
-      if (repeat < 1) seg["repeat"].fail("must be >= 1");
-      const std::string order = seg.getString("order", "alternating");
-      if (order != "alternating" && order != "balanced") {
-        seg["order"].fail("must be 'alternating' or 'balanced', not '" + order + "'");
-      }
-      const double duration = positive("duration"), settle = seg.getDouble("settle", 0.0);
+      const DualRateSegment d = readDualRate(seg);
+      const std::vector<double>& rates = d.rates;
+      const double duration = d.duration, settle = d.settle;
       const double reversal = std::abs(rates[1] - rates[0]) / acceleration;  // s
-      for (long n = 0; n < 2 * repeat; ++n) {
-        const int k = order == "balanced" ? thueMorse(n) : static_cast<int>(n % 2);
+      for (long n = 0; n < 2 * d.repeat; ++n) {
+        const int k = d.balanced ? thueMorse(n) : static_cast<int>(n % 2);
         const std::string sub = label + "/rate" + std::to_string(k + 1);
         if (n > 0 && tp.finalRate() == rates[k]) {
           // The same rate again: hold it for as long as a reversal takes, so the plateaus stay
@@ -157,18 +197,8 @@ TurntableProfile TurntableProfile::parse(const YamlField& profile, double accele
         tp.append(dwell, 0.0, 0.0, label + "/dwell");
       }
     } else if (type == "piecewise") {
-      seg.rejectUnknownKeys({"type", "label", "points"});
-      const YamlField pts = seg["points"];
-      pts.requireSequence();
-      if (pts.size() < 2) pts.fail("need at least two [time, rate] points");
-      std::vector<double> t(pts.size()), w(pts.size());
-      for (std::size_t k = 0; k < pts.size(); ++k) {
-        const std::vector<double> p = pts.at(k).asDoubles(2);
-        t[k] = p[0];
-        w[k] = p[1];
-        if (k == 0 && t[0] != 0.0) pts.at(0).fail("the first point must be at time 0");
-        if (k > 0 && !(t[k] > t[k - 1])) pts.at(k).fail("times must be strictly increasing");
-      }
+      std::vector<double> t, w;
+      readPoints(seg, &t, &w);
       tp.rampTo(w[0], acceleration, label);
       for (std::size_t k = 1; k < t.size(); ++k) {
         const double dt = t[k] - t[k - 1];

@@ -95,6 +95,13 @@ class TableClockOffsetEstimator {
     std::vector<Sample> samples;
   };
   void keep(std::deque<Sample>* into, Nanoseconds origin, Nanoseconds stamp, double theta, double phi, int side);
+  /// The steps of add(): a sample while a change of rate is open; the change complete, settled on
+  /// its new plateau; a settled sample on a plateau; the table leaving its plateau.
+  void addInTransition(Nanoseconds stamp, double theta, double table_angle, std::uint64_t plateau, double plateau_rate,
+                       bool settled);
+  void completeTransition(Nanoseconds stamp, double t, std::uint64_t plateau, double plateau_rate);
+  void addOnPlateau(Nanoseconds stamp, double theta, double table_angle, std::uint64_t plateau, double plateau_rate);
+  void beginTransition(Nanoseconds stamp, double theta, double table_angle);
   /// One change of rate's offset from the model's integral along its path (K0 `k0` where the change
   /// has no sample of its own); false when a side has fewer than 3 samples.
   static bool measure(const Transition& tr, ModelPairEvaluator* models, double earth_rate, double frequency, double k0,

@@ -83,6 +83,14 @@ class TableStampRegulariser {
   /// The record's count: from the sequence number while it counts records, else from the line.
   /// *trustworthy false: the stamp gives no count (at or before the last record's).
   double countOf(Nanoseconds stamp, std::uint64_t sequence, bool* trustworthy);
+  /// The steps of regularise(): the first record; a record before the line is fitted; one off the
+  /// line (a glitch, or a clock step once the run persists); one on it, put on the line.
+  Nanoseconds first(Nanoseconds stamp, std::uint64_t sequence);
+  Nanoseconds beforeTheLine(Nanoseconds stamp, std::uint64_t sequence, double count, double t);
+  Nanoseconds offTheLine(Nanoseconds stamp, std::uint64_t sequence, double count, double residual, double threshold);
+  Nanoseconds onTheLine(Nanoseconds stamp, std::uint64_t sequence, double count, double t, double residual);
+  /// The record just taken becomes the last one.
+  void remember(Nanoseconds stamp, std::uint64_t sequence, double count);
 
   StampRegulariserSettings settings_;
   TableStampStatistics statistics_;
