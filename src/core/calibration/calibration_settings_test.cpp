@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "core/testing/refusal.h"
+
 namespace hrg_gyro {
 namespace core {
 namespace {
@@ -19,14 +21,14 @@ CalibrationSettings parse(const std::string& yaml) {
   return CalibrationSettings::parse(YamlField(YAML::Load(yaml), ""));
 }
 
-/// The key a refusal names ("" when nothing is refused).
-std::string refusedKey(const std::string& yaml) {
-  try {
-    parse(yaml);
-  } catch (const ConfigError& e) {
-    return e.key();
-  }
-  return "";
+/// The key a refusal names ("accepted" when nothing is refused).
+std::string keyOf(const std::string& yaml) {
+  return refusedKey([&] { parse(yaml); });
+}
+
+/// Each settings text and the key it is refused by ("accepted": none).
+void expectRefused(const std::vector<RefusalCase>& cases) {
+  expectRefusedKeys([](const std::string& yaml) { parse(yaml); }, cases);
 }
 
 TEST(CalibrationSettingsTest, TheBiasTrendIsLinearByDefaultAndItsKeysAreChecked) {
@@ -36,12 +38,14 @@ TEST(CalibrationSettingsTest, TheBiasTrendIsLinearByDefaultAndItsKeysAreChecked)
   EXPECT_DOUBLE_EQ(d.gates.max_trend_k0_std, 2e-6);
   EXPECT_EQ(parse("bias_trend_order: 0").bias_trend_order, 0);
   EXPECT_EQ(parse("bias_trend_order: 2").bias_trend_order, 2);
-  EXPECT_EQ(refusedKey("bias_trend_order: 3"), "bias_trend_order");
-  EXPECT_EQ(refusedKey("bias_trend_order: -1"), "bias_trend_order");
-  EXPECT_EQ(refusedKey("bias_trend_order: linear"), "bias_trend_order");
-  EXPECT_EQ(refusedKey("gates: {max_trend_inflation: 0.5}"), "gates.max_trend_inflation");
-  EXPECT_EQ(refusedKey("gates: {max_trend_k0_std: 0}"), "gates.max_trend_k0_std");
-  EXPECT_EQ(refusedKey("gates: {max_trend_k0_std: -1e-6}"), "gates.max_trend_k0_std");
+  expectRefused({
+      {"bias_trend_order: 3", "bias_trend_order"},
+      {"bias_trend_order: -1", "bias_trend_order"},
+      {"bias_trend_order: linear", "bias_trend_order"},
+      {"gates: {max_trend_inflation: 0.5}", "gates.max_trend_inflation"},
+      {"gates: {max_trend_k0_std: 0}", "gates.max_trend_k0_std"},
+      {"gates: {max_trend_k0_std: -1e-6}", "gates.max_trend_k0_std"},
+  });
 }
 
 TEST(CalibrationSettingsTest, TheFieldMethodsKeysAreReadAndChecked) {
@@ -65,45 +69,52 @@ TEST(CalibrationSettingsTest, TheFieldMethodsKeysAreReadAndChecked) {
   EXPECT_DOUBLE_EQ(f.max_excess_scatter, 1.5);
   EXPECT_DOUBLE_EQ(f.max_gain_error, 0.01);
   EXPECT_DOUBLE_EQ(f.max_drift_std, 2e-8);
-  EXPECT_EQ(refusedKey("field: {rate: 0}"), "field.rate");
-  EXPECT_EQ(refusedKey("field: {rate: 11}"), "field.rate");
-  EXPECT_EQ(refusedKey("field: {rate: .nan}"), "field.rate");
-  EXPECT_EQ(refusedKey("field: {turns: -1}"), "field.turns");
-  EXPECT_EQ(refusedKey("field: {directions: []}"), "field.directions");
-  EXPECT_EQ(refusedKey("field: {directions: [1, 2]}"), "field.directions[1]");
-  EXPECT_EQ(refusedKey("field: {directions: [1, 1]}"), "field.directions");          // one way cannot pass
-  EXPECT_EQ(refusedKey("field: {axis_earth_rate: 1e-4}"), "field.axis_earth_rate");  // beyond the Earth's rate
-  EXPECT_EQ(refusedKey("field: {axis_earth_rate: up}"), "field.axis_earth_rate");
-  EXPECT_EQ(refusedKey("field: {rest: -1}"), "field.rest");
-  EXPECT_EQ(refusedKey("field: {gain_orders: [3]}").rfind("field.gain_orders", 0), 0u);
-  EXPECT_EQ(refusedKey("field: {max_excess_scatter: 0.5}"), "field.max_excess_scatter");
-  EXPECT_EQ(refusedKey("field: {max_drift_std: 0}"), "field.max_drift_std");
-  EXPECT_EQ(refusedKey("field: {speed: 1}"), "field.speed");
-  EXPECT_EQ(refusedKey("field: 1"), "field");
+  expectRefused({
+      {"field: {rate: 0}", "field.rate"},
+      {"field: {rate: 11}", "field.rate"},
+      {"field: {rate: .nan}", "field.rate"},
+      {"field: {turns: -1}", "field.turns"},
+      {"field: {directions: []}", "field.directions"},
+      {"field: {directions: [1, 2]}", "field.directions[1]"},
+      {"field: {directions: [1, 1]}", "field.directions"},          // one way cannot pass
+      {"field: {axis_earth_rate: 1e-4}", "field.axis_earth_rate"},  // beyond the Earth's rate
+      {"field: {axis_earth_rate: up}", "field.axis_earth_rate"},
+      {"field: {rest: -1}", "field.rest"},
+  });
+  EXPECT_EQ(keyOf("field: {gain_orders: [3]}").rfind("field.gain_orders", 0), 0u);
+  expectRefused({
+      {"field: {max_excess_scatter: 0.5}", "field.max_excess_scatter"},
+      {"field: {max_drift_std: 0}", "field.max_drift_std"},
+      {"field: {speed: 1}", "field.speed"},
+      {"field: 1", "field"},
+  });
 }
 
 // Every key that sets the plan's length is bounded and refused by name beyond its bound, so that no
 // plan runs for ever (turns: 1e308 did); within the bounds, a plan longer than a day is refused too
 // when the field method is the one that will run it (the plateau's settle time counts).
 TEST(CalibrationSettingsTest, TheFieldPlansLengthIsBoundedKeyByKeyAndWhole) {
-  EXPECT_EQ(refusedKey("field: {turns: 1e308}"), "field.turns");
-  EXPECT_EQ(refusedKey("field: {turns: 100.5}"), "field.turns");
-  EXPECT_EQ(refusedKey("field: {turns: 0}"), "field.turns");
-  EXPECT_EQ(refusedKey("field: {turns: .inf}"), "field.turns");
-  EXPECT_EQ(refusedKey("field: {rest: 1e308}"), "field.rest");
-  EXPECT_EQ(refusedKey("field: {rest: 601}"), "field.rest");
-  EXPECT_EQ(refusedKey("field: {rate: 1e-300}"), "field.rate");
-  EXPECT_EQ(refusedKey("field: {rate: 0.009}"), "field.rate");
-  EXPECT_EQ(refusedKey("field: {directions: [1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1]}"),
-            "field.directions");
-  EXPECT_EQ(refusedKey("field: {turns: 100, rate: 10, rest: 600, directions: [1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, "
-                       "-1, 1, -1, 1, -1]}"),
-            "");  // every bound reached, 16 x 66 s
+  expectRefused({
+      {"field: {turns: 1e308}", "field.turns"},
+      {"field: {turns: 100.5}", "field.turns"},
+      {"field: {turns: 0}", "field.turns"},
+      {"field: {turns: .inf}", "field.turns"},
+      {"field: {rest: 1e308}", "field.rest"},
+      {"field: {rest: 601}", "field.rest"},
+      {"field: {rate: 1e-300}", "field.rate"},
+      {"field: {rate: 0.009}", "field.rate"},
+      {"field: {directions: [1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1]}", "field.directions"},
+      {"field: {turns: 100, rate: 10, rest: 600, directions: [1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, "
+       "-1, 1, -1, 1, -1]}",
+       "accepted"},  // every bound reached, 16 x 66 s
+  });
   // Each key within its bound, the plan not: 2 segments of 100 turns at 0.01 rad/s are 35 h.
-  EXPECT_EQ(refusedKey("method: field\nfield: {rate: 0.01, turns: 100, directions: [1, -1]}"), "field");
-  EXPECT_EQ(refusedKey("method: dual_rate\nfield: {rate: 0.01, turns: 100, directions: [1, -1]}"), "");
-  EXPECT_EQ(refusedKey("method: field\nfield: {rate: 0.01, turns: 50, directions: [1, -1]}"), "");  // 17.5 h
-  EXPECT_EQ(refusedKey("method: field\nplateau: {settle_time: 1e308}"), "field");
+  expectRefused({
+      {"method: field\nfield: {rate: 0.01, turns: 100, directions: [1, -1]}", "field"},
+      {"method: dual_rate\nfield: {rate: 0.01, turns: 100, directions: [1, -1]}", "accepted"},
+      {"method: field\nfield: {rate: 0.01, turns: 50, directions: [1, -1]}", "accepted"},  // 17.5 h
+      {"method: field\nplateau: {settle_time: 1e308}", "field"},
+  });
   try {
     parse("method: field\nfield: {rate: 0.01, turns: 100, directions: [1, -1]}");
   } catch (const ConfigError& e) {
@@ -139,18 +150,18 @@ TEST(CalibrationSettingsTest, TheGyrosResonatorIsUnknownOrGivenWithEveryValueThe
   EXPECT_DOUBLE_EQ(r->drive.gain_error_c, 2e-3);
   EXPECT_DOUBLE_EQ(r->drive.gain_error_s, -1e-3);
   EXPECT_DOUBLE_EQ(r->drive.phase_error, 1e-3);
-  EXPECT_EQ(refusedKey("field: {resonator: known}"), "field.resonator");
-  EXPECT_EQ(refusedKey(with(shell + ", " + loops)), "field.resonator.drive");
-  EXPECT_EQ(refusedKey(with(shell + ", " + loops + ", " + drive + ", pickoff: {}")), "field.resonator.pickoff");
-  EXPECT_EQ(refusedKey(with("shell: {frequency_split: 0.03, frequency_axis: 0, damping_anisotropy: 0}, " + loops +
-                            ", " + drive)),
-            "field.resonator.shell.damping_axis");  // nothing unknown is taken for zero
-  EXPECT_EQ(refusedKey(with(shell + ", " + loops + ", drive: {gain_error_c: 0, gain_error_s: 0, phase_error: 2}")),
+  EXPECT_EQ(keyOf("field: {resonator: known}"), "field.resonator");
+  EXPECT_EQ(keyOf(with(shell + ", " + loops)), "field.resonator.drive");
+  EXPECT_EQ(keyOf(with(shell + ", " + loops + ", " + drive + ", pickoff: {}")), "field.resonator.pickoff");
+  EXPECT_EQ(
+      keyOf(with("shell: {frequency_split: 0.03, frequency_axis: 0, damping_anisotropy: 0}, " + loops + ", " + drive)),
+      "field.resonator.shell.damping_axis");  // nothing unknown is taken for zero
+  EXPECT_EQ(keyOf(with(shell + ", " + loops + ", drive: {gain_error_c: 0, gain_error_s: 0, phase_error: 2}")),
             "field.resonator.drive");  // |phase| < pi/2
-  EXPECT_EQ(refusedKey(with(shell +
-                            ", loops: {energy_bandwidth: 5, quadrature_bandwidth: 0, damping_ratio: 0.7, "
-                            "control_rate: 5000}, " +
-                            drive)),
+  EXPECT_EQ(keyOf(with(shell +
+                       ", loops: {energy_bandwidth: 5, quadrature_bandwidth: 0, damping_ratio: 0.7, "
+                       "control_rate: 5000}, " +
+                       drive)),
             "field.resonator");  // a split with the quadrature loop open: nothing settles
 }
 
@@ -171,37 +182,43 @@ TEST(CalibrationSettingsTest, KeyPathsListEveryKeyOnce) {
 TEST(CalibrationSettingsTest, RangeChecksMatchTheirMessages) {
   EXPECT_DOUBLE_EQ(parse("table_clock: {window: 1}").table_clock.window, 1.0);
   EXPECT_DOUBLE_EQ(parse("table_clock: {window: 600}").table_clock.window, 600.0);
-  EXPECT_EQ(refusedKey("table_clock: {window: 0.999}"), "table_clock.window");
-  EXPECT_EQ(refusedKey("table_clock: {window: 600.001}"), "table_clock.window");
-  EXPECT_EQ(refusedKey("table_clock: {window: 1000}"), "table_clock.window");
+  expectRefused({
+      {"table_clock: {window: 0.999}", "table_clock.window"},
+      {"table_clock: {window: 600.001}", "table_clock.window"},
+      {"table_clock: {window: 1000}", "table_clock.window"},
+  });
   try {
     parse("table_clock: {window: 1000}");
   } catch (const ConfigError& e) {
     EXPECT_NE(e.problem().find("[1, 600] s"), std::string::npos) << e.what();
   }
   EXPECT_DOUBLE_EQ(parse("table_clock: {offset: -3600}").table_clock.offset, -3600.0);
-  EXPECT_EQ(refusedKey("table_clock: {offset: 3600.5}"), "table_clock.offset");
+  EXPECT_EQ(keyOf("table_clock: {offset: 3600.5}"), "table_clock.offset");
   EXPECT_EQ(parse("bins: 8").bins, 8);
   EXPECT_EQ(parse("bins: 4096").bins, 4096);
-  EXPECT_EQ(refusedKey("bins: 4097"), "bins");
+  EXPECT_EQ(keyOf("bins: 4097"), "bins");
   EXPECT_EQ(parse("jump_persist: 1000").jump_persist, 1000);
-  EXPECT_EQ(refusedKey("jump_persist: 1001"), "jump_persist");
+  EXPECT_EQ(keyOf("jump_persist: 1001"), "jump_persist");
   EXPECT_EQ(parse("backward_persist: 7").jump_persist, 7);  // its former name
-  EXPECT_EQ(refusedKey("backward_persist: 1001"), "backward_persist");
-  EXPECT_EQ(refusedKey("{backward_persist: 5, jump_persist: 5}"), "backward_persist");
+  expectRefused({
+      {"backward_persist: 1001", "backward_persist"},
+      {"{backward_persist: 5, jump_persist: 5}", "backward_persist"},
+  });
   EXPECT_DOUBLE_EQ(parse("forward_jump: 600").forward_jump, 600.0);
-  EXPECT_EQ(refusedKey("forward_jump: 600.5"), "forward_jump");
-  EXPECT_EQ(refusedKey("forward_jump: 0"), "forward_jump");
+  expectRefused({
+      {"forward_jump: 600.5", "forward_jump"},
+      {"forward_jump: 0", "forward_jump"},
+  });
   EXPECT_DOUBLE_EQ(parse("plateau: {smoothing_span: 20}").plateau.smoothing_span, 20.0);
-  EXPECT_EQ(refusedKey("plateau: {smoothing_span: 20.5}"), "plateau.smoothing_span");
+  EXPECT_EQ(keyOf("plateau: {smoothing_span: 20.5}"), "plateau.smoothing_span");
   EXPECT_DOUBLE_EQ(parse("gates: {min_coverage: 1}").gates.min_coverage, 1.0);
-  EXPECT_EQ(refusedKey("gates: {min_coverage: 1.01}"), "gates.min_coverage");
+  EXPECT_EQ(keyOf("gates: {min_coverage: 1.01}"), "gates.min_coverage");
   EXPECT_DOUBLE_EQ(parse("field: {rate: 10}").field.rate, 10.0);
-  EXPECT_EQ(refusedKey("field: {rate: 10.5}"), "field.rate");
+  EXPECT_EQ(keyOf("field: {rate: 10.5}"), "field.rate");
   EXPECT_EQ(parse("thermal: {node_count: 32}").thermal.node_count, 32);
-  EXPECT_EQ(refusedKey("thermal: {node_count: 33}"), "thermal.node_count");
+  EXPECT_EQ(keyOf("thermal: {node_count: 33}"), "thermal.node_count");
   EXPECT_EQ(parse("thermal: {max_slices: 100000}").thermal.max_slices, 100000);
-  EXPECT_EQ(refusedKey("thermal: {max_slices: 100001}"), "thermal.max_slices");
+  EXPECT_EQ(keyOf("thermal: {max_slices: 100001}"), "thermal.max_slices");
 }
 
 }  // namespace

@@ -100,9 +100,9 @@ TEST(WaveEstimatorTest, HugeAndTinyAmplitudesGiveTheSameWaveScaled) {
   }
 }
 
-// estimateWaves computes four samples per instruction; each must be bit for bit estimateWave's, with
-// every kind of sample side by side in one group of lanes (the processor's batch path relies on it).
-TEST(WaveEstimatorTest, BatchIsBitIdenticalToOneSampleAtATime) {
+// 20000 channel samples, one in two odd in some way: NaN, infinite, overflowing, below the floor,
+// degenerate, out of range, zero, random bits.
+std::vector<ChannelVector> oddAndOrdinarySamples() {
   std::mt19937_64 rng(23);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
@@ -144,6 +144,13 @@ TEST(WaveEstimatorTest, BatchIsBitIdenticalToOneSampleAtATime) {
     }
     z.push_back(sample);
   }
+  return z;
+}
+
+// estimateWaves computes four samples per instruction; each must be bit for bit estimateWave's, with
+// every kind of sample side by side in one group of lanes (the processor's batch path relies on it).
+TEST(WaveEstimatorTest, BatchIsBitIdenticalToOneSampleAtATime) {
+  const std::vector<ChannelVector> z = oddAndOrdinarySamples();
   WaveLimits limits;
   limits.max_amplitude = 2.5;  // some ordinary samples out of range too
   CorrectionMatrix none, some;
@@ -169,8 +176,16 @@ TEST(WaveEstimatorTest, BatchIsBitIdenticalToOneSampleAtATime) {
       }
     }
   }
-  // Channels and states as fields of larger records: the same states, the fields around the states
-  // untouched.
+}
+
+// Channels and states as fields of larger records: the same states, the fields around the states
+// untouched.
+TEST(WaveEstimatorTest, BatchReadsAndWritesFieldsOfLargerRecords) {
+  const std::vector<ChannelVector> z = oddAndOrdinarySamples();
+  WaveLimits limits;
+  limits.max_amplitude = 2.5;
+  CorrectionMatrix some;
+  some.p = {1e-3, -2e-3, 3e-3, 0.5e-3};
   struct Record {
     double before = -1.0;
     WaveState wave;

@@ -275,23 +275,44 @@ TEST(TriadSimulationConfigTest, AnAxisMayRunTheAveragedResonatorOnItsSchedule) {
   EXPECT_FALSE(c.axisScenario(0).dynamics.averaged());
 }
 
-TEST(TriadSimulationConfigTest, RejectsBadValuesByKey) {
-  auto expectError = [](const std::string& yaml, const std::string& key) {
-    try {
-      parseText(yaml);
-      ADD_FAILURE() << "accepted: " << yaml;
-    } catch (const ConfigError& e) {
-      EXPECT_EQ(e.key(), key) << e.what();
-    }
-  };
-  auto replaced = [](std::string text, const std::string& from, const std::string& to) {
-    const std::size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    return text.replace(at, from.size(), to);
-  };
+// A scenario the parser must refuse, and the key it must name.
+void expectError(const std::string& yaml, const std::string& key) {
+  try {
+    parseText(yaml);
+    ADD_FAILURE() << "accepted: " << yaml;
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), key) << e.what();
+  }
+}
+
+// The good scenario with one piece of its text replaced.
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+// Each edit of the good scenario (replace `from` by `to`) and the key that refuses it.
+struct BadEdit {
+  std::string from, to, key;
+};
+
+void expectErrors(const std::vector<BadEdit>& edits) {
+  const std::string good = scenario();
+  for (const BadEdit& e : edits) expectError(replaced(good, e.from, e.to), e.key);
+}
+
+// A section appended to the good triad section, and the key under `prefix` that refuses it.
+void expectSectionErrors(const std::string& section, const std::vector<std::pair<std::string, std::string>>& cases) {
+  const std::string prefix = "triad." + section;
+  for (const auto& [value, key] : cases) {
+    expectError(scenario() + "  " + section + ": " + value + "\n", prefix + (key.empty() ? "" : "." + key));
+  }
+}
+
+TEST(TriadSimulationConfigTest, RejectsBadTopLevelAndTriadKeys) {
   const std::string good = scenario();
   EXPECT_NO_THROW(parseText(good));
-  // Top level and the triad section.
   expectError("seed: 1\n", "triad");
   expectError(good + "resonator: {frequency: 5000}\n", "resonator");
   expectError(replaced(good, "seed: 3", "seed: -1"), "seed");
@@ -300,7 +321,9 @@ TEST(TriadSimulationConfigTest, RejectsBadValuesByKey) {
   expectError(replaced(good, "frame_id: fixture", "frame_id: fixture\n  wobble: 1"), "triad.wobble");
   expectError(good + "  fixture_error_std: 0.5\n", "triad.fixture_error_std");
   expectError(good + "  fixture_error_std: -1.0e-4\n", "triad.fixture_error_std");
-  // The accelerometer: each section after the good scenario, and the key it is refused by.
+}
+
+TEST(TriadSimulationConfigTest, RejectsBadAccelerometerKeys) {
   const std::vector<std::pair<std::string, std::string>> accelerometer = {
       {"{gain: 1}", "gain"},
       {"1", ""},
@@ -326,10 +349,11 @@ TEST(TriadSimulationConfigTest, RejectsBadValuesByKey) {
       {"{quantum: -1.0e-3}", "quantum"},
       {"{quantum: 2.0}", "quantum"},
       {"{quantum: .inf}", "quantum"}};
-  for (const auto& [section, key] : accelerometer) {
-    expectError(good + "  accelerometer: " + section + "\n", "triad.accelerometer" + (key.empty() ? "" : "." + key));
-  }
-  // The base's motion, named as the file writes it (its own checks: BaseMotionTest).
+  expectSectionErrors("accelerometer", accelerometer);
+}
+
+// The base's motion, named as the file writes it (its own checks: BaseMotionTest).
+TEST(TriadSimulationConfigTest, RejectsBadBaseMotionKeys) {
   const std::vector<std::pair<std::string, std::string>> base = {
       {"1", ""},
       {"{sway: []}", "sway"},
@@ -343,66 +367,66 @@ TEST(TriadSimulationConfigTest, RejectsBadValuesByKey) {
       {"{vibration: {rms: 0.05, low: 40.0, high: 10.0}}", "vibration.low"},
       {"{vibration: {rms: 0.05, components: 0}}", "vibration.components"},
       {"{vibration: {rms: 0.05, band: 1}}", "vibration.band"}};
-  for (const auto& [section, key] : base) {
-    expectError(good + "  base_motion: " + section + "\n", "triad.base_motion" + (key.empty() ? "" : "." + key));
-  }
-  // The axes.
-  expectError(replaced(good, "    - {name: z, misalignment: [-2.5e-4, 0.5e-4], scale: -2.0e-4}\n", ""), "triad.axes");
-  expectError(replaced(good, "{name: y,", "{name: x,"), "triad.axes[1].name");
-  expectError(replaced(good, "{name: y,", "{name: 'y/1',"), "triad.axes[1].name");
-  expectError(replaced(good, "{name: y,", "{name: y, gain: 2,"), "triad.axes[1].gain");
-  expectError(replaced(good, "[3.0e-4, 1.0e-4]", "[3.0e-4]"), "triad.axes[1].misalignment");
-  expectError(replaced(good, "[3.0e-4, 1.0e-4]", "[3.0e-4, 0.2]"), "triad.axes[1].misalignment[1]");
-  expectError(replaced(good, "scale: -2.0e-4", "scale: 0.1"), "triad.axes[2].scale");
-  expectError(replaced(good, "{name: y,", "{name: y, resonator: {samples_per_period: 4},"),
-              "triad.axes[1].resonator.samples_per_period");
-  expectError(replaced(good, "{name: y,", "{name: y, resonator: {frequency: 5001},"),
-              "triad.axes[1].resonator.frequency");
-  expectError(replaced(good, "{name: y,", "{name: y, resonator: {periods_per_output: 25},"),
-              "triad.axes[1].resonator.periods_per_output");
-  expectError(replaced(good, "{name: y,", "{name: y, pickoff: {amplitude_to_gap: 0.7},"),
-              "triad.axes[1].pickoff.amplitude_to_gap");
-  expectError(replaced(good, "{name: y,", "{name: y, channels: {drop_probability: 2},"),
-              "triad.axes[1].channels.drop_probability");
-  expectError(replaced(good, "{name: y,", "{name: y, dynamics: {model: averaged, shel: {}},"),
-              "triad.axes[1].dynamics.shel");
-  expectError(replaced(good, "{name: y,", "{name: y, dynamics: {commands: [{time: 1.0, rate: 0.2}]},"),
-              "triad.axes[1].dynamics");
-  expectError(
-      replaced(good, "{name: y,",
-               "{name: y, dynamics: {model: averaged}, resonator: {scale_factor: {orders: [2], mean: -0.5, cos: [0.0], "
-               "sin: [0.0]}},"),
-      "triad.axes[1].resonator.scale_factor");
-  expectError(replaced(good, "{name: y,", "{name: y, dynamics: {model: averaged}, resonator: {quadrature: 0.01},"),
-              "triad.axes[1].resonator.quadrature");
-  // The turntable.
+  expectSectionErrors("base_motion", base);
+}
+
+TEST(TriadSimulationConfigTest, RejectsBadAxisKeys) {
+  expectErrors({
+      {"    - {name: z, misalignment: [-2.5e-4, 0.5e-4], scale: -2.0e-4}\n", "", "triad.axes"},
+      {"{name: y,", "{name: x,", "triad.axes[1].name"},
+      {"{name: y,", "{name: 'y/1',", "triad.axes[1].name"},
+      {"{name: y,", "{name: y, gain: 2,", "triad.axes[1].gain"},
+      {"[3.0e-4, 1.0e-4]", "[3.0e-4]", "triad.axes[1].misalignment"},
+      {"[3.0e-4, 1.0e-4]", "[3.0e-4, 0.2]", "triad.axes[1].misalignment[1]"},
+      {"scale: -2.0e-4", "scale: 0.1", "triad.axes[2].scale"},
+      {"{name: y,", "{name: y, resonator: {samples_per_period: 4},", "triad.axes[1].resonator.samples_per_period"},
+      {"{name: y,", "{name: y, resonator: {frequency: 5001},", "triad.axes[1].resonator.frequency"},
+      {"{name: y,", "{name: y, resonator: {periods_per_output: 25},", "triad.axes[1].resonator.periods_per_output"},
+      {"{name: y,", "{name: y, pickoff: {amplitude_to_gap: 0.7},", "triad.axes[1].pickoff.amplitude_to_gap"},
+      {"{name: y,", "{name: y, channels: {drop_probability: 2},", "triad.axes[1].channels.drop_probability"},
+      {"{name: y,", "{name: y, dynamics: {model: averaged, shel: {}},", "triad.axes[1].dynamics.shel"},
+      {"{name: y,", "{name: y, dynamics: {commands: [{time: 1.0, rate: 0.2}]},", "triad.axes[1].dynamics"},
+      {"{name: y,",
+       "{name: y, dynamics: {model: averaged}, resonator: {scale_factor: {orders: [2], mean: -0.5, cos: [0.0], "
+       "sin: [0.0]}},",
+       "triad.axes[1].resonator.scale_factor"},
+      {"{name: y,", "{name: y, dynamics: {model: averaged}, resonator: {quadrature: 0.01},",
+       "triad.axes[1].resonator.quadrature"},
+  });
+}
+
+TEST(TriadSimulationConfigTest, RejectsBadTurntableKeys) {
   const std::string table = "turntable: {latitude: 0.9, azimuth: 0.3}";
-  expectError(replaced(good, table, "turntable: {latitude: 2.0}"), "triad.turntable.latitude");
-  expectError(replaced(good, table, "turntable: {azimuth: .nan}"), "triad.turntable.azimuth");
-  expectError(replaced(good, table, "turntable: {acceleration: 0}"), "triad.turntable.acceleration");
-  expectError(replaced(good, table, "turntable: {profile: []}"), "triad.turntable.profile");
-  expectError(replaced(good, table, "turntable: {wobble: {amplitude: 0.1}}"), "triad.turntable.wobble.amplitude");
-  expectError(replaced(good, table, "turntable: {wobble: {amplitude: 1.0e-4, phase: 1}}"),
-              "triad.turntable.wobble.phase");
-  expectError(replaced(good, table, "turntable: {ripple: {amplitude: 0.01}}"), "triad.turntable.ripple.frequency");
-  expectError(replaced(good, table, "turntable: {log: {rate: -1}}"), "triad.turntable.log.rate");
-  // The positions.
-  expectError(replaced(good, kPositions, "  positions: []\n"), "triad.positions");
-  expectError(replaced(good, "up: '-x'", "up: 'x'"), "triad.positions[1].up");
-  expectError(replaced(good, "up: '-x'", "up: '-x', body_to_table: {roll: 0}"), "triad.positions[1].up");
-  expectError(replaced(good, "{name: x down, up: '-x',", "{name: x down,"), "triad.positions[1].up");
-  expectError(replaced(good, "roll: 0.1,", "roll: 0.1, spin: 2,"), "triad.positions[2].body_to_table.spin");
-  expectError(replaced(good, "name: x down", "name: z up"), "triad.positions[1].name");
-  expectError(replaced(good, "name: x down", "name: ''"), "triad.positions[1].name");
-  expectError(replaced(good, "move: 3.0,", "move: 0,"), "triad.positions[1].move");
-  expectError(replaced(good, "move: 3.0,", ""), "triad.positions[1].move");
-  expectError(replaced(good, "up: '+z',", "up: '+z', move: 1.0,"), "triad.positions[0].move");
-  expectError(replaced(good, "move: 3.0,", "move: 3.0, error: [0, 0.2, 0],"), "triad.positions[1].error[1]");
-  expectError(replaced(good, "move: 3.0,", "move: 3.0, error: [0, 0],"), "triad.positions[1].error");
-  expectError(replaced(good, "move: 3.0,", "move: 3.0, speed: 1,"), "triad.positions[1].speed");
-  expectError(replaced(good, "[{type: dwell, duration: 2.0}]", "[{type: dwell}]"),
-              "triad.positions[0].profile[0].duration");
-  expectError(replaced(good, ", profile: [{type: dwell, duration: 2.0}]", ""), "triad.positions[0].profile");
+  expectErrors({
+      {table, "turntable: {latitude: 2.0}", "triad.turntable.latitude"},
+      {table, "turntable: {azimuth: .nan}", "triad.turntable.azimuth"},
+      {table, "turntable: {acceleration: 0}", "triad.turntable.acceleration"},
+      {table, "turntable: {profile: []}", "triad.turntable.profile"},
+      {table, "turntable: {wobble: {amplitude: 0.1}}", "triad.turntable.wobble.amplitude"},
+      {table, "turntable: {wobble: {amplitude: 1.0e-4, phase: 1}}", "triad.turntable.wobble.phase"},
+      {table, "turntable: {ripple: {amplitude: 0.01}}", "triad.turntable.ripple.frequency"},
+      {table, "turntable: {log: {rate: -1}}", "triad.turntable.log.rate"},
+  });
+}
+
+TEST(TriadSimulationConfigTest, RejectsBadPositionKeys) {
+  expectErrors({
+      {kPositions, "  positions: []\n", "triad.positions"},
+      {"up: '-x'", "up: 'x'", "triad.positions[1].up"},
+      {"up: '-x'", "up: '-x', body_to_table: {roll: 0}", "triad.positions[1].up"},
+      {"{name: x down, up: '-x',", "{name: x down,", "triad.positions[1].up"},
+      {"roll: 0.1,", "roll: 0.1, spin: 2,", "triad.positions[2].body_to_table.spin"},
+      {"name: x down", "name: z up", "triad.positions[1].name"},
+      {"name: x down", "name: ''", "triad.positions[1].name"},
+      {"move: 3.0,", "move: 0,", "triad.positions[1].move"},
+      {"move: 3.0,", "", "triad.positions[1].move"},
+      {"up: '+z',", "up: '+z', move: 1.0,", "triad.positions[0].move"},
+      {"move: 3.0,", "move: 3.0, error: [0, 0.2, 0],", "triad.positions[1].error[1]"},
+      {"move: 3.0,", "move: 3.0, error: [0, 0],", "triad.positions[1].error"},
+      {"move: 3.0,", "move: 3.0, speed: 1,", "triad.positions[1].speed"},
+      {"[{type: dwell, duration: 2.0}]", "[{type: dwell}]", "triad.positions[0].profile[0].duration"},
+      {", profile: [{type: dwell, duration: 2.0}]", "", "triad.positions[0].profile"},
+  });
 }
 
 }  // namespace

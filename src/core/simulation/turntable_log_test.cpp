@@ -8,6 +8,7 @@
 
 #include <cmath>
 
+#include "core/testing/refusal.h"
 #include "hrg_gyro/core/simulation/gyro_simulator.h"
 
 namespace hrg_gyro {
@@ -520,50 +521,46 @@ TEST(TurntableLogTest, ScenarioKeysAreParsedAndBadOnesNamed) {
   EXPECT_DOUBLE_EQ(clock.errorAt(700.0), 0.1 - 3e-6 * 700.0 + 0.05);
   EXPECT_FALSE(SimulationConfig::parse(parse(base)).turntable_log.clock.enabled());
 
-  auto key = [&](const std::string& extra) {
-    try {
-      SimulationConfig::parse(parse(base + extra));
-    } catch (const ConfigError& e) {
-      return e.key();
-    }
-    return std::string("accepted");
+  auto parse_section = [&](const std::string& extra) { SimulationConfig::parse(parse(base + extra)); };
+  const std::vector<RefusalCase> refused = {
+      {"  ripple: {amplitude: -0.1, frequency: 1}\n", "turntable.ripple.amplitude"},
+      {"  ripple: {amplitude: 0.01}\n", "turntable.ripple.frequency"},
+      {"  ripple: {amplitude: 0.01, frequency: 1, phse: 0}\n", "turntable.ripple.phse"},
+      {"  log: {rate: -1}\n", "turntable.log.rate"},
+      {"  log: {angle_noise: -1.0e-6}\n", "turntable.log.angle_noise"},
+      {"  log: {angle_resolution: .nan}\n", "turntable.log.angle_resolution"},
+      {"  log: {logged_rate: encoder}\n", "turntable.log.logged_rate"},
+      {"  log: {drop_probability: 1.0}\n", "turntable.log.drop_probability"},
+      {"  log: {gaps: [[1, 0]]}\n", "turntable.log.gaps[0]"},
+      {"  log: {stamp_glitches: [[1, 0]]}\n", "turntable.log.stamp_glitches[0]"},
+      {"  log: {stamp_glitches: [[2, 1], [1, 1]]}\n", "turntable.log.stamp_glitches[1]"},
+      {"  log: {stamp_glitches: [[1, .inf]]}\n", "turntable.log.stamp_glitches[0][1]"},
+      {"  log: {glitches: {nan_rate: 2}}\n", "turntable.log.glitches.nan_rate"},
+      {"  log: {glitches: {nan_rate: 0.6, zero_stamp: 0.6}}\n", "turntable.log.glitches"},
+      {"  log: {glitches: {nan: 0.1}}\n", "turntable.log.glitches.nan"},
+      {"  log: {clock: {offset: .nan}}\n", "turntable.log.clock.offset"},
+      {"  log: {clock: {jitter: -0.001}}\n", "turntable.log.clock.jitter"},
+      {"  log: {clock: {jitter: .inf}}\n", "turntable.log.clock.jitter"},
+      {"  log: {clock: {rate_error: 1.5}}\n", "turntable.log.clock.rate_error"},
+      {"  log: {clock: {rate_error: .nan}}\n", "turntable.log.clock.rate_error"},
+      {"  log: {clock: {steps: 0.1}}\n", "turntable.log.clock.steps"},
+      {"  log: {clock: {steps: [0.1, 0.2]}}\n", "turntable.log.clock.steps[0]"},
+      {"  log: {clock: {steps: [[10, 0.1], [20]]}}\n", "turntable.log.clock.steps[1]"},
+      {"  log: {clock: {steps: [[10, 0.1, 3]]}}\n", "turntable.log.clock.steps[0]"},
+      {"  log: {clock: {steps: [[-1, 0.1]]}}\n", "turntable.log.clock.steps[0]"},
+      {"  log: {clock: {steps: [[1, .inf]]}}\n", "turntable.log.clock.steps[0][1]"},
+      {"  log: {clock: {ofset: 0.1}}\n", "turntable.log.clock.ofset"},
+      {"  log: {clock: 0.1}\n", "turntable.log.clock"},
+      {"  log: {clock: {offset: -0.05, steps: []}}\n", "accepted"},
+      {"  log: {rest_angle_errors: [1.0e-4, 0.2]}\n", "turntable.log.rest_angle_errors[1]"},
+      {"  log: {rest_angle_errors: 1.0e-4}\n", "turntable.log.rest_angle_errors"},
+      {"  log: {rest_angle_error_std: -1.0e-5}\n", "turntable.log.rest_angle_error_std"},
+      {"  log: {rest_angle_errors: [1.0e-4, -2.0e-4], rest_angle_error_std: 3.0e-5}\n", "accepted"},
+      {"channels: {drop_probability: -0.1}\n", "channels.drop_probability"},
+      {"channels: {gaps: [[-1, 1]]}\n", "channels.gaps[0]"},
+      {"channels: {gap: []}\n", "channels.gap"},
   };
-  EXPECT_EQ(key("  ripple: {amplitude: -0.1, frequency: 1}\n"), "turntable.ripple.amplitude");
-  EXPECT_EQ(key("  ripple: {amplitude: 0.01}\n"), "turntable.ripple.frequency");
-  EXPECT_EQ(key("  ripple: {amplitude: 0.01, frequency: 1, phse: 0}\n"), "turntable.ripple.phse");
-  EXPECT_EQ(key("  log: {rate: -1}\n"), "turntable.log.rate");
-  EXPECT_EQ(key("  log: {angle_noise: -1.0e-6}\n"), "turntable.log.angle_noise");
-  EXPECT_EQ(key("  log: {angle_resolution: .nan}\n"), "turntable.log.angle_resolution");
-  EXPECT_EQ(key("  log: {logged_rate: encoder}\n"), "turntable.log.logged_rate");
-  EXPECT_EQ(key("  log: {drop_probability: 1.0}\n"), "turntable.log.drop_probability");
-  EXPECT_EQ(key("  log: {gaps: [[1, 0]]}\n"), "turntable.log.gaps[0]");
-  EXPECT_EQ(key("  log: {stamp_glitches: [[1, 0]]}\n"), "turntable.log.stamp_glitches[0]");
-  EXPECT_EQ(key("  log: {stamp_glitches: [[2, 1], [1, 1]]}\n"), "turntable.log.stamp_glitches[1]");
-  EXPECT_EQ(key("  log: {stamp_glitches: [[1, .inf]]}\n"), "turntable.log.stamp_glitches[0][1]");
-  EXPECT_EQ(key("  log: {glitches: {nan_rate: 2}}\n"), "turntable.log.glitches.nan_rate");
-  EXPECT_EQ(key("  log: {glitches: {nan_rate: 0.6, zero_stamp: 0.6}}\n"), "turntable.log.glitches");
-  EXPECT_EQ(key("  log: {glitches: {nan: 0.1}}\n"), "turntable.log.glitches.nan");
-  EXPECT_EQ(key("  log: {clock: {offset: .nan}}\n"), "turntable.log.clock.offset");
-  EXPECT_EQ(key("  log: {clock: {jitter: -0.001}}\n"), "turntable.log.clock.jitter");
-  EXPECT_EQ(key("  log: {clock: {jitter: .inf}}\n"), "turntable.log.clock.jitter");
-  EXPECT_EQ(key("  log: {clock: {rate_error: 1.5}}\n"), "turntable.log.clock.rate_error");
-  EXPECT_EQ(key("  log: {clock: {rate_error: .nan}}\n"), "turntable.log.clock.rate_error");
-  EXPECT_EQ(key("  log: {clock: {steps: 0.1}}\n"), "turntable.log.clock.steps");
-  EXPECT_EQ(key("  log: {clock: {steps: [0.1, 0.2]}}\n"), "turntable.log.clock.steps[0]");
-  EXPECT_EQ(key("  log: {clock: {steps: [[10, 0.1], [20]]}}\n"), "turntable.log.clock.steps[1]");
-  EXPECT_EQ(key("  log: {clock: {steps: [[10, 0.1, 3]]}}\n"), "turntable.log.clock.steps[0]");
-  EXPECT_EQ(key("  log: {clock: {steps: [[-1, 0.1]]}}\n"), "turntable.log.clock.steps[0]");
-  EXPECT_EQ(key("  log: {clock: {steps: [[1, .inf]]}}\n"), "turntable.log.clock.steps[0][1]");
-  EXPECT_EQ(key("  log: {clock: {ofset: 0.1}}\n"), "turntable.log.clock.ofset");
-  EXPECT_EQ(key("  log: {clock: 0.1}\n"), "turntable.log.clock");
-  EXPECT_EQ(key("  log: {clock: {offset: -0.05, steps: []}}\n"), "accepted");
-  EXPECT_EQ(key("  log: {rest_angle_errors: [1.0e-4, 0.2]}\n"), "turntable.log.rest_angle_errors[1]");
-  EXPECT_EQ(key("  log: {rest_angle_errors: 1.0e-4}\n"), "turntable.log.rest_angle_errors");
-  EXPECT_EQ(key("  log: {rest_angle_error_std: -1.0e-5}\n"), "turntable.log.rest_angle_error_std");
-  EXPECT_EQ(key("  log: {rest_angle_errors: [1.0e-4, -2.0e-4], rest_angle_error_std: 3.0e-5}\n"), "accepted");
-  EXPECT_EQ(key("channels: {drop_probability: -0.1}\n"), "channels.drop_probability");
-  EXPECT_EQ(key("channels: {gaps: [[-1, 1]]}\n"), "channels.gaps[0]");
-  EXPECT_EQ(key("channels: {gap: []}\n"), "channels.gap");
+  expectRefusedKeys(parse_section, refused);
 }
 
 TEST(TurntableLogTest, EachRestStopsOffByItsGivenOrDrawnAngleError) {

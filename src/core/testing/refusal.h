@@ -2,8 +2,11 @@
 // question -- refused, and naming which key? -- so it is asked once here.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "hrg_gyro/core/common/yaml_field.h"
 
@@ -19,6 +22,18 @@ std::string refusedKey(const Make& make) {
     return e.key();
   }
   return "accepted";
+}
+
+/// An input and the key it must be refused by ("accepted": none).
+struct RefusalCase {
+  std::string input, key;
+};
+
+/// Each case's input through `parse`, the key it is refused by checked: one expectation per case,
+/// naming its input, so a table of cases reads as the settings' rules.
+template <class Parse>
+void expectRefusedKeys(const Parse& parse, const std::vector<RefusalCase>& cases) {
+  for (const RefusalCase& c : cases) EXPECT_EQ(refusedKey([&] { parse(c.input); }), c.key) << c.input;
 }
 
 /// The message of the std::invalid_argument `make()` throws, or "accepted" when it throws none.

@@ -259,11 +259,31 @@ TEST_F(TriadResultSetTest, ABackupNotKeptAfterTheRenamesLeavesTheNewSet) {
   EXPECT_EQ(now.size(), 8u);
 }
 
+// The inputs a triad calibration reads, each with some content: the priors, the bag, the settings.
+void writeInputs(const std::string& dir) {
+  for (const char* name : {"triad.yaml", "x.yaml", "y.yaml", "z.yaml", "session.bag", "settings.yaml"}) {
+    std::ofstream(dir + "/" + name) << "content\n";
+  }
+}
+
+// The four outputs in a directory of their own (created).
+TriadResultPaths outputsIn(const std::string& dir) {
+  fs::create_directory(dir);
+  TriadResultPaths outs;
+  outs.triad = dir + "/triad.yaml";
+  for (int i = 0; i < 3; ++i) outs.axes[i] = dir + "/" + std::string(1, "xyz"[i]) + ".yaml";
+  return outs;
+}
+
+// `paths` with one output moved: slot 0..2 an axis, 3 the triad file.
+TriadResultPaths withSlot(TriadResultPaths paths, int slot, const std::string& path) {
+  (slot < 3 ? paths.axes[slot] : paths.triad) = path;
+  return paths;
+}
+
 // The paths' rule, by file identity: an output may be its own prior, never another input or output.
 TEST_F(TriadResultFilesTest, AnOutputMayRefreshItsOwnPriorOnly) {
-  for (const char* name : {"triad.yaml", "x.yaml", "y.yaml", "z.yaml", "session.bag", "settings.yaml"}) {
-    std::ofstream(dir_ + "/" + name) << "content\n";
-  }
+  writeInputs(dir_);
   const std::string bag = dir_ + "/session.bag", settings = dir_ + "/settings.yaml";
   fs::create_symlink("x.yaml", dir_ + "/link_to_x.yaml");
   fs::create_hard_link(dir_ + "/y.yaml", dir_ + "/hard_y.yaml");
@@ -281,16 +301,9 @@ TEST_F(TriadResultFilesTest, AnOutputMayRefreshItsOwnPriorOnly) {
   EXPECT_NO_THROW(checkTriadPaths(paths_, nominal, {bag, ""}, {""}));
 
   // Outputs elsewhere, one of them then put on an input.
-  fs::create_directory(dir_ + "/out");
-  TriadResultPaths outs;
-  outs.triad = dir_ + "/out/triad.yaml";
-  for (int i = 0; i < 3; ++i) outs.axes[i] = dir_ + "/out/" + std::string(1, "xyz"[i]) + ".yaml";
+  const TriadResultPaths outs = outputsIn(dir_ + "/out");
   EXPECT_NO_THROW(checkTriadPaths(outs, priors, {bag, settings}, {dir_ + "/out/report.yaml"}));
-  auto with = [&](int slot, const std::string& path) {
-    TriadResultPaths p = outs;
-    (slot < 3 ? p.axes[slot] : p.triad) = path;
-    return p;
-  };
+  auto with = [&](int slot, const std::string& path) { return withSlot(outs, slot, path); };
   struct Case {
     TriadResultPaths out;
     std::string report;
@@ -321,8 +334,14 @@ TEST_F(TriadResultFilesTest, AnOutputMayRefreshItsOwnPriorOnly) {
       EXPECT_NE(what.find("'" + c.input + "'"), std::string::npos) << what;
     }
   }
+}
 
-  // An output's backup may be neither an input nor another output.
+// An output's backup may be neither an input nor another output.
+TEST_F(TriadResultFilesTest, ABackupIsNeitherAnInputNorAnotherOutput) {
+  writeInputs(dir_);
+  const std::string bag = dir_ + "/session.bag";
+  const TriadResultPaths priors = paths_, outs = outputsIn(dir_ + "/out");
+  auto with = [&](int slot, const std::string& path) { return withSlot(outs, slot, path); };
   TriadResultPaths from_backup = priors;
   from_backup.triad = paths_.triad + ".bak";  // "recalibrate from the backup, into the file"
   std::ofstream(from_backup.triad) << "content\n";
