@@ -172,6 +172,132 @@ TEST_F(CoreLayoutTest, EveryModuleIsNamedInItsFoldersReadmeAndInTheLayout) {
   EXPECT_GT(checked, 60);
 }
 
+// The maps name only what is there: a file table's entry (a folder README's `## Files` table, the
+// core table of docs/layout.md) is a module of its folder, and a file a README, the layout or a core
+// header's comment names by its name (foo.h, bar.cpp, baz.md) exists in the repository.
+std::vector<std::string> backticked(const std::string& cell) {
+  std::vector<std::string> out;
+  const std::regex name("`([a-z_0-9]+)`");
+  for (std::sregex_iterator it(cell.begin(), cell.end(), name), end; it != end; ++it) out.push_back((*it)[1]);
+  return out;
+}
+
+// A Markdown table's entries in one column, the header's and the rule's rows aside; with column > 0
+// each row's first cell comes first, marked by a leading '|'.
+std::vector<std::string> tableEntries(const std::string& text, int column) {
+  std::vector<std::string> out;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.compare(0, 2, "| ") != 0 || line.compare(0, 5, "| ---") == 0) continue;
+    std::vector<std::string> cells;
+    std::istringstream row(line.substr(1));
+    for (std::string cell; std::getline(row, cell, '|');) cells.push_back(cell);
+    if (static_cast<int>(cells.size()) <= column) continue;
+    if (column > 0) out.push_back("|" + cells[0]);  // the row's folder, then its entries
+    for (const std::string& e : backticked(cells[static_cast<std::size_t>(column)])) out.push_back(e);
+  }
+  return out;
+}
+
+// Every file name of the repository, the build and the VCS's own trees excluded.
+void collectFileNames(const std::string& dir, std::set<std::string>* names) {
+  for (const std::string& f : entries(dir, false)) names->insert(f);
+  for (const std::string& d : entries(dir, true)) {
+    if (d[0] == '.' || d == "build" || d == "devel" || d == "install") continue;
+    collectFileNames(dir + "/" + d, names);
+  }
+}
+
+// The file names a text names (foo.h, bar_baz.cpp, README.md), placeholders (foo, bar) aside; in
+// comments_only mode just those in // comments, so an #include is not taken for a claim.
+std::set<std::string> namedFiles(const std::string& text, bool comments_only) {
+  std::set<std::string> out;
+  const std::regex file(R"((^|[^A-Za-z0-9_.-])([a-z][a-z_0-9]*\.(h|cpp|md|py))\b)");
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (comments_only) {
+      const std::size_t c = line.find("//");
+      if (c == std::string::npos) continue;
+      line = line.substr(c);
+    }
+    for (std::sregex_iterator it(line.begin(), line.end(), file), end; it != end; ++it) {
+      const std::string n = (*it)[2];
+      if (n.compare(0, 3, "foo") != 0 && n.compare(0, 3, "bar") != 0) out.insert(n);
+    }
+  }
+  return out;
+}
+
+TEST_F(CoreLayoutTest, TablesAndTextsNameOnlyFilesThatExist) {
+  int checked = 0;
+  for (const auto& [folder, rank] : rankedFolders()) {
+    (void)rank;
+    std::set<std::string> modules = modulesIn(include_ + "/" + folder);
+    for (const std::string& m : modulesIn(src_ + "/" + folder)) modules.insert(m);
+    const std::string readme = read(src_ + "/" + folder + "/README.md");
+    const std::size_t files = readme.find("## Files");
+    ASSERT_NE(files, std::string::npos) << "src/core/" << folder << "/README.md has no ## Files table";
+    for (const std::string& m : tableEntries(readme.substr(files), 0)) {
+      EXPECT_TRUE(modules.count(m)) << "src/core/" << folder << "/README.md lists " << m << ", no file of " << folder;
+      ++checked;
+    }
+  }
+  // docs/layout.md: a core row (folder | files | concept) names files of its folder; the other tables'
+  // first column (the ROS layer, the tools, the test helpers) names files somewhere in src/ or include/.
+  std::map<std::string, int> rank;
+  for (const auto& [folder, r] : rankedFolders()) rank[folder] = r;
+  std::set<std::string> anywhere = modulesIn(root_ + "/src");
+  for (const std::string& m : modulesIn(root_ + "/include")) anywhere.insert(m);
+  std::string folder;
+  for (const std::string& e : tableEntries(read(root_ + "/docs/layout.md"), 1)) {
+    if (e[0] == '|') {
+      std::istringstream cell(e.substr(1));
+      folder.clear();
+      cell >> folder;
+      if (!rank.count(folder)) {
+        for (const std::string& m : backticked(e)) {
+          EXPECT_TRUE(anywhere.count(m)) << "docs/layout.md lists " << m << ", no file of src/ or include/";
+          ++checked;
+        }
+      }
+      continue;
+    }
+    if (!rank.count(folder)) continue;
+    std::set<std::string> modules = modulesIn(include_ + "/" + folder);
+    for (const std::string& m : modulesIn(src_ + "/" + folder)) modules.insert(m);
+    EXPECT_TRUE(modules.count(e)) << "docs/layout.md lists " << e << " under " << folder << ", no file of it";
+    ++checked;
+  }
+  EXPECT_GT(checked, 120);
+
+  std::set<std::string> existing;
+  collectFileNames(root_, &existing);
+  std::vector<std::pair<std::string, bool>> texts = {{"/docs/layout.md", false}, {"/README.md", false}};
+  for (const auto& [folder, rank] : rankedFolders()) {
+    (void)rank;
+    texts.emplace_back("/src/core/" + folder + "/README.md", false);
+    for (const std::string& h : entries(include_ + "/" + folder, false))
+      texts.emplace_back("/include/hrg_gyro/core/" + folder + "/" + h, true);
+  }
+  int named = 0;
+  for (const auto& [path, comments_only] : texts) {
+    for (const std::string& n : namedFiles(read(root_ + path), comments_only)) {
+      EXPECT_TRUE(existing.count(n)) << path.substr(1) << " names " << n << ", which does not exist";
+      ++named;
+    }
+  }
+  EXPECT_GT(named, 50);
+}
+
+// The check itself: it sees a file table's entry that names no file, and a comment's file that is gone.
+TEST(CoreLayoutCheck, SeesANamedFileThatIsMissing) {
+  EXPECT_EQ(tableEntries("| file | concept |\n| --- | --- |\n| `a`, `b_c` | x |\n", 0),
+            (std::vector<std::string>{"a", "b_c"}));
+  EXPECT_EQ(namedFiles("#include \"x/gone.h\"\n// see gone_too.h and foo.cpp\n", true),
+            (std::set<std::string>{"gone_too.h"}));
+  EXPECT_EQ(namedFiles("the table (`kept.cpp`, docs/x_y.md)\n", false), (std::set<std::string>{"kept.cpp", "x_y.md"}));
+}
+
 // Beyond the core: the ROS layer, the offline tools and the core's test helpers are in docs/layout.md too.
 TEST_F(CoreLayoutTest, EveryWrapperToolAndTestHelperIsNamedInTheLayout) {
   const std::string layout = read(root_ + "/docs/layout.md");

@@ -3,7 +3,7 @@
 // else asks this header instead of comparing names: a new method is added here once, and every
 // front-end, help text and check follows.
 //
-// Not to be confused with CalibrationMethod (calibration_method.h), the interface a method's
+// Not to be confused with CalibrationMethod (calibration_method_interface.h), the interface a method's
 // implementation fulfils; makeCalibrationMethod() turns a kind into that implementation.
 //
 // A parameter file also records where its numbers came from (calibration.method): a method, or

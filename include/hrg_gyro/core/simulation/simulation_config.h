@@ -1,5 +1,5 @@
 // A simulation scenario: the gyro (resonator, pickoffs), the turntable profile, the generator
-// sweep and, optionally, the temperature (thermal_model.h). The keys are those of the driver_sim node's private
+// sweep and, optionally, the temperature (temperature_dependence.h). The keys are those of the driver_sim node's private
 // parameters, so one YAML file serves `roslaunch` (rosparam load into ~) and `hrg_bag simulate` alike. Defaults: the
 // shipped simulated gyro (docs/simulation.md).
 #pragma once
