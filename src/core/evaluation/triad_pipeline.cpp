@@ -69,6 +69,49 @@ struct Window {
   double begin, end;  // s from the scenario start
 };
 
+/// The segments a verification judges: the table's constant-rate pieces (moves between positions
+/// aside) longer than twice the margin, each with its window, the margin cut from both ends.
+void verificationSegments(const TriadSimulationConfig& scenario, const TriadMotion& motion, double margin,
+                          std::vector<TriadVerificationSegment>* segments, std::vector<Window>* windows) {
+  for (const TurntableProfile::Piece& piece : scenario.table_profile.pieces()) {
+    const bool move = piece.label.size() >= 5 && piece.label.compare(piece.label.size() - 5, 5, "/move") == 0;
+    if (move || piece.accel != 0.0 || piece.duration <= 2.0 * margin) continue;
+    TriadVerificationSegment segment;
+    segment.label = piece.label;
+    segment.table_rate = piece.rate0;
+    segment.position = motion.stateAt(piece.start + 0.5 * piece.duration).position;
+    segments->push_back(segment);
+    windows->push_back({piece.start + margin, piece.start + piece.duration - margin});
+  }
+}
+
+/// One chain's sums per segment as its verification: each segment's mean rate and error, the worst and
+/// rms relative error where the table turned, the worst rest error where it did not.
+TriadVerification summarise(const VerifiedChain& chain, const std::vector<TriadVerificationSegment>& segments) {
+  TriadVerification v;
+  v.combiner = chain.triad->combiner().counters();
+  double sum_square = 0.0;
+  int turning = 0;
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    if (!(chain.seconds[k] > 0.0)) continue;
+    TriadVerificationSegment segment = segments[k];
+    segment.seconds = chain.seconds[k];
+    segment.mean_rate = chain.exact[k] / chain.seconds[k];
+    segment.mean_error = (chain.published[k] - chain.exact[k]) / chain.seconds[k];
+    if (segment.turning()) {
+      const double ppm = segment.relativeErrorPpm();
+      v.worst_turning_ppm = std::max(v.worst_turning_ppm, ppm);
+      sum_square += ppm * ppm;
+      ++turning;
+    } else {
+      v.worst_rest_error = std::max(v.worst_rest_error, segment.mean_error.norm());
+    }
+    v.segments.push_back(segment);
+  }
+  if (turning > 0) v.rms_turning_ppm = std::sqrt(sum_square / turning);
+  return v;
+}
+
 }  // namespace
 
 std::vector<TriadVerification> verifyTriadOnSimulation(const TriadSimulationConfig& scenario,
@@ -77,16 +120,7 @@ std::vector<TriadVerification> verifyTriadOnSimulation(const TriadSimulationConf
   const TriadMotion motion(scenario);
   std::vector<TriadVerificationSegment> segments;
   std::vector<Window> windows;
-  for (const TurntableProfile::Piece& piece : scenario.table_profile.pieces()) {
-    const bool move = piece.label.size() >= 5 && piece.label.compare(piece.label.size() - 5, 5, "/move") == 0;
-    if (move || piece.accel != 0.0 || piece.duration <= 2.0 * margin) continue;
-    TriadVerificationSegment segment;
-    segment.label = piece.label;
-    segment.table_rate = piece.rate0;
-    segment.position = motion.stateAt(piece.start + 0.5 * piece.duration).position;
-    segments.push_back(segment);
-    windows.push_back({piece.start + margin, piece.start + piece.duration - margin});
-  }
+  verificationSegments(scenario, motion, margin, &segments, &windows);
 
   std::vector<VerifiedChain> chains(files.size());
   for (std::size_t c = 0; c < files.size(); ++c) {
@@ -139,28 +173,8 @@ std::vector<TriadVerification> verifyTriadOnSimulation(const TriadSimulationConf
     cursor = 0;
     chain.triad->finish(nullptr, &chain.completed);
     accumulate(&chain);
-    TriadVerification& v = results[c];
-    v.name = files[c].name;
-    v.combiner = chain.triad->combiner().counters();
-    double sum_square = 0.0;
-    int turning = 0;
-    for (std::size_t k = 0; k < segments.size(); ++k) {
-      if (!(chain.seconds[k] > 0.0)) continue;
-      TriadVerificationSegment segment = segments[k];
-      segment.seconds = chain.seconds[k];
-      segment.mean_rate = chain.exact[k] / chain.seconds[k];
-      segment.mean_error = (chain.published[k] - chain.exact[k]) / chain.seconds[k];
-      if (segment.turning()) {
-        const double ppm = segment.relativeErrorPpm();
-        v.worst_turning_ppm = std::max(v.worst_turning_ppm, ppm);
-        sum_square += ppm * ppm;
-        ++turning;
-      } else {
-        v.worst_rest_error = std::max(v.worst_rest_error, segment.mean_error.norm());
-      }
-      v.segments.push_back(segment);
-    }
-    if (turning > 0) v.rms_turning_ppm = std::sqrt(sum_square / turning);
+    results[c] = summarise(chain, segments);
+    results[c].name = files[c].name;
   }
   return results;
 }

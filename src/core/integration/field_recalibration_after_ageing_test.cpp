@@ -11,6 +11,7 @@
 // comments and in docs/field_calibration.md.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <cstdio>
 
@@ -38,6 +39,25 @@ SimulationConfig aged(SimulationConfig c) {
 
 /// The table sessions: +-0.1 rad/s, one full turn of theta per plateau (as resonator_calibration_test).
 TurntableProfile dualRateProfile() { return testing::dualRateProfile(0.1, -0.1, 118.0); }
+
+// The figures the test judges, printed before it judges them: the drift of the fresh and the aged
+// gyro, each calibration's estimate and its largest error in its own sigmas (table on the fresh gyro,
+// the table's D on the aged one, field on the aged one), the virtual rate's gain.
+void printDrifts(const EffectiveModel& fresh_model, const EffectiveModel& aged_model, const HarmonicFitResult& d_table,
+                 const HarmonicFitResult& d_field, const std::array<double, 3>& errors, const HarmonicFitResult& gain) {
+  std::printf("[ measured ] D0 rad/s: fresh %.5g, aged %.5g; table %.5g (sigma %.2g), field %.5g (sigma %.2g)\n",
+              fresh_model.drift.mean, aged_model.drift.mean, d_table.mean, d_table.mean_std, d_field.mean,
+              d_field.mean_std);
+  std::printf(
+      "[ measured ] D cos2, sin2 rad/s: aged %.5g, %.5g; table %.5g, %.5g; field %.5g, %.5g (sigma %.2g, %.2g)\n",
+      aged_model.drift.cos[0], aged_model.drift.sin[0], d_table.cos[0], d_table.sin[0], d_field.cos[0], d_field.sin[0],
+      d_field.cos_std[0], d_field.sin_std[0]);
+  std::printf(
+      "[ measured ] largest |D - exact| / sigma: table on the fresh gyro %.2f, table's D on the aged gyro %.0f, "
+      "field on the aged gyro %.2f\n",
+      errors[0], errors[1], errors[2]);
+  std::printf("[ measured ] virtual rate gain %.8f +- %.2g\n", gain.mean, gain.mean_std);
+}
 
 TEST(FieldRecalibrationAfterAgeing, FieldCalibrationRestoresTheDriftAndTheAngleError) {
   const auto start = std::chrono::steady_clock::now();
@@ -78,19 +98,8 @@ TEST(FieldRecalibrationAfterAgeing, FieldCalibrationRestoresTheDriftAndTheAngleE
   // the table calibration's own sigmas.
   const double stale_error = worstNormalisedError(d_table, aged_model.drift);
   const double table_error = worstNormalisedError(d_table, fresh_model.drift);
-  std::printf("[ measured ] D0 rad/s: fresh %.5g, aged %.5g; table %.5g (sigma %.2g), field %.5g (sigma %.2g)\n",
-              fresh_model.drift.mean, aged_model.drift.mean, d_table.mean, d_table.mean_std, d_field.mean,
-              d_field.mean_std);
-  std::printf(
-      "[ measured ] D cos2, sin2 rad/s: aged %.5g, %.5g; table %.5g, %.5g; field %.5g, %.5g (sigma %.2g, %.2g)\n",
-      aged_model.drift.cos[0], aged_model.drift.sin[0], d_table.cos[0], d_table.sin[0], d_field.cos[0], d_field.sin[0],
-      d_field.cos_std[0], d_field.sin_std[0]);
-  std::printf(
-      "[ measured ] largest |D - exact| / sigma: table on the fresh gyro %.2f, table's D on the aged gyro %.0f, "
-      "field on the aged gyro %.2f\n",
-      table_error, stale_error, field_error);
-  std::printf("[ measured ] virtual rate gain %.8f +- %.2g\n", field.outcome.field.virtual_rate_gain.mean,
-              field.outcome.field.virtual_rate_gain.mean_std);
+  printDrifts(fresh_model, aged_model, d_table, d_field, {table_error, stale_error, field_error},
+              field.outcome.field.virtual_rate_gain);
   EXPECT_LT(field_error, 3.0);
   EXPECT_GT(stale_error, 30.0);  // the ageing is far beyond the table calibration's uncertainty
 

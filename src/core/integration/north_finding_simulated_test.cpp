@@ -157,6 +157,15 @@ void expectShippedNoise(const AlignmentResult& r) {
   for (double w : r.white_noise) EXPECT_NEAR(w / testing::kShippedBodyAngleNoise, 1.0, 0.15);
 }
 
+/// What every accepted heading of the shipped gyros must show: its figures printed, accepted, within
+/// 3 sigma of the truth, the window's white noise the shipped gyro's.
+void expectCoveredHeadingOfTheShippedGyros(const char* what, const SimulatedAlignment& a) {
+  print(what, a);
+  ASSERT_TRUE(a.result.accepted) << a.result.summary();
+  EXPECT_LT(std::abs(a.error), 3.0 * a.result.budget.total);
+  expectShippedNoise(a.result);
+}
+
 class NorthFindingSimulated : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -239,10 +248,7 @@ TEST_F(NorthFindingSimulated, IndexedTwoPositionsOf60s) {
 TEST_F(NorthFindingSimulated, IndexedFourPositions) {
   const TriadSimulationConfig c = scenario("north_indexed_four.yaml");
   const SimulatedAlignment a = align(c, files_, settingsFor(c, AlignmentMode::kIndexed, c.duration() - 0.5));
-  print("indexed, four positions of 60 s", a);
-  ASSERT_TRUE(a.result.accepted) << a.result.summary();
-  EXPECT_LT(std::abs(a.error), 3.0 * a.result.budget.total);
-  expectShippedNoise(a.result);
+  expectCoveredHeadingOfTheShippedGyros("indexed, four positions of 60 s", a);
 }
 
 TEST_F(NorthFindingSimulated, IndexedContinuousRotation) {
@@ -250,10 +256,7 @@ TEST_F(NorthFindingSimulated, IndexedContinuousRotation) {
   AlignmentSettings s = settingsFor(c, AlignmentMode::kIndexed, c.duration() - 0.5);
   s.indexer.continuous = true;
   const SimulatedAlignment a = align(c, files_, s);
-  print("indexed, continuous rotation, two turns", a);
-  ASSERT_TRUE(a.result.accepted) << a.result.summary();
-  EXPECT_LT(std::abs(a.error), 3.0 * a.result.budget.total);
-  expectShippedNoise(a.result);
+  expectCoveredHeadingOfTheShippedGyros("indexed, continuous rotation, two turns", a);
 }
 
 // The sweep: each axis's wave turned +0.2, -0.2, -0.2, +0.2 rad/s through 2 whole turns by its

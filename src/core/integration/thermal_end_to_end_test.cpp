@@ -25,6 +25,28 @@ testing::ModelResidual residualAgainst(const HarmonicModel& estimate, const Harm
   return testing::residualAgainst(estimate, f, truth, NAN, 512);
 }
 
+// Node estimates within a few standard errors of the exact injected model at the node's
+// temperature (T from the node frequency).
+void expectNodesNearTheExactModel(const SimulationConfig& cal, const GyroParameters& prior,
+                                  const CalibrationSettings& thermal_settings, const CalibrationOutcome& thermal) {
+  const ThermalConfig& t = cal.thermal;
+  const double f0 = cal.resonator.frequency;
+  for (std::size_t j = 0; j < thermal.frequency_nodes.size(); ++j) {
+    const double temperature = t.reference_temperature + (thermal.frequency_nodes[j] - f0) / t.frequency_coefficient;
+    const EffectiveModel exact =
+        computeEffectiveModel(atTemperature(cal, temperature), prior.correction, thermal_settings.scale_factor_orders,
+                              thermal_settings.drift_orders);
+    const std::vector<double> k = thermal.scale_factor[j].terms(), k_sd = thermal.scale_factor[j].termStds();
+    const std::vector<double> k_true = exact.scale_factor.terms();
+    for (std::size_t i = 0; i < k.size(); ++i)
+      EXPECT_NEAR(k[i], k_true[i], 4 * k_sd[i]) << "K term " << i << " node " << j;
+    const std::vector<double> d = thermal.drift[j].terms(), d_sd = thermal.drift[j].termStds();
+    const std::vector<double> d_true = exact.drift.terms();
+    for (std::size_t i = 0; i < d.size(); ++i)
+      EXPECT_NEAR(d[i], d_true[i], 4 * d_sd[i]) << "D term " << i << " node " << j;
+  }
+}
+
 TEST(ThermalEndToEnd, RampCalibrationBringsTheResidualBelowOnePpmAcrossTheRange) {
   const auto start = std::chrono::steady_clock::now();
   const SimulationConfig cal = shippedScenario("thermal_ramp.yaml");
@@ -54,22 +76,7 @@ TEST(ThermalEndToEnd, RampCalibrationBringsTheResidualBelowOnePpmAcrossTheRange)
   EXPECT_NEAR(thermal.frequency_nodes.front(), t.frequencyAt(15.0, f0), 1e-9);
   EXPECT_NEAR(thermal.frequency_nodes.back(), t.frequencyAt(35.0, f0), 1e-9);
 
-  // Node estimates within a few standard errors of the exact injected model at the node's
-  // temperature (T from the node frequency).
-  for (std::size_t j = 0; j < thermal.frequency_nodes.size(); ++j) {
-    const double temperature = t.reference_temperature + (thermal.frequency_nodes[j] - f0) / t.frequency_coefficient;
-    const EffectiveModel exact =
-        computeEffectiveModel(atTemperature(cal, temperature), prior->correction, thermal_settings.scale_factor_orders,
-                              thermal_settings.drift_orders);
-    const std::vector<double> k = thermal.scale_factor[j].terms(), k_sd = thermal.scale_factor[j].termStds();
-    const std::vector<double> k_true = exact.scale_factor.terms();
-    for (std::size_t i = 0; i < k.size(); ++i)
-      EXPECT_NEAR(k[i], k_true[i], 4 * k_sd[i]) << "K term " << i << " node " << j;
-    const std::vector<double> d = thermal.drift[j].terms(), d_sd = thermal.drift[j].termStds();
-    const std::vector<double> d_true = exact.drift.terms();
-    for (std::size_t i = 0; i < d.size(); ++i)
-      EXPECT_NEAR(d[i], d_true[i], 4 * d_sd[i]) << "D term " << i << " node " << j;
-  }
+  expectNodesNearTheExactModel(cal, *prior, thermal_settings, thermal);
 
   // Across 15..35 degC: the frequency-independent model leaves several ppm, the spline < 1 ppm.
   double thermal_worst = 0.0, dual_worst = 0.0, thermal_scale = 0.0, dual_scale = 0.0;
