@@ -1,8 +1,9 @@
 # hrg_gyro: the two set-up commands (README) and the benchmark entry point.
 #   make run    install missing Debian packages, build, run the main job, print the summary
 #   make test   install, build, run every unit test and rostest, then catkin_test_results
-#   make unit   install, build the gtest binaries alone (core, tools, bag writer, fuzz corpus) and run
-#               them, no master, no rostest: the daily loop (GTEST_FILTER selects cases)
+#   make unit   install, build the gtest binaries alone (the core's, one per concept folder, the tools',
+#               the bag writer's, the fuzz corpus's) and run them, no master, no rostest: the daily loop
+#               (UNIT=alignment,... selects binaries, GTEST_FILTER cases)
 #   make bench  install, build, run the benchmarks
 #   make soak   1 simulated h at 10 kHz through the nodes (sim clock, 2x), memory and drops watched
 #   make fuzz   libFuzzer + ASan/UBSan on the parameter loader and the sample path (FUZZ_SECONDS each)
@@ -19,6 +20,7 @@ WS := $(ROOT)/.ws
 export PATH := /usr/bin:/bin:$(PATH)
 CATKIN_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release
 JOBS ?= $(shell nproc)
+TEST_JOBS ?= $(JOBS)
 
 .PHONY: deps build test unit run figures bench fuzz soak clean
 
@@ -35,7 +37,9 @@ build: deps
 
 test: build
 	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) tests
-	cd $(WS) && source devel/setup.bash && catkin_make $(CATKIN_ARGS) -j1 run_tests
+	@# The tests side by side, TEST_JOBS at once: no two share a file, a port or a work directory (each
+	@# rostest has its own master on a free port and its own directory under the build's test_work/).
+	cd $(WS) && source devel/setup.bash && catkin_make $(CATKIN_ARGS) -j$(TEST_JOBS) run_tests
 	@# The package as a user installs it (fresh prefix, only the install space sourced) and catkin_lint.
 	bash $(ROOT)/test/install_space/run.sh $(WS)
 	@# rosrun finds each documented program once, without a prompt or a warning (devel space sourced).
@@ -44,11 +48,16 @@ test: build
 	@# Every C++ file formatted as .clang-format says; the fuzz build finds every core source.
 	ROS_TEST_RESULTS_DIR=$(WS)/build/test_results /usr/bin/python3 $(ROOT)/test/source_format_test.py
 	ROS_TEST_RESULTS_DIR=$(WS)/build/test_results /usr/bin/python3 $(ROOT)/test/fuzz/fuzz_sources_test.py
+	@# No function in src/ or include/ over 80 lines.
+	ROS_TEST_RESULTS_DIR=$(WS)/build/test_results /usr/bin/python3 $(ROOT)/test/source_function_length_test.py
 	@# --verbose: a failed test's whole result file (its assertion and output) ends the log.
 	cd $(WS) && catkin_test_results --verbose build/test_results
 
-# The unit tests alone: their four binaries and what they link (the core library), not the nodes.
-UNIT_TESTS := core tools bag_writer fuzz_corpus
+# The unit tests alone: their binaries and what they link (the core library), not the nodes.
+CORE_TESTS := common model resonator signal estimation processing alignment calibration simulation integration
+UNIT ?= $(CORE_TESTS) tools bag_writer fuzz_corpus
+comma := ,
+UNIT_TESTS := $(subst $(comma), ,$(UNIT))
 GTEST_FILTER ?= *
 unit: deps
 	@bash $(ROOT)/scripts/link_workspace.sh $(ROOT) $(WS)
