@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "hrg_gyro/AlignmentResult.h"
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/model/triad_file.h"
 #include "hrg_gyro/ros/conversions.h"

@@ -452,9 +452,7 @@ void MotionSettings::validate() const {
 }
 
 void AlignmentSettings::validate() const {
-  if (!std::isfinite(latitude) || std::abs(latitude) > 0.5 * 3.14159265358979323846) {
-    throw ConfigError("latitude", "must be given, in [-pi/2, pi/2] rad");
-  }
+  if (!validLatitude(latitude)) throw ConfigError("latitude", kLatitudeRule);
   if (!std::isfinite(max_latitude) || !(max_latitude > 0.0) || max_latitude >= 1.5707) {
     throw ConfigError("max_latitude", "must be in (0, pi/2) rad");
   }

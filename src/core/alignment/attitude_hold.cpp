@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "hrg_gyro/core/common/yaml_field.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -18,9 +19,7 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
 }  // namespace
 
 void AttitudeHoldSettings::validate() const {
-  if (!std::isfinite(latitude) || std::abs(latitude) > 0.5 * kPi) {
-    throw ConfigError("latitude", "must be given, in [-pi/2, pi/2] rad");
-  }
+  if (!validLatitude(latitude)) throw ConfigError("latitude", kLatitudeRule);
   noise.requireComplete();
   if (std::isnan(scale_factor_sigma)) {
     throw ConfigError("hold/scale_factor_sigma",

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -58,8 +59,8 @@ std::vector<EarthCheck> checkAgainstTheEarth(const Eigen::Vector3d& w, const Eig
   out.push_back(make("length", length, kEarthRotationRate, wh.dot(wc * wh), sigmas, kRateFloor));
   if (!vertical_measured) return out;
   const Eigen::Vector3d u = up.normalized();
-  out.push_back(make("vertical", w.dot(u), kEarthRotationRate * std::sin(latitude), u.dot(wc * u) + w.dot(uc * w),
-                     sigmas, kRateFloor));
+  out.push_back(
+      make("vertical", w.dot(u), verticalEarthRate(latitude), u.dot(wc * u) + w.dot(uc * w), sigmas, kRateFloor));
   const double cosine = std::clamp(wh.dot(u), -1.0, 1.0), sine = std::sqrt(std::max(1.0 - cosine * cosine, 1e-300));
   const Eigen::Vector3d by_rate = -(u - cosine * wh) / (length * sine), by_up = -wh / sine;
   out.push_back(make("angle", std::acos(cosine), 0.5 * kPi - latitude,

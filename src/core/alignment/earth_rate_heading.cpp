@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hrg_gyro/core/model/earth_rate.h"
+
 namespace hrg_gyro {
 namespace core {
 

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -29,7 +30,7 @@ TEST(EarthRateHeadingTest, TheExactRateGivesTheExactAttitude) {
       const HeadingSolution h = solveHeading(exact(a, latitude), level, latitude);
       EXPECT_NEAR(wrapToPi(h.attitude.yaw - a.yaw), 0.0, 1e-12) << latitude;
       EXPECT_NEAR(h.horizontal_rate, horizontalEarthRate(latitude), 1e-18);
-      EXPECT_NEAR(h.levelled_rate.z(), kEarthRotationRate * std::sin(latitude), 1e-18);
+      EXPECT_NEAR(h.levelled_rate.z(), verticalEarthRate(latitude), 1e-18);
       EXPECT_LT(h.orientation.angularDistance(orientationFromEuler(a)), 1e-12);
     }
   }

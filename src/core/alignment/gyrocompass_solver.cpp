@@ -5,7 +5,11 @@
 #include <cmath>
 #include <cstdio>
 
+#include "hrg_gyro/core/alignment/motion_gate.h"
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/earth_rate.h"
+#include "hrg_gyro/core/processing/block_mean_stillness.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -46,25 +50,48 @@ void integrateCosSin(double a, double b, double dt, double* c, double* s) {
   *s = k * std::sin(middle);
 }
 
-}  // namespace
-
-std::string formatAlignmentMessage(const char* pattern, double a, double b, double c, double d) {
-  char buffer[512];
-  std::snprintf(buffer, sizeof buffer, pattern, a, b, c, d);
-  return buffer;
+// A channel's regressors at time t in the indexed mode: its direction d turned by the indexer, integrated
+// (the integrals of cos psi and sin psi so far), and t for its bias.
+void indexedPoint(const Eigen::Vector3d& d, double cos_integral, double sin_integral, double t, double* point) {
+  point[0] = d.x() * cos_integral - d.y() * sin_integral;
+  point[1] = d.x() * sin_integral + d.y() * cos_integral;
+  point[2] = t;
 }
 
-AlignmentResult Gyrocompass::finish() const { return GyrocompassSolver(*this).solve(); }
+// An axis's regressors at time t in the sweep mode: t, the commanded angle and its gain harmonics.
+const double* sweepPoint(double t, double angle, const std::vector<int>& orders, std::vector<double>* x) {
+  (*x)[0] = t;
+  (*x)[1] = angle;
+  for (std::size_t o = 0; o < orders.size(); ++o) {
+    (*x)[2 + 2 * o] = std::sin(orders[o] * angle);
+    (*x)[3 + 2 * o] = std::cos(orders[o] * angle);
+  }
+  return x->data();
+}
+
+// The residual drift harmonics' rate integrals over a sample: orders 2 and 4 of the wave angle, which
+// the commanded angle moves (the wave's own offset only turns the pair), added to `sum`.
+void addDriftProbes(double psi_a, double psi_b, double dt, std::array<double, 4>* sum) {
+  double c2, s2, c4, s4;
+  integrateCosSin(2.0 * psi_a, 2.0 * psi_b, dt, &c2, &s2);
+  integrateCosSin(4.0 * psi_a, 4.0 * psi_b, dt, &c4, &s4);
+  (*sum)[0] += c2;
+  (*sum)[1] += s2;
+  (*sum)[2] += c4;
+  (*sum)[3] += s4;
+}
+
+}  // namespace
 
 bool GyrocompassSolver::buildStatic() {
-  const Gyrocompass::Stream& st = g_.streams_[0];
+  const GyroStreamRecords& st = w_.streams[0];
   parameters_ = 3;
   series_.assign(3, AngleSeries());
   for (std::size_t c = 0; c < 3; ++c) {
     series_[c].columns = {static_cast<int>(c)};
     series_[c].regressors.assign(1, {});
   }
-  Gyrocompass::BlockMotion motion;
+  BlockMeanStillness motion(3, s_.motion.block);
   std::array<double, 3> y{{0.0, 0.0, 0.0}};
   int seg = -1;
   double last_time = -INFINITY;
@@ -93,17 +120,17 @@ bool GyrocompassSolver::buildStatic() {
       series_[c].push(t_end, seg, y[c], &t_end);
     }
     segments_.back().end = t_end;
-    motion.add(st.dt[k], inc, s_.motion.block);
+    motion.add(st.dt[k], inc);
     used_seconds_ += st.dt[k];
     ++samples_;
     last_time = t_end;
   }
-  worst_motion_ = motion.worst;
+  worst_motion_ = motion.worstHalfSpread();
   return true;
 }
 
 bool GyrocompassSolver::prepareIndexer() {
-  const auto& records = g_.indexer_;
+  const auto& records = w_.indexer;
   if (records.size() < 2) return refuse("input", "no indexer records in the window (addIndexer)");
   for (const IndexerRecord& r : records) {
     indexer_time_.push_back(seconds(r.stamp));
@@ -141,12 +168,8 @@ bool GyrocompassSolver::prepareIndexer() {
     rest.to = indexer_time_[e - 1];
     rest.angle = sum / static_cast<double>(e - k);
     if (rest.to > rest.from) {
-      if (high - low > x.position_tolerance) {
-        return refuse("motion",
-                      formatAlignmentMessage("the indexer's angle wandered by %.3g rad while at rest near %.2f deg "
-                                             "(position_tolerance %.3g rad)",
-                                             high - low, rest.angle * kDegrees, x.position_tolerance));
-      }
+      const std::string wandered = indexerWanderProblem(high - low, rest.angle, x.position_tolerance);
+      if (!wandered.empty()) return refuse(kMotionGate, wandered);
       rests_.push_back(rest);
     }
     k = e;
@@ -161,13 +184,10 @@ bool GyrocompassSolver::indexerAt(double t, double* angle) const {
 
 bool GyrocompassSolver::buildIndexed() {
   if (!prepareIndexer()) return false;
-  const Gyrocompass::Stream& st = g_.streams_[0];
+  const GyroStreamRecords& st = w_.streams[0];
   const std::size_t channels = st.channels;
   const IndexerSettings& x = s_.indexer;
-  std::vector<Eigen::Vector3d> direction(channels);
-  for (std::size_t c = 0; c < channels; ++c) {
-    direction[c] = s_.single_gyro ? x.gyro_axis : Eigen::Vector3d(x.body_to_platform.col(c));
-  }
+  const std::vector<Eigen::Vector3d> direction = indexedDirections(channels);
   parameters_ = 2 + channels;
   series_.assign(channels, AngleSeries());
   for (std::size_t c = 0; c < channels; ++c) {
@@ -179,8 +199,7 @@ bool GyrocompassSolver::buildIndexed() {
   std::vector<Eigen::Matrix2d> s2(channels, Eigen::Matrix2d::Zero());
   double cos_integral = 0.0, sin_integral = 0.0, weight = 0.0;
   std::array<double, 3> y{{0.0, 0.0, 0.0}};
-  Gyrocompass::BlockMotion motion;
-  motion.channels = channels;
+  BlockMeanStillness motion(channels, s_.motion.block);
   int seg = -1, current_rest = -1;
   bool continues = false;
   double last_time = -INFINITY;
@@ -207,9 +226,8 @@ bool GyrocompassSolver::buildIndexed() {
       segments_.push_back(g);
       y = {{0.0, 0.0, 0.0}};
       for (std::size_t c = 0; c < channels; ++c) {
-        const Eigen::Vector3d& d = direction[c];
-        const double point[3] = {d.x() * cos_integral - d.y() * sin_integral,
-                                 d.x() * sin_integral + d.y() * cos_integral, t_a};
+        double point[3];
+        indexedPoint(direction[c], cos_integral, sin_integral, t_a, point);
         series_[c].push(t_a, seg, 0.0, point);
       }
       motion.restart();
@@ -220,8 +238,8 @@ bool GyrocompassSolver::buildIndexed() {
     for (std::size_t c = 0; c < channels; ++c) {
       const Eigen::Vector3d& d = direction[c];
       y[c] += inc[c];
-      const double point[3] = {d.x() * cos_integral - d.y() * sin_integral, d.x() * sin_integral + d.y() * cos_integral,
-                               t_b};
+      double point[3];
+      indexedPoint(d, cos_integral, sin_integral, t_b, point);
       series_[c].push(t_b, seg, y[c], point);
       const Eigen::Vector2d u(d.x() * dc - d.y() * ds, d.x() * ds + d.y() * dc);  // integral of its turned direction
       s1[c] += u;
@@ -231,18 +249,27 @@ bool GyrocompassSolver::buildIndexed() {
     Segment& g = segments_.back();
     g.end = t_b;
     g.angle = std::isfinite(g.angle) ? g.angle : 0.5 * (psi_a + psi_b);
-    motion.add(t_b - t_a, inc, s_.motion.block);
+    motion.add(t_b - t_a, inc);
     used_seconds_ += t_b - t_a;
     ++samples_;
     last_time = t_b;
     continues = true;
   }
-  worst_motion_ = motion.worst;
+  worst_motion_ = motion.worstHalfSpread();
   if (samples_ < 10) {
     return refuse("input", x.continuous ? "no gyro samples within the indexer's records"
                                         : "no gyro samples while the indexer rested (indexer/settle, rest_rate)");
   }
   return indexedDesignResolvesHeading(s1, s2, weight);
+}
+
+std::vector<Eigen::Vector3d> GyrocompassSolver::indexedDirections(std::size_t channels) const {
+  const IndexerSettings& x = s_.indexer;
+  std::vector<Eigen::Vector3d> direction(channels);
+  for (std::size_t c = 0; c < channels; ++c) {
+    direction[c] = s_.single_gyro ? x.gyro_axis : Eigen::Vector3d(x.body_to_platform.col(c));
+  }
+  return direction;
 }
 
 bool GyrocompassSolver::indexerSpan(double t_a, double t_b, int* rest, double* psi_a, double* psi_b) const {
@@ -265,8 +292,7 @@ bool GyrocompassSolver::indexedDesignResolvesHeading(const std::vector<Eigen::Ve
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(information);
   const double small = eigen.eigenvalues()(0), large = eigen.eigenvalues()(1);
   std::string angles;
-  for (const Rest& r : rests_)
-    angles += (angles.empty() ? "" : ", ") + formatAlignmentMessage("%.1f", r.angle * kDegrees);
+  for (const Rest& r : rests_) angles += (angles.empty() ? "" : ", ") + formatNumbers("%.1f", r.angle * kDegrees);
   if (!(large > 1e-6)) {
     return refuse("design", x.continuous || rests_.size() > 1
                                 ? "the indexer's turning shows the gyros no horizontal component of the Earth's "
@@ -286,96 +312,80 @@ bool GyrocompassSolver::indexedDesignResolvesHeading(const std::vector<Eigen::Ve
 }
 
 bool GyrocompassSolver::buildSweep() {
-  const SweepSettings& sw = s_.sweep;
-  const std::size_t orders = sw.gain_orders.size(), per_axis = 2 + 2 * orders;
+  const std::size_t per_axis = 2 + 2 * s_.sweep.gain_orders.size();
   parameters_ = 3 * per_axis;
   series_.assign(3, AngleSeries());
-  std::vector<double> x(per_axis);
   for (std::size_t axis = 0; axis < 3; ++axis) {
-    const Gyrocompass::Stream& st = g_.streams_[axis];
-    const auto& records = g_.precession_[axis];
     AngleSeries& out = series_[axis];
     for (std::size_t k = 0; k < per_axis; ++k) out.columns.push_back(static_cast<int>(axis * per_axis + k));
     out.regressors.assign(per_axis, {});
-    if (records.size() < 2) {
-      return refuse("input",
-                    formatAlignmentMessage("no precession state for axis %.0f in the window (addPrecession)", axis));
+    if (w_.precession[axis].size() < 2) {
+      return refuse("input", formatNumbers("no precession state for axis %.0f in the window (addPrecession)", axis));
     }
-    std::vector<double> times, psi, change_time, change_rate;
-    commandTrack(records, &times, &psi, &change_time, &change_rate);
-    Gyrocompass::BlockMotion motion;
-    motion.channels = 1;
-    double y = 0.0, turned_up = 0.0, turned_down = 0.0, last_time = -INFINITY;
-    int seg = -1, command = -1;
-    bool continues = false;
-    for (auto& probe : sweep_probes_[axis]) probe.clear();
-    std::array<double, 4> probe_sum{{0.0, 0.0, 0.0, 0.0}};
-    std::uint64_t used = 0;
-    for (std::size_t k = 0; k < st.stamp.size(); ++k) {
-      const double t_b = seconds(st.stamp[k]), t_a = std::max(t_b - st.dt[k], last_time);
-      double psi_a, psi_b;
-      const int m =
-          static_cast<int>(std::upper_bound(change_time.begin(), change_time.end(), t_b) - change_time.begin()) - 1;
-      const bool usable = m >= 0 && t_a >= change_time[m] + sw.settle &&
-                          interpolate(times, psi, t_a, s_.indexer.max_record_gap, &psi_a) &&
-                          interpolate(times, psi, t_b, s_.indexer.max_record_gap, &psi_b);
-      if (!usable) {
-        continues = false;
-        continue;
-      }
-      auto point = [&](double t, double angle) {
-        x[0] = t;
-        x[1] = angle;
-        for (std::size_t o = 0; o < orders; ++o) {
-          x[2 + 2 * o] = std::sin(sw.gain_orders[o] * angle);
-          x[3 + 2 * o] = std::cos(sw.gain_orders[o] * angle);
-        }
-        return x.data();
-      };
-      auto pushProbes = [&]() {
-        for (std::size_t p = 0; p < 4; ++p) sweep_probes_[axis][p].push_back(probe_sum[p]);
-      };
-      if (!continues || st.broken[k] || m != command) {
-        seg = static_cast<int>(segments_.size());
-        Segment g;
-        g.channel = static_cast<int>(axis);
-        g.start = t_a;
-        g.rate = change_rate[m];
-        g.group = seg;
-        segments_.push_back(g);
-        y = 0.0;
-        out.push(t_a, seg, 0.0, point(t_a, psi_a));
-        pushProbes();
-        motion.restart();
-        command = m;
-      }
-      y += st.increment[k];
-      out.push(t_b, seg, y, point(t_b, psi_b));
-      // The residual drift harmonics' rate integrals: orders 2 and 4 of the wave angle, which the
-      // commanded angle moves (the wave's own offset only turns the pair).
-      double c2, s2, c4, s4;
-      integrateCosSin(2.0 * psi_a, 2.0 * psi_b, t_b - t_a, &c2, &s2);
-      integrateCosSin(4.0 * psi_a, 4.0 * psi_b, t_b - t_a, &c4, &s4);
-      probe_sum[0] += c2;
-      probe_sum[1] += s2;
-      probe_sum[2] += c4;
-      probe_sum[3] += s4;
-      pushProbes();
-      (psi_b > psi_a ? turned_up : turned_down) += std::abs(psi_b - psi_a);
-      segments_.back().end = t_b;
-      motion.add(t_b - t_a, &st.increment[k], s_.motion.block);
-      if (axis == 0) used_seconds_ += t_b - t_a;
-      ++used;
-      last_time = t_b;
-      continues = true;
-    }
-    worst_motion_ = std::max(worst_motion_, motion.worst);
-    if (used < 10)
-      return refuse("input", formatAlignmentMessage("axis %.0f: no outputs within its precession state", axis));
-    if (axis == 0) samples_ = used;
-    if (!sweptBothWays(axis, turned_up, turned_down)) return false;
+    if (!buildSweepAxis(axis, per_axis)) return false;
   }
   return true;
+}
+
+bool GyrocompassSolver::buildSweepAxis(std::size_t axis, std::size_t per_axis) {
+  const SweepSettings& sw = s_.sweep;
+  const GyroStreamRecords& st = w_.streams[axis];
+  AngleSeries& out = series_[axis];
+  std::vector<double> x(per_axis);
+  std::vector<double> times, psi, change_time, change_rate;
+  commandTrack(w_.precession[axis], &times, &psi, &change_time, &change_rate);
+  BlockMeanStillness motion(1, s_.motion.block);
+  double y = 0.0, turned_up = 0.0, turned_down = 0.0, last_time = -INFINITY;
+  int seg = -1, command = -1;
+  bool continues = false;
+  for (auto& probe : sweep_probes_[axis]) probe.clear();
+  std::array<double, 4> probe_sum{{0.0, 0.0, 0.0, 0.0}};
+  auto pushProbes = [&]() {
+    for (std::size_t p = 0; p < 4; ++p) sweep_probes_[axis][p].push_back(probe_sum[p]);
+  };
+  std::uint64_t used = 0;
+  for (std::size_t k = 0; k < st.stamp.size(); ++k) {
+    const double t_b = seconds(st.stamp[k]), t_a = std::max(t_b - st.dt[k], last_time);
+    double psi_a, psi_b;
+    const int m =
+        static_cast<int>(std::upper_bound(change_time.begin(), change_time.end(), t_b) - change_time.begin()) - 1;
+    const bool usable = m >= 0 && t_a >= change_time[m] + sw.settle &&
+                        interpolate(times, psi, t_a, s_.indexer.max_record_gap, &psi_a) &&
+                        interpolate(times, psi, t_b, s_.indexer.max_record_gap, &psi_b);
+    if (!usable) {
+      continues = false;
+      continue;
+    }
+    if (!continues || st.broken[k] || m != command) {
+      seg = static_cast<int>(segments_.size());
+      Segment g;
+      g.channel = static_cast<int>(axis);
+      g.start = t_a;
+      g.rate = change_rate[m];
+      g.group = seg;
+      segments_.push_back(g);
+      y = 0.0;
+      out.push(t_a, seg, 0.0, sweepPoint(t_a, psi_a, sw.gain_orders, &x));
+      pushProbes();
+      motion.restart();
+      command = m;
+    }
+    y += st.increment[k];
+    out.push(t_b, seg, y, sweepPoint(t_b, psi_b, sw.gain_orders, &x));
+    addDriftProbes(psi_a, psi_b, t_b - t_a, &probe_sum);
+    pushProbes();
+    (psi_b > psi_a ? turned_up : turned_down) += std::abs(psi_b - psi_a);
+    segments_.back().end = t_b;
+    motion.add(t_b - t_a, &st.increment[k]);
+    if (axis == 0) used_seconds_ += t_b - t_a;
+    ++used;
+    last_time = t_b;
+    continues = true;
+  }
+  worst_motion_ = std::max(worst_motion_, motion.worstHalfSpread());
+  if (used < 10) return refuse("input", formatNumbers("axis %.0f: no outputs within its precession state", axis));
+  if (axis == 0) samples_ = used;
+  return sweptBothWays(axis, turned_up, turned_down);
 }
 
 void GyrocompassSolver::commandTrack(const std::vector<PrecessionStateRecord>& records, std::vector<double>* times,
@@ -398,15 +408,14 @@ void GyrocompassSolver::commandTrack(const std::vector<PrecessionStateRecord>& r
 bool GyrocompassSolver::sweptBothWays(std::size_t axis, double turned_up, double turned_down) {
   const SweepSettings& sw = s_.sweep;
   if (std::min(turned_up, turned_down) < sw.min_turns * kTwoPi) {
-    return refuse("design", formatAlignmentMessage(
-                                "axis %.0f: the commanded angle turned %.2f turns up and %.2f down in the data "
+    return refuse("design",
+                  formatNumbers("axis %.0f: the commanded angle turned %.2f turns up and %.2f down in the data "
                                 "used; the sweep needs at least %.2f each way (sweep/min_turns)",
                                 axis, turned_up / kTwoPi, turned_down / kTwoPi, sw.min_turns));
   }
   if (std::abs(turned_up - turned_down) > 0.05 * kTwoPi) {
-    result_.notes.push_back(
-        formatAlignmentMessage("axis %.0f: %.2f turns up, %.2f down: unequal sweeps leave part of D(theta)", axis,
-                               turned_up / kTwoPi, turned_down / kTwoPi));
+    result_.notes.push_back(formatNumbers("axis %.0f: %.2f turns up, %.2f down: unequal sweeps leave part of D(theta)",
+                                          axis, turned_up / kTwoPi, turned_down / kTwoPi));
   }
   return true;
 }
@@ -426,8 +435,8 @@ bool GyrocompassSolver::level(LevelMeasurement* out) {
   Eigen::Matrix3d mounting = Eigen::Matrix3d::Zero();  // d f_frame / d (the mounting's error, accelerometer axes)
   std::size_t n = 0, pairs = 0;
   int previous_group = -2;
-  for (const AccelerometerRecord& r : g_.accelerometer_) {
-    if (r.stamp < g_.start_ || r.stamp > g_.end_) continue;
+  for (const AccelerometerRecord& r : w_.accelerometer) {
+    if (r.stamp < w_.start || r.stamp > w_.end) continue;
     const double t = seconds(r.stamp);
     if (excludedSample(t, t)) continue;
     Eigen::Matrix3d to_frame = indexed ? mount : Eigen::Matrix3d(carriedRotation(t) * mount);
@@ -469,8 +478,7 @@ bool GyrocompassSolver::level(LevelMeasurement* out) {
   transfer /= static_cast<double>(n);
   result_.accelerometer_gravity = mean.norm();
   if (std::abs(mean.norm() / kStandardGravity - 1.0) > l.max_gravity_error) {
-    return refuse("level",
-                  formatAlignmentMessage("the accelerometer's mean specific force is %.4g m/s^2, not gravity (%.5g, "
+    return refuse("level", formatNumbers("the accelerometer's mean specific force is %.4g m/s^2, not gravity (%.5g, "
                                          "level/max_gravity_error %.3g): a wrong unit, frame or a moving base",
                                          mean.norm(), kStandardGravity, l.max_gravity_error));
   }
@@ -509,11 +517,11 @@ bool GyrocompassSolver::measure(const IntegratedAngleFit& fit, const LevelMeasur
     l(0, 0) = l(1, 1) = 1.0;
     l(2, 0) = -level_rotation(2, 0) / level_rotation(2, 2);
     l(2, 1) = -level_rotation(2, 1) / level_rotation(2, 2);
-    offset.z() = kEarthRotationRate * std::sin(s_.latitude) / level_rotation(2, 2);
+    offset.z() = verticalEarthRate(s_.latitude) / level_rotation(2, 2);
   } else {
     const std::size_t per_axis = parameters_ / 3;
     for (int i = 0; i < 3; ++i) l.col(i * per_axis) = triad_matrix_.col(i);
-    offset = -g_.triad_.bias;
+    offset = -w_.triad.bias;
   }
   const Eigen::VectorXd beta = f.parameters;
   m->rate = l * beta + offset;
@@ -525,7 +533,7 @@ bool GyrocompassSolver::measure(const IntegratedAngleFit& fit, const LevelMeasur
   for (std::size_t c = 0; c < channels; ++c) per_channel.col(c) = l * f.constant_rate[c];
   if (s_.mode == AlignmentMode::kSweep) {
     // A body bias b reaches the axes as A b (A = M^-1), then the fit and M.
-    bias_transfer = per_channel * g_.triad_.bodyToAxis();
+    bias_transfer = per_channel * w_.triad.bodyToAxis();
   } else if (channels == 3) {
     bias_transfer = per_channel;  // the channels are the body axes
   }
@@ -597,23 +605,23 @@ AlignmentResult GyrocompassSolver::solve() {
   r.mode = s_.mode;
   r.single_gyro = s_.single_gyro;
   r.frame = s_.mode == AlignmentMode::kIndexed ? "indexer" : "body";
-  r.start = g_.start_;
-  r.end = g_.end_;
-  for (std::size_t i = 0; i < g_.stream_count_; ++i) r.last_sample = std::max(r.last_sample, g_.streams_[i].last);
+  r.start = w_.start;
+  r.end = w_.end;
+  r.last_sample = std::max(r.last_sample, w_.lastSample());
   r.budget.latitude = s_.latitude;
   r.budget.max_latitude = s_.max_latitude;
   r.budget.horizontal_earth_rate = horizontalEarthRate(s_.latitude);
   r.noise_sources = s_.noise_sources.summary();
-  if (!g_.refused_gate_.empty()) {
-    refuse(g_.refused_gate_, g_.refused_reason_);
+  if (!w_.refused_gate.empty()) {
+    refuse(w_.refused_gate, w_.refused_reason);
     return r;
   }
-  if (!g_.started_) {
+  if (!w_.started) {
     refuse("input", "no gyro samples");
     return r;
   }
   if (!allanRateMatches()) return r;
-  triad_matrix_ = g_.triad_.axis_to_body;
+  triad_matrix_ = w_.triad.axis_to_body;
   HeadingSolution still;
   if (!solveStill(&still)) return r;  // refused by what no estimator changes: input, design, level
   const InertialFrameResult tracked = canTrack() ? track() : InertialFrameResult();
@@ -624,16 +632,16 @@ AlignmentResult GyrocompassSolver::solve() {
 }
 
 bool GyrocompassSolver::allanRateMatches() {
-  const std::vector<double>& dt = g_.streams_[0].dt;
+  const std::vector<double>& dt = w_.streams[0].dt;
   if (s_.allan_tau0 <= 0.0 || dt.empty()) return true;
   std::vector<double> sorted = dt;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
   const double period = sorted[sorted.size() / 2];
   if (std::abs(period / s_.allan_tau0 - 1.0) <= 0.02) return true;
-  return refuse("noise", formatAlignmentMessage("the window's samples are %.6g s apart, the Allan file's (tau0) %.6g "
-                                                "s: its white angle noise Q is per sample of another rate; measure "
-                                                "it at this stream's rate (hrg_bag allan)",
-                                                period, s_.allan_tau0));
+  return refuse("noise", formatNumbers("the window's samples are %.6g s apart, the Allan file's (tau0) %.6g "
+                                       "s: its white angle noise Q is per sample of another rate; measure "
+                                       "it at this stream's rate (hrg_bag allan)",
+                                       period, s_.allan_tau0));
 }
 
 void GyrocompassSolver::describeHoldStart(const HeadingSolution& h) {
@@ -647,11 +655,11 @@ void GyrocompassSolver::describeHoldStart(const HeadingSolution& h) {
   r.body_orientation = r.orientation;
   if (s_.mode == AlignmentMode::kIndexed) {
     double psi = indexer_angle_.back();
-    indexerAt(seconds(g_.streams_[0].last), &psi);
+    indexerAt(seconds(w_.streams[0].last), &psi);
     const Eigen::Matrix3d body = r.orientation.toRotationMatrix() * rotZ(psi) *
                                  (s_.single_gyro ? Eigen::Matrix3d::Identity() : s_.indexer.body_to_platform);
     r.body_orientation = Eigen::Quaterniond(body).normalized();
-    r.notes.push_back(formatAlignmentMessage("indexed: %.0f segments; the gyros' own bias cancels", segments_.size()));
+    r.notes.push_back(formatNumbers("indexed: %.0f segments; the gyros' own bias cancels", segments_.size()));
   }
 }
 
@@ -661,10 +669,10 @@ bool GyrocompassSolver::applyStillGates(const HeadingSolution& h) {
   const double mismatch = std::abs(h.horizontal_rate - hh);
   if (mismatch > std::max(s_.max_earth_rate_error * hh, 4.0 * h.horizontal_rate_std)) {
     return refuse("earth_rate",
-                  formatAlignmentMessage("the horizontal rate measured, %.4g rad/s, is not the Earth's %.4g rad/s at "
-                                         "latitude %.3f deg (max_earth_rate_error %.2f): a bias far beyond the "
-                                         "calibration's, a wrong latitude or a turning base",
-                                         h.horizontal_rate, hh, s_.latitude * kDegrees, s_.max_earth_rate_error));
+                  formatNumbers("the horizontal rate measured, %.4g rad/s, is not the Earth's %.4g rad/s at "
+                                "latitude %.3f deg (max_earth_rate_error %.2f): a bias far beyond the "
+                                "calibration's, a wrong latitude or a turning base",
+                                h.horizontal_rate, hh, s_.latitude * kDegrees, s_.max_earth_rate_error));
   }
   return checkEarth(still_rate_, still_level_);
 }
@@ -681,9 +689,9 @@ bool GyrocompassSolver::checkEarth(const EarthRateMeasurement& m, const LevelMea
 
 bool GyrocompassSolver::gateAttitude() {
   if (std::abs(result_.attitude.pitch) <= kMaxPitch) return true;
-  return refuse("attitude", formatAlignmentMessage(
-                                "pitch %.1f deg: the frame's x axis is within %.0f deg of vertical and has no heading",
-                                result_.attitude.pitch * kDegrees, 90.0 - kMaxPitch * kDegrees));
+  return refuse("attitude",
+                formatNumbers("pitch %.1f deg: the frame's x axis is within %.0f deg of vertical and has no heading",
+                              result_.attitude.pitch * kDegrees, 90.0 - kMaxPitch * kDegrees));
 }
 
 }  // namespace core

@@ -6,6 +6,8 @@
 #include <cmath>
 
 #include "hrg_gyro/core/alignment/gyrocompass_solver.h"
+#include "hrg_gyro/core/alignment/motion_gate.h"
+#include "hrg_gyro/core/common/number_format.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -101,7 +103,7 @@ bool GyrocompassSolver::stepScanApplies(const AngleFitResult& f) {
   const double walks = arw * arw * t / 24.0 + rrw * rrw * t * t * t / 420.0;
   const double share = n * walks / (4.0 * white * white);
   if (share <= 0.1) return true;
-  result_.notes.push_back(formatAlignmentMessage(
+  result_.notes.push_back(formatNumbers(
       "the base's steps were not looked for: the noise model's random walks are %.2g times the white noise's "
       "share of a step's statistic",
       share));
@@ -142,31 +144,21 @@ bool GyrocompassSolver::fitStillBase() {
 
 std::pair<std::string, std::string> GyrocompassSolver::stillBaseProblem() const {
   const AlignmentResult& r = result_;
-  double excluded = 0.0;
-  for (const Interval& x : excluded_) excluded += x.to - x.from;
-  if (excluded > s_.motion.max_excluded * s_.duration) {
-    return {"motion", formatAlignmentMessage("the base moved for %.1f s of the %.1f s window (steps and their "
-                                             "transitions; motion/max_excluded %.2f)",
-                                             excluded, s_.duration, s_.motion.max_excluded)};
-  }
-  if (steps_exhausted_) {
-    return {"motion", formatAlignmentMessage("the base kept moving: %.0f steps carried (motion/max_steps %.0f) and "
-                                             "it does not rest between them",
-                                             static_cast<double>(steps_.size()), s_.motion.max_steps)};
-  }
-  if (worst_motion_ > s_.motion.max_motion) {
-    return {"motion", formatAlignmentMessage("the base moved within a rest: block mean rates spread over %.3g rad/s "
-                                             "(limit %.3g)",
-                                             2.0 * worst_motion_, 2.0 * s_.motion.max_motion)};
-  }
+  BaseMotionEvidence motion;
+  for (const Interval& x : excluded_) motion.excluded_seconds += x.to - x.from;
+  motion.steps_carried = steps_.size();
+  motion.steps_exhausted = steps_exhausted_;
+  motion.worst_block_spread = worst_motion_;
+  const std::string moved = baseMotionProblem(motion, s_.motion, s_.duration);
+  if (!moved.empty()) return {kMotionGate, moved};
   if (r.scatter > s_.motion.max_scatter) {
-    return {"stillness", formatAlignmentMessage("the residuals scatter %.2f times what the noise model predicts "
+    return {"stillness", formatNumbers("the residuals scatter %.2f times what the noise model predicts "
                                                 "(motion/max_scatter %.2f): a base that sways or vibrates, a bias "
                                                 "that jumps, or angle noise beyond the settings'",
                                                 r.scatter, s_.motion.max_scatter)};
   }
   if (r.low_frequency_scatter > r.low_frequency_limit) {
-    return {"stillness", formatAlignmentMessage("the residuals' %.3g s means scatter %.2f times what the noise model "
+    return {"stillness", formatNumbers("the residuals' %.3g s means scatter %.2f times what the noise model "
                                                 "predicts (a still base exceeds %.2f once in %.3g windows): a base "
                                                 "that sways slowly, or a random walk beyond the settings'",
                                                 s_.motion.block, r.low_frequency_scatter, r.low_frequency_limit,
@@ -197,7 +189,7 @@ bool GyrocompassSolver::solveStill(HeadingSolution* h) {
   measure(*fit_, still_level_, &still_rate_);
   *h = solveHeading(still_rate_, still_level_, s_.latitude);
   if (!steps_.empty()) {
-    r.notes.push_back(formatAlignmentMessage("the base took %.0f step(s), carried: %.1f s left out around them",
+    r.notes.push_back(formatNumbers("the base took %.0f step(s), carried: %.1f s left out around them",
                                              static_cast<double>(steps_.size()), r.excluded_seconds));
   }
   return true;

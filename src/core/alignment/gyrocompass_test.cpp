@@ -40,6 +40,14 @@ MountScenario noiseless() {
   return s;
 }
 
+// A scenario aligned in `mode` and refused by `gate`, its reason naming `words`.
+void expectRefused(const MountScenario& s, AlignmentMode mode, const std::string& gate, const std::string& words) {
+  const AlignmentResult r = testing::alignScenario(settingsFor(s, mode), s);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_EQ(r.gate, gate) << r.reason;
+  EXPECT_NE(r.reason.find(words), std::string::npos) << r.reason;
+}
+
 TEST(GyrocompassTest, EachModeFindsTheTrueAttitudeWithoutNoise) {
   for (double yaw : {0.3, -2.0, 3.1, kPi / 2}) {
     MountScenario s = noiseless();
@@ -101,10 +109,7 @@ TEST(GyrocompassTest, OneGyroNeedsFourPositionsOrRotation) {
   MountScenario one = noiseless();
   one.indexed = true;
   one.stops = {{0.0, 0.0, 30.0}};
-  const AlignmentResult single = testing::alignScenario(settingsFor(one, AlignmentMode::kIndexed), one);
-  EXPECT_FALSE(single.accepted);
-  EXPECT_EQ(single.gate, "design");
-  EXPECT_NE(single.reason.find("one indexer position"), std::string::npos) << single.reason;
+  expectRefused(one, AlignmentMode::kIndexed, "design", "one indexer position");
 }
 
 TEST(GyrocompassTest, UnusableInputsAreRefusedNamingTheGate) {
@@ -378,10 +383,7 @@ TEST(GyrocompassTest, ASweepThatDoesNotTurnBothWaysIsRefused) {
   s.sweep = true;
   s.sweep_turns = 1.0;
   s.sweep_directions = {1, 1};
-  const AlignmentResult r = testing::alignScenario(settingsFor(s, AlignmentMode::kSweep), s);
-  EXPECT_FALSE(r.accepted);
-  EXPECT_EQ(r.gate, "design");
-  EXPECT_NE(r.reason.find("turns up"), std::string::npos) << r.reason;
+  expectRefused(s, AlignmentMode::kSweep, "design", "turns up");
 }
 
 TEST(GyrocompassTest, StreamsOutOfOrderAreDroppedAndCounted) {

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "hrg_gyro/core/alignment/gyrocompass_solver.h"
+#include "hrg_gyro/core/common/number_format.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -25,11 +26,11 @@ double yawVariance(const EulerAngles& a, const Eigen::Matrix3d& enu) {
 
 bool GyrocompassSolver::canTrack() const {
   return s_.estimator != EstimatorChoice::kStillBase && !s_.single_gyro && s_.mode != AlignmentMode::kSweep &&
-         s_.level.source == LevelSource::kAccelerometer && g_.accelerometer_.size() >= 100;
+         s_.level.source == LevelSource::kAccelerometer && w_.accelerometer.size() >= 100;
 }
 
 InertialFrameResult GyrocompassSolver::track() {
-  const Gyrocompass::Stream& st = g_.streams_[0];
+  const GyroStreamRecords& st = w_.streams[0];
   // The unbroken stretch of samples that ends the window: the body's turn over a gap is unknown.
   std::size_t first = 0;
   for (std::size_t k = 0; k < st.stamp.size(); ++k) {
@@ -47,7 +48,7 @@ InertialFrameResult GyrocompassSolver::track() {
   InertialFrameInput in;
   in.latitude = s_.latitude;
   const Eigen::Matrix3d mount = s_.level.accelerometer_to_body.normalized().toRotationMatrix();
-  for (const AccelerometerRecord& r : g_.accelerometer_) {
+  for (const AccelerometerRecord& r : w_.accelerometer) {
     const double t = seconds(r.stamp);
     if (t <= body.start() || t > body.end()) continue;
     in.accel_time.push_back(t);
@@ -104,10 +105,10 @@ bool GyrocompassSolver::chooseAndAnswer(const HeadingSolution& still, const Iner
   }
   if (tracked.ok && std::abs(r.estimator_difference) > s_.max_estimator_sigmas) {
     return answerFromTracking(
-        tracked, formatAlignmentMessage("the still-base fit and the tracking differ by %.1f standard errors of their "
-                                        "noise (max_estimator_sigmas %.1f): the base moved in a way the gyros alone "
-                                        "cannot tell from the Earth's rate (a slow lean)",
-                                        r.estimator_difference, s_.max_estimator_sigmas));
+        tracked, formatNumbers("the still-base fit and the tracking differ by %.1f standard errors of their "
+                               "noise (max_estimator_sigmas %.1f): the base moved in a way the gyros alone "
+                               "cannot tell from the Earth's rate (a slow lean)",
+                               r.estimator_difference, s_.max_estimator_sigmas));
   }
   return answerFromStill(still, steps_.empty() ? "the base was still: the still-base fit is the most precise"
                                                : "the base was still between its steps, carried");
@@ -116,7 +117,7 @@ bool GyrocompassSolver::chooseAndAnswer(const HeadingSolution& still, const Iner
 Eigen::Matrix3d GyrocompassSolver::trackedFrameFromBody() const {
   // Indexed: the body sits on the platform turned by the indexer's angle at the window's end.
   double psi = indexer_angle_.empty() ? 0.0 : indexer_angle_.back();
-  indexerAt(seconds(g_.streams_[0].last), &psi);
+  indexerAt(seconds(w_.streams[0].last), &psi);
   return rotZ(psi) * s_.indexer.body_to_platform;  // body -> the indexer's zero frame
 }
 
@@ -154,10 +155,10 @@ bool GyrocompassSolver::answerFromTracking(const InertialFrameResult& t, const s
   r.horizontal_rate = r.horizontal_rate_std = NAN;
   // The noise is measured from these residuals: only a gross misfit shows, twice max_scatter.
   if (t.scatter > 2.0 * s_.motion.max_scatter) {
-    return refuse("stillness", formatAlignmentMessage("tracking: the velocity residuals scatter %.2f times the noise "
-                                                      "measured (limit twice motion/max_scatter, %.2f): the base "
-                                                      "travels, or the accelerometer is not on the gyros' body",
-                                                      t.scatter, 2.0 * s_.motion.max_scatter));
+    return refuse("stillness", formatNumbers("tracking: the velocity residuals scatter %.2f times the noise "
+                                             "measured (limit twice motion/max_scatter, %.2f): the base "
+                                             "travels, or the accelerometer is not on the gyros' body",
+                                             t.scatter, 2.0 * s_.motion.max_scatter));
   }
   return checkEarthTracked(t);
 }

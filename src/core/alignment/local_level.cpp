@@ -44,12 +44,6 @@ Eigen::Matrix3d rotYDerivative(double a) {
 
 }  // namespace
 
-Eigen::Vector3d earthRateEnu(double latitude) {
-  return Eigen::Vector3d(0.0, kEarthRotationRate * std::cos(latitude), kEarthRotationRate * std::sin(latitude));
-}
-
-double horizontalEarthRate(double latitude) { return kEarthRotationRate * std::cos(latitude); }
-
 Eigen::Matrix3d levelRotation(double roll, double pitch) { return rotY(pitch) * rotX(roll); }
 Eigen::Matrix3d levelRotationByRoll(double roll, double pitch) { return rotY(pitch) * rotXDerivative(roll); }
 Eigen::Matrix3d levelRotationByPitch(double roll, double pitch) { return rotYDerivative(pitch) * rotX(roll); }

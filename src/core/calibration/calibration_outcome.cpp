@@ -4,8 +4,8 @@
 
 #include <cmath>
 #include <ctime>
-#include <sstream>
 
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
@@ -58,13 +58,6 @@ std::string utcNow() {
   const std::time_t now = std::time(nullptr);
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   return buf;
-}
-
-std::string formatShort(double value, int precision) {
-  std::ostringstream s;
-  s.precision(precision);
-  s << value;
-  return s.str();
 }
 
 int maxFittedOrder(const std::vector<int>& scale_factor_orders, const std::vector<int>& drift_orders) {

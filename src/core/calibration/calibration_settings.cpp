@@ -4,8 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "hrg_gyro/core/calibration/field_command_plan.h"
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/resonator/first_order_model.h"
 
 namespace hrg_gyro {
@@ -310,6 +311,24 @@ CalibrationSettings CalibrationSettings::parse(const YamlField& root, const std:
   }
   if (root.has("thermal")) parseThermalKeys(root["thermal"], &s);
   return s;
+}
+
+double fieldSegmentDuration(const CalibrationSettings& s) {
+  const double sweep = s.field.turns * kTwoPi / s.field.rate;
+  return s.plateau.settle_time + sweep + 0.5 * s.plateau.smoothing_span + 1.0;
+}
+
+double fieldPlanDuration(const CalibrationSettings& s) {
+  return s.field.rest + static_cast<double>(s.field.directions.size()) * fieldSegmentDuration(s);
+}
+
+std::string fieldPlanLengthProblem(const CalibrationSettings& s) {
+  const double total = fieldPlanDuration(s);
+  if (total <= kMaxFieldPlanDuration) return "";
+  return "the plan lasts " + formatShort(total, 3) + " s (rest " + formatShort(s.field.rest, 3) + " s + " +
+         std::to_string(s.field.directions.size()) + " segments of " + formatShort(fieldSegmentDuration(s), 3) +
+         " s: plateau settle time + turns x 2 pi / rate + 1.5 s), more than " + formatShort(kMaxFieldPlanDuration, 6) +
+         " s (a day): fewer turns or directions, a faster rate or a shorter rest";
 }
 
 }  // namespace core

@@ -6,7 +6,9 @@
 #include <stdexcept>
 
 #include "hrg_gyro/core/calibration/outcome_from_fits.h"
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -159,9 +161,8 @@ CalibrationOutcome DualRateMethod::finish(const GyroParameters& prior) const {
          "plateau rates " + formatShort(w1) + " and " + formatShort(w2) + " rad/s");
   // The Earth rate's uncertainty: the latitude taken as known to 0.01 degree.
   const double earth = prior.earth_rate.verticalRate();
-  const double earth_std = prior.earth_rate.enabled
-                               ? kEarthRotationRate * std::abs(std::cos(prior.earth_rate.latitude)) * 0.01 * kPi / 180
-                               : 0.0;
+  const double earth_std =
+      prior.earth_rate.enabled ? std::abs(horizontalEarthRate(prior.earth_rate.latitude)) * 0.01 * kPi / 180 : 0.0;
   // One threshold for the bins of both groups: the longer of their windows' quarters.
   const IncrementFit e = regression_.solve(earth, earth_std, std::max(minBinTime(w1), minBinTime(w2)), q.max_condition);
   if (!e.ok) {

@@ -6,6 +6,7 @@
 
 #include "hrg_gyro/core/calibration/field_command_plan.h"
 #include "hrg_gyro/core/calibration/outcome_from_fits.h"
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/units.h"
 
 namespace hrg_gyro {

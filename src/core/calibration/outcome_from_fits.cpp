@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/units.h"
 
 namespace hrg_gyro {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "hrg_gyro/core/calibration/outcome_from_fits.h"
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
 

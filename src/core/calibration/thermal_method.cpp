@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "hrg_gyro/core/calibration/outcome_from_fits.h"
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/estimation/thermal_estimator.h"
 

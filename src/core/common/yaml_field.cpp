@@ -1,6 +1,5 @@
 #include "hrg_gyro/core/common/yaml_field.h"
 
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <set>
@@ -166,15 +165,6 @@ std::vector<long> YamlField::asIntegers() const {
   std::vector<long> out;
   for (std::size_t i = 0; i < node_.size(); ++i) out.push_back(at(i).asInteger());
   return out;
-}
-
-std::string formatDouble(double value) {
-  char buf[64];
-  const auto res = std::to_chars(buf, buf + sizeof(buf), value);
-  std::string s(buf, res.ptr);
-  // Keep it visibly a float for YAML readers that would otherwise type "1" as an integer.
-  if (std::isfinite(value) && s.find_first_of(".eE") == std::string::npos) s += ".0";
-  return s;
 }
 
 }  // namespace core

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/model/harmonic_model.h"
 
 namespace hrg_gyro {

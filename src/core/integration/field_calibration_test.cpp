@@ -15,6 +15,7 @@
 #include "core/testing/shipped_scenarios.h"
 #include "hrg_gyro/core/calibration/field_command_plan.h"
 #include "hrg_gyro/core/evaluation/offline_pipeline.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/resonator/first_order_model.h"
 #include "hrg_gyro/core/simulation/injected_model.h"
 
@@ -166,7 +167,7 @@ TEST(FieldCalibration, TheEarthRateAboutATiltedAxisComesFromTheSettings) {
   prior->earth_rate.latitude = site;  // the prior knows the site, not the mounting
   const EffectiveModel injected = computeEffectiveModel(c, prior->correction, s.scale_factor_orders, s.drift_orders);
   const CalibrationOutcome assumed = calibrateOnSimulation(c, prior, s).outcome;
-  s.field.axis_earth_rate = kEarthRotationRate * std::cos(site);
+  s.field.axis_earth_rate = horizontalEarthRate(site);
   const CalibrationOutcome told = calibrateOnSimulation(c, prior, s).outcome;
   ASSERT_TRUE(told.accepted) << told.reason;
   const double expected_offset =

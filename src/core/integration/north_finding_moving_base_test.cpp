@@ -19,6 +19,7 @@
 
 #include "core/testing/angle_level_mount.h"
 #include "hrg_gyro/core/alignment/gyrocompass.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 
 namespace hrg_gyro {
 namespace core {

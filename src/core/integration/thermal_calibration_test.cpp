@@ -6,6 +6,7 @@
 #include "core/testing/angle_level_session.h"
 #include "core/testing/model_errors.h"
 #include "hrg_gyro/core/calibration/thermal_method.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {

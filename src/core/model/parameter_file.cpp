@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "hrg_gyro/core/common/atomic_file.h"
+#include "hrg_gyro/core/common/number_format.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -39,8 +41,8 @@ std::vector<double> parseNodeValues(const YamlField& f, std::size_t nodes) {
   return f.asDoubles(nodes);
 }
 
-/// The model's frequency nodes and interpolation: one node (a frequency-independent model) without them.
-FrequencyInterpolator parseFrequencyNodes(const YamlField& f) {
+// The frequency nodes and their interpolation; a frequency-independent interpolator without the key.
+FrequencyInterpolator parseInterpolator(const YamlField& f) {
   if (!f.has("frequency_nodes")) {
     if (f.has("interpolation")) f["interpolation"].fail("only meaningful together with frequency_nodes");
     return FrequencyInterpolator();
@@ -63,8 +65,68 @@ FrequencyInterpolator parseFrequencyNodes(const YamlField& f) {
   return FrequencyInterpolator(nodes, kind_of_interp);
 }
 
-/// The coefficients, a column per node: mean, then cos and sin of each order.
-Eigen::MatrixXd parseCoefficients(const YamlField& f, std::size_t n, std::size_t nodes) {
+// The limits a model's coefficients at one frequency (mean, then n cos and n sin) are held to: K must
+// keep its sign and D stay plausible. `where` says at which node or between which nodes.
+void checkCoefficients(const YamlField& f, ModelKind kind, const Eigen::VectorXd& v, std::size_t n,
+                       const std::string& where) {
+  const double m0 = v(0);
+  double harmonics = 0.0;
+  for (std::size_t r = 1; r < 1 + 2 * n; ++r) harmonics += std::abs(v(r));
+  if (!std::isfinite(m0) || !std::isfinite(harmonics)) f.fail("coefficients overflow" + where);
+  if (kind == ModelKind::kScaleFactor) {
+    if (m0 == 0.0) f["mean"].fail("K0 must be non-zero" + where);
+    if (m0 > 0.0) {
+      f["mean"].fail("K0 must be negative (electrical wave angle lags the body rotation, K0 = -2k); got " +
+                     formatDouble(m0) + where);
+    }
+    if (std::abs(m0) < kMinScaleFactorMagnitude || std::abs(m0) > kMaxScaleFactorMagnitude) {
+      f["mean"].fail("|K0| must be in [" + formatDouble(kMinScaleFactorMagnitude) + ", " +
+                     formatDouble(kMaxScaleFactorMagnitude) +
+                     "] (K0 = -2k, Bryan factor k below 1; -0.56 for a "
+                     "hemisphere); got " +
+                     formatDouble(m0) + where);
+    }
+    if (harmonics >= 0.5 * std::abs(m0)) {
+      f.fail("harmonics too large: sum of |cos| + |sin| = " + formatDouble(harmonics) +
+             " must stay below |K0|/2 so that K(theta) keeps its sign" + where);
+    }
+  } else if (std::abs(m0) + harmonics > kMaxDriftMagnitude) {
+    f.fail("drift coefficients add up to " + formatDouble(std::abs(m0) + harmonics) +
+           " rad/s, above the plausible limit of " + formatDouble(kMaxDriftMagnitude) +
+           " rad/s (units are rad/s of electrical angle)" + where);
+  }
+}
+
+// The same limits hold at every node and, for a spline (which can overshoot its nodes), on a grid
+// between them: K must keep its sign and D stay plausible at every temperature.
+void checkEveryFrequency(const YamlField& f, ModelKind kind, const FrequencyInterpolator& interp,
+                         const Eigen::MatrixXd& values, std::size_t n) {
+  const std::size_t nodes = interp.size();
+  for (std::size_t j = 0; j < nodes; ++j) {
+    checkCoefficients(f, kind, values.col(j), n, nodes > 1 ? " at frequency node " + std::to_string(j) : "");
+  }
+  if (nodes < 2 || interp.kind() != Interpolation::kNaturalCubicSpline) return;
+  constexpr int kPointsPerInterval = 16;
+  const std::vector<double>& fn = interp.nodes();
+  Eigen::VectorXd w(nodes);
+  for (std::size_t j = 0; j + 1 < nodes; ++j) {
+    for (int i = 1; i < kPointsPerInterval; ++i) {
+      const double fi = fn[j] + (fn[j + 1] - fn[j]) * i / kPointsPerInterval;
+      interp.weights(fi, w.data());
+      checkCoefficients(f, kind, values * w, n,
+                        " between frequency nodes " + std::to_string(j) + " and " + std::to_string(j + 1) +
+                            " (the spline at " + formatDouble(fi) +
+                            " Hz overshoots; add nodes or use piecewise_linear)");
+    }
+  }
+}
+
+HarmonicModel parseModel(const YamlField& f, ModelKind kind) {
+  f.requireMap();
+  f.rejectUnknownKeys({"orders", "mean", "cos", "sin", "frequency_nodes", "interpolation"});
+  const std::vector<int> orders = parseOrders(f["orders"]);
+  const FrequencyInterpolator interp = parseInterpolator(f);
+  const std::size_t n = orders.size(), nodes = interp.size();
   Eigen::MatrixXd values(1 + 2 * n, nodes);
   const std::vector<double> mean = parseNodeValues(f["mean"], nodes);
   for (std::size_t j = 0; j < nodes; ++j) values(0, j) = mean[j];
@@ -81,74 +143,7 @@ Eigen::MatrixXd parseCoefficients(const YamlField& f, std::size_t n, std::size_t
       for (std::size_t j = 0; j < nodes; ++j) values(row0 + i, j) = v[j];
     }
   }
-  return values;
-}
-
-/// The limits of one set of coefficients (a node's, or the spline's between nodes): K keeps its sign and a
-/// Bryan factor's magnitude, D stays plausible. `where` says which set, for the message.
-void checkCoefficients(const YamlField& f, ModelKind kind, const Eigen::VectorXd& v, const std::string& where) {
-  const double m0 = v(0);
-  double harmonics = 0.0;
-  for (Eigen::Index r = 1; r < v.size(); ++r) harmonics += std::abs(v(r));
-  if (!std::isfinite(m0) || !std::isfinite(harmonics)) f.fail("coefficients overflow" + where);
-  if (kind != ModelKind::kScaleFactor) {
-    if (std::abs(m0) + harmonics > kMaxDriftMagnitude) {
-      f.fail("drift coefficients add up to " + formatDouble(std::abs(m0) + harmonics) +
-             " rad/s, above the plausible limit of " + formatDouble(kMaxDriftMagnitude) +
-             " rad/s (units are rad/s of electrical angle)" + where);
-    }
-    return;
-  }
-  if (m0 == 0.0) f["mean"].fail("K0 must be non-zero" + where);
-  if (m0 > 0.0) {
-    f["mean"].fail("K0 must be negative (electrical wave angle lags the body rotation, K0 = -2k); got " +
-                   formatDouble(m0) + where);
-  }
-  if (std::abs(m0) < kMinScaleFactorMagnitude || std::abs(m0) > kMaxScaleFactorMagnitude) {
-    f["mean"].fail("|K0| must be in [" + formatDouble(kMinScaleFactorMagnitude) + ", " +
-                   formatDouble(kMaxScaleFactorMagnitude) +
-                   "] (K0 = -2k, Bryan factor k below 1; -0.56 for a "
-                   "hemisphere); got " +
-                   formatDouble(m0) + where);
-  }
-  if (harmonics >= 0.5 * std::abs(m0)) {
-    f.fail("harmonics too large: sum of |cos| + |sin| = " + formatDouble(harmonics) +
-           " must stay below |K0|/2 so that K(theta) keeps its sign" + where);
-  }
-}
-
-/// The same limits hold at every node and, for a spline (which can overshoot its nodes), on a grid
-/// between them: K must keep its sign and D stay plausible at every temperature.
-void checkEveryFrequency(const YamlField& f, ModelKind kind, const FrequencyInterpolator& interp,
-                         const Eigen::MatrixXd& values) {
-  const std::size_t nodes = interp.size();
-  for (std::size_t j = 0; j < nodes; ++j) {
-    checkCoefficients(f, kind, values.col(j), nodes > 1 ? " at frequency node " + std::to_string(j) : "");
-  }
-  if (nodes < 2 || interp.kind() != Interpolation::kNaturalCubicSpline) return;
-  constexpr int kPointsPerInterval = 16;
-  const std::vector<double>& fn = interp.nodes();
-  Eigen::VectorXd w(nodes);
-  for (std::size_t j = 0; j + 1 < nodes; ++j) {
-    for (int i = 1; i < kPointsPerInterval; ++i) {
-      const double fi = fn[j] + (fn[j + 1] - fn[j]) * i / kPointsPerInterval;
-      interp.weights(fi, w.data());
-      checkCoefficients(f, kind, values * w,
-                        " between frequency nodes " + std::to_string(j) + " and " + std::to_string(j + 1) +
-                            " (the spline at " + formatDouble(fi) +
-                            " Hz overshoots; add nodes or use piecewise_linear)");
-    }
-  }
-}
-
-HarmonicModel parseModel(const YamlField& f, ModelKind kind) {
-  f.requireMap();
-  f.rejectUnknownKeys({"orders", "mean", "cos", "sin", "frequency_nodes", "interpolation"});
-  const std::vector<int> orders = parseOrders(f["orders"]);
-  const FrequencyInterpolator interp = parseFrequencyNodes(f);
-  const std::size_t n = orders.size(), nodes = interp.size();
-  const Eigen::MatrixXd values = parseCoefficients(f, n, nodes);
-  checkEveryFrequency(f, kind, interp, values);
+  checkEveryFrequency(f, kind, interp, values, n);
   if (nodes == 1) {
     std::vector<double> c(n), s(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -226,7 +221,7 @@ GyroParameters parseParameters(const YAML::Node& root) {
   er.rejectUnknownKeys({"enabled", "latitude"});
   p.earth_rate.enabled = er["enabled"].asBool();
   p.earth_rate.latitude = er["latitude"].asDouble();
-  if (std::abs(p.earth_rate.latitude) > kPi / 2) er["latitude"].fail("latitude must be in [-pi/2, pi/2] rad");
+  if (!validLatitude(p.earth_rate.latitude)) er["latitude"].fail(std::string("latitude ") + kLatitudeRule);
 
   if (doc.has("calibration")) p.calibration = parseProvenance(doc["calibration"]);
   return p;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "hrg_gyro/core/common/atomic_file.h"
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/common/yaml_file.h"
 #include "hrg_gyro/core/model/parameter_file.h"

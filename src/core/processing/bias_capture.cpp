@@ -17,6 +17,12 @@ std::string format(const char* pattern, double a, double b = 0.0, double c = 0.0
   return buffer;
 }
 
+// The settings checked before any member is built on them (the stillness test's block).
+const BiasCaptureSettings& validated(const BiasCaptureSettings& settings) {
+  settings.validate();
+  return settings;
+}
+
 }  // namespace
 
 void BiasCaptureSettings::validate() const {
@@ -31,26 +37,15 @@ void BiasCaptureSettings::validate() const {
 }
 
 BiasCapture::BiasCapture(const BiasCaptureSettings& settings, const GyroParameters& in_force)
-    : settings_(settings), in_force_(in_force), earth_rate_(in_force.earth_rate.verticalRate()) {
-  settings_.validate();
-}
+    : settings_(validated(settings)),
+      in_force_(in_force),
+      earth_rate_(in_force.earth_rate.verticalRate()),
+      stillness_(1, settings.block) {}
 
 void BiasCapture::abort(const std::string& reason) {
   if (finished_) return;
   refusal_ = reason;
   finished_ = true;
-}
-
-void BiasCapture::closeBlock() {
-  const double rate = block_dalpha_ / block_dt_;
-  if (!has_block_) {
-    min_block_rate_ = max_block_rate_ = rate;
-    has_block_ = true;
-  } else {
-    min_block_rate_ = std::min(min_block_rate_, rate);
-    max_block_rate_ = std::max(max_block_rate_, rate);
-  }
-  block_dt_ = block_dalpha_ = 0.0;
 }
 
 bool BiasCapture::add(const AngleIncrement& increment, std::uint8_t flags) {
@@ -76,17 +71,15 @@ bool BiasCapture::add(const AngleIncrement& increment, std::uint8_t flags) {
     frequency_dt_ += dt;
   }
   ++samples_;
-  block_dt_ += dt;
-  block_dalpha_ += increment.dalpha;
-  if (block_dt_ >= settings_.block) closeBlock();
+  stillness_.add(dt, &increment.dalpha);
   // Motion is judged as it happens, so a capture during motion ends without waiting.
-  if (has_block_ && max_block_rate_ - min_block_rate_ > 2.0 * settings_.max_motion) {
+  if (stillness_.moved(settings_.max_motion)) {
     abort(format("the gyro moved during the capture: block mean rates spread over %.3g rad/s (limit %.3g)",
-                 max_block_rate_ - min_block_rate_, 2.0 * settings_.max_motion));
+                 2.0 * stillness_.worstHalfSpread(), 2.0 * settings_.max_motion));
     return true;
   }
   if (sum_dt_ >= settings_.duration) {
-    if (block_dt_ > 0.5 * settings_.block) closeBlock();
+    stillness_.closePartialBlock(0.5);
     finished_ = true;
   }
   return finished_;
@@ -100,8 +93,8 @@ BiasCaptureResult BiasCapture::result() const {
   r.mean_rate = sum_dt_ > 0.0 ? sum_dalpha_ / sum_dt_ : 0.0;
   const double frequency = frequency_dt_ > 0.0 ? sum_frequency_dt_ / frequency_dt_ : NAN;
   r.previous_d0 = in_force_.drift.meanAt(frequency);
-  if (has_block_) {
-    r.worst_motion = std::max(max_block_rate_ - r.mean_rate, r.mean_rate - min_block_rate_);
+  if (stillness_.hasBlock()) {
+    r.worst_motion = std::max(stillness_.highestMean(0) - r.mean_rate, r.mean_rate - stillness_.lowestMean(0));
   }
   if (!finished_) {
     r.reason = "the capture has not ended";

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 
 namespace hrg_gyro {

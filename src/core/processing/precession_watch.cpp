@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 
 namespace hrg_gyro {

@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "hrg_gyro/core/calibration/calibration_outcome.h"
+#include "hrg_gyro/core/common/number_format.h"
 
 namespace hrg_gyro {
 namespace core {

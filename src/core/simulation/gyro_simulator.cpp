@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/simulation/intrinsic_model.h"
 
 namespace hrg_gyro {

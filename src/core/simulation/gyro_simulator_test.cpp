@@ -9,6 +9,7 @@
 #include "core/testing/refusal.h"
 #include "core/testing/simulator_pairs.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/processing/gyro_processor.h"
 #include "hrg_gyro/core/resonator/first_order_model.h"
 #include "hrg_gyro/core/simulation/injected_model.h"

@@ -2,7 +2,9 @@
 
 #include <cmath>
 
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/yaml_file.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 
 namespace hrg_gyro {
@@ -219,7 +221,7 @@ SimulationConfig SimulationConfig::parse(const YamlField& root, const std::vecto
     const YamlField t = root["turntable"];
     t.rejectUnknownKeys({"latitude", "acceleration", "profile", "ripple", "log"});
     c.latitude = t.getDouble("latitude", 0.0);
-    if (std::abs(c.latitude) > kPi / 2) t["latitude"].fail("must be in [-pi/2, pi/2] rad");
+    if (!validLatitude(c.latitude)) t["latitude"].fail(kLatitudeRule);
     c.acceleration = t.getDouble("acceleration", c.acceleration);
     if (!(c.acceleration > 0.0)) t["acceleration"].fail("must be positive (rad/s^2)");
     if (t.has("profile")) c.profile = TurntableProfile::parse(t["profile"], c.acceleration);

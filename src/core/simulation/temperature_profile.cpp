@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hrg_gyro/core/common/number_format.h"
+
 namespace hrg_gyro {
 namespace core {
 namespace {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -13,8 +14,7 @@ TriadMotion::TriadMotion(const TriadSimulationConfig& config)
       wobble_(config.turntable.wobble.platterToTable()),
       table_zero_to_enu_(config.turntable.tableZeroToEnu()),
       earth_zero_(config.turntable.earthRateInTableZero()),
-      earth_enu_(0.0, kEarthRotationRate * std::cos(config.turntable.latitude),
-                 verticalEarthRate(config.turntable.latitude)),
+      earth_enu_(earthRateEnu(config.turntable.latitude)),
       base_(config.base_motion, config.seed) {
   Eigen::Matrix3d previous =
       config.positions.empty() ? Eigen::Matrix3d::Identity() : config.positions[0].bodyToPlatter();

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 
 namespace hrg_gyro {
 namespace core {

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <set>
 
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/simulation/gaussian_noise.h"
 
 namespace hrg_gyro {
@@ -81,7 +83,7 @@ TriadTurntableConfig parseTurntable(const YamlField& t) {
   t.rejectUnknownKeys({"latitude", "azimuth", "acceleration", "ripple", "log", "wobble"});
   TriadTurntableConfig c;
   c.latitude = t.getDouble("latitude", 0.0);
-  if (!(std::abs(c.latitude) <= kPi / 2)) t["latitude"].fail("must be in [-pi/2, pi/2] rad");
+  if (!validLatitude(c.latitude)) t["latitude"].fail(kLatitudeRule);
   c.azimuth = finite(t, "azimuth", 0.0, "rad from North towards East");
   c.acceleration = t.getDouble("acceleration", c.acceleration);
   if (!(c.acceleration > 0.0)) t["acceleration"].fail("must be positive (rad/s^2)");
@@ -263,7 +265,7 @@ Eigen::Matrix3d TableWobbleConfig::platterToTable() const {
 }
 
 Eigen::Vector3d TriadTurntableConfig::earthRateInTableZero() const {
-  const double horizontal = kEarthRotationRate * std::cos(latitude);
+  const double horizontal = horizontalEarthRate(latitude);
   return Eigen::Vector3d(horizontal * std::cos(azimuth), horizontal * std::sin(azimuth), verticalEarthRate(latitude));
 }
 

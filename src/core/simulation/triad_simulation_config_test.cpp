@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/model/triad_file.h"
 
 namespace hrg_gyro {

@@ -15,7 +15,9 @@
 
 #include "core/testing/bit_fingerprint.h"
 #include "core/testing/shipped_scenarios.h"
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/signal/wave_estimator.h"
 
 namespace hrg_gyro {

@@ -5,6 +5,8 @@
 #include <limits>
 #include <numeric>
 
+#include "hrg_gyro/core/common/number_format.h"
+
 namespace hrg_gyro {
 namespace core {
 

@@ -15,6 +15,7 @@
 #include <functional>
 
 #include "hrg_gyro/core/calibration/calibration_session.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/model/model_pair_evaluator.h"
 #include "hrg_gyro/core/simulation/gaussian_noise.h"
 #include "hrg_gyro/core/simulation/turntable_profile.h"

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "hrg_gyro/core/calibration/triad/triad_calibration.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/model/model_pair_evaluator.h"
 #include "hrg_gyro/core/simulation/gaussian_noise.h"
 #include "hrg_gyro/core/simulation/turntable_profile.h"
@@ -92,9 +93,8 @@ inline Eigen::Matrix3d axisAlongTable(int axis, int sign) {
 
 inline Eigen::Vector3d earthInPlatterFrame(double latitude, double azimuth, double table_angle) {
   const double heading = azimuth - table_angle;
-  const double horizontal = kEarthRotationRate * std::cos(latitude);
-  return Eigen::Vector3d(horizontal * std::cos(heading), horizontal * std::sin(heading),
-                         kEarthRotationRate * std::sin(latitude));
+  const double horizontal = horizontalEarthRate(latitude);
+  return Eigen::Vector3d(horizontal * std::cos(heading), horizontal * std::sin(heading), verticalEarthRate(latitude));
 }
 
 struct TriadSinks {

@@ -21,6 +21,7 @@
 #include "hrg_gyro/PrecessionState.h"
 #include "hrg_gyro/TriadOutput.h"
 #include "hrg_gyro/TurntableState.h"
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/model/triad_file.h"
 #include "hrg_gyro/ros/conversions.h"

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "hrg_gyro/core/common/units.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 
 namespace hrg_gyro {
 namespace csv {

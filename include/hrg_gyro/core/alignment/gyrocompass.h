@@ -17,7 +17,7 @@
 //   motion      the base moved beyond what the still-base fit carries (too many steps, too much of the
 //               window in transitions, block mean rates spread beyond 2 max_motion within a rest) and
 //               no tracking estimator could answer, or the wave was turned on command outside the
-//               sweep mode;
+//               sweep mode (motion_gate.h);
 //   stillness   the residuals scatter beyond max_scatter times the noise model's prediction, per
 //               point or per block mean (a sway), and no tracking estimator could answer;
 //   level       no gravity reference, or |f| not g;
@@ -56,6 +56,7 @@
 
 #include "hrg_gyro/core/alignment/alignment_result.h"
 #include "hrg_gyro/core/alignment/alignment_settings.h"
+#include "hrg_gyro/core/alignment/gyrocompass_records.h"
 #include "hrg_gyro/core/common/stamp_timeline.h"
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/triad_parameters.h"
@@ -64,20 +65,6 @@
 
 namespace hrg_gyro {
 namespace core {
-
-/// The indexer's (or rate table's) state, as TurntableState carries it.
-struct IndexerRecord {
-  Nanoseconds stamp = 0;
-  double angle = 0.0;  ///< rad, counter-clockwise seen from above (about the platform's z)
-  double rate = NAN;   ///< rad/s; NaN: taken from the angles
-};
-
-/// One accelerometer sample: the specific force in the accelerometer's frame (sensor_msgs/Imu
-/// linear_acceleration, REP-145: +g up at rest), m/s^2.
-struct AccelerometerRecord {
-  Nanoseconds stamp = 0;
-  Eigen::Vector3d specific_force = Eigen::Vector3d::Zero();
-};
 
 struct AlignmentProgress {
   double seconds = 0.0;   ///< of gyro stamps in the window so far
@@ -118,38 +105,21 @@ class Gyrocompass {
 
   const AlignmentSettings& settings() const { return settings_; }
   /// The window's start and end, gyro stamps (0 before the first sample).
-  Nanoseconds windowStart() const { return start_; }
-  Nanoseconds windowEnd() const { return end_; }
+  Nanoseconds windowStart() const { return records_.start; }
+  Nanoseconds windowEnd() const { return records_.end; }
 
  private:
-  // One gyro stream: a triad's three body axes, one gyro, or one axis of a sweep.
-  struct Stream {
-    std::size_t channels = 3;
-    std::vector<Nanoseconds> stamp;
-    std::vector<double> dt;
-    std::vector<double> increment;     // `channels` per sample
-    std::vector<std::uint8_t> broken;  // 1: the sample does not continue the previous one
-    Nanoseconds last = 0;
+  // What the intake keeps of one gyro stream beside its records: a break pending, full, its stamp rule.
+  struct StreamIntake {
     bool pending_break = false;
     bool full = false;
     StampTimeline timeline{gyrocompassStampRule()};
-    void clear();
   };
   static StampRule gyrocompassStampRule();
-  // Running block means of one stream within a segment (the stillness judged as data come).
-  struct BlockMotion {
-    std::size_t channels = 3;
-    double block_dt = 0.0;
-    std::array<double, 3> block_sum{{0.0, 0.0, 0.0}}, low{{0.0, 0.0, 0.0}}, high{{0.0, 0.0, 0.0}};
-    bool has_block = false;
-    double worst = 0.0;  // largest half-spread of block rates so far, rad/s
-    void restart();
-    void add(double dt, const double* increment, double block);
-  };
 
-  bool admit(Stream* stream, Nanoseconds stamp, double dt, const double* increment, std::size_t channels, bool gap,
+  bool admit(std::size_t stream, Nanoseconds stamp, double dt, const double* increment, std::size_t channels, bool gap,
              bool precessing);
-  bool timed(Stream* stream, Nanoseconds stamp, double dt);
+  bool timed(std::size_t stream, Nanoseconds stamp, double dt);
   void restartWindow();
   void startWindow(Nanoseconds stamp, double dt);
   // The one stamp rule for a record stream (accelerometer, indexer, precession): false to drop it;
@@ -161,22 +131,13 @@ class Gyrocompass {
   void resolveNoise();
 
   AlignmentSettings settings_;
-  TriadParameters triad_;
-  std::array<Stream, 3> streams_;  // [0]: triad or single gyro; sweep: one per axis
-  std::size_t stream_count_ = 1;
-  Nanoseconds start_ = 0, end_ = 0;
-  bool started_ = false;
-  std::vector<IndexerRecord> indexer_;
-  std::vector<AccelerometerRecord> accelerometer_;
-  std::array<std::vector<PrecessionStateRecord>, 3> precession_;
+  GyrocompassRecords records_;  // what finish() hands the solver
+  std::array<StreamIntake, 3> intake_;
   StampTimeline indexer_time_{gyrocompassStampRule()}, accelerometer_time_{gyrocompassStampRule()};
   std::array<StampTimeline, 3> precession_time_{{StampTimeline(gyrocompassStampRule()),
                                                  StampTimeline(gyrocompassStampRule()),
                                                  StampTimeline(gyrocompassStampRule())}};
-  std::string refused_gate_, refused_reason_;
   std::uint64_t gaps_ = 0, dropped_ = 0, restarts_ = 0;
-
-  friend class GyrocompassSolver;
 };
 
 }  // namespace core

@@ -1,5 +1,5 @@
-// The solution of a gyrocompass window: the records Gyrocompass holds turned into integrated-angle
-// series by mode (static: the triad's three body axes; indexed: the channels' directions turned by the
+// The solution of a gyrocompass window: the records Gyrocompass holds (gyrocompass_records.h) turned into
+// integrated-angle series by mode (static: the triad's three body axes; indexed: the channels' directions turned by the
 // indexer, its rests or its continuous angle; sweep: each axis against its commanded angle and that
 // angle's harmonics), the level from the gravity reference, one IntegratedAngleFit, the Earth's rate
 // with every term of its covariance, the heading (earth_rate_heading) and the gates. Gyrocompass::finish
@@ -27,21 +27,21 @@
 #include <utility>
 #include <vector>
 
+#include "hrg_gyro/core/alignment/alignment_result.h"
+#include "hrg_gyro/core/alignment/alignment_settings.h"
 #include "hrg_gyro/core/alignment/base_motion_scan.h"
 #include "hrg_gyro/core/alignment/earth_rate_heading.h"
-#include "hrg_gyro/core/alignment/gyrocompass.h"
+#include "hrg_gyro/core/alignment/gyrocompass_records.h"
 #include "hrg_gyro/core/alignment/inertial_frame_alignment.h"
 #include "hrg_gyro/core/alignment/integrated_angle_fit.h"
 
 namespace hrg_gyro {
 namespace core {
 
-/// printf-style message with up to four numbers (the refusals' wording).
-std::string formatAlignmentMessage(const char* pattern, double a = 0.0, double b = 0.0, double c = 0.0, double d = 0.0);
-
 class GyrocompassSolver {
  public:
-  explicit GyrocompassSolver(const Gyrocompass& g) : g_(g), s_(g.settings_) {}
+  /// `settings` as the gyrocompass resolved them (its noise model complete); `records` its window's.
+  GyrocompassSolver(const AlignmentSettings& settings, const GyrocompassRecords& records) : w_(records), s_(settings) {}
   AlignmentResult solve();
 
  private:
@@ -56,7 +56,7 @@ class GyrocompassSolver {
     result_.reason = reason;
     return false;
   }
-  double seconds(Nanoseconds stamp) const { return toSeconds(stamp - g_.start_); }
+  double seconds(Nanoseconds stamp) const { return w_.seconds(stamp); }
   // The still-base fit: the series by mode, fitted, cut at the base's steps until none is left.
   void resetSeries();
   bool buildSeries();
@@ -80,6 +80,8 @@ class GyrocompassSolver {
   bool buildStatic();
   bool buildIndexed();
   bool buildSweep();
+  bool buildSweepAxis(std::size_t axis, std::size_t per_axis);  // one axis's series, against its commanded angle
+  std::vector<Eigen::Vector3d> indexedDirections(std::size_t channels) const;  // the channels' in the platform
   bool prepareIndexer();
   bool indexerAt(double t, double* angle) const;
   // The indexer's angle at both ends of a sample (its rest's, or interpolated); false: not usable.
@@ -99,7 +101,7 @@ class GyrocompassSolver {
   bool measure(const IntegratedAngleFit& fit, const LevelMeasurement& level, EarthRateMeasurement* m);
   void summariseSegments(const AngleFitResult& fit);
 
-  const Gyrocompass& g_;
+  const GyrocompassRecords& w_;  // the window's records
   const AlignmentSettings& s_;
   AlignmentResult result_;
   std::unique_ptr<IntegratedAngleFit> fit_;

@@ -30,6 +30,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "hrg_gyro/core/model/earth_rate.h"  // the Earth's rate in ENU and its parts
+
 namespace hrg_gyro {
 namespace core {
 
@@ -39,11 +41,6 @@ constexpr double kStandardGravity = 9.80665;
 struct EulerAngles {
   double roll = 0.0, pitch = 0.0, yaw = 0.0;  ///< rad, C = Rz(yaw) Ry(pitch) Rx(roll)
 };
-
-/// The Earth's rotation rate in ENU at `latitude` (rad), rad/s.
-Eigen::Vector3d earthRateEnu(double latitude);
-/// Omega cos(lat): the horizontal Earth rate north-finding measures, rad/s.
-double horizontalEarthRate(double latitude);
 
 /// Ry(pitch) Rx(roll): body -> levelled frame.
 Eigen::Matrix3d levelRotation(double roll, double pitch);

@@ -125,8 +125,6 @@ struct CalibrationOutcome {
 
 /// ISO 8601 UTC time of now, for CalibrationProvenance::time.
 std::string utcNow();
-/// A number with `precision` significant digits, for gate messages.
-std::string formatShort(double value, int precision = 4);
 /// Highest harmonic order fitted for K or D (2 if none): what the window smoothing is sized for.
 int maxFittedOrder(const std::vector<int>& scale_factor_orders, const std::vector<int>& drift_orders);
 

@@ -98,7 +98,7 @@ struct FieldSettings {
   double max_drift_std = 1e-7;   ///< gate: rad/s, the largest standard error of a D term
 
   /// Bounds of the plan's keys (each refused by name beyond them); the whole plan is bounded by
-  /// kMaxFieldPlanDuration (field_command_plan.h).
+  /// kMaxFieldPlanDuration (below).
   static constexpr double kMinRate = 0.01;  ///< rad/s (the largest: kMaxPrecessionRate, control_loops.h)
   static constexpr double kMaxTurns = 100.0;
   static constexpr double kMaxRest = 600.0;  ///< s
@@ -138,6 +138,15 @@ struct CalibrationSettings {
   /// Former names of keys that parse() still reads (backward_persist), not in keyPaths().
   static std::vector<std::string> formerKeyPaths();
 };
+
+/// The longest field plan, s: a day of a still vehicle.
+constexpr double kMaxFieldPlanDuration = 86400.0;
+/// s of one segment of the field plan at the settings' rate (field_command_plan.h: the plan).
+double fieldSegmentDuration(const CalibrationSettings& settings);
+/// s from the plan's start to its last command (rest + one segment per direction); may be infinite.
+double fieldPlanDuration(const CalibrationSettings& settings);
+/// "the plan lasts ...: ..." when it is longer than kMaxFieldPlanDuration (or not finite), else "".
+std::string fieldPlanLengthProblem(const CalibrationSettings& settings);
 
 }  // namespace core
 }  // namespace hrg_gyro

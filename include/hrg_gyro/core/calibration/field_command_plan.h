@@ -31,9 +31,6 @@
 namespace hrg_gyro {
 namespace core {
 
-/// The longest plan, s: a day of a still vehicle.
-constexpr double kMaxFieldPlanDuration = 86400.0;
-
 struct PlannedPrecession {
   double time = 0.0;  ///< s from the start of the plan
   double rate = 0.0;  ///< rad/s, electrical, commanded from `time` on
@@ -42,12 +39,8 @@ struct PlannedPrecession {
 /// The commands in order; the last one (rate 0) ends the virtual rotation. Throws
 /// std::invalid_argument when the plan would last longer than kMaxFieldPlanDuration (or for ever).
 std::vector<PlannedPrecession> fieldCommandPlan(const CalibrationSettings& settings);
-/// s of one segment at the settings' rate.
-double fieldSegmentDuration(const CalibrationSettings& settings);
-/// s from the plan's start to its last command (rest + one segment per direction); may be infinite.
-double fieldPlanDuration(const CalibrationSettings& settings);
-/// "the plan lasts ...: ..." when it is longer than kMaxFieldPlanDuration (or not finite), else "".
-std::string fieldPlanLengthProblem(const CalibrationSettings& settings);
+// The plan's length (fieldSegmentDuration, fieldPlanDuration, fieldPlanLengthProblem) is part of
+// its settings: calibration_settings.h, which checks it when the settings are read.
 
 /// The largest drift (rad/s, the peak over theta) the loops' lag adds to a wave precessed at `rate`
 /// for the gyro of field.resonator; NaN when that is unknown.

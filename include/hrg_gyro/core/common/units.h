@@ -13,17 +13,11 @@ namespace core {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kTwoPi = 2.0 * kPi;
-/// Sidereal rotation rate of the Earth, rad/s (WGS-84).
-constexpr double kEarthRotationRate = 7.2921150e-5;
 
 using Nanoseconds = std::int64_t;
 
 constexpr double toSeconds(Nanoseconds ns) { return static_cast<double>(ns) * 1e-9; }
 inline Nanoseconds toNanoseconds(double seconds) { return static_cast<Nanoseconds>(std::llround(seconds * 1e9)); }
-
-/// Vertical component of the Earth rate (rad/s) at a geodetic latitude (rad): what a gyro with its
-/// axis along the local up direction (REP-103 z up) sees at rest.
-inline double verticalEarthRate(double latitude) { return kEarthRotationRate * std::sin(latitude); }
 
 /// std::round (halves away from zero, sign of zero kept) without the library call: the per-sample
 /// path rounds angle ratios several times. Exact: x - trunc(x) has no rounding error; beyond 2^52

@@ -80,8 +80,5 @@ class YamlField {
   std::string path_;
 };
 
-/// Shortest decimal text that reads back to exactly the same double (round-trip exact files).
-std::string formatDouble(double value);
-
 }  // namespace core
 }  // namespace hrg_gyro

@@ -8,6 +8,7 @@
 #include "hrg_gyro/core/common/units.h"
 #include "hrg_gyro/core/model/calibration_method_kind.h"
 #include "hrg_gyro/core/model/correction_matrix.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 #include "hrg_gyro/core/model/harmonic_model.h"
 
 namespace hrg_gyro {

@@ -9,7 +9,7 @@
 // angles the wave visited are accounted for, and any frequency dependence of K and D too). For a
 // frequency-dependent model every node's mean moves by the same amount.
 //
-// Stillness is judged on the compensated rate, in blocks of `block` seconds: the capture is
+// Stillness is judged on the compensated rate, in blocks of `block` seconds (block_mean_stillness.h): the capture is
 // refused when a block's mean rate leaves the capture's mean by more than `max_motion`, when the
 // mean itself is further than `max_bias` from the Earth rate (a turntable at constant rate), when
 // the input has a gap or a reset, when the precession loop turns the wave (an output flagged
@@ -20,6 +20,7 @@
 #include <string>
 
 #include "hrg_gyro/core/model/gyro_parameters.h"
+#include "hrg_gyro/core/processing/block_mean_stillness.h"
 #include "hrg_gyro/core/processing/compensator.h"
 
 namespace hrg_gyro {
@@ -62,8 +63,6 @@ class BiasCapture {
   BiasCaptureResult result() const;
 
  private:
-  void closeBlock();
-
   BiasCaptureSettings settings_;
   GyroParameters in_force_;
   double earth_rate_;
@@ -73,10 +72,7 @@ class BiasCapture {
   double sum_dt_ = 0.0, sum_dtheta_ = 0.0, sum_k_dt_ = 0.0, sum_harmonic_d_dt_ = 0.0, sum_dalpha_ = 0.0;
   double sum_frequency_dt_ = 0.0, frequency_dt_ = 0.0;
   std::uint64_t samples_ = 0;
-  // Block means of the compensated rate, kept as running min and max.
-  double block_dt_ = 0.0, block_dalpha_ = 0.0;
-  double min_block_rate_ = 0.0, max_block_rate_ = 0.0;
-  bool has_block_ = false;
+  BlockMeanStillness stillness_;  // block means of the compensated rate
 };
 
 /// The parameter file's `calibration.notes` after a bias capture at `when` (UTC text): the capture's

@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+#include "hrg_gyro/core/common/number_format.h"
+#include "hrg_gyro/core/model/earth_rate.h"
+
 namespace hrg_gyro {
 namespace core {
 namespace {
@@ -48,9 +51,8 @@ double driftStdAt(const CalibrationOutcome& axis, double theta) {
 
 Eigen::Vector3d earthInPlatter(double latitude, double azimuth, double table_angle) {
   const double heading = azimuth - table_angle;
-  const double horizontal = kEarthRotationRate * std::cos(latitude);
-  return Eigen::Vector3d(horizontal * std::cos(heading), horizontal * std::sin(heading),
-                         kEarthRotationRate * std::sin(latitude));
+  const double horizontal = horizontalEarthRate(latitude);
+  return Eigen::Vector3d(horizontal * std::cos(heading), horizontal * std::sin(heading), verticalEarthRate(latitude));
 }
 
 void measureRests(const TriadLockedPosition& position, double latitude, const TriadCalibrationSettings& settings,

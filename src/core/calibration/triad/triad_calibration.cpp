@@ -9,6 +9,7 @@
 
 #include "hrg_gyro/core/calibration/triad/triad_axis_directions.h"
 #include "hrg_gyro/core/calibration/triad/triad_body_bias.h"
+#include "hrg_gyro/core/model/earth_rate.h"
 
 namespace hrg_gyro {
 namespace core {
@@ -269,7 +270,7 @@ std::array<GyroParameters, 3> TriadCalibration::fitAxes(TriadOutcome* o) const {
 
 void TriadCalibration::measureTilts(TriadOutcome* o) const {
   const EarthRateSettings& earth = priors_[0].earth_rate;
-  const double horizontal = kEarthRotationRate * std::cos(earth.latitude);
+  const double horizontal = horizontalEarthRate(earth.latitude);
   for (int i = 0; i < 3; ++i) {
     const CalibrationOutcome& axis = o->axes[i];
     if (unslotted_[i] > 0) {

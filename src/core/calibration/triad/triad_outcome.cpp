@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "hrg_gyro/core/common/number_format.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/core/model/triad_file.h"
 
