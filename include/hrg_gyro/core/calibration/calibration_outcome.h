@@ -10,7 +10,7 @@
 #include "hrg_gyro/core/estimation/binned_rate_fit.h"
 #include "hrg_gyro/core/estimation/defect_diagnosis.h"
 #include "hrg_gyro/core/estimation/harmonic_fit.h"
-#include "hrg_gyro/core/estimation/increment_regression.h"
+#include "hrg_gyro/core/estimation/increment_fit.h"
 #include "hrg_gyro/core/estimation/table_clock_offset.h"
 #include "hrg_gyro/core/estimation/table_stamp_regulariser.h"
 #include "hrg_gyro/core/model/correction_matrix.h"
