@@ -12,6 +12,7 @@
 #include "hrg_gyro/core/common/atomic_file.h"
 #include "hrg_gyro/core/common/output_directory.h"
 #include "hrg_gyro/core/model/parameter_file.h"
+#include "hrg_gyro/ros/calibrator_node_keys.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "hrg_gyro/ros/output_directory_check.h"
 #include "hrg_gyro/ros/param_tree.h"
@@ -20,15 +21,6 @@ namespace hrg_gyro {
 namespace {
 
 using diagnostic_msgs::DiagnosticStatus;
-
-const std::vector<std::string>& nodeOnlyKeys() {
-  static const std::vector<std::string> keys = {
-      "parameter_file", "report_file", "output_directory", "reload_service", "write", "autostart", "stages",
-      "queue_size", "diagnostic_period", "heap_trim_period",
-      // read by the triad mode only (TriadCalibratorRos), accepted in the shared template
-      "triad_file", "axis_parameter_files", "reload_services", "stream_hold", "triad"};
-  return keys;
-}
 
 }  // namespace
 
@@ -64,7 +56,8 @@ CalibratorRos::CalibratorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
 }
 
 void CalibratorRos::readSettings() {
-  base_settings_ = core::CalibrationSettings::parse(core::YamlField(privateParameters(pnh_), ""), nodeOnlyKeys());
+  base_settings_ =
+      core::CalibrationSettings::parse(core::YamlField(privateParameters(pnh_), ""), calibratorNodeOnlyKeys());
   params_.claim(core::CalibrationSettings::keyPaths());
   params_.claim(core::CalibrationSettings::formerKeyPaths(), true);  // read when set, never a default
   // The triad mode's keys (TriadCalibratorRos reads them): shared template, not used by one axis.

@@ -364,48 +364,17 @@ void DriverSimRos::play(Simulator& sim, Sample* sample, const Publish& publish) 
   // behind the clock for good). While the clock stands still (its source not started yet, or done)
   // the driver goes on at its own ~time_scale, and waits again once the clock runs behind it.
   const bool follow_clock = use_sim_time_ && clock_pub_.getTopic().empty() && time_scale_ > 0.0;
-  ros::Time clock_seen = ros::Time::now();
-  ros::WallTime clock_moved = ros::WallTime::now();
+  ClockWatch clock{ros::Time::now(), ros::WallTime::now()};
   std::uint64_t on_clock = 0;
   for (;;) {
     if (stop_ || !ros::ok()) break;
     takeCommand(sim);
     if (!sim.next(&s)) break;
     const ros::Time stamp = toRosTime(origin + s.stamp);
-    bool reached = false;
-    while (follow_clock && !stop_ && ros::ok()) {
-      const ros::Time now = ros::Time::now();
-      const ros::WallTime wall = ros::WallTime::now();
-      if (now != clock_seen) {
-        clock_seen = now;
-        clock_moved = wall;
-      }
-      if (now >= stamp) {
-        reached = true;
-        // This sample is due now: if the clock stops, the own schedule goes on from here.
-        schedule.start(wall.toSec() - sim.elapsed() / time_scale_);
-        break;
-      }
-      if ((wall - clock_moved).toSec() > kStillClock) break;
-      ros::WallDuration(0.0005).sleep();
-    }
+    const bool reached = follow_clock && waitForClock(stamp, sim.elapsed(), &clock);
     if (stop_ || !ros::ok()) break;
     on_clock += reached ? 1 : 0;
-    double late = 0.0;
-    const double wait = reached ? 0.0 : schedule.waitFor(sim.elapsed(), ros::WallTime::now().toSec(), &late);
-    if (wait > 0.0) {
-      ros::WallDuration(wait).sleep();
-    } else if (late > 0.1 && !use_sim_time_) {
-      // The stamps still say when each sample was due (as a hardware clock would), so consumers
-      // see the delay; this says where it came from.
-      ROS_WARN_THROTTLE(10.0, "driver_sim: %.3f s behind schedule (this thread was not run in time); catching up",
-                        late);
-    } else if (late > max_lag_ && use_sim_time_) {
-      ROS_INFO_THROTTLE(30.0,
-                        "driver_sim: %.3f s behind schedule: the simulated clock runs slower than "
-                        "~time_scale (%.1f s let go so far)",
-                        late, schedule.slid());
-    }
+    if (!reached) keepSchedule(sim.elapsed());
     if (pace_sub_ && !waitForConsumer(origin + s.stamp)) break;
     if (!clock_pub_.getTopic().empty() && sim.elapsed() >= next_clock) {
       rosgraph_msgs::Clock c;
@@ -419,7 +388,49 @@ void DriverSimRos::play(Simulator& sim, Sample* sample, const Publish& publish) 
     ++seq;
   }
   if (stop_ || !ros::ok()) return;
-  const double wall = (ros::WallTime::now() - wall_start).toSec();
+  reportComplete(seq, sim.elapsed(), (ros::WallTime::now() - wall_start).toSec(), follow_clock, on_clock);
+}
+
+bool DriverSimRos::waitForClock(const ros::Time& stamp, double elapsed, ClockWatch* clock) {
+  while (!stop_ && ros::ok()) {
+    const ros::Time now = ros::Time::now();
+    const ros::WallTime wall = ros::WallTime::now();
+    if (now != clock->seen) {
+      clock->seen = now;
+      clock->moved = wall;
+    }
+    if (now >= stamp) {
+      // This sample is due now: if the clock stops, the own schedule goes on from here.
+      schedule_->start(wall.toSec() - elapsed / time_scale_);
+      return true;
+    }
+    if ((wall - clock->moved).toSec() > kStillClock) return false;
+    ros::WallDuration(0.0005).sleep();
+  }
+  return false;
+}
+
+void DriverSimRos::keepSchedule(double elapsed) {
+  core::PlaybackSchedule& schedule = *schedule_;
+  double late = 0.0;
+  const double wait = schedule.waitFor(elapsed, ros::WallTime::now().toSec(), &late);
+  if (wait > 0.0) {
+    ros::WallDuration(wait).sleep();
+  } else if (late > 0.1 && !use_sim_time_) {
+    // The stamps still say when each sample was due (as a hardware clock would), so consumers
+    // see the delay; this says where it came from.
+    ROS_WARN_THROTTLE(10.0, "driver_sim: %.3f s behind schedule (this thread was not run in time); catching up", late);
+  } else if (late > max_lag_ && use_sim_time_) {
+    ROS_INFO_THROTTLE(30.0,
+                      "driver_sim: %.3f s behind schedule: the simulated clock runs slower than "
+                      "~time_scale (%.1f s let go so far)",
+                      late, schedule.slid());
+  }
+}
+
+void DriverSimRos::reportComplete(std::uint32_t seq, double elapsed, double wall, bool follow_clock,
+                                  std::uint64_t on_clock) {
+  const core::PlaybackSchedule& schedule = *schedule_;
   char lateness[128] = "";
   if (time_scale_ > 0.0 && !use_sim_time_) {
     std::snprintf(lateness, sizeof lateness, ", at most %.3f s behind schedule", schedule.maxLateness());
@@ -430,8 +441,8 @@ void DriverSimRos::play(Simulator& sim, Sample* sample, const Publish& publish) 
     std::snprintf(lateness, sizeof lateness, ", the schedule let go %.3f s in %llu pauses", schedule.slid(),
                   static_cast<unsigned long long>(schedule.slides()));
   }
-  ROS_INFO("driver_sim: scenario complete: %u samples, %.1f s simulated in %.1f s of wall time (%.1fx)%s", seq,
-           sim.elapsed(), wall, wall > 0 ? sim.elapsed() / wall : 0.0, lateness);
+  ROS_INFO("driver_sim: scenario complete: %u samples, %.1f s simulated in %.1f s of wall time (%.1fx)%s", seq, elapsed,
+           wall, wall > 0 ? elapsed / wall : 0.0, lateness);
   std_msgs::Bool done;
   done.data = true;
   done_pub_.publish(done);

@@ -28,6 +28,21 @@ void writeSummary(const std::string& path, const std::string& text) {
   }
 }
 
+/// Largest |estimated - injected| / standard error over the calibration's first K and D terms.
+double worstZ(const core::SessionSummary& s) {
+  double worst_z = 0.0;
+  auto zs = [&](const core::HarmonicFitResult& e, const core::HarmonicFitResult& i) {
+    worst_z = std::max(worst_z, std::abs(e.mean - i.mean) / e.mean_std);
+    for (std::size_t j = 0; j < e.orders.size(); ++j) {
+      worst_z = std::max(worst_z, std::abs(e.cos[j] - i.cos[j]) / e.cos_std[j]);
+      worst_z = std::max(worst_z, std::abs(e.sin[j] - i.sin[j]) / e.sin_std[j]);
+    }
+  };
+  zs(s.calibration.scale_factor[0], s.injected.scale_factor);
+  zs(s.calibration.drift[0], s.injected.drift);
+  return worst_z;
+}
+
 }  // namespace
 
 SessionMonitorRos::SessionMonitorRos(ros::NodeHandle nh, ros::NodeHandle pnh)
@@ -206,19 +221,7 @@ void SessionMonitorRos::finish() {
   y << YAML::Key << "before_unmatched" << YAML::Value << before_->unmatched;
   y << YAML::Key << "angle_error_before" << YAML::Value << s.before.angle_error_max;
   y << YAML::Key << "angle_error_after" << YAML::Value << s.after.angle_error_max;
-  // Largest |estimated - injected| / standard error over the K and D terms.
-  double worst_z = 0.0;
-  if (result_ && !s.calibration.scale_factor.empty()) {
-    auto zs = [&](const core::HarmonicFitResult& e, const core::HarmonicFitResult& i) {
-      worst_z = std::max(worst_z, std::abs(e.mean - i.mean) / e.mean_std);
-      for (std::size_t j = 0; j < e.orders.size(); ++j) {
-        worst_z = std::max(worst_z, std::abs(e.cos[j] - i.cos[j]) / e.cos_std[j]);
-        worst_z = std::max(worst_z, std::abs(e.sin[j] - i.sin[j]) / e.sin_std[j]);
-      }
-    };
-    zs(s.calibration.scale_factor[0], s.injected.scale_factor);
-    zs(s.calibration.drift[0], s.injected.drift);
-  }
+  const double worst_z = result_ && !s.calibration.scale_factor.empty() ? worstZ(s) : 0.0;
   y << YAML::Key << "worst_z" << YAML::Value << worst_z;
   y << YAML::EndMap;
   if (!summary_file_.empty()) writeSummary(summary_file_ + ".yaml", std::string(y.c_str()) + "\n");

@@ -13,10 +13,11 @@
 #include "hrg_gyro/core/common/output_directory.h"
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/model/triad_file.h"
+#include "hrg_gyro/ros/calibrator_node_keys.h"
+#include "hrg_gyro/ros/calibrator_services.h"
 #include "hrg_gyro/ros/conversions.h"
-#include "hrg_gyro/ros/diagnostics_timer.h"
+#include "hrg_gyro/ros/output_directory_check.h"
 #include "hrg_gyro/ros/param_tree.h"
-#include "hrg_gyro/ros/process_heap.h"
 
 namespace hrg_gyro {
 namespace {
@@ -26,16 +27,6 @@ using diagnostic_msgs::DiagnosticStatus;
 constexpr const char* kNode = "calibrator (triad)";
 // In an entry of ~reload_services, replaced by each axis's name in turn.
 constexpr const char* kAxisPlaceholder = "{axis}";
-
-/// The calibrator's keys that are not calibration settings (both modes read or claim them all).
-const std::vector<std::string>& nodeOnlyKeys() {
-  static const std::vector<std::string> keys = {"parameter_file",   "report_file", "output_directory",
-                                                "reload_service",   "write",       "autostart",
-                                                "stages",           "queue_size",  "diagnostic_period",
-                                                "heap_trim_period", "triad_file",  "axis_parameter_files",
-                                                "reload_services",  "stream_hold", "triad"};
-  return keys;
-}
 
 std::invalid_argument error(const std::string& what) { return std::invalid_argument(std::string(kNode) + ": " + what); }
 
@@ -88,7 +79,7 @@ void TriadCalibratorRos::readSettings() {
   // The calibration settings, as the single-axis calibrator and hrg_bag calibrate read them.
   const YAML::Node tree = privateParameters(pnh_);
   const core::YamlField root(tree, "");
-  axis_settings_ = core::CalibrationSettings::parse(root, nodeOnlyKeys());
+  axis_settings_ = core::CalibrationSettings::parse(root, calibratorNodeOnlyKeys());
   if (axis_settings_.method != core::CalibrationMethodKind::kTriad) {
     throw error("~method is " + core::nameOf(axis_settings_.method) + ": this wrapper runs the triad method only");
   }
@@ -165,18 +156,9 @@ void TriadCalibratorRos::readOutputs() {
                                       "~axis_parameter_files/" + axes_[1], "~axis_parameter_files/" + axes_[2],
                                       "~report_file"};
   for (std::size_t k = 0; k < outputs.size(); ++k) {
-    const std::string& f = outputs[k];
     // Links followed, also a link at the file itself: the writer replaces the file it points to.
-    if (!core::isInsideDirectory(f, output_directory_)) {
-      std::string target = f;
-      try {
-        target = core::resolveOutputTarget(f);
-      } catch (const std::runtime_error& e) {
-        target = e.what();  // a link loop
-      }
-      throw error(keys[k] + " '" + f + "'" + (target != f ? " (a link to '" + target + "')" : "") +
-                  " is outside ~output_directory '" + output_directory_ + "' (or its directory does not exist)");
-    }
+    const std::string outside = outsideOutputDirectory(outputs[k], output_directory_);
+    if (!outside.empty()) throw error(keys[k] + " " + outside);
   }
   try {
     // Each file is the prior it refreshes, so the outputs are the inputs: they must be distinct (two
@@ -223,13 +205,11 @@ void TriadCalibratorRos::serve(int queue_size, double heap_trim_period, bool aut
   }
   turntable_sub_ = in.subscribe("turntable/state", queue_size, &TriadCalibratorRos::onTurntable, this,
                                 ros::TransportHints().tcpNoDelay());
-  start_srv_ = pnh_.advertiseService("start", &TriadCalibratorRos::onStart, this);
-  finish_srv_ = pnh_.advertiseService("finish", &TriadCalibratorRos::onFinish, this);
-  abort_srv_ = pnh_.advertiseService("abort", &TriadCalibratorRos::onAbort, this);
-  updater_.setHardwareID("hrg_gyro");
-  updater_.add("triad calibration", this, &TriadCalibratorRos::diagnose);
-  addProcessHeapDiagnostic(updater_, heap_trim_period);
-  diagnostics_timer_ = createDiagnosticsTimer(nh_, updater_);
+  services_ = CalibratorServices(pnh_, this, &TriadCalibratorRos::onStart, &TriadCalibratorRos::onFinish,
+                                 &TriadCalibratorRos::onAbort);
+  diagnostics_timer_ = startCalibratorDiagnostics(
+      nh_, updater_, "triad calibration", [this](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnose(s); },
+      heap_trim_period);
   ROS_INFO("%s: axes %s from %s, %s, %s; triad file %s; %s", kNode, joined(axes_).c_str(), axis_files_[0].c_str(),
            axis_files_[1].c_str(), axis_files_[2].c_str(), triad_file_.c_str(),
            autostart ? "run started" : "waiting for ~start");

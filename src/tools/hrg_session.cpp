@@ -73,6 +73,34 @@ std::vector<int> checkedEvaluationOrders(const std::vector<int>& orders) {
   }
 }
 
+/// Before anything runs: --out (when given) must be a regular file or none, and not one of the
+/// `inputs` read; ArgumentError otherwise.
+void checkOutputFile(const std::string& out, const std::vector<std::string>& inputs) {
+  if (out.empty()) return;
+  try {
+    struct stat st {};
+    if (::stat(out.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+      throw std::runtime_error("'" + out + "' exists and is not a regular file (a directory?)");
+    }
+    checkDistinct(inputs, {out});
+  } catch (const std::runtime_error& e) {
+    throw ArgumentError(std::string("--out refused: ") + e.what());
+  }
+}
+
+/// The accepted parameters into `out` (atomically, the previous file kept); false, said on stderr,
+/// when they could not be written.
+bool writeCalibrated(const std::string& out, const GyroParameters& calibrated) {
+  try {
+    saveParameterFile(out, calibrated);
+  } catch (const std::exception& e) {
+    std::cerr << "hrg_session: the calibration was accepted but not written: " << e.what() << "\n";
+    return false;
+  }
+  std::cerr << "hrg_session: wrote " << out << "\n";
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -117,16 +145,7 @@ int main(int argc, char** argv) {
   const int parsed = hrg_gyro::tools::parseCommandLine(app, argc, argv);
   if (parsed >= 0) return parsed;
   try {
-    try {
-      // Before anything runs: --out must not be one of the files read.
-      struct stat st {};
-      if (!out.empty() && ::stat(out.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
-        throw std::runtime_error("'" + out + "' exists and is not a regular file (a directory?)");
-      }
-      if (!out.empty()) checkDistinct({calibration, verification, params}, {out});
-    } catch (const std::runtime_error& e) {
-      throw ArgumentError(std::string("--out refused: ") + e.what());
-    }
+    checkOutputFile(out, {calibration, verification, params});
     CalibrationSettings settings = checkedSettings(method, orders, drift_orders, bins, window);
     EvaluationSettings evaluation;
     evaluation.orders = checkedEvaluationOrders(evaluation_orders);
@@ -142,15 +161,7 @@ int main(int argc, char** argv) {
     auto calibrated = uncalibrated;
     if (cal.outcome.accepted) {
       calibrated = std::make_shared<const GyroParameters>(cal.outcome.parameters);
-      if (!out.empty()) {
-        try {
-          saveParameterFile(out, *calibrated);
-        } catch (const std::exception& e) {
-          std::cerr << "hrg_session: the calibration was accepted but not written: " << e.what() << "\n";
-          return 3;
-        }
-        std::cerr << "hrg_session: wrote " << out << "\n";
-      }
+      if (!out.empty() && !writeCalibrated(out, *calibrated)) return 3;
     }
     std::cerr << "hrg_session: verifying on " << verification << " ...\n";
     const auto results = verifyOnSimulation(ver_scenario, {uncalibrated, calibrated}, evaluation);

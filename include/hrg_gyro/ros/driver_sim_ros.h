@@ -70,6 +70,18 @@ class DriverSimRos {
   /// origin)` publishes one sample's messages.
   template <class Simulator, class Sample, class Publish>
   void play(Simulator& sim, Sample* sample, const Publish& publish);
+  /// When another source drives /clock: the clock last seen and when (wall time) it last moved.
+  struct ClockWatch {
+    ros::Time seen;
+    ros::WallTime moved;
+  };
+  /// Waits until /clock reaches `stamp` (true; the schedule restarted from there, `elapsed` s of
+  /// simulation in) or stands still for kStillClock s (false: the own schedule goes on).
+  bool waitForClock(const ros::Time& stamp, double elapsed, ClockWatch* clock);
+  /// Sleeps until the sample `elapsed` s in is due on the schedule; says so when running behind.
+  void keepSchedule(double elapsed);
+  /// The "scenario complete" line and ~done; shuts the process down when asked to.
+  void reportComplete(std::uint32_t seq, double elapsed, double wall, bool follow_clock, std::uint64_t on_clock);
   void publishSingle(const core::SimulationSample& s, const ros::Time& stamp, core::Nanoseconds origin);
   void publishTriad(const core::TriadSample& s, const ros::Time& stamp, core::Nanoseconds origin);
   bool waitForSubscribers();

@@ -30,6 +30,7 @@
 #include "hrg_gyro/TurntableState.h"
 #include "hrg_gyro/WaveState.h"
 #include "hrg_gyro/core/calibration/triad/triad_feed.h"
+#include "hrg_gyro/ros/calibrator_services.h"
 #include "hrg_gyro/ros/input_thread.h"
 #include "hrg_gyro/ros/job_worker.h"
 #include "hrg_gyro/ros/parameter_reader.h"
@@ -119,7 +120,7 @@ class TriadCalibratorRos {
   std::array<ros::Subscriber, 3> wave_subs_;
   ros::Subscriber turntable_sub_, fixture_sub_;
   ros::Publisher result_pub_;
-  ros::ServiceServer start_srv_, finish_srv_, abort_srv_;
+  CalibratorServices services_;  // ~start, ~finish, ~abort
   diagnostic_updater::Updater updater_;
   ros::WallTimer diagnostics_timer_;
 

@@ -26,6 +26,7 @@
 #include "hrg_gyro/core/model/triad_file.h"
 #include "hrg_gyro/ros/conversions.h"
 #include "process_triad.h"
+#include "read_messages.h"
 #include "reused_message_reader.h"
 
 namespace hrg_gyro {
@@ -171,36 +172,31 @@ class BagFeed {
     }
     rosbag::View view(bag, rosbag::TopicQuery(topics));
     Progress progress("align", view.size());
-    try {
-      for (const rosbag::MessageInstance& m : view) {
-        const std::string& topic = m.getTopic();
-        const auto axis = axis_of_topic.find(topic);
-        const auto precessing = axis_of_precession.find(topic);
-        if (axis != axis_of_topic.end()) {
-          channels(m, axis->second);
-        } else if (precessing != axis_of_precession.end()) {
-          precession(m, precessing->second);
-        } else if (topic == in_.triad) {
-          if (triad_reader_.read(m, &triad_) && admit(toNanoseconds(triad_.header.stamp))) {
-            run_->addTriad(fromMessage(triad_));
-          }
-        } else if (topic == in_.gyro) {
-          if (gyro_reader_.read(m, &gyro_) && admit(toNanoseconds(gyro_.header.stamp))) {
-            run_->addAxis(toAxisOutput(gyro_));
-          }
-        } else if (topic == in_.imu) {
-          if (accelerometer_reader_.read(m, &imu_)) imuSample();
-        } else if (topic == in_.turntable) {
-          if (table_reader_.read(m, &table_)) run_->addIndexer(fromMessage(table_));
-        } else if (accelerometer_reader_.read(m, &imu_)) {
-          run_->addAccelerometer(fromAccelerometerMessage(imu_));
+    records_ = readMessages(view, progress, [&](const rosbag::MessageInstance& m) {
+      const std::string& topic = m.getTopic();
+      const auto axis = axis_of_topic.find(topic);
+      const auto precessing = axis_of_precession.find(topic);
+      if (axis != axis_of_topic.end()) {
+        channels(m, axis->second);
+      } else if (precessing != axis_of_precession.end()) {
+        precession(m, precessing->second);
+      } else if (topic == in_.triad) {
+        if (triad_reader_.read(m, &triad_) && admit(toNanoseconds(triad_.header.stamp))) {
+          run_->addTriad(fromMessage(triad_));
         }
-        if (++records_ % 4096 == 0) progress.update(static_cast<double>(records_), records_);
-        if (run_->complete()) break;
+      } else if (topic == in_.gyro) {
+        if (gyro_reader_.read(m, &gyro_) && admit(toNanoseconds(gyro_.header.stamp))) {
+          run_->addAxis(toAxisOutput(gyro_));
+        }
+      } else if (topic == in_.imu) {
+        if (accelerometer_reader_.read(m, &imu_)) imuSample();
+      } else if (topic == in_.turntable) {
+        if (table_reader_.read(m, &table_)) run_->addIndexer(fromMessage(table_));
+      } else if (accelerometer_reader_.read(m, &imu_)) {
+        run_->addAccelerometer(fromAccelerometerMessage(imu_));
       }
-    } catch (...) {
-      rethrowBagReadError(records_);
-    }
+      return !run_->complete();
+    });
     progress.finish(records_);
     if (chain_ && !run_->complete()) {
       std::vector<core::TriadAxisOutput> decided;

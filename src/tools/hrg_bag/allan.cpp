@@ -20,6 +20,7 @@
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/processing/imu_increment_converter.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "read_messages.h"
 #include "reused_message_reader.h"
 
 namespace hrg_gyro {
@@ -101,20 +102,14 @@ int runAxesAllan(const AllanOptions& o) {
   TriadOutput triad_message;
   AxisAngles angles;
   rosbag::View view(*bag, rosbag::TopicQuery(topic));
-  std::uint64_t records = 0;
-  try {
-    for (const rosbag::MessageInstance& m : view) {
-      ++records;
-      if (imu && imu_reader.read(m, &imu_message)) {
-        const auto sample = converter.convert(fromImuMessage(imu_message));
-        if (sample) angles.add(*sample, o.from, o.to);
-      } else if (!imu && triad_reader.read(m, &triad_message)) {
-        angles.add(fromMessage(triad_message), o.from, o.to);
-      }
+  readMessages(view, nullptr, [&](const rosbag::MessageInstance& m) {
+    if (imu && imu_reader.read(m, &imu_message)) {
+      const auto sample = converter.convert(fromImuMessage(imu_message));
+      if (sample) angles.add(*sample, o.from, o.to);
+    } else if (!imu && triad_reader.read(m, &triad_message)) {
+      angles.add(fromMessage(triad_message), o.from, o.to);
     }
-  } catch (...) {
-    rethrowBagReadError(records);
-  }
+  });
   angles.cut();
   const std::size_t n = angles.best[0].size();
   if (n < 100) throw UsageError("fewer than 100 continuous samples on " + topic + ": nothing to analyse");

@@ -22,6 +22,7 @@
 #include "hrg_gyro/core/common/output_directory.h"
 #include "hrg_gyro/core/common/yaml_field.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "read_messages.h"
 #include "reused_message_reader.h"
 #include "serial_worker.h"
 
@@ -451,35 +452,29 @@ std::uint64_t replayChannels(const rosbag::Bag& bag, const std::string& topic, c
   ReusedMessageReader<ChannelAmplitudes> reader;
   PrecessionStateReader state_reader;
   std::size_t filling = 0;
-  std::uint64_t n = 0, read = 0;  // channel messages; every message of the view
-  try {
-    for (const rosbag::MessageInstance& m : view) {
-      ++read;
-      ReplayBlock& block = blocks[filling];
-      if (!precession_topic.empty() && m.getTopic() == precession_topic) {
-        if (block.state_count == block.states.size()) {
-          block.states.emplace_back();
-          block.before.push_back(0);
-        }
-        if (!state_reader.read(m, &block.states[block.state_count])) continue;
-        block.before[block.state_count++] = block.count;
-        continue;
+  std::uint64_t n = 0;  // channel messages
+  readMessages(view, progress, [&](const rosbag::MessageInstance& m) {
+    ReplayBlock& block = blocks[filling];
+    if (!precession_topic.empty() && m.getTopic() == precession_topic) {
+      if (block.state_count == block.states.size()) {
+        block.states.emplace_back();
+        block.before.push_back(0);
       }
-      if (!reader.read(m, &block.messages[block.count])) continue;
-      ++n;
-      if (++block.count == ReplayBlock::kSize) {
-        submit(&block);
-        filling = (filling + 1) % blocks.size();
-        blocks[filling].count = 0;
-        blocks[filling].state_count = 0;
-        progress.update(read, n);
-      }
+      if (!state_reader.read(m, &block.states[block.state_count])) return;
+      block.before[block.state_count++] = block.count;
+      return;
     }
-    if (blocks[filling].count > 0 || blocks[filling].state_count > 0) submit(&blocks[filling]);
-    worker.finish();  // rethrows what the processing or the sink threw
-  } catch (...) {
-    rethrowBagReadError(n);
-  }
+    if (!reader.read(m, &block.messages[block.count])) return;
+    ++n;
+    if (++block.count == ReplayBlock::kSize) {
+      submit(&block);
+      filling = (filling + 1) % blocks.size();
+      blocks[filling].count = 0;
+      blocks[filling].state_count = 0;
+    }
+  });
+  if (blocks[filling].count > 0 || blocks[filling].state_count > 0) submit(&blocks[filling]);
+  worker.finish();  // rethrows what the processing or the sink threw
   progress.finish(n);
   return n;
 }

@@ -367,6 +367,41 @@ void ImuLogReader::setupSite(const PsinsHeader* header) {
 
 void ImuLogReader::bad(BadRowReason reason, const std::string& detail) const { throw RowRefusal{reason, detail}; }
 
+core::Nanoseconds ImuLogReader::logTime(const std::vector<std::string_view>& fields, std::uint64_t n) const {
+  if (time_ < 0) {
+    // Row n closes start + n interval; computed from n, so no error accumulates.
+    return core::toNanoseconds(setup_.start) +
+           static_cast<core::Nanoseconds>(std::llround(static_cast<double>(n) * (*setup_.interval * 1e9)));
+  }
+  try {
+    return signedSeconds(fields[time_]);
+  } catch (const OutOfRangeError& e) {
+    bad(BadRowReason::kStampRange, "time (#" + std::to_string(time_ + 1) + "): " + e.what());
+  } catch (const FieldError& e) {
+    bad(BadRowReason::kStamp, "time (#" + std::to_string(time_ + 1) + "): " + e.what());
+  }
+}
+
+double ImuLogReader::columnValue(const std::vector<std::string_view>& fields, int column, const char* key,
+                                 double factor) const {
+  double v = 0.0;
+  try {
+    v = parseNumber(fields[column]);
+  } catch (const FieldError& e) {
+    bad(BadRowReason::kNumber, std::string(key) + " (#" + std::to_string(column + 1) + "): " + e.what());
+  }
+  if (!std::isfinite(v)) {
+    bad(BadRowReason::kNotANumber, std::string(key) + " (#" + std::to_string(column + 1) + ") is " +
+                                       excerpt(fields[column]) + " (a number is required here)");
+  }
+  const double si = v * factor;
+  if (!std::isfinite(si)) {
+    bad(BadRowReason::kNotANumber, std::string(key) + " (#" + std::to_string(column + 1) + ") " +
+                                       excerpt(fields[column]) + " times its scale and unit overflows");
+  }
+  return si;
+}
+
 bool ImuLogReader::readRow(Row* row) {
   for (;;) {
     try {
@@ -383,21 +418,7 @@ bool ImuLogReader::readRow(Row* row) {
                                            (has_header_ ? "the header has " : "the first row has ") +
                                            std::to_string(csv_.header().size()));
       }
-      // The log's time of the row, then its stamp.
-      core::Nanoseconds log_time = 0;
-      if (time_ >= 0) {
-        try {
-          log_time = signedSeconds(fields[time_]);
-        } catch (const OutOfRangeError& e) {
-          bad(BadRowReason::kStampRange, "time (#" + std::to_string(time_ + 1) + "): " + e.what());
-        } catch (const FieldError& e) {
-          bad(BadRowReason::kStamp, "time (#" + std::to_string(time_ + 1) + "): " + e.what());
-        }
-      } else {
-        // Row n closes start + n interval; computed from n, so no error accumulates.
-        log_time = core::toNanoseconds(setup_.start) +
-                   static_cast<core::Nanoseconds>(std::llround(static_cast<double>(n) * (*setup_.interval * 1e9)));
-      }
+      const core::Nanoseconds log_time = logTime(fields, n);
       core::Nanoseconds stamp = 0;
       if (__builtin_add_overflow(log_time, setup_.epoch, &stamp) || stamp < settings_.earliest_stamp ||
           stamp > settings_.latest_stamp) {
@@ -419,27 +440,10 @@ bool ImuLogReader::readRow(Row* row) {
       row->record.stamp = stamp;
       row->record.line = csv_.line();
       row->record.row = n - 1;
-      auto value = [&](int column, const char* key, double factor) {
-        double v = 0.0;
-        try {
-          v = parseNumber(fields[column]);
-        } catch (const FieldError& e) {
-          bad(BadRowReason::kNumber, std::string(key) + " (#" + std::to_string(column + 1) + "): " + e.what());
-        }
-        if (!std::isfinite(v)) {
-          bad(BadRowReason::kNotANumber, std::string(key) + " (#" + std::to_string(column + 1) + ") is " +
-                                             excerpt(fields[column]) + " (a number is required here)");
-        }
-        const double si = v * factor;
-        if (!std::isfinite(si)) {
-          bad(BadRowReason::kNotANumber, std::string(key) + " (#" + std::to_string(column + 1) + ") " +
-                                             excerpt(fields[column]) + " times its scale and unit overflows");
-        }
-        return si;
-      };
       for (int i = 0; i < 3; ++i) {
-        row->gyro[i] = value(gyro_columns_[i], kGyroKeys[i], setup_.gyro_factor[i]);
-        row->accel[i] = setup_.accelerometer ? value(accel_columns_[i], kAccelKeys[i], setup_.accel_factor[i]) : 0.0;
+        row->gyro[i] = columnValue(fields, gyro_columns_[i], kGyroKeys[i], setup_.gyro_factor[i]);
+        row->accel[i] =
+            setup_.accelerometer ? columnValue(fields, accel_columns_[i], kAccelKeys[i], setup_.accel_factor[i]) : 0.0;
       }
       return true;
     } catch (const RowRefusal& r) {

@@ -17,6 +17,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "csv_reader.h"
@@ -182,6 +183,11 @@ class ImuLogReader {
     bool have_previous = false;  ///< a previous row's stamp is known: record.interval holds the difference
   };
   bool readRow(Row* row);
+  /// Row `n`'s time in the log (its time column, or start + n interval); refuses the row when bad.
+  core::Nanoseconds logTime(const std::vector<std::string_view>& fields, std::uint64_t n) const;
+  /// The number in `fields[column]` (the log's `key`) times `factor`; refuses the row when it is not
+  /// a finite number or the product overflows.
+  double columnValue(const std::vector<std::string_view>& fields, int column, const char* key, double factor) const;
   // The constructor's sections, in order: each setting given wins over the PSINS header's (`header`,
   // nullptr without one), which wins over the default; each throws what the constructor documents.
   void setupUnits(const PsinsHeader* header);

@@ -15,6 +15,7 @@
 #include "bag_tools.h"
 #include "hrg_gyro/GroundTruth.h"
 #include "hrg_gyro/TurntableState.h"
+#include "read_messages.h"
 
 namespace hrg_gyro {
 namespace {
@@ -57,10 +58,10 @@ template <typename M>
 StampStats scan(const rosbag::Bag& bag, const std::string& topic) {
   StampStats s;
   rosbag::View view(bag, rosbag::TopicQuery(topic));
-  for (const rosbag::MessageInstance& m : view) {
+  bag_tools::readMessages(view, nullptr, [&s](const rosbag::MessageInstance& m) {
     const typename M::ConstPtr msg = m.instantiate<M>();
     if (msg) s.add(msg->header, m.getTime());
-  }
+  });
   return s;
 }
 
@@ -69,6 +70,60 @@ struct InfoOptions {
   bag_tools::GyroTopics topics;
   double gap_factor = 3.0;
 };
+
+/// What the streams' checks found: an error makes the bag INVALID, a warning is said.
+struct Verdict {
+  int errors = 0, warnings = 0;
+};
+
+/// One stream's stamps on stdout: its rate, the spread of its intervals against the median, its
+/// gaps (above `gap_factor` x the median) and its bad stamps, counted into `v` (as errors when the
+/// stream is `required`).
+void reportStream(const std::string& name, const StampStats& s, bool required, double gap_factor, Verdict* v) {
+  int& errors = v->errors;
+  int& warnings = v->warnings;
+  std::printf("%s (%s): %lu messages\n", name.c_str(), name.c_str(), static_cast<unsigned long>(s.count));
+  if (s.dts.empty()) {
+    if (required) {
+      std::printf("  ERROR: fewer than two valid stamps\n");
+      ++errors;
+    }
+    return;
+  }
+  std::vector<double> sorted = s.dts;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  std::printf("  span %.3f s, median dt %.6f s (%.2f Hz), mean rate %.2f Hz\n", s.last - s.first, median, 1.0 / median,
+              (s.count - 1) / std::max(1e-12, s.last - s.first));
+  const double edges[] = {0.0, 0.5, 0.9, 1.1, 2.0, 10.0, INFINITY};
+  std::uint64_t counts[6] = {0, 0, 0, 0, 0, 0};
+  std::uint64_t gaps = 0;
+  double largest = 0.0;
+  for (double dt : s.dts) {
+    const double r = dt / median;
+    for (int b = 0; b < 6; ++b) {
+      if (r >= edges[b] && r < edges[b + 1]) ++counts[b];
+    }
+    if (r > gap_factor) ++gaps;
+    largest = std::max(largest, dt);
+  }
+  std::printf("  dt / median: <0.5 %lu | 0.5-0.9 %lu | 0.9-1.1 %lu | 1.1-2 %lu | 2-10 %lu | >10 %lu\n",
+              static_cast<unsigned long>(counts[0]), static_cast<unsigned long>(counts[1]),
+              static_cast<unsigned long>(counts[2]), static_cast<unsigned long>(counts[3]),
+              static_cast<unsigned long>(counts[4]), static_cast<unsigned long>(counts[5]));
+  std::printf("  gaps above %.1f x median: %lu (largest %.6f s); lost sequence numbers: %lu\n", gap_factor,
+              static_cast<unsigned long>(gaps), largest, static_cast<unsigned long>(s.seq_lost));
+  std::printf("  header vs record time: largest difference %.6f s\n", s.max_record_lag);
+  if (gaps || s.seq_lost) ++warnings;
+  if (s.zero || s.duplicate || s.backwards) {
+    std::printf("  ERROR: %lu zero, %lu duplicate, %lu backward stamps\n", static_cast<unsigned long>(s.zero),
+                static_cast<unsigned long>(s.duplicate), static_cast<unsigned long>(s.backwards));
+    if (required)
+      ++errors;
+    else
+      ++warnings;
+  }
+}
 
 int runInfo(const InfoOptions& o) {
   using namespace bag_tools;
@@ -82,50 +137,9 @@ int runInfo(const InfoOptions& o) {
   for (const auto& kv : topics)
     std::printf("  %-28s %-34s %10lu\n", kv.first.c_str(), kv.second.first.c_str(),
                 static_cast<unsigned long>(kv.second.second));
-  int errors = 0, warnings = 0;
-  const double gap_factor = o.gap_factor;
+  Verdict v;
   auto report = [&](const std::string& name, const StampStats& s, bool required) {
-    std::printf("%s (%s): %lu messages\n", name.c_str(), name.c_str(), static_cast<unsigned long>(s.count));
-    if (s.dts.empty()) {
-      if (required) {
-        std::printf("  ERROR: fewer than two valid stamps\n");
-        ++errors;
-      }
-      return;
-    }
-    std::vector<double> sorted = s.dts;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    const double median = sorted[sorted.size() / 2];
-    std::printf("  span %.3f s, median dt %.6f s (%.2f Hz), mean rate %.2f Hz\n", s.last - s.first, median,
-                1.0 / median, (s.count - 1) / std::max(1e-12, s.last - s.first));
-    const double edges[] = {0.0, 0.5, 0.9, 1.1, 2.0, 10.0, INFINITY};
-    std::uint64_t counts[6] = {0, 0, 0, 0, 0, 0};
-    std::uint64_t gaps = 0;
-    double largest = 0.0;
-    for (double dt : s.dts) {
-      const double r = dt / median;
-      for (int b = 0; b < 6; ++b) {
-        if (r >= edges[b] && r < edges[b + 1]) ++counts[b];
-      }
-      if (r > gap_factor) ++gaps;
-      largest = std::max(largest, dt);
-    }
-    std::printf("  dt / median: <0.5 %lu | 0.5-0.9 %lu | 0.9-1.1 %lu | 1.1-2 %lu | 2-10 %lu | >10 %lu\n",
-                static_cast<unsigned long>(counts[0]), static_cast<unsigned long>(counts[1]),
-                static_cast<unsigned long>(counts[2]), static_cast<unsigned long>(counts[3]),
-                static_cast<unsigned long>(counts[4]), static_cast<unsigned long>(counts[5]));
-    std::printf("  gaps above %.1f x median: %lu (largest %.6f s); lost sequence numbers: %lu\n", gap_factor,
-                static_cast<unsigned long>(gaps), largest, static_cast<unsigned long>(s.seq_lost));
-    std::printf("  header vs record time: largest difference %.6f s\n", s.max_record_lag);
-    if (gaps || s.seq_lost) ++warnings;
-    if (s.zero || s.duplicate || s.backwards) {
-      std::printf("  ERROR: %lu zero, %lu duplicate, %lu backward stamps\n", static_cast<unsigned long>(s.zero),
-                  static_cast<unsigned long>(s.duplicate), static_cast<unsigned long>(s.backwards));
-      if (required)
-        ++errors;
-      else
-        ++warnings;
-    }
+    reportStream(name, s, required, o.gap_factor, &v);
   };
   // A bag of an IMU's log (hrg_bag import --imu) holds no channels: its sensor_msgs/Imu topics are what
   // is validated, each as channels would be.
@@ -137,9 +151,9 @@ int runInfo(const InfoOptions& o) {
   }
   if (!has_channels && !imu_topics.empty() && o.topics.channels.empty()) {
     for (const std::string& topic : imu_topics) report(topic, scan<sensor_msgs::Imu>(*bag, topic), true);
-    std::printf("%s: %d error(s), %d warning(s) (an IMU bag: no gyro channels)\n", errors ? "INVALID" : "OK", errors,
-                warnings);
-    return errors ? 1 : 0;
+    std::printf("%s: %d error(s), %d warning(s) (an IMU bag: no gyro channels)\n", v.errors ? "INVALID" : "OK",
+                v.errors, v.warnings);
+    return v.errors ? 1 : 0;
   }
   GyroTopics t;
   try {
@@ -153,11 +167,11 @@ int runInfo(const InfoOptions& o) {
     report(t.turntable, scan<TurntableState>(*bag, t.turntable), false);
   } else {
     std::printf("WARNING: no TurntableState topic: the bag can be processed but not calibrated\n");
-    ++warnings;
+    ++v.warnings;
   }
   if (!t.truth.empty()) report(t.truth, scan<GroundTruth>(*bag, t.truth), false);
-  std::printf("%s: %d error(s), %d warning(s)\n", errors ? "INVALID" : "OK", errors, warnings);
-  return errors ? 1 : 0;
+  std::printf("%s: %d error(s), %d warning(s)\n", v.errors ? "INVALID" : "OK", v.errors, v.warnings);
+  return v.errors ? 1 : 0;
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "hrg_gyro/core/model/parameter_file.h"
 #include "hrg_gyro/core/model/triad_file.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "read_messages.h"
 #include "reused_message_reader.h"
 #include "triad_axis_options.h"
 
@@ -162,25 +163,20 @@ std::uint64_t replayTriad(const rosbag::Bag& bag, const std::array<AxisInput, 3>
   core::ProcessorResult result;
   std::vector<core::TriadAxisOutput> decided;
   std::vector<core::TriadBodySample> completed;
-  std::uint64_t n = 0;
-  try {
-    for (const rosbag::MessageInstance& instance : view) {
-      if (!reader.read(instance, &msg)) continue;
-      ++n;
-      const std::size_t axis = axis_of_topic.at(instance.getTopic());
-      triad->process(axis, fromMessage(msg), &result);
-      if (result.has_output) {
-        outputs->hold(axis, msg.header, result);
-        decided.clear();
-        completed.clear();
-        triad->release(&decided, &completed);
-        outputs->write(decided, completed);
-      }
-      if (n % 4096 == 0) progress.update(n, n);
+  std::uint64_t n = 0;  // channel samples
+  readMessages(view, progress, [&](const rosbag::MessageInstance& instance) {
+    if (!reader.read(instance, &msg)) return;
+    ++n;
+    const std::size_t axis = axis_of_topic.at(instance.getTopic());
+    triad->process(axis, fromMessage(msg), &result);
+    if (result.has_output) {
+      outputs->hold(axis, msg.header, result);
+      decided.clear();
+      completed.clear();
+      triad->release(&decided, &completed);
+      outputs->write(decided, completed);
     }
-  } catch (...) {
-    rethrowBagReadError(n);
-  }
+  });
   progress.finish(n);
   decided.clear();
   completed.clear();

@@ -1,33 +1,47 @@
-// The hrg_bag subcommands' loop over a bag's messages: each message of a view in record order, the
-// progress on stderr as it goes, and a read error of the bag (a truncated or corrupt chunk) as the
-// UsageError every subcommand reports for it.
+// The hrg_bag subcommands' one loop over a bag's messages: each message of a view in record order,
+// the progress on stderr as it goes, and a read error of the bag (a truncated or corrupt chunk, a
+// record shorter than its type) as the UsageError every subcommand reports for it
+// (rethrowBagReadError). Every subcommand reads its bag through it, so they all stop, count and fail
+// alike.
 #pragma once
 
 #include <rosbag/view.h>
 
 #include <cstdint>
-#include <string>
+#include <type_traits>
 
 #include "bag_tools.h"
 
 namespace hrg_gyro {
 namespace bag_tools {
 
-/// Calls `each(message)` (a rosbag::MessageInstance) for every message of `view`, updating
-/// `progress` by the messages read; returns how many were read. The caller finishes the progress.
+/// Calls `each(message)` (a rosbag::MessageInstance) for every message of `view`, until an `each`
+/// that returns bool returns false (one returning void reads them all); updates `progress` (may be
+/// null) every 4096 messages. Returns how many messages were read. The caller finishes the progress.
 template <class Each>
-std::uint64_t readMessages(rosbag::View& view, Progress& progress, Each&& each) {
+std::uint64_t readMessages(rosbag::View& view, Progress* progress, Each&& each) {
   std::uint64_t n = 0;
   try {
     for (const rosbag::MessageInstance& m : view) {
       ++n;
-      progress.update(n, n);
-      each(m);
+      bool go_on = true;
+      if constexpr (std::is_void<decltype(each(m))>::value) {
+        each(m);
+      } else {
+        go_on = each(m);
+      }
+      if (progress && n % 4096 == 0) progress->update(static_cast<double>(n), n);
+      if (!go_on) break;
     }
-  } catch (const rosbag::BagException& e) {
-    throw UsageError(std::string("bag read error (truncated?): ") + e.what());
+  } catch (...) {
+    rethrowBagReadError(n);
   }
   return n;
+}
+
+template <class Each>
+std::uint64_t readMessages(rosbag::View& view, Progress& progress, Each&& each) {
+  return readMessages(view, &progress, std::forward<Each>(each));
 }
 
 }  // namespace bag_tools

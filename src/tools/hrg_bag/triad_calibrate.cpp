@@ -17,6 +17,7 @@
 #include "hrg_gyro/core/model/triad_file.h"
 #include "hrg_gyro/core/processing/triad_processor.h"
 #include "hrg_gyro/ros/conversions.h"
+#include "read_messages.h"
 #include "triad_axis_options.h"
 
 namespace hrg_gyro {
@@ -163,35 +164,28 @@ core::TriadOutcome calibrate(const rosbag::Bag& bag, const TriadCalibrateOptions
   rosbag::View view(bag, rosbag::TopicQuery(wanted));
   Progress progress("calibrate", view.size());
   core::ProcessorResult r;
-  std::uint64_t n = 0;
-  try {
-    for (const rosbag::MessageInstance& m : view) {
-      ++n;
-      progress.update(n, n);
-      const std::string& topic = m.getTopic();
-      if (topic == in.turntable_topic) {
-        const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
-        if (t) calibration.addTurntable(toNanoseconds(t->header.stamp), t->angle, t->rate, t->header.seq);
-        continue;
-      }
-      if (topic == in.fixture_topic) {
-        const FixturePosition::ConstPtr f = m.instantiate<FixturePosition>();
-        if (f) calibration.addFixture(fromMessage(*f));  // checked there: not a rotation, a bad stamp (as live)
-        continue;
-      }
-      for (std::size_t i = 0; i < 3; ++i) {
-        if (topic != in.channel_topics[i]) continue;
-        const ChannelAmplitudes::ConstPtr c = m.instantiate<ChannelAmplitudes>();
-        if (!c) break;
-        const core::ChannelSample sample = fromMessage(*c);
-        processors.process(i, sample, &r);
-        if (r.has_wave) calibration.addWave(static_cast<int>(i), sample.stamp, r.wave.theta, sample.frequency);
-        break;
-      }
+  const std::uint64_t n = readMessages(view, progress, [&](const rosbag::MessageInstance& m) {
+    const std::string& topic = m.getTopic();
+    if (topic == in.turntable_topic) {
+      const TurntableState::ConstPtr t = m.instantiate<TurntableState>();
+      if (t) calibration.addTurntable(toNanoseconds(t->header.stamp), t->angle, t->rate, t->header.seq);
+      return;
     }
-  } catch (...) {
-    rethrowBagReadError(n);
-  }
+    if (topic == in.fixture_topic) {
+      const FixturePosition::ConstPtr f = m.instantiate<FixturePosition>();
+      if (f) calibration.addFixture(fromMessage(*f));  // checked there: not a rotation, a bad stamp (as live)
+      return;
+    }
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (topic != in.channel_topics[i]) continue;
+      const ChannelAmplitudes::ConstPtr c = m.instantiate<ChannelAmplitudes>();
+      if (!c) return;
+      const core::ChannelSample sample = fromMessage(*c);
+      processors.process(i, sample, &r);
+      if (r.has_wave) calibration.addWave(static_cast<int>(i), sample.stamp, r.wave.theta, sample.frequency);
+      return;
+    }
+  });
   progress.finish(n);
   core::TriadOutcome outcome = calibration.finish();
   outcome.triad.calibration.source = o.bag;
