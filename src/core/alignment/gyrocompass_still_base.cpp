@@ -153,16 +153,16 @@ std::pair<std::string, std::string> GyrocompassSolver::stillBaseProblem() const 
   if (!moved.empty()) return {kMotionGate, moved};
   if (r.scatter > s_.motion.max_scatter) {
     return {"stillness", formatNumbers("the residuals scatter %.2f times what the noise model predicts "
-                                                "(motion/max_scatter %.2f): a base that sways or vibrates, a bias "
-                                                "that jumps, or angle noise beyond the settings'",
-                                                r.scatter, s_.motion.max_scatter)};
+                                       "(motion/max_scatter %.2f): a base that sways or vibrates, a bias "
+                                       "that jumps, or angle noise beyond the settings'",
+                                       r.scatter, s_.motion.max_scatter)};
   }
   if (r.low_frequency_scatter > r.low_frequency_limit) {
     return {"stillness", formatNumbers("the residuals' %.3g s means scatter %.2f times what the noise model "
-                                                "predicts (a still base exceeds %.2f once in %.3g windows): a base "
-                                                "that sways slowly, or a random walk beyond the settings'",
-                                                s_.motion.block, r.low_frequency_scatter, r.low_frequency_limit,
-                                                1.0 / s_.motion.block_false_alarm)};
+                                       "predicts (a still base exceeds %.2f once in %.3g windows): a base "
+                                       "that sways slowly, or a random walk beyond the settings'",
+                                       s_.motion.block, r.low_frequency_scatter, r.low_frequency_limit,
+                                       1.0 / s_.motion.block_false_alarm)};
   }
   return {"", ""};
 }
@@ -190,7 +190,7 @@ bool GyrocompassSolver::solveStill(HeadingSolution* h) {
   *h = solveHeading(still_rate_, still_level_, s_.latitude);
   if (!steps_.empty()) {
     r.notes.push_back(formatNumbers("the base took %.0f step(s), carried: %.1f s left out around them",
-                                             static_cast<double>(steps_.size()), r.excluded_seconds));
+                                    static_cast<double>(steps_.size()), r.excluded_seconds));
   }
   return true;
 }

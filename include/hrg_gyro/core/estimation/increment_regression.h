@@ -32,13 +32,12 @@ namespace hrg_gyro {
 namespace core {
 
 class IncrementRegression {
-public:
+ public:
   /// Orders must be positive. bins: wave-angle bins over [0, pi) for the binned
   /// curves. bias_trend_order: degree of the bias's polynomial in time (0: a
   /// constant bias; at most 2). horizontal_slots: fixture positions whose
   /// horizontal Earth rate is fitted (0: none).
-  IncrementRegression(const std::vector<int> &k_orders,
-                      const std::vector<int> &d_orders, int bins,
+  IncrementRegression(const std::vector<int>& k_orders, const std::vector<int>& d_orders, int bins,
                       int bias_trend_order = 0, int horizontal_slots = 0);
 
   /// Starts a chain of plateau group `group` averaged over windows of `window`
@@ -50,16 +49,14 @@ public:
   /// stamps increasing. horizontal_slot: the fixture position whose horizontal
   /// Earth rate the sample carries (-1: none), psi the heading of the platter's
   /// x, rad.
-  void add(Nanoseconds stamp, double theta, double phi, double phi_rate = NAN,
-           int horizontal_slot = -1, double psi = 0.0);
+  void add(Nanoseconds stamp, double theta, double phi, double phi_rate = NAN, int horizontal_slot = -1,
+           double psi = 0.0);
   /// Closes the open chain (its last, partial window is left out).
   void endChain();
   /// rad^2: an error of the angle that is smooth in time (regularised stamps),
   /// which the window means' scatter does not show; counted against the angle
   /// when the two sources are weighed.
-  void setAngleSmoothError(double variance) {
-    chains_.setAngleSmoothError(variance);
-  }
+  void setAngleSmoothError(double variance) { chains_.setAngleSmoothError(variance); }
   bool inChain() const { return chains_.inChain(); }
   int horizontalSlots() const { return model_.horizontalSlots(); }
 
@@ -68,25 +65,21 @@ public:
   /// earth_rate: rad/s added to dphi/dt; earth_rate_std: its uncertainty
   /// (propagated to K). min_bin_time: s of increments a bin needs in both
   /// groups to be shown.
-  IncrementFit solve(double earth_rate, double earth_rate_std,
-                     double min_bin_time, double max_condition) const;
+  IncrementFit solve(double earth_rate, double earth_rate_std, double min_bin_time, double max_condition) const;
 
-private:
+ private:
   /// An increment of a chain that ended, to each part that keeps the session's
   /// sums.
-  void addIncrement(const WindowIncrement &increment);
+  void addIncrement(const WindowIncrement& increment);
   /// The coefficients' covariances at the solution: the sandwich, the white
   /// floor, the walk's.
-  IncrementCovariances covariances(const std::vector<IncrementBlock> &blocks,
-                                   const std::vector<int> &sel,
-                                   const Eigen::MatrixXd &map,
-                                   const LeastSquaresSolution &solution,
-                                   double angle_noise, BiasWalkFit *walk) const;
+  IncrementCovariances covariances(const std::vector<IncrementBlock>& blocks, const std::vector<int>& sel,
+                                   const Eigen::MatrixXd& map, const LeastSquaresSolution& solution, double angle_noise,
+                                   BiasWalkFit* walk) const;
   /// The fitted terms into the fit's K, D, trend and horizontal Earth rate.
-  void fillResults(const IncrementColumns &columns, const IncrementTerms &terms,
-                   const LeastSquaresSolution &solution,
-                   const Eigen::MatrixXd &map, const Eigen::MatrixXd &total,
-                   double reference_time, IncrementFit *fit) const;
+  void fillResults(const IncrementColumns& columns, const IncrementTerms& terms, const LeastSquaresSolution& solution,
+                   const Eigen::MatrixXd& map, const Eigen::MatrixXd& total, double reference_time,
+                   IncrementFit* fit) const;
 
   IncrementModel model_;
   WindowChains chains_;
@@ -95,9 +88,8 @@ private:
   IncrementBins bins_;
   std::size_t increments_ = 0;
   double increment_time_ = 0.0;
-  double increment_time_moment_ =
-      0.0; // sum of increment dt x mean time: the trend's reference
+  double increment_time_moment_ = 0.0;  // sum of increment dt x mean time: the trend's reference
 };
 
-} // namespace core
-} // namespace hrg_gyro
+}  // namespace core
+}  // namespace hrg_gyro

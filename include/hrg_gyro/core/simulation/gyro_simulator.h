@@ -21,10 +21,10 @@
 // (SimulationConfig::channels); a lost one is still simulated (its index counts, as a publisher's
 // sequence number does) but flagged not delivered. The truth is always the exact motion.
 //
-// With a thermal section (temperature_dependence.h, temperature_profile.h) the temperature is evaluated at the centre of each
-// output window and held over it: the pickoff defects, the amplitude and the intrinsic K and D are
-// those of that temperature, and the sample reports T and f(T). Without one every sample reports
-// the nominal frequency and an unknown (NaN) temperature, exactly as before thermal support existed.
+// With a thermal section (temperature_dependence.h, temperature_profile.h) the temperature is evaluated at the centre
+// of each output window and held over it: the pickoff defects, the amplitude and the intrinsic K and D are those of
+// that temperature, and the sample reports T and f(T). Without one every sample reports the nominal frequency and an
+// unknown (NaN) temperature, exactly as before thermal support existed.
 //
 // With the averaged resonator (SimulationConfig::dynamics, dynamics_config.h) the wave is not
 // integrated from given K and D: ResonatorDynamics is stepped once per carrier period with the sensed

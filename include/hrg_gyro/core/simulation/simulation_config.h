@@ -1,7 +1,7 @@
 // A simulation scenario: the gyro (resonator, pickoffs), the turntable profile, the generator
-// sweep and, optionally, the temperature (temperature_dependence.h). The keys are those of the driver_sim node's private
-// parameters, so one YAML file serves `roslaunch` (rosparam load into ~) and `hrg_bag simulate` alike. Defaults: the
-// shipped simulated gyro (docs/simulation.md).
+// sweep and, optionally, the temperature (temperature_dependence.h). The keys are those of the driver_sim node's
+// private parameters, so one YAML file serves `roslaunch` (rosparam load into ~) and `hrg_bag simulate` alike.
+// Defaults: the shipped simulated gyro (docs/simulation.md).
 #pragma once
 
 #include <cstddef>
