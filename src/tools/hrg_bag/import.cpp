@@ -128,11 +128,18 @@ int runImuMode(ImportOptions& o, const CLI::App& command) {
   return runImuImport(imu, *log.stream, bytes);
 }
 
+/// A logged record's header: its stamp, its place in its stream, the frame the log is in.
+std_msgs::Header recordHeader(core::Nanoseconds stamp, std::uint64_t seq, const std::string& frame_id) {
+  std_msgs::Header h;
+  h.stamp = toRosTime(stamp);
+  h.seq = static_cast<std::uint32_t>(seq);
+  h.frame_id = frame_id;
+  return h;
+}
+
 ChannelAmplitudes channelMessage(const csv::ChannelRecord& c, std::uint64_t seq, const std::string& frame_id) {
   ChannelAmplitudes m;
-  m.header.stamp = toRosTime(c.stamp);
-  m.header.seq = static_cast<std::uint32_t>(seq);
-  m.header.frame_id = frame_id;
+  m.header = recordHeader(c.stamp, seq, frame_id);
   m.c_in = c.ac;
   m.c_quad = c.bc;
   m.s_in = c.as;
@@ -145,9 +152,7 @@ ChannelAmplitudes channelMessage(const csv::ChannelRecord& c, std::uint64_t seq,
 
 TurntableState turntableMessage(const csv::TurntableRecord& t, std::uint64_t seq, const std::string& frame_id) {
   TurntableState m;
-  m.header.stamp = toRosTime(t.stamp);
-  m.header.seq = static_cast<std::uint32_t>(seq);
-  m.header.frame_id = frame_id;
+  m.header = recordHeader(t.stamp, seq, frame_id);
   m.angle = t.angle;
   m.rate = t.rate;
   return m;
